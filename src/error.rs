@@ -1,0 +1,68 @@
+//! One error type for the whole crate.
+//!
+//! Every variant names *where* the problem is (file, row, field) so the CLI can
+//! print it as is and exit non-zero. Library code never panics on user input.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in sagcal, from reading a file to solving the statics.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A file could not be opened, read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file as a whole is not in a format sagcal understands.
+    #[error("{path}: {message}")]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// One field of one row of a data file is wrong.
+    #[error("{path}: row {row}, field `{field}`: {message}")]
+    Field {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number in the file (the header is line 1).
+        row: usize,
+        /// The column name.
+        field: String,
+        /// What is wrong with the value.
+        message: String,
+    },
+    /// A robot description is invalid (coincident anchors, unknown reference cable, ...).
+    #[error("robot {path}: {message}")]
+    Robot {
+        /// The robot file (or `<built-in>`).
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// The kineto-static problem has no solution with positive cable tensions.
+    #[error("no static equilibrium: {0}")]
+    NoEquilibrium(String),
+    /// An argument given on the command line or through the API is out of range.
+    #[error("invalid input: {0}")]
+    InvalidInput(String),
+}
+
+/// Shorthand for `Result<T, sagcal::Error>`.
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    /// Build an [`Error::Io`] for `path`.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}

@@ -1,0 +1,5 @@
+//! Files: robot descriptions and measurement logs. The lowest layer: it knows
+//! formats and validation of single values, no physics.
+
+pub mod recurdyn;
+pub mod robot_file;

@@ -1,0 +1,1 @@
+//! Loader for the RecurDyn finite-element log (placeholder, being written).

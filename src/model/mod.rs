@@ -1,0 +1,10 @@
+//! Cable physics and the robot's kineto-statics (paper Sec. III).
+
+pub mod catenary;
+pub mod pose;
+pub mod robot;
+pub mod statics;
+
+pub use catenary::Catenary;
+pub use pose::PlatformPose;
+pub use robot::{Robot, CABLE_COUNT};

@@ -1,0 +1,1 @@
+//! Kineto-statics (placeholder, being written).
