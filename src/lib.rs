@@ -31,5 +31,6 @@ pub mod error;
 pub mod generated;
 pub mod io;
 pub mod model;
+pub mod verify;
 
 pub use error::{Error, Result};

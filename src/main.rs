@@ -1,8 +1,7 @@
-//! The `sagcal` command line.
-fn main() {
-    std::process::exit(sagcal_cli_main());
-}
+//! The `sagcal` command line: a thin layer over the library.
 
-fn sagcal_cli_main() -> i32 {
-    0
+mod cli;
+
+fn main() {
+    std::process::exit(cli::run());
 }

@@ -1,1 +1,665 @@
-//! Kineto-statics (placeholder, being written).
+//! Kineto-statics of the suspended 4-cable robot (paper Sec. III-C, eq. 5-11).
+//!
+//! Equilibrium of the platform under its weight and four catenary cables
+//! (paper eq. 5-8): with `r_i = R b_i` and `s_i` the horizontal unit vector
+//! from anchor `i` towards its attachment, cable `i` pulls the platform with
+//! `-s_i f_h,i + z f_v,i`, and
+//! ```text
+//! sum_i [ -s_i ; -r_i x s_i ] f_h,i + [ z ; r_i x z ] f_v,i = [ z ; (R b_com) x z ] m_e g
+//! ```
+//! Given the reference cable's `(f_h, f_v)`, eq. (11) gives the other six
+//! components ([`cable_tensions`]). Each cable must then also *reach* its
+//! attachment: the catenary hanging from anchor `i` with those tensions ends at
+//! the attachment height (eq. 15, [`attachment_height_residuals`]).
+//!
+//! At a fixed position the unknowns are the orientation (3) and the reference
+//! tension (2) against 4 height equations: a one-parameter family. One more
+//! measurement closes it:
+//! * (a) [`solve_with_reference_tension`]: the load cell's tension magnitude (eq. 16);
+//! * (b) [`solve_with_cable_lengths`]: the four cable lengths (least squares);
+//! * (c) [`solve_forward`]: cable lengths only, position unknown too (localisation).
+//!
+//! This module is hand-written and shares no code with `generated/`: the tests
+//! compare the two.
+
+use nalgebra::{DMatrix, DVector, Matrix6, SMatrix, UnitQuaternion, Vector3, Vector6};
+
+use crate::error::{Error, Result};
+use crate::model::catenary::Catenary;
+use crate::model::pose::PlatformPose;
+use crate::model::robot::{Robot, CABLE_COUNT};
+
+/// Tension of one cable at its platform attachment, paper eq. (7).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CableTension {
+    /// Horizontal component `f_h` (towards the anchor), newtons; > 0 for a taut cable.
+    pub horizontal_n: f64,
+    /// Vertical component `f_v` (upward pull on the platform), newtons.
+    pub vertical_n: f64,
+}
+
+impl CableTension {
+    /// Tension magnitude `sqrt(f_h^2 + f_v^2)`, newtons.
+    pub fn magnitude_n(&self) -> f64 {
+        self.horizontal_n.hypot(self.vertical_n)
+    }
+
+    /// Whether the cable pulls (`f_h > 0`; false for NaN): a catenary needs a taut cable.
+    pub fn is_taut(&self) -> bool {
+        self.horizontal_n > 0.0
+    }
+}
+
+/// Where cable `i` runs for a given platform pose (paper Sec. III-A).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CableGeometry {
+    /// Attachment point in the world frame, `p + R b_i`, metres.
+    pub attachment_world_m: Vector3<f64>,
+    /// Horizontal unit vector `s_c,i` from the anchor towards the attachment.
+    pub horizontal_direction: Vector3<f64>,
+    /// Horizontal span `L_i = |b_xy - a_xy|`, metres.
+    pub span_m: f64,
+    /// Height of the anchor above the attachment, metres.
+    pub height_difference_m: f64,
+}
+
+/// The geometry of the four cables at `pose`.
+pub fn cable_geometry(robot: &Robot, pose: &PlatformPose) -> [CableGeometry; CABLE_COUNT] {
+    let rotation = pose.rotation_matrix();
+    std::array::from_fn(|i| {
+        let attachment_world_m = pose.position_m + rotation * robot.attachments_m[i];
+        let mut horizontal = attachment_world_m - robot.anchors_m[i];
+        horizontal.z = 0.0;
+        let span_m = horizontal.norm();
+        CableGeometry {
+            attachment_world_m,
+            horizontal_direction: horizontal / span_m,
+            span_m,
+            height_difference_m: robot.anchors_m[i].z - attachment_world_m.z,
+        }
+    })
+}
+
+/// The transposed structure matrix `J^T` (6 x 8, paper eq. 8): columns `(f_h,i, f_v,i)` per cable.
+pub fn structure_matrix(robot: &Robot, pose: &PlatformPose) -> SMatrix<f64, 6, 8> {
+    let geometry = cable_geometry(robot, pose);
+    let rotation = pose.rotation_matrix();
+    let z = Vector3::z();
+    let mut jt = SMatrix::<f64, 6, 8>::zeros();
+    for (i, cable) in geometry.iter().enumerate() {
+        let r = rotation * robot.attachments_m[i];
+        let s = cable.horizontal_direction;
+        let h_column = Vector6::from_iterator((-s).iter().copied().chain((-r.cross(&s)).iter().copied()));
+        let v_column = Vector6::from_iterator(z.iter().copied().chain(r.cross(&z).iter().copied()));
+        jt.set_column(2 * i, &h_column);
+        jt.set_column(2 * i + 1, &v_column);
+    }
+    jt
+}
+
+/// The gravity wrench the cables must carry, `[z; (R b_com) x z] m_e g` (paper eq. 6).
+pub fn gravity_wrench(robot: &Robot, pose: &PlatformPose) -> Vector6<f64> {
+    let z = Vector3::z();
+    let moment = (pose.rotation_matrix() * robot.com_offset_m).cross(&z);
+    Vector6::new(z.x, z.y, z.z, moment.x, moment.y, moment.z) * robot.platform_weight_n
+}
+
+/// All four cable tensions from the reference cable's, paper eq. (11):
+/// `f_res = (J_res^T)^-1 (w - J_ref^T f_ref)`.
+///
+/// Fails when `J_res^T` is singular (the other three cables cannot balance the platform).
+pub fn cable_tensions(
+    robot: &Robot,
+    pose: &PlatformPose,
+    reference: CableTension,
+) -> Result<[CableTension; CABLE_COUNT]> {
+    let jt = structure_matrix(robot, pose);
+    let wrench = gravity_wrench(robot, pose);
+    let r = robot.reference_cable;
+    let others: Vec<usize> = (0..CABLE_COUNT).filter(|&i| i != r).collect();
+    let mut j_res = Matrix6::<f64>::zeros();
+    for (k, &i) in others.iter().enumerate() {
+        j_res.set_column(2 * k, &jt.column(2 * i));
+        j_res.set_column(2 * k + 1, &jt.column(2 * i + 1));
+    }
+    let rhs = wrench - jt.column(2 * r) * reference.horizontal_n - jt.column(2 * r + 1) * reference.vertical_n;
+    let lu = j_res.lu();
+    let solution = lu
+        .solve(&rhs)
+        .filter(|x| x.iter().all(|v| v.is_finite()))
+        .ok_or_else(|| {
+            Error::NoEquilibrium(format!(
+                "the structure matrix of the non-reference cables is singular at position {:?}",
+                pose.position_m.as_slice()
+            ))
+        })?;
+    let mut tensions = [reference; CABLE_COUNT];
+    for (k, &i) in others.iter().enumerate() {
+        tensions[i] = CableTension {
+            horizontal_n: solution[2 * k],
+            vertical_n: solution[2 * k + 1],
+        };
+    }
+    Ok(tensions)
+}
+
+/// The catenary of every cable for a pose and its tensions.
+pub fn catenaries(
+    robot: &Robot,
+    pose: &PlatformPose,
+    tensions: &[CableTension; CABLE_COUNT],
+) -> [Catenary; CABLE_COUNT] {
+    let geometry = cable_geometry(robot, pose);
+    std::array::from_fn(|i| Catenary {
+        span_m: geometry[i].span_m,
+        horizontal_tension_n: tensions[i].horizontal_n,
+        vertical_tension_n: tensions[i].vertical_n,
+        cable_weight_n_per_m: robot.cable_weight_n_per_m,
+    })
+}
+
+/// Attachment-height residuals (paper eq. 15): attachment height minus the
+/// catenary's height at the attachment, metres. Zero at equilibrium.
+pub fn attachment_height_residuals(
+    robot: &Robot,
+    pose: &PlatformPose,
+    tensions: &[CableTension; CABLE_COUNT],
+) -> [f64; CABLE_COUNT] {
+    let geometry = cable_geometry(robot, pose);
+    let cables = catenaries(robot, pose, tensions);
+    std::array::from_fn(|i| cables[i].drop_m() - geometry[i].height_difference_m)
+}
+
+/// A static equilibrium of the robot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Equilibrium {
+    /// Platform pose.
+    pub pose: PlatformPose,
+    /// Tensions at the attachments, in cable order.
+    pub tensions: [CableTension; CABLE_COUNT],
+    /// Catenary (true) cable lengths, metres.
+    pub cable_lengths_m: [f64; CABLE_COUNT],
+    /// Remaining attachment-height residuals, metres (~1e-12 at a solved equilibrium).
+    pub height_residuals_m: [f64; CABLE_COUNT],
+    /// Newton / Levenberg-Marquardt iterations used.
+    pub iterations: usize,
+}
+
+impl Equilibrium {
+    fn evaluate(robot: &Robot, pose: PlatformPose, reference: CableTension, iterations: usize) -> Result<Self> {
+        let tensions = cable_tensions(robot, &pose, reference)?;
+        let cables = catenaries(robot, &pose, &tensions);
+        Ok(Self {
+            pose,
+            tensions,
+            cable_lengths_m: std::array::from_fn(|i| cables[i].length_m()),
+            height_residuals_m: attachment_height_residuals(robot, &pose, &tensions),
+            iterations,
+        })
+    }
+
+    /// Largest attachment-height residual, metres (NaN if any residual is NaN).
+    pub fn max_height_residual_m(&self) -> f64 {
+        self.height_residuals_m.iter().fold(0.0, |m: f64, r| {
+            if r.is_nan() || m.is_nan() {
+                f64::NAN
+            } else {
+                m.max(r.abs())
+            }
+        })
+    }
+}
+
+/// Options of the kineto-static solvers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StaticsOptions {
+    /// Maximum number of Levenberg-Marquardt iterations.
+    pub max_iterations: usize,
+    /// Largest attachment-height residual accepted as equilibrium, metres.
+    pub height_tolerance_m: f64,
+    /// Standard deviation of a cable-length measurement in (b) and (c), metres.
+    pub length_sigma_m: f64,
+}
+
+impl Default for StaticsOptions {
+    /// 100 iterations, 1e-9 m height tolerance, 1 mm cable-length sigma.
+    fn default() -> Self {
+        Self {
+            max_iterations: 100,
+            height_tolerance_m: 1e-9,
+            length_sigma_m: 1e-3,
+        }
+    }
+}
+
+/// A small dense Levenberg-Marquardt with central-difference Jacobians, for
+/// the 4-8 unknowns of one pose. `residual` returns `None` where the model is
+/// undefined (a slack cable): such a trial step is rejected like a bad one.
+fn dense_least_squares(
+    start: DVector<f64>,
+    steps: &DVector<f64>,
+    max_iterations: usize,
+    residual: impl Fn(&DVector<f64>) -> Option<DVector<f64>>,
+) -> Option<(DVector<f64>, usize)> {
+    let mut x = start;
+    let mut r = residual(&x)?;
+    let mut cost = r.norm_squared();
+    let mut damping = 1e-6;
+    for iteration in 1..=max_iterations {
+        let n = x.len();
+        let mut jacobian = DMatrix::<f64>::zeros(r.len(), n);
+        for j in 0..n {
+            let mut plus = x.clone();
+            let mut minus = x.clone();
+            plus[j] += steps[j];
+            minus[j] -= steps[j];
+            let (rp, rm) = (residual(&plus)?, residual(&minus)?);
+            jacobian.set_column(j, &((rp - rm) / (2.0 * steps[j])));
+        }
+        let hessian = jacobian.transpose() * &jacobian;
+        let gradient = jacobian.transpose() * &r;
+        let mut accepted = false;
+        for _ in 0..30 {
+            let mut damped = hessian.clone();
+            for k in 0..n {
+                damped[(k, k)] += damping * hessian[(k, k)].max(1e-12);
+            }
+            let Some(step) = damped.cholesky().map(|c| -c.solve(&gradient)) else {
+                damping *= 10.0;
+                continue;
+            };
+            let trial = &x + &step;
+            match residual(&trial) {
+                Some(rt) if rt.norm_squared() < cost => {
+                    let small_step = step.iter().zip(steps.iter()).all(|(d, h)| d.abs() < 1e-6 * h);
+                    x = trial;
+                    r = rt;
+                    cost = r.norm_squared();
+                    damping = (damping / 10.0).max(1e-12);
+                    accepted = true;
+                    if small_step || cost < 1e-30 {
+                        return Some((x, iteration));
+                    }
+                    break;
+                }
+                _ => damping *= 10.0,
+            }
+        }
+        if !accepted {
+            return Some((x, iteration));
+        }
+    }
+    Some((x, max_iterations))
+}
+
+fn rotated(base: &UnitQuaternion<f64>, x: &DVector<f64>) -> UnitQuaternion<f64> {
+    base * UnitQuaternion::from_scaled_axis(Vector3::new(x[0], x[1], x[2]))
+}
+
+fn check_equilibrium(equilibrium: Equilibrium, options: &StaticsOptions, what: &str) -> Result<Equilibrium> {
+    if let Some((i, t)) = equilibrium.tensions.iter().enumerate().find(|(_, t)| !t.is_taut()) {
+        return Err(Error::NoEquilibrium(format!(
+            "{what}: cable {} would have to push (horizontal tension {:.3} N)",
+            i + 1,
+            t.horizontal_n
+        )));
+    }
+    let residual = equilibrium.max_height_residual_m();
+    if residual.is_nan() || residual > options.height_tolerance_m {
+        return Err(Error::NoEquilibrium(format!(
+            "{what}: no orientation lets all four catenaries reach the platform (attachment height residual {:.3e} m after {} iterations)",
+            equilibrium.max_height_residual_m(),
+            equilibrium.iterations
+        )));
+    }
+    Ok(equilibrium)
+}
+
+/// A reference-cable tension of magnitude `magnitude_n` whose direction
+/// follows the chord to the anchor, flattened by the sag (`u ~ dz/L - lambda/2`).
+fn reference_tension_guess(robot: &Robot, pose: &PlatformPose, magnitude_n: f64) -> f64 {
+    let geometry = cable_geometry(robot, pose)[robot.reference_cable];
+    let half_lambda = 0.5 * robot.cable_weight_n_per_m * geometry.span_m / magnitude_n;
+    (geometry.height_difference_m / geometry.span_m - half_lambda).atan()
+}
+
+/// Problem (a): position and the load cell's reference-tension magnitude
+/// (paper eq. 16) -> orientation, all four tensions, catenary lengths.
+///
+/// The reference tension is parametrised as `f_m (cos phi, sin phi)`, so the
+/// unknowns `(orientation, phi)` meet the four attachment-height equations
+/// exactly (a square Newton system). `initial_rotation` defaults to level.
+pub fn solve_with_reference_tension(
+    robot: &Robot,
+    position_m: Vector3<f64>,
+    reference_tension_n: f64,
+    initial_rotation: Option<UnitQuaternion<f64>>,
+    options: &StaticsOptions,
+) -> Result<Equilibrium> {
+    if !(reference_tension_n.is_finite() && reference_tension_n > 0.0) {
+        return Err(Error::InvalidInput(format!(
+            "reference-cable tension must be positive, got {reference_tension_n} N"
+        )));
+    }
+    let base = initial_rotation.unwrap_or_else(UnitQuaternion::identity);
+    let base_pose = PlatformPose::new(position_m, base);
+    let phi0 = reference_tension_guess(robot, &base_pose, reference_tension_n);
+    let reference = |phi: f64| CableTension {
+        horizontal_n: reference_tension_n * phi.cos(),
+        vertical_n: reference_tension_n * phi.sin(),
+    };
+    let residual = |x: &DVector<f64>| -> Option<DVector<f64>> {
+        let pose = PlatformPose::new(position_m, rotated(&base, x));
+        let tensions = cable_tensions(robot, &pose, reference(x[3])).ok()?;
+        if !tensions.iter().all(CableTension::is_taut) {
+            return None;
+        }
+        Some(DVector::from_row_slice(&attachment_height_residuals(
+            robot, &pose, &tensions,
+        )))
+    };
+    let steps = DVector::from_row_slice(&[1e-7, 1e-7, 1e-7, 1e-7]);
+    let mut best: Option<Equilibrium> = None;
+    // Start at the sag-corrected chord angle; if eq. (11) yields a slack cable
+    // there, widen the search over the reference cable's angle.
+    for offset_deg in [0.0, 5.0, -5.0, 10.0, -10.0, 20.0, -20.0] {
+        let start = DVector::from_row_slice(&[0.0, 0.0, 0.0, phi0 + f64::to_radians(offset_deg)]);
+        let Some((x, iterations)) = dense_least_squares(start, &steps, options.max_iterations, residual) else {
+            continue;
+        };
+        let pose = PlatformPose::new(position_m, rotated(&base, &x));
+        let equilibrium = Equilibrium::evaluate(robot, pose, reference(x[3]), iterations)?;
+        if equilibrium.max_height_residual_m() <= options.height_tolerance_m {
+            return check_equilibrium(equilibrium, options, "position + reference tension");
+        }
+        if best
+            .as_ref()
+            .is_none_or(|b| equilibrium.max_height_residual_m() < b.max_height_residual_m())
+        {
+            best = Some(equilibrium);
+        }
+    }
+    match best {
+        Some(equilibrium) => check_equilibrium(equilibrium, options, "position + reference tension"),
+        None => Err(Error::NoEquilibrium(format!(
+            "position {:?} with reference tension {reference_tension_n} N: every start gives a slack cable",
+            position_m.as_slice()
+        ))),
+    }
+}
+
+/// A rough reference-tension magnitude for a position: the straight-cable
+/// force balance `sum t_i e_i = m_e g z` solved in the least-norm sense.
+fn reference_tension_magnitude_guess(robot: &Robot, position_m: Vector3<f64>) -> f64 {
+    let pose = PlatformPose::from_position(position_m);
+    let geometry = cable_geometry(robot, &pose);
+    let mut directions = nalgebra::Matrix3x4::<f64>::zeros();
+    for (i, cable) in geometry.iter().enumerate() {
+        directions.set_column(i, &(robot.anchors_m[i] - cable.attachment_world_m).normalize());
+    }
+    let weight = Vector3::new(0.0, 0.0, robot.platform_weight_n);
+    let tensions = directions.pseudo_inverse(1e-12).map(|p| p * weight).ok();
+    let guess = tensions.map(|t| t[robot.reference_cable]).unwrap_or(0.0);
+    // Cable weight hangs on the platform too: add half of the reference cable's.
+    let cable_weight = 0.5 * robot.cable_weight_n_per_m * (robot.anchors_m[robot.reference_cable] - position_m).norm();
+    if guess.is_finite() && guess > 0.0 {
+        guess + cable_weight
+    } else {
+        robot.platform_weight_n / CABLE_COUNT as f64 + cable_weight
+    }
+}
+
+/// Problem (b): position and the four (true, offset-free) cable lengths ->
+/// orientation and tensions.
+///
+/// The equilibria at a fixed position form a one-parameter family, which (a)
+/// parametrises by the reference-tension magnitude `f_m`. (b) walks along that
+/// family: Gauss-Newton on the single unknown `f_m`, minimising the squared
+/// length errors, every evaluation an exact (a)-solve. The attachment heights
+/// (eq. 15) therefore hold exactly while the lengths are fitted in the
+/// least-squares sense.
+pub fn solve_with_cable_lengths(
+    robot: &Robot,
+    position_m: Vector3<f64>,
+    cable_lengths_m: &[f64; CABLE_COUNT],
+    options: &StaticsOptions,
+) -> Result<Equilibrium> {
+    validate_lengths(cable_lengths_m)?;
+    let (mut magnitude, mut current) = feasible_start(robot, position_m, None, options)?;
+    let length_errors = |eq: &Equilibrium| -> [f64; CABLE_COUNT] {
+        std::array::from_fn(|i| eq.cable_lengths_m[i] - cable_lengths_m[i])
+    };
+    let sum_sq = |r: &[f64; CABLE_COUNT]| r.iter().map(|x| x * x).sum::<f64>();
+    let mut iterations = current.iterations;
+    for _ in 0..options.max_iterations {
+        let h = 1e-6 * magnitude;
+        let plus =
+            solve_with_reference_tension(robot, position_m, magnitude + h, Some(current.pose.rotation), options)?;
+        let minus =
+            solve_with_reference_tension(robot, position_m, magnitude - h, Some(current.pose.rotation), options)?;
+        let r = length_errors(&current);
+        let slope: [f64; CABLE_COUNT] =
+            std::array::from_fn(|i| (plus.cable_lengths_m[i] - minus.cable_lengths_m[i]) / (2.0 * h));
+        let jtj: f64 = slope.iter().map(|d| d * d).sum();
+        let jtr: f64 = slope.iter().zip(r.iter()).map(|(d, e)| d * e).sum();
+        let mut step = -jtr / jtj;
+        let cost = sum_sq(&r);
+        let mut accepted = None;
+        // Halve the step until the cost does not increase and the family still exists.
+        for _ in 0..40 {
+            let trial = magnitude + step;
+            if trial > 0.0 {
+                if let Ok(eq) =
+                    solve_with_reference_tension(robot, position_m, trial, Some(current.pose.rotation), options)
+                {
+                    if sum_sq(&length_errors(&eq)) <= cost {
+                        accepted = Some((trial, eq));
+                        break;
+                    }
+                }
+            }
+            step *= 0.5;
+        }
+        let Some((trial, eq)) = accepted else { break };
+        iterations += eq.iterations;
+        magnitude = trial;
+        current = eq;
+        if step.abs() <= 1e-12 * magnitude {
+            break;
+        }
+    }
+    current.iterations = iterations;
+    Ok(current)
+}
+
+/// A point of the one-parameter family at `position_m`: the straight-cable
+/// guess of the reference tension, or, where the family does not extend that
+/// far (a slack cable), the nearest of a ladder of magnitudes around it.
+fn feasible_start(
+    robot: &Robot,
+    position_m: Vector3<f64>,
+    initial_rotation: Option<UnitQuaternion<f64>>,
+    options: &StaticsOptions,
+) -> Result<(f64, Equilibrium)> {
+    let guess = reference_tension_magnitude_guess(robot, position_m);
+    let mut first_error = None;
+    for factor in [1.0, 1.2, 0.85, 1.5, 0.7, 2.0, 0.5, 3.0] {
+        match solve_with_reference_tension(robot, position_m, guess * factor, initial_rotation, options) {
+            Ok(eq) => return Ok((guess * factor, eq)),
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    Err(first_error.unwrap_or_else(|| Error::NoEquilibrium("no start for the statics".into())))
+}
+
+fn validate_lengths(cable_lengths_m: &[f64; CABLE_COUNT]) -> Result<()> {
+    if let Some((i, l)) = cable_lengths_m
+        .iter()
+        .enumerate()
+        .find(|(_, l)| !(l.is_finite() && **l > 0.0))
+    {
+        return Err(Error::InvalidInput(format!(
+            "cable {} length must be a positive number of metres, got {l}",
+            i + 1
+        )));
+    }
+    Ok(())
+}
+
+/// Problem (c), the forward kineto-statics (localisation): the four cable
+/// lengths -> pose and tensions. Eight equations (4 heights, 4 lengths) in
+/// eight unknowns (pose, reference tension). Without `initial_guess` the
+/// start is the straight-cable trilateration of the lengths.
+pub fn solve_forward(
+    robot: &Robot,
+    cable_lengths_m: &[f64; CABLE_COUNT],
+    initial_guess: Option<PlatformPose>,
+    options: &StaticsOptions,
+) -> Result<Equilibrium> {
+    validate_lengths(cable_lengths_m)?;
+    let start_position = match initial_guess {
+        Some(pose) => pose.position_m,
+        None => trilaterate(robot, cable_lengths_m),
+    };
+    let (_, start) = feasible_start(robot, start_position, initial_guess.map(|p| p.rotation), options)?;
+    let reference = start.tensions[robot.reference_cable];
+    let base = start.pose;
+    let residual = |x: &DVector<f64>| -> Option<DVector<f64>> {
+        let pose = base.retract(&Vector6::new(x[0], x[1], x[2], x[3], x[4], x[5]));
+        let tensions = cable_tensions(
+            robot,
+            &pose,
+            CableTension {
+                horizontal_n: x[6],
+                vertical_n: x[7],
+            },
+        )
+        .ok()?;
+        if !tensions.iter().all(CableTension::is_taut) {
+            return None;
+        }
+        let heights = attachment_height_residuals(robot, &pose, &tensions);
+        let cables = catenaries(robot, &pose, &tensions);
+        let mut r = DVector::zeros(2 * CABLE_COUNT);
+        for i in 0..CABLE_COUNT {
+            r[i] = heights[i];
+            r[CABLE_COUNT + i] = cables[i].length_m() - cable_lengths_m[i];
+        }
+        Some(r)
+    };
+    let mut x0 = DVector::zeros(8);
+    x0[6] = reference.horizontal_n;
+    x0[7] = reference.vertical_n;
+    let tension_step = 1e-6 * reference.horizontal_n;
+    let steps = DVector::from_row_slice(&[1e-7, 1e-7, 1e-7, 1e-6, 1e-6, 1e-6, tension_step, tension_step]);
+    let (x, iterations) = dense_least_squares(x0, &steps, options.max_iterations, residual)
+        .ok_or_else(|| Error::NoEquilibrium("forward kineto-statics: the start has a slack cable".into()))?;
+    let pose = base.retract(&Vector6::new(x[0], x[1], x[2], x[3], x[4], x[5]));
+    let equilibrium = Equilibrium::evaluate(
+        robot,
+        pose,
+        CableTension {
+            horizontal_n: x[6],
+            vertical_n: x[7],
+        },
+        iterations + start.iterations,
+    )?;
+    let length_error = (0..CABLE_COUNT)
+        .map(|i| (equilibrium.cable_lengths_m[i] - cable_lengths_m[i]).abs())
+        .fold(0.0, f64::max);
+    if length_error > 1e-6 {
+        return Err(Error::NoEquilibrium(format!(
+            "forward kineto-statics: no pose reproduces the cable lengths (worst length error {length_error:.3e} m)"
+        )));
+    }
+    check_equilibrium(equilibrium, options, "forward kineto-statics")
+}
+
+/// Position whose straight-line distances to the anchors best match the
+/// lengths (attachments taken at a level platform), by Gauss-Newton from
+/// below the anchors' centroid.
+fn trilaterate(robot: &Robot, cable_lengths_m: &[f64; CABLE_COUNT]) -> Vector3<f64> {
+    let centroid = robot.anchors_m.iter().sum::<Vector3<f64>>() / CABLE_COUNT as f64;
+    let mean_length = cable_lengths_m.iter().sum::<f64>() / CABLE_COUNT as f64;
+    let mut start = centroid;
+    start.z -= 0.5 * mean_length;
+    let residual = |x: &DVector<f64>| -> Option<DVector<f64>> {
+        let p = Vector3::new(x[0], x[1], x[2]);
+        Some(DVector::from_iterator(
+            CABLE_COUNT,
+            (0..CABLE_COUNT).map(|i| (robot.anchors_m[i] - p - robot.attachments_m[i]).norm() - cable_lengths_m[i]),
+        ))
+    };
+    let x0 = DVector::from_row_slice(start.as_slice());
+    let steps = DVector::from_element(3, 1e-6);
+    dense_least_squares(x0, &steps, 100, residual)
+        .map(|(x, _)| Vector3::new(x[0], x[1], x[2]))
+        .unwrap_or(start)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn large() -> Robot {
+        Robot::builtin("large").unwrap()
+    }
+
+    #[test]
+    fn equilibrium_balances_forces_and_moments() {
+        let robot = large();
+        let eq = solve_with_reference_tension(
+            &robot,
+            Vector3::new(10.0, -5.0, 12.0),
+            700.0,
+            None,
+            &StaticsOptions::default(),
+        )
+        .unwrap();
+        let mut f = nalgebra::SVector::<f64, 8>::zeros();
+        for i in 0..CABLE_COUNT {
+            f[2 * i] = eq.tensions[i].horizontal_n;
+            f[2 * i + 1] = eq.tensions[i].vertical_n;
+        }
+        let imbalance = structure_matrix(&robot, &eq.pose) * f - gravity_wrench(&robot, &eq.pose);
+        assert!(imbalance.norm() < 1e-9, "wrench imbalance {imbalance}");
+        assert!((eq.tensions[0].magnitude_n() - 700.0).abs() < 1e-9);
+        assert!(eq.max_height_residual_m() < 1e-9);
+    }
+
+    #[test]
+    fn the_three_closures_agree() {
+        let robot = large();
+        let options = StaticsOptions::default();
+        let position = Vector3::new(-8.0, 6.0, 15.0);
+        let a = solve_with_reference_tension(&robot, position, 650.0, None, &options).unwrap();
+        let b = solve_with_cable_lengths(&robot, position, &a.cable_lengths_m, &options).unwrap();
+        assert!(
+            a.pose.angle_to_deg(&b.pose) < 1e-6,
+            "{} deg",
+            a.pose.angle_to_deg(&b.pose)
+        );
+        assert!((b.tensions[0].magnitude_n() - 650.0).abs() < 1e-4);
+        let c = solve_forward(&robot, &a.cable_lengths_m, None, &options).unwrap();
+        assert!((c.pose.position_m - position).norm() < 1e-6, "{}", c.pose.position_m);
+        assert!(a.pose.angle_to_deg(&c.pose) < 1e-5);
+        assert!((c.tensions[0].magnitude_n() - 650.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn a_slack_reference_cable_has_no_equilibrium() {
+        let robot = large();
+        // 5 N cannot hold anything: the other cables would have to push.
+        let err = solve_with_reference_tension(
+            &robot,
+            Vector3::new(0.0, 0.0, 10.0),
+            5.0,
+            None,
+            &StaticsOptions::default(),
+        )
+        .unwrap_err();
+        assert!(matches!(err, Error::NoEquilibrium(_)), "{err}");
+    }
+}

@@ -1,0 +1,349 @@
+//! Model verification against measured data (paper Sec. V-A, Table I).
+//!
+//! For every kept row of a measurement log, the kineto-static model is closed
+//! with the row's *position* and one measured quantity (by default the
+//! reference cable's load-cell tension, paper eq. 16), and its predictions
+//! are compared with everything else the row measured: the four cable lengths,
+//! the tensions of the other cables, and the orientation.
+//!
+//! The measured orientation is deliberately **not** an input: in the RecurDyn
+//! log it disagrees with the model's equilibrium by about 2 degrees and some
+//! rows carry permuted angle columns, so it is reported, not trusted
+//! ([`OrientationConventionFit`]).
+
+use nalgebra::{UnitQuaternion, Vector3};
+use serde::Serialize;
+
+use crate::io::recurdyn::{RecurDynLog, RecurDynRow, RejectedRow};
+use crate::model::pose::PlatformPose;
+use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::statics::{self, Equilibrium, StaticsOptions};
+
+/// The paper's Table I for the large robot (5 random poses).
+pub const PAPER_TABLE1_LARGE: (f64, f64) = (8.8947e-3, 0.9154);
+
+/// Which measurement closes the one-parameter family of equilibria.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Closure {
+    /// Position + the reference cable's measured tension magnitude (problem (a)).
+    ReferenceTension,
+    /// Position + the four measured cable lengths, least squares (problem (b)).
+    CableLengths,
+}
+
+/// Prediction against measurement for one row.
+#[derive(Debug, Clone, Serialize)]
+pub struct RowVerification {
+    /// Line number in the data file.
+    pub line: usize,
+    /// Measured position, metres.
+    pub position_m: [f64; 3],
+    /// Measured cable lengths, metres.
+    pub measured_length_m: [f64; CABLE_COUNT],
+    /// Predicted catenary lengths, metres.
+    pub predicted_length_m: [f64; CABLE_COUNT],
+    /// `100 * |predicted - measured| / measured` per cable.
+    pub length_error_pct: [f64; CABLE_COUNT],
+    /// Measured tension magnitudes, newtons (absent where the log has none).
+    pub measured_tension_n: [Option<f64>; CABLE_COUNT],
+    /// Predicted tension magnitudes at the attachments, newtons.
+    pub predicted_tension_n: [f64; CABLE_COUNT],
+    /// Percentage tension error for the measured cables that were not an input.
+    pub tension_error_pct: [Option<f64>; CABLE_COUNT],
+    /// Measured `(roll, pitch, yaw)` in degrees (R = Rz(yaw) Ry(pitch) Rx(roll)).
+    pub measured_roll_pitch_yaw_deg: [f64; 3],
+    /// The model's equilibrium orientation as `(roll, pitch, yaw)` in degrees.
+    pub predicted_roll_pitch_yaw_deg: [f64; 3],
+    /// Angle between measured and predicted orientation, degrees.
+    pub orientation_error_deg: f64,
+    /// Largest attachment-height residual of the solved equilibrium, metres.
+    pub height_residual_m: f64,
+}
+
+/// A row the statics could not solve (no equilibrium with positive tensions).
+#[derive(Debug, Clone, Serialize)]
+pub struct UnsolvedRow {
+    /// Line number in the data file.
+    pub line: usize,
+    /// Why.
+    pub reason: String,
+}
+
+/// How well one reading of the three angle columns matches the model's orientations.
+#[derive(Debug, Clone, Serialize)]
+pub struct OrientationConventionFit {
+    /// E.g. `R = Rz(yaw) Ry(pitch) Rx(roll)` with the file's columns named as in its header.
+    pub convention: String,
+    /// Mean angle to the model's equilibrium over all solved rows, degrees.
+    pub mean_error_deg: f64,
+    /// Median of the same, degrees.
+    pub median_error_deg: f64,
+}
+
+/// A row whose angles match the model far better with their columns permuted.
+#[derive(Debug, Clone, Serialize)]
+pub struct SuspectOrientationRow {
+    /// Line number in the data file.
+    pub line: usize,
+    /// Error with the documented convention, degrees.
+    pub documented_error_deg: f64,
+    /// The best alternative reading.
+    pub best_convention: String,
+    /// Error with that reading, degrees.
+    pub best_error_deg: f64,
+}
+
+/// The whole verification.
+#[derive(Debug, Clone, Serialize)]
+pub struct VerifyReport {
+    /// Robot name.
+    pub robot: String,
+    /// Data file.
+    pub data: String,
+    /// The closing measurement.
+    pub closure: Closure,
+    /// Rows kept by the loader.
+    pub rows_kept: usize,
+    /// Rows the loader rejected, with reasons.
+    pub rows_rejected: Vec<RejectedRow>,
+    /// Kept rows the statics could not solve.
+    pub rows_unsolved: Vec<UnsolvedRow>,
+    /// Per-row results.
+    pub rows: Vec<RowVerification>,
+    /// Mean percentage error of the cable lengths over all solved rows and cables (MPE-L).
+    pub mpe_length_pct: f64,
+    /// Largest percentage length error.
+    pub max_length_error_pct: f64,
+    /// Mean percentage error of the tensions not used as input (MPE-F).
+    pub mpe_force_pct: f64,
+    /// Number of tension comparisons behind MPE-F.
+    pub force_comparisons: usize,
+    /// Mean orientation error with the documented convention, degrees.
+    pub orientation_error_deg: f64,
+    /// Largest orientation error, degrees.
+    pub max_orientation_error_deg: f64,
+    /// Every reading of the angle columns tried, best first.
+    pub orientation_conventions: Vec<OrientationConventionFit>,
+    /// Rows that look like they carry permuted angle columns.
+    pub suspect_orientation_rows: Vec<SuspectOrientationRow>,
+    /// The paper's Table I (MPE-L %, MPE-F %) for comparison.
+    pub paper_table1_mpe_length_pct: f64,
+    /// See `paper_table1_mpe_length_pct`.
+    pub paper_table1_mpe_force_pct: f64,
+}
+
+fn solve_row(
+    robot: &Robot,
+    row: &RecurDynRow,
+    closure: Closure,
+    options: &StaticsOptions,
+) -> crate::Result<Equilibrium> {
+    let position = Vector3::from(row.position_m);
+    match closure {
+        Closure::ReferenceTension => {
+            let measured = row.tensions[robot.reference_cable]
+                .as_ref()
+                .map(|t| t.total_n)
+                .ok_or_else(|| {
+                    crate::Error::InvalidInput(format!(
+                        "row {}: no tension for the reference cable {}",
+                        row.line,
+                        robot.reference_cable + 1
+                    ))
+                })?;
+            statics::solve_with_reference_tension(robot, position, measured, None, options)
+        }
+        Closure::CableLengths => statics::solve_with_cable_lengths(robot, position, &row.cable_lengths_m, options),
+    }
+}
+
+/// The names of the three angle columns as the file gives them, in file order.
+const ANGLE_COLUMNS: [&str; 3] = ["pitch", "roll", "yaw"];
+
+/// A reading of the angle columns: which file column plays roll, pitch, yaw,
+/// and whether the product is `Rz Ry Rx` (true) or `Rx Ry Rz`.
+#[derive(Clone, Copy)]
+struct AngleReading {
+    roll_pitch_yaw_columns: [usize; 3],
+    z_y_x: bool,
+}
+
+impl AngleReading {
+    const DOCUMENTED: AngleReading = AngleReading {
+        roll_pitch_yaw_columns: [1, 0, 2],
+        z_y_x: true,
+    };
+
+    fn all() -> Vec<AngleReading> {
+        let permutations = [[1, 0, 2], [0, 1, 2], [0, 2, 1], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+        let mut all = Vec::new();
+        for columns in permutations {
+            for z_y_x in [true, false] {
+                all.push(AngleReading {
+                    roll_pitch_yaw_columns: columns,
+                    z_y_x,
+                });
+            }
+        }
+        all
+    }
+
+    fn name(&self) -> String {
+        let [r, p, y] = self.roll_pitch_yaw_columns.map(|c| ANGLE_COLUMNS[c]);
+        if self.z_y_x {
+            format!("R = Rz({y}) Ry({p}) Rx({r})")
+        } else {
+            format!("R = Rx({r}) Ry({p}) Rz({y})")
+        }
+    }
+
+    fn rotation(&self, file_angles_deg: [f64; 3]) -> UnitQuaternion<f64> {
+        let [roll, pitch, yaw] = self.roll_pitch_yaw_columns.map(|c| file_angles_deg[c].to_radians());
+        let rx = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), roll);
+        let ry = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), pitch);
+        let rz = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw);
+        if self.z_y_x {
+            rz * ry * rx
+        } else {
+            rx * ry * rz
+        }
+    }
+}
+
+fn mean(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        f64::NAN
+    } else {
+        values.iter().sum::<f64>() / values.len() as f64
+    }
+}
+
+fn median(values: &[f64]) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    match sorted.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => sorted[n / 2],
+        n => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
+    }
+}
+
+/// Verify the model on every kept row of `log`.
+pub fn verify(robot: &Robot, log: &RecurDynLog, closure: Closure, options: &StaticsOptions) -> VerifyReport {
+    let mut rows = Vec::new();
+    let mut unsolved = Vec::new();
+    let mut solved_orientations = Vec::new();
+    for row in &log.rows {
+        let equilibrium = match solve_row(robot, row, closure, options) {
+            Ok(eq) => eq,
+            Err(e) => {
+                unsolved.push(UnsolvedRow {
+                    line: row.line,
+                    reason: e.to_string(),
+                });
+                continue;
+            }
+        };
+        let file_angles = [row.pitch_deg, row.roll_deg, row.yaw_deg];
+        let measured_rotation = AngleReading::DOCUMENTED.rotation(file_angles);
+        let measured_pose = PlatformPose::new(Vector3::from(row.position_m), measured_rotation);
+        let predicted_tension_n: [f64; CABLE_COUNT] = std::array::from_fn(|i| equilibrium.tensions[i].magnitude_n());
+        let measured_tension_n: [Option<f64>; CABLE_COUNT] =
+            std::array::from_fn(|i| row.tensions[i].map(|t| t.total_n));
+        let tension_error_pct = std::array::from_fn(|i| {
+            let is_input = closure == Closure::ReferenceTension && i == robot.reference_cable;
+            match measured_tension_n[i] {
+                Some(m) if !is_input => Some(100.0 * (predicted_tension_n[i] - m).abs() / m),
+                _ => None,
+            }
+        });
+        let (r, p, y) = equilibrium.pose.roll_pitch_yaw_deg();
+        rows.push(RowVerification {
+            line: row.line,
+            position_m: row.position_m,
+            measured_length_m: row.cable_lengths_m,
+            predicted_length_m: equilibrium.cable_lengths_m,
+            length_error_pct: std::array::from_fn(|i| {
+                100.0 * (equilibrium.cable_lengths_m[i] - row.cable_lengths_m[i]).abs() / row.cable_lengths_m[i]
+            }),
+            measured_tension_n,
+            predicted_tension_n,
+            tension_error_pct,
+            measured_roll_pitch_yaw_deg: [row.roll_deg, row.pitch_deg, row.yaw_deg],
+            predicted_roll_pitch_yaw_deg: [r, p, y],
+            orientation_error_deg: measured_pose.angle_to_deg(&equilibrium.pose),
+            height_residual_m: equilibrium.max_height_residual_m(),
+        });
+        solved_orientations.push((row.line, file_angles, equilibrium.pose.rotation));
+    }
+
+    let readings = AngleReading::all();
+    let errors_per_reading: Vec<Vec<f64>> = readings
+        .iter()
+        .map(|reading| {
+            solved_orientations
+                .iter()
+                .map(|(_, angles, model)| reading.rotation(*angles).angle_to(model).to_degrees())
+                .collect()
+        })
+        .collect();
+    let mut orientation_conventions: Vec<OrientationConventionFit> = readings
+        .iter()
+        .zip(&errors_per_reading)
+        .map(|(reading, errors)| OrientationConventionFit {
+            convention: reading.name(),
+            mean_error_deg: mean(errors),
+            median_error_deg: median(errors),
+        })
+        .collect();
+    orientation_conventions.sort_by(|a, b| a.mean_error_deg.total_cmp(&b.mean_error_deg));
+    // Documented reading is index 0 of `readings`.
+    let suspect_orientation_rows = solved_orientations
+        .iter()
+        .enumerate()
+        .filter_map(|(k, (line, _, _))| {
+            let documented = errors_per_reading[0][k];
+            let (best, best_error) = readings
+                .iter()
+                .zip(&errors_per_reading)
+                .skip(1)
+                .map(|(reading, errors)| (reading, errors[k]))
+                .min_by(|a, b| a.1.total_cmp(&b.1))?;
+            // A different reading of the columns explains the row at least twice as well,
+            // and the documented one is off by more than the typical 2 degrees.
+            (best_error < 0.5 * documented && documented > 2.0).then(|| SuspectOrientationRow {
+                line: *line,
+                documented_error_deg: documented,
+                best_convention: best.name(),
+                best_error_deg: best_error,
+            })
+        })
+        .collect();
+
+    let length_errors: Vec<f64> = rows.iter().flat_map(|r| r.length_error_pct).collect();
+    let force_errors: Vec<f64> = rows
+        .iter()
+        .flat_map(|r| r.tension_error_pct.into_iter().flatten())
+        .collect();
+    let orientation_errors: Vec<f64> = rows.iter().map(|r| r.orientation_error_deg).collect();
+    VerifyReport {
+        robot: robot.name.clone(),
+        data: log.path.display().to_string(),
+        closure,
+        rows_kept: log.rows.len(),
+        rows_rejected: log.rejected.clone(),
+        rows_unsolved: unsolved,
+        mpe_length_pct: mean(&length_errors),
+        max_length_error_pct: length_errors.iter().copied().fold(0.0, f64::max),
+        mpe_force_pct: mean(&force_errors),
+        force_comparisons: force_errors.len(),
+        orientation_error_deg: mean(&orientation_errors),
+        max_orientation_error_deg: orientation_errors.iter().copied().fold(0.0, f64::max),
+        orientation_conventions,
+        suspect_orientation_rows,
+        paper_table1_mpe_length_pct: PAPER_TABLE1_LARGE.0,
+        paper_table1_mpe_force_pct: PAPER_TABLE1_LARGE.1,
+        rows,
+    }
+}

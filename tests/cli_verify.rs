@@ -1,0 +1,162 @@
+//! `sagcal verify` end to end: the target on the shared RecurDyn data, and
+//! clear errors with a non-zero exit on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn sagcal(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sagcal"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the sagcal binary runs")
+}
+
+fn shared_data() -> Option<PathBuf> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/recurdyn-large/recurdyn_large.csv");
+    if path.exists() {
+        Some(path)
+    } else {
+        eprintln!(
+            "skipped: {} not found (the shared RecurDyn data is not beside this checkout)",
+            path.display()
+        );
+        None
+    }
+}
+
+#[test]
+fn verify_beats_table_one_on_the_recurdyn_data() {
+    let Some(data) = shared_data() else { return };
+    let out = sagcal(&[
+        "verify",
+        "--robot",
+        "robots/large.toml",
+        "--data",
+        data.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["rows_kept"], 57);
+    assert_eq!(report["rows_rejected"].as_array().unwrap().len(), 35);
+    assert_eq!(report["rows_unsolved"].as_array().unwrap().len(), 0);
+    let mpe_l = report["mpe_length_pct"].as_f64().unwrap();
+    let mpe_f = report["mpe_force_pct"].as_f64().unwrap();
+    let orientation = report["orientation_error_deg"].as_f64().unwrap();
+    // The paper's Table I: 0.0089 % and 0.9154 %; the reference analysis: 0.0036 % and 0.21 %.
+    assert!(mpe_l < 0.00365, "MPE-L {mpe_l}");
+    assert!(mpe_f < 0.215, "MPE-F {mpe_f}");
+    assert_eq!(report["force_comparisons"], 39);
+    // The logged orientations are ~1.9 degrees off the model's equilibria.
+    assert!((1.8..2.1).contains(&orientation), "orientation error {orientation}");
+    // The documented reading of the angle columns fits better than any permutation of them.
+    let conventions = report["orientation_conventions"].as_array().unwrap();
+    let best = conventions[0]["convention"].as_str().unwrap();
+    assert!(
+        best.contains("Rx(roll) Ry(pitch) Rz(yaw)") || best.contains("Rz(yaw) Ry(pitch) Rx(roll)"),
+        "{best}"
+    );
+    for row in report["rows"].as_array().unwrap() {
+        assert!(row["height_residual_m"].as_f64().unwrap() < 1e-9);
+    }
+}
+
+#[test]
+fn closing_with_cable_lengths_predicts_tensions_too() {
+    let Some(data) = shared_data() else { return };
+    let out = sagcal(&[
+        "verify",
+        "--robot",
+        "robots/large.toml",
+        "--data",
+        data.to_str().unwrap(),
+        "--close-with",
+        "cable-lengths",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // All four cables' tensions are now predictions (57 reference + 39 others).
+    assert_eq!(report["force_comparisons"], 96);
+    let mpe_f = report["mpe_force_pct"].as_f64().unwrap();
+    assert!(mpe_f < 5.0, "MPE-F {mpe_f}");
+}
+
+fn expect_failure(args: &[&str], needles: &[&str]) {
+    let out = sagcal(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "expected failure for {args:?}");
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for needle in needles {
+        assert!(stderr.contains(needle), "`{needle}` missing from: {stderr}");
+    }
+    assert!(out.stdout.is_empty(), "nothing on stdout on failure");
+}
+
+const HEADER: &str = "x,y,z,pitch,roll,yaw,L1,L2,L3,L4,fc1,fz1,fh1,fc2,fz2,fh2,fc3,fz3,fh3,fc4,fz4,fh4,";
+const GOOD_ROW: &str = "-9.92414615236591,-9.90879763138036,11.0432049462401,-0.087901686672993,1.08382713920521,-2.3271554167164,168.56,169.9,178.5,177.4,722.303,158.657,704.855,,,,,,,,,,";
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = "robots/large.toml";
+    expect_failure(
+        &["verify", "--robot", robot, "--data", "no/such/file.csv"],
+        &["no/such/file.csv"],
+    );
+    let unknown = write(dir.path(), "unknown.csv", "a,b,c\n1,2,3\n");
+    expect_failure(&["verify", "--robot", robot, "--data", &unknown], &["unknown.csv"]);
+    let text_column = write(
+        dir.path(),
+        "text.csv",
+        &format!("{HEADER}\n{}\n", GOOD_ROW.replacen("168.56", "long", 1)),
+    );
+    expect_failure(
+        &["verify", "--robot", robot, "--data", &text_column],
+        &["text.csv", "row 2", "L1"],
+    );
+    let nan = write(
+        dir.path(),
+        "nan.csv",
+        &format!("{HEADER}\n{GOOD_ROW}\n{}\n", GOOD_ROW.replacen("722.303", "NaN", 1)),
+    );
+    expect_failure(
+        &["verify", "--robot", robot, "--data", &nan],
+        &["nan.csv", "row 3", "fc1"],
+    );
+    let coincident = std::fs::read_to_string("robots/large.toml")
+        .unwrap()
+        .replace("anchor_m = [125.0, -110.0, 48.0]", "anchor_m = [-125.0, -110.0, 48.0]");
+    let coincident = write(dir.path(), "coincident.toml", &coincident);
+    let good = write(dir.path(), "good.csv", &format!("{HEADER}\n{GOOD_ROW}\n"));
+    expect_failure(
+        &["verify", "--robot", &coincident, "--data", &good],
+        &["coincident.toml", "coincident anchors", "cables 1 and 2"],
+    );
+    let no_reference = std::fs::read_to_string("robots/large.toml")
+        .unwrap()
+        .replace("reference_cable = 1", "reference_cable = 7");
+    let no_reference = write(dir.path(), "noref.toml", &no_reference);
+    expect_failure(
+        &["verify", "--robot", &no_reference, "--data", &good],
+        &["noref.toml", "reference_cable", "cable 7"],
+    );
+    let broken_toml = write(dir.path(), "broken.toml", "name = \"x\"\nreference_cable = \n");
+    expect_failure(&["verify", "--robot", &broken_toml, "--data", &good], &["broken.toml"]);
+}
+
+#[test]
+fn usage_errors_exit_with_two() {
+    let out = sagcal(&["verify", "--robot"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = sagcal(&["no-such-command"]);
+    assert_eq!(out.status.code(), Some(2));
+}
