@@ -29,8 +29,10 @@ pub mod error;
 #[path = "../generated/mod.rs"]
 #[allow(missing_docs, clippy::all)]
 pub mod generated;
+pub mod graph;
 pub mod io;
 pub mod model;
+pub mod solver;
 pub mod verify;
 
 pub use error::{Error, Result};

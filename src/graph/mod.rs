@@ -1,0 +1,79 @@
+//! The factor graph: variables, factors, noise models and robust kernels.
+//!
+//! The objective minimised by [`crate::solver`] is
+//! ```text
+//! sum_f  1/2 rho_f( || r_f(x) / sigma_f ||^2 )
+//! ```
+//! with `r_f` a factor's residual (the generated functions of `generated/`
+//! wrapped in [`crate::calib`]), `sigma_f` its per-component standard
+//! deviations and `rho_f` its robust kernel.
+
+pub mod robust;
+pub mod values;
+
+pub use robust::RobustKernel;
+pub use values::{Values, VariableId, VariableValue};
+
+use nalgebra::{DMatrix, DVector};
+
+/// A residual on a few variables, with analytic Jacobians.
+///
+/// The Jacobian blocks are taken along each variable's retraction
+/// ([`VariableValue::retract`]): for a pose, `[d rotation tangent, d position]`.
+pub trait Factor: Send + Sync {
+    /// The variables this factor reads, in the order of the Jacobian blocks.
+    fn variables(&self) -> &[VariableId];
+    /// Length of the residual vector.
+    fn residual_dim(&self) -> usize;
+    /// The unwhitened residual; when `jacobians` is given, also fill one block
+    /// per variable (`residual_dim x tangent_dim`, already sized). `None` where
+    /// the model is undefined (e.g. a slack cable): the solver rejects such steps.
+    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>>;
+    /// Standard deviation of every residual component (same units as the residual).
+    fn sigmas(&self) -> &DVector<f64>;
+    /// The robust kernel applied to the whitened squared norm.
+    fn robust_kernel(&self) -> RobustKernel {
+        RobustKernel::None
+    }
+    /// A short name of the factor type, for per-type statistics (`"catenary_length"`, ...).
+    fn kind(&self) -> &'static str;
+}
+
+/// A factor graph: variables with values, and factors between them.
+#[derive(Default)]
+pub struct FactorGraph {
+    /// Current values of every variable.
+    pub values: Values,
+    /// The factors.
+    pub factors: Vec<Box<dyn Factor>>,
+}
+
+impl FactorGraph {
+    /// An empty graph.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Add a factor.
+    pub fn add(&mut self, factor: impl Factor + 'static) {
+        self.factors.push(Box::new(factor));
+    }
+
+    /// Whitened residual of one factor at `values`, with the robust kernel's
+    /// cost `1/2 rho(s)`; `None` if the model is undefined there.
+    pub fn factor_cost(factor: &dyn Factor, values: &Values) -> Option<f64> {
+        let residual = factor.evaluate(values, None)?;
+        let s = whitened_squared_norm(&residual, factor.sigmas());
+        s.is_finite().then(|| 0.5 * factor.robust_kernel().rho(s))
+    }
+
+    /// Total cost `sum 1/2 rho(|r/sigma|^2)`; `None` if any factor is undefined.
+    pub fn cost(&self, values: &Values) -> Option<f64> {
+        self.factors.iter().map(|f| Self::factor_cost(f.as_ref(), values)).sum()
+    }
+}
+
+/// `|r / sigma|^2`.
+pub fn whitened_squared_norm(residual: &DVector<f64>, sigmas: &DVector<f64>) -> f64 {
+    residual.iter().zip(sigmas.iter()).map(|(r, s)| (r / s) * (r / s)).sum()
+}

@@ -1,0 +1,121 @@
+//! Variables and their values.
+
+use nalgebra::{DVector, Vector6};
+
+use crate::model::pose::{PlatformPose, POSE_TANGENT_DIM};
+
+/// Index of a variable in a [`Values`] container.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct VariableId(pub usize);
+
+/// The value of one variable.
+#[derive(Debug, Clone, PartialEq)]
+pub enum VariableValue {
+    /// A platform pose (tangent dimension 6, see [`PlatformPose::retract`]).
+    Pose(PlatformPose),
+    /// A Euclidean vector (anchor, tension, offset, ...), retracted additively.
+    Vector(DVector<f64>),
+}
+
+impl VariableValue {
+    /// Dimension of the tangent space.
+    pub fn tangent_dim(&self) -> usize {
+        match self {
+            VariableValue::Pose(_) => POSE_TANGENT_DIM,
+            VariableValue::Vector(v) => v.len(),
+        }
+    }
+
+    /// Move along `delta` (length [`tangent_dim`](Self::tangent_dim)).
+    pub fn retract(&self, delta: &[f64]) -> Self {
+        match self {
+            VariableValue::Pose(pose) => VariableValue::Pose(pose.retract(&Vector6::from_column_slice(delta))),
+            VariableValue::Vector(v) => VariableValue::Vector(v + DVector::from_column_slice(delta)),
+        }
+    }
+}
+
+/// One variable: a name for reports, its value, and whether the solver may move it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Variable {
+    /// E.g. `anchor 2` or `pose 17`.
+    pub name: String,
+    /// Current value.
+    pub value: VariableValue,
+    /// Held constant by the solver.
+    pub fixed: bool,
+}
+
+/// All variables of a graph.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Values {
+    variables: Vec<Variable>,
+}
+
+impl Values {
+    /// An empty container.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Add a variable, returning its id.
+    pub fn insert(&mut self, name: impl Into<String>, value: VariableValue) -> VariableId {
+        self.variables.push(Variable {
+            name: name.into(),
+            value,
+            fixed: false,
+        });
+        VariableId(self.variables.len() - 1)
+    }
+
+    /// Number of variables.
+    pub fn len(&self) -> usize {
+        self.variables.len()
+    }
+
+    /// Whether there are no variables.
+    pub fn is_empty(&self) -> bool {
+        self.variables.is_empty()
+    }
+
+    /// The variable `id`.
+    pub fn variable(&self, id: VariableId) -> &Variable {
+        &self.variables[id.0]
+    }
+
+    /// All variables in id order.
+    pub fn iter(&self) -> impl Iterator<Item = (VariableId, &Variable)> {
+        self.variables.iter().enumerate().map(|(i, v)| (VariableId(i), v))
+    }
+
+    /// Hold `id` constant (or release it).
+    pub fn set_fixed(&mut self, id: VariableId, fixed: bool) {
+        self.variables[id.0].fixed = fixed;
+    }
+
+    /// Replace the value of `id`.
+    pub fn set(&mut self, id: VariableId, value: VariableValue) {
+        self.variables[id.0].value = value;
+    }
+
+    /// The pose stored in `id` (panics if `id` is not a pose: a programming error).
+    pub fn pose(&self, id: VariableId) -> &PlatformPose {
+        match &self.variables[id.0].value {
+            VariableValue::Pose(p) => p,
+            VariableValue::Vector(_) => panic!("variable {} is not a pose", self.variables[id.0].name),
+        }
+    }
+
+    /// The vector stored in `id` (panics if `id` is a pose: a programming error).
+    pub fn vector(&self, id: VariableId) -> &DVector<f64> {
+        match &self.variables[id.0].value {
+            VariableValue::Vector(v) => v,
+            VariableValue::Pose(_) => panic!("variable {} is not a vector", self.variables[id.0].name),
+        }
+    }
+
+    /// Tangent dimension of `id`.
+    pub fn tangent_dim(&self, id: VariableId) -> usize {
+        self.variables[id.0].value.tangent_dim()
+    }
+}

@@ -1,0 +1,305 @@
+//! A sparse Levenberg-Marquardt for [`crate::graph::FactorGraph`]s.
+//!
+//! Each iteration linearises every factor once (whitened by its sigmas,
+//! reweighted by its robust kernel), assembles `H = J^T J` and `g = J^T r`
+//! into the pattern analysed once by [`LinearSystem`], and tries damped steps
+//! `(H + lambda D) dx = -g` with `D = clamp(diag H)` (Marquardt scaling).
+//! A trial is accepted when the gain ratio
+//! `rho = (actual cost decrease) / (decrease predicted by the linear model)`
+//! is positive; lambda then follows Nielsen's rule
+//! (`lambda *= max(1/3, 1 - (2 rho - 1)^3)`), and on rejection or a failed
+//! factorisation it grows by `nu`, `nu` doubling (Madsen, Nielsen & Tingleff,
+//! *Methods for Non-Linear Least Squares Problems*, 2004, Sec. 3.2). A
+//! rejected step reuses the linearisation.
+
+mod covariance;
+mod linear_system;
+
+pub use covariance::{marginal_covariance, Covariance, UnobservableDirection};
+pub use linear_system::LinearSystem;
+
+use nalgebra::DMatrix;
+use serde::Serialize;
+
+use crate::graph::{whitened_squared_norm, FactorGraph, Values};
+
+/// Stopping rules and damping limits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LmParams {
+    /// Maximum number of linearisations.
+    pub max_iterations: usize,
+    /// Stop when an accepted step lowers the cost by less than this fraction.
+    pub relative_cost_tolerance: f64,
+    /// Stop when the largest gradient component (`|J^T r|_inf`) falls below this.
+    pub gradient_tolerance: f64,
+    /// Stop when the step is this small relative to the variables' scale.
+    pub relative_step_tolerance: f64,
+    /// Initial damping `lambda`.
+    pub initial_damping: f64,
+    /// Give up when `lambda` exceeds this without an acceptable step.
+    pub max_damping: f64,
+}
+
+impl Default for LmParams {
+    /// 100 iterations, cost tolerance 1e-12, gradient 1e-10, step 1e-12, lambda 1e-4 .. 1e16.
+    fn default() -> Self {
+        Self {
+            max_iterations: 100,
+            relative_cost_tolerance: 1e-12,
+            gradient_tolerance: 1e-10,
+            relative_step_tolerance: 1e-12,
+            initial_damping: 1e-4,
+            max_damping: 1e16,
+        }
+    }
+}
+
+/// Why the solver stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Termination {
+    /// The relative cost decrease fell below the tolerance.
+    CostConverged,
+    /// The gradient vanished.
+    GradientConverged,
+    /// The step became negligible.
+    StepConverged,
+    /// No damping produced a lower cost (a local minimum at working precision).
+    DampingExhausted,
+    /// The iteration budget ran out.
+    MaxIterations,
+    /// The model is undefined at the starting values (e.g. a slack cable).
+    InvalidStart,
+}
+
+impl Termination {
+    /// Whether the solver stopped at a minimum (not for lack of iterations or a bad start).
+    pub fn converged(&self) -> bool {
+        matches!(
+            self,
+            Termination::CostConverged
+                | Termination::GradientConverged
+                | Termination::StepConverged
+                | Termination::DampingExhausted
+        )
+    }
+}
+
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let text = match self {
+            Termination::CostConverged => "cost converged",
+            Termination::GradientConverged => "gradient converged",
+            Termination::StepConverged => "step converged",
+            Termination::DampingExhausted => "no further decrease at any damping",
+            Termination::MaxIterations => "iteration limit reached",
+            Termination::InvalidStart => "model undefined at the initial values",
+        };
+        f.write_str(text)
+    }
+}
+
+/// One linearisation of the solve.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct IterationSummary {
+    /// 1-based iteration number.
+    pub iteration: usize,
+    /// Cost after this iteration.
+    pub cost: f64,
+    /// Gain ratio of the accepted step (NaN if none was accepted).
+    pub gain_ratio: f64,
+    /// Damping used by the accepted step.
+    pub damping: f64,
+    /// Norm of the accepted step (tangent space).
+    pub step_norm: f64,
+    /// Damping trials in this iteration (rejected steps and failed factorisations included).
+    pub trials: usize,
+}
+
+/// The outcome of a solve.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SolveSummary {
+    /// Cost at the start.
+    pub initial_cost: f64,
+    /// Cost at the end.
+    pub final_cost: f64,
+    /// Number of linearisations.
+    pub iterations: usize,
+    /// Why it stopped.
+    pub termination: Termination,
+    /// Per-iteration history.
+    pub history: Vec<IterationSummary>,
+}
+
+/// Whitened, robust-reweighted linearisation of the whole graph: `H`, `g`, cost.
+pub(crate) fn linearize(graph: &FactorGraph, values: &Values, system: &LinearSystem) -> Option<(Vec<f64>, Vec<f64>, f64)> {
+    let mut hessian = system.zero_hessian();
+    let mut gradient = vec![0.0; system.dim];
+    let mut cost = 0.0;
+    for (index, factor) in graph.factors.iter().enumerate() {
+        let variables = factor.variables();
+        let rows = factor.residual_dim();
+        let mut jacobians: Vec<DMatrix<f64>> = variables
+            .iter()
+            .map(|&v| DMatrix::zeros(rows, values.tangent_dim(v)))
+            .collect();
+        let residual = factor.evaluate(values, Some(&mut jacobians))?;
+        let sigmas = factor.sigmas();
+        let s = whitened_squared_norm(&residual, sigmas);
+        if !s.is_finite() {
+            return None;
+        }
+        let kernel = factor.robust_kernel();
+        cost += 0.5 * kernel.rho(s);
+        let scale = kernel.weight(s).sqrt();
+        let whitened: Vec<f64> = (0..rows).map(|r| residual[r] / sigmas[r] * scale).collect();
+        for jac in &mut jacobians {
+            for r in 0..rows {
+                let w = scale / sigmas[r];
+                for c in 0..jac.ncols() {
+                    jac[(r, c)] *= w;
+                }
+            }
+        }
+        if jacobians.iter().any(|j| j.iter().any(|v| !v.is_finite())) {
+            return None;
+        }
+        system.accumulate(index, variables, &jacobians, &whitened, &mut hessian, &mut gradient);
+    }
+    Some((hessian, gradient, cost))
+}
+
+/// Apply a tangent step to every free variable.
+pub(crate) fn retract_all(values: &Values, system: &LinearSystem, step: &[f64]) -> Values {
+    let mut next = values.clone();
+    for (id, variable) in values.iter() {
+        if let Some(offset) = system.offsets[id.0] {
+            let dim = variable.value.tangent_dim();
+            next.set(id, variable.value.retract(&step[offset..offset + dim]));
+        }
+    }
+    next
+}
+
+/// Minimise the graph's cost from its current values; the values are updated in place.
+pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSummary, String> {
+    let system = LinearSystem::new(&graph.values, &graph.factors)?;
+    let mut values = graph.values.clone();
+    let Some((mut hessian, mut gradient, mut cost)) = linearize(graph, &values, &system) else {
+        return Ok(SolveSummary {
+            initial_cost: f64::NAN,
+            final_cost: f64::NAN,
+            iterations: 0,
+            termination: Termination::InvalidStart,
+            history: Vec::new(),
+        });
+    };
+    let initial_cost = cost;
+    let mut damping = params.initial_damping;
+    let mut nu = 2.0;
+    let mut history = Vec::new();
+    let mut termination = Termination::MaxIterations;
+    for iteration in 1..=params.max_iterations {
+        if gradient.iter().fold(0.0f64, |m, g| m.max(g.abs())) < params.gradient_tolerance {
+            termination = Termination::GradientConverged;
+            break;
+        }
+        let diagonal: Vec<f64> = system.diagonal(&hessian).iter().map(|d| d.clamp(1e-6, 1e32)).collect();
+        let rhs: Vec<f64> = gradient.iter().map(|g| -g).collect();
+        let mut trials = 0;
+        let mut accepted = None;
+        while damping <= params.max_damping {
+            trials += 1;
+            let damp: Vec<f64> = diagonal.iter().map(|d| damping * d).collect();
+            let Some(step) = system.solve(&hessian, &damp, &rhs) else {
+                damping *= nu;
+                nu *= 2.0;
+                continue;
+            };
+            // Predicted decrease of 1/2|r + J dx|^2: -g.dx - 1/2 dx.H dx = 1/2 dx.(lambda D dx - g).
+            let predicted: f64 = 0.5
+                * step
+                    .iter()
+                    .zip(&damp)
+                    .zip(&gradient)
+                    .map(|((dx, d), g)| dx * (d * dx - g))
+                    .sum::<f64>();
+            let candidate = retract_all(&values, &system, &step);
+            let new_cost = graph.cost(&candidate);
+            match new_cost {
+                Some(new_cost) if new_cost < cost && predicted > 0.0 => {
+                    let gain_ratio = (cost - new_cost) / predicted;
+                    damping *= (1.0 / 3.0f64).max(1.0 - (2.0 * gain_ratio - 1.0).powi(3));
+                    damping = damping.max(1e-15);
+                    nu = 2.0;
+                    accepted = Some((step, candidate, new_cost, gain_ratio));
+                    break;
+                }
+                _ => {
+                    damping *= nu;
+                    nu *= 2.0;
+                }
+            }
+        }
+        let Some((step, candidate, new_cost, gain_ratio)) = accepted else {
+            termination = Termination::DampingExhausted;
+            history.push(IterationSummary {
+                iteration,
+                cost,
+                gain_ratio: f64::NAN,
+                damping,
+                step_norm: 0.0,
+                trials,
+            });
+            break;
+        };
+        let step_norm = step.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let relative_decrease = (cost - new_cost) / cost.max(f64::MIN_POSITIVE);
+        let step_scale = 1.0 + variables_scale(&values);
+        history.push(IterationSummary {
+            iteration,
+            cost: new_cost,
+            gain_ratio,
+            damping,
+            step_norm,
+            trials,
+        });
+        values = candidate;
+        cost = new_cost;
+        let Some(linearization) = linearize(graph, &values, &system) else {
+            // The accepted point had a finite cost, so this cannot happen; stop safely if it does.
+            termination = Termination::DampingExhausted;
+            break;
+        };
+        (hessian, gradient, _) = linearization;
+        if relative_decrease < params.relative_cost_tolerance {
+            termination = Termination::CostConverged;
+            break;
+        }
+        if step_norm < params.relative_step_tolerance * step_scale {
+            termination = Termination::StepConverged;
+            break;
+        }
+    }
+    graph.values = values;
+    Ok(SolveSummary {
+        initial_cost,
+        final_cost: cost,
+        iterations: history.len(),
+        termination,
+        history,
+    })
+}
+
+/// A rough scale of the free variables (Euclidean norm of the vector ones).
+fn variables_scale(values: &Values) -> f64 {
+    values
+        .iter()
+        .filter(|(_, v)| !v.fixed)
+        .map(|(_, v)| match &v.value {
+            crate::graph::VariableValue::Vector(x) => x.norm_squared(),
+            crate::graph::VariableValue::Pose(p) => p.position_m.norm_squared(),
+        })
+        .sum::<f64>()
+        .sqrt()
+}

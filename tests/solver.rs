@@ -1,0 +1,160 @@
+//! The sparse Levenberg-Marquardt on small problems with known answers.
+
+use nalgebra::{DMatrix, DVector, Vector3};
+use sagcal::graph::{Factor, FactorGraph, RobustKernel, VariableId, VariableValue};
+use sagcal::solver::{marginal_covariance, optimize, Covariance, LmParams};
+
+/// Range from a point variable to a known beacon: `|p - b| - d`.
+struct Range {
+    variables: [VariableId; 1],
+    beacon: Vector3<f64>,
+    measured_m: f64,
+    sigmas: DVector<f64>,
+    kernel: RobustKernel,
+}
+
+impl Factor for Range {
+    fn variables(&self) -> &[VariableId] {
+        &self.variables
+    }
+    fn residual_dim(&self) -> usize {
+        1
+    }
+    fn evaluate(&self, values: &sagcal::graph::Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        let p = values.vector(self.variables[0]);
+        let d = Vector3::new(p[0], p[1], p[2]) - self.beacon;
+        if let Some(j) = jacobians {
+            let u = d.normalize();
+            j[0].copy_from(&DMatrix::from_row_slice(1, 3, u.as_slice()));
+        }
+        Some(DVector::from_element(1, d.norm() - self.measured_m))
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn robust_kernel(&self) -> RobustKernel {
+        self.kernel
+    }
+    fn kind(&self) -> &'static str {
+        "range"
+    }
+}
+
+fn beacons() -> Vec<Vector3<f64>> {
+    vec![
+        Vector3::new(0.0, 0.0, 10.0),
+        Vector3::new(20.0, 0.0, 12.0),
+        Vector3::new(0.0, 20.0, 9.0),
+        Vector3::new(20.0, 20.0, 11.0),
+        Vector3::new(10.0, -5.0, 0.0),
+    ]
+}
+
+fn graph_with(
+    beacons: &[Vector3<f64>],
+    truth: Vector3<f64>,
+    start: Vector3<f64>,
+    kernel: RobustKernel,
+) -> (FactorGraph, VariableId) {
+    let mut graph = FactorGraph::new();
+    let point = graph.values.insert(
+        "point",
+        VariableValue::Vector(DVector::from_column_slice(start.as_slice())),
+    );
+    for b in beacons {
+        graph.add(Range {
+            variables: [point],
+            beacon: *b,
+            measured_m: (truth - b).norm(),
+            sigmas: DVector::from_element(1, 0.01),
+            kernel,
+        });
+    }
+    (graph, point)
+}
+
+#[test]
+fn converges_from_far_and_covariance_is_the_inverse_information() {
+    let truth = Vector3::new(7.0, 4.0, 3.0);
+    let (mut graph, point) = graph_with(&beacons(), truth, Vector3::new(30.0, -20.0, 40.0), RobustKernel::None);
+    let summary = optimize(&mut graph, &LmParams::default()).unwrap();
+    assert!(summary.termination.converged(), "{:?}", summary.termination);
+    let p = graph.values.vector(point);
+    assert!((Vector3::new(p[0], p[1], p[2]) - truth).norm() < 1e-9, "{p}");
+    assert!(summary.final_cost < 1e-18);
+    assert!(summary.history.iter().all(|h| h.cost <= summary.initial_cost));
+    // Closed form: (J^T W J)^-1 with rows u_j^T / sigma.
+    let mut information = nalgebra::Matrix3::<f64>::zeros();
+    for b in beacons() {
+        let u = (truth - b).normalize();
+        information += u * u.transpose() / (0.01 * 0.01);
+    }
+    let expected = information.try_inverse().unwrap();
+    match marginal_covariance(&graph, &[point]).unwrap() {
+        Covariance::Full(c) => {
+            for i in 0..3 {
+                for j in 0..3 {
+                    assert!(
+                        (c[(i, j)] - expected[(i, j)]).abs() < 1e-9 * expected.norm(),
+                        "{c} vs {expected}"
+                    );
+                }
+            }
+        }
+        other => panic!("expected a full covariance, got {other:?}"),
+    }
+}
+
+#[test]
+fn two_ranges_leave_a_circle_unobservable() {
+    let truth = Vector3::new(7.0, 4.0, 3.0);
+    let (mut graph, point) = graph_with(&beacons()[..2], truth, Vector3::new(8.0, 5.0, 2.0), RobustKernel::None);
+    optimize(&mut graph, &LmParams::default()).unwrap();
+    match marginal_covariance(&graph, &[point]).unwrap() {
+        Covariance::RankDeficient(directions) => {
+            assert_eq!(directions.len(), 1, "{directions:?}");
+            // The free direction is perpendicular to both beacon lines of sight.
+            let p = graph.values.vector(point);
+            let p = Vector3::new(p[0], p[1], p[2]);
+            let axis = (p - beacons()[0]).cross(&(p - beacons()[1])).normalize();
+            let mut v = Vector3::zeros();
+            for (name, coordinate, weight) in &directions[0].components {
+                assert_eq!(name, "point");
+                v[*coordinate] = *weight;
+            }
+            assert!(v.normalize().dot(&axis).abs() > 0.99, "{v} vs {axis}");
+        }
+        other => panic!("expected rank deficiency, got {other:?}"),
+    }
+}
+
+#[test]
+fn a_robust_kernel_resists_an_outlier() {
+    let truth = Vector3::new(7.0, 4.0, 3.0);
+    let mut all = beacons();
+    all.push(Vector3::new(-10.0, 8.0, 5.0));
+    all.push(Vector3::new(25.0, 12.0, 2.0));
+    let solve = |kernel| {
+        let (mut graph, point) = graph_with(&all, truth, Vector3::new(5.0, 5.0, 5.0), kernel);
+        // Corrupt one range by 2 m (200 sigma).
+        let mut factors = std::mem::take(&mut graph.factors);
+        let outlier = Range {
+            variables: [point],
+            beacon: all[0],
+            measured_m: (truth - all[0]).norm() + 2.0,
+            sigmas: DVector::from_element(1, 0.01),
+            kernel,
+        };
+        factors[0] = Box::new(outlier);
+        graph.factors = factors;
+        optimize(&mut graph, &LmParams::default()).unwrap();
+        let p = graph.values.vector(point);
+        (Vector3::new(p[0], p[1], p[2]) - truth).norm()
+    };
+    let plain = solve(RobustKernel::None);
+    let cauchy = solve(RobustKernel::Cauchy(2.0));
+    let huber = solve(RobustKernel::Huber(1.345));
+    assert!(plain > 0.2, "least squares is pulled by the outlier: {plain}");
+    assert!(cauchy < 0.01 * plain, "cauchy {cauchy} vs plain {plain}");
+    assert!(huber < plain, "huber {huber} vs plain {plain}");
+}
