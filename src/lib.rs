@@ -25,6 +25,7 @@
 
 #![warn(missing_docs)]
 
+pub mod calib;
 pub mod error;
 #[path = "../generated/mod.rs"]
 #[allow(missing_docs, clippy::all)]
@@ -32,6 +33,8 @@ pub mod generated;
 pub mod graph;
 pub mod io;
 pub mod model;
+pub mod plot;
+pub mod sim;
 pub mod solver;
 pub mod verify;
 

@@ -86,7 +86,11 @@ mod tests {
 
     #[test]
     fn weight_is_the_derivative_of_rho() {
-        for kernel in [RobustKernel::None, RobustKernel::Huber(1.345), RobustKernel::Cauchy(2.0)] {
+        for kernel in [
+            RobustKernel::None,
+            RobustKernel::Huber(1.345),
+            RobustKernel::Cauchy(2.0),
+        ] {
             for s in [0.1, 1.0, 1.8, 4.0, 30.0] {
                 let h = 1e-6 * s;
                 let numeric = (kernel.rho(s + h) - kernel.rho(s - h)) / (2.0 * h);

@@ -1,5 +1,6 @@
 //! Files: robot descriptions and measurement logs. The lowest layer: it knows
 //! formats and validation of single values, no physics.
 
+pub mod measurements;
 pub mod recurdyn;
 pub mod robot_file;

@@ -3,6 +3,7 @@
 pub mod catenary;
 pub mod pose;
 pub mod robot;
+pub mod sensors;
 pub mod statics;
 
 pub use catenary::Catenary;

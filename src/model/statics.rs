@@ -388,9 +388,68 @@ pub fn solve_with_reference_tension(
     }
 }
 
-/// A rough reference-tension magnitude for a position: the straight-cable
+/// The most level equilibrium at `position_m`: the member of the
+/// one-parameter family whose platform tilt (angle between the platform's and
+/// the world's z axes) is smallest. This is how a robot that commands its
+/// cable lengths for a level platform hangs; the search runs over the
+/// reference-tension magnitude (a grid from 0.5 to 2 times the straight-cable
+/// guess, then golden-section refinement).
+pub fn solve_level(robot: &Robot, position_m: Vector3<f64>, options: &StaticsOptions) -> Result<Equilibrium> {
+    let guess = reference_tension_magnitude_guess(robot, position_m);
+    let tilt = |eq: &Equilibrium| (eq.pose.rotation * Vector3::z()).z.clamp(-1.0, 1.0).acos();
+    let evaluate = |magnitude: f64| solve_with_reference_tension(robot, position_m, magnitude, None, options).ok();
+    let mut best: Option<(f64, f64)> = None;
+    let step = 0.05;
+    let mut factor = 0.5;
+    while factor <= 2.0 + 1e-9 {
+        if let Some(eq) = evaluate(guess * factor) {
+            let t = tilt(&eq);
+            if best.is_none_or(|(_, bt)| t < bt) {
+                best = Some((factor, t));
+            }
+        }
+        factor += step;
+    }
+    let (center, _) = best.ok_or_else(|| {
+        Error::NoEquilibrium(format!(
+            "position {:?}: no positive-tension equilibrium for reference tensions between {:.1} and {:.1} N",
+            position_m.as_slice(),
+            0.5 * guess,
+            2.0 * guess
+        ))
+    })?;
+    let phi = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut lo, mut hi) = (center - step, center + step);
+    let cost = |f: f64| evaluate(guess * f).map_or(f64::INFINITY, |eq| tilt(&eq));
+    let (mut x1, mut x2) = (hi - phi * (hi - lo), lo + phi * (hi - lo));
+    let (mut c1, mut c2) = (cost(x1), cost(x2));
+    for _ in 0..40 {
+        if c1 <= c2 {
+            hi = x2;
+            x2 = x1;
+            c2 = c1;
+            x1 = hi - phi * (hi - lo);
+            c1 = cost(x1);
+        } else {
+            lo = x1;
+            x1 = x2;
+            c1 = c2;
+            x2 = lo + phi * (hi - lo);
+            c2 = cost(x2);
+        }
+    }
+    let best_factor = if c1 <= c2 { x1 } else { x2 };
+    let candidates = [best_factor, center];
+    candidates
+        .iter()
+        .filter_map(|&f| evaluate(guess * f))
+        .min_by(|a, b| tilt(a).total_cmp(&tilt(b)))
+        .ok_or_else(|| Error::NoEquilibrium(format!("position {:?}: level search failed", position_m.as_slice())))
+}
+
+/// A rough reference-tension magnitude for a position, newtons: the straight-cable
 /// force balance `sum t_i e_i = m_e g z` solved in the least-norm sense.
-fn reference_tension_magnitude_guess(robot: &Robot, position_m: Vector3<f64>) -> f64 {
+pub fn reference_tension_magnitude_guess(robot: &Robot, position_m: Vector3<f64>) -> f64 {
     let pose = PlatformPose::from_position(position_m);
     let geometry = cable_geometry(robot, &pose);
     let mut directions = nalgebra::Matrix3x4::<f64>::zeros();
@@ -475,7 +534,7 @@ pub fn solve_with_cable_lengths(
 /// A point of the one-parameter family at `position_m`: the straight-cable
 /// guess of the reference tension, or, where the family does not extend that
 /// far (a slack cable), the nearest of a ladder of magnitudes around it.
-fn feasible_start(
+pub fn feasible_start(
     robot: &Robot,
     position_m: Vector3<f64>,
     initial_rotation: Option<UnitQuaternion<f64>>,

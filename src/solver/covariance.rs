@@ -33,58 +33,87 @@ pub enum Covariance {
 }
 
 /// Marginal covariance of `selected` (all must be free) at the graph's current values.
+///
+/// 1. `H` (undamped) is factored by the sparse Cholesky; if that fails, `H`
+///    is singular and, for problems small enough to decompose densely, its
+///    null space is reported.
+/// 2. Otherwise the selected block `Sigma_s` of `H^-1` is formed. Its
+///    eigen-decomposition tells whether the selected parameters are determined:
+///    an eigenvalue above `1e8` (a 10 km standard deviation in metres) or
+///    `1e14` times the smallest one marks a direction the data do not fix
+///    (rounding noise made `H` look positive definite), reported with its
+///    components in the selected variables.
 pub fn marginal_covariance(graph: &FactorGraph, selected: &[VariableId]) -> Result<Covariance, String> {
     let system = LinearSystem::new(&graph.values, &graph.factors)?;
-    let (hessian, _, _) = linearize(graph, &graph.values, &system)
-        .ok_or_else(|| "the model is undefined at the solution".to_string())?;
-    let columns: Vec<usize> = selected
-        .iter()
-        .flat_map(|&id| {
-            let offset = system.offsets[id.0];
-            let dim = graph.values.tangent_dim(id);
-            offset.into_iter().flat_map(move |o| o..o + dim)
-        })
-        .collect();
-    let dense_limit = 4000;
-    // A tiny relative floor keeps the Cholesky from succeeding on a numerically singular H.
-    let max_diagonal = system.diagonal(&hessian).iter().fold(0.0f64, |m, d| m.max(*d));
+    let (hessian, _, _) =
+        linearize(graph, &graph.values, &system).map_err(|e| format!("covariance at the solution: {e}"))?;
+    let mut columns = Vec::new();
+    let mut labels = Vec::new();
+    for &id in selected {
+        let offset = system.offsets[id.0].ok_or_else(|| format!("{} is fixed", graph.values.variable(id).name))?;
+        for c in 0..graph.values.tangent_dim(id) {
+            columns.push(offset + c);
+            labels.push((graph.values.variable(id).name.clone(), c));
+        }
+    }
     let zero_damping = vec![0.0; system.dim];
     let mut covariance = DMatrix::zeros(columns.len(), columns.len());
-    let mut factored = true;
     for (k, &col) in columns.iter().enumerate() {
         let mut unit = vec![0.0; system.dim];
         unit[col] = 1.0;
-        match system.solve(&hessian, &zero_damping, &unit) {
-            Some(x) => {
-                for (m, &row) in columns.iter().enumerate() {
-                    covariance[(m, k)] = x[row];
-                }
-            }
-            None => {
-                factored = false;
-                break;
-            }
+        let Some(x) = system.solve(&hessian, &zero_damping, &unit) else {
+            return Ok(Covariance::RankDeficient(null_space(graph, &system, &hessian)));
+        };
+        for (m, &row) in columns.iter().enumerate() {
+            covariance[(m, k)] = x[row];
         }
     }
-    // Even when the Cholesky succeeds, an eigenvalue ratio near 1e-16 means garbage: check small problems.
-    if system.dim <= dense_limit {
-        let dense = system.dense(&hessian);
-        let eigen = SymmetricEigen::new(dense);
-        let largest = eigen.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let mut directions = Vec::new();
-        for (i, &value) in eigen.eigenvalues.iter().enumerate() {
-            if value <= 1e-10 * largest {
-                directions.push(describe(graph, &system, eigen.eigenvectors.column(i).as_slice(), value / largest));
-            }
-        }
-        if !directions.is_empty() {
-            return Ok(Covariance::RankDeficient(directions));
+    let symmetric = (&covariance + covariance.transpose()) * 0.5;
+    let eigen = SymmetricEigen::new(symmetric.clone());
+    let largest = eigen.eigenvalues.iter().fold(0.0f64, |m, v| m.max(*v));
+    let smallest = eigen.eigenvalues.iter().fold(f64::INFINITY, |m, v| m.min(*v));
+    let mut directions = Vec::new();
+    for (i, &value) in eigen.eigenvalues.iter().enumerate() {
+        if !value.is_finite()
+            || value > 1e8
+            || (smallest > 0.0 && value > 1e14 * smallest)
+            || smallest <= 0.0 && value == largest
+        {
+            let vector = eigen.eigenvectors.column(i);
+            let mut components: Vec<(String, usize, f64)> = labels
+                .iter()
+                .zip(vector.iter())
+                .filter(|(_, w)| w.abs() > 0.05)
+                .map(|((name, c), w)| (name.clone(), *c, *w))
+                .collect();
+            components.sort_by(|a, b| b.2.abs().total_cmp(&a.2.abs()));
+            directions.push(UnobservableDirection {
+                relative_eigenvalue: if value > 0.0 { smallest / value } else { 0.0 },
+                components,
+            });
         }
     }
-    if !factored || max_diagonal == 0.0 {
-        return Ok(Covariance::RankDeficient(Vec::new()));
+    if directions.is_empty() {
+        Ok(Covariance::Full(symmetric))
+    } else {
+        Ok(Covariance::RankDeficient(directions))
     }
-    Ok(Covariance::Full(covariance))
+}
+
+/// Null space of a singular `H` by dense eigen-decomposition (up to 4000 unknowns).
+fn null_space(graph: &FactorGraph, system: &LinearSystem, hessian: &[f64]) -> Vec<UnobservableDirection> {
+    if system.dim > 4000 {
+        return Vec::new();
+    }
+    let eigen = SymmetricEigen::new(system.dense(hessian));
+    let largest = eigen.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    eigen
+        .eigenvalues
+        .iter()
+        .enumerate()
+        .filter(|(_, &value)| value <= 1e-14 * largest)
+        .map(|(i, &value)| describe(graph, system, eigen.eigenvectors.column(i).as_slice(), value / largest))
+        .collect()
 }
 
 fn describe(graph: &FactorGraph, system: &LinearSystem, vector: &[f64], relative: f64) -> UnobservableDirection {

@@ -57,20 +57,21 @@ impl LinearSystem {
         let mut block_order: Vec<(VariableId, VariableId)> = Vec::new();
         let mut entry_count = 0;
         let mut factor_blocks = Vec::with_capacity(factors.len());
-        let mut block_for = |a: VariableId, b: VariableId, blocks: &mut HashMap<(usize, usize), BlockLayout>| -> usize {
-            let layout = blocks.entry((a.0, b.0)).or_insert_with(|| {
-                let size = if a == b {
-                    tangent(a) * (tangent(a) + 1) / 2
-                } else {
-                    tangent(a) * tangent(b)
-                };
-                let start = entry_count;
-                entry_count += size;
-                block_order.push((a, b));
-                BlockLayout { start }
-            });
-            layout.start
-        };
+        let mut block_for =
+            |a: VariableId, b: VariableId, blocks: &mut HashMap<(usize, usize), BlockLayout>| -> usize {
+                let layout = blocks.entry((a.0, b.0)).or_insert_with(|| {
+                    let size = if a == b {
+                        tangent(a) * (tangent(a) + 1) / 2
+                    } else {
+                        tangent(a) * tangent(b)
+                    };
+                    let start = entry_count;
+                    entry_count += size;
+                    block_order.push((a, b));
+                    BlockLayout { start }
+                });
+                layout.start
+            };
         // Every free variable gets its diagonal block, even if no factor touches it
         // (then H is singular and the solver reports it instead of crashing).
         for (id, _) in values.iter() {
@@ -95,7 +96,13 @@ impl LinearSystem {
             factor_blocks.push(list);
         }
         // Scalar (row, col) of every stored entry, in storage order.
-        let mut indices = vec![Pair { row: 0usize, col: 0usize }; entry_count];
+        let mut indices = vec![
+            Pair {
+                row: 0usize,
+                col: 0usize
+            };
+            entry_count
+        ];
         let mut diagonal_slots = vec![0; dim];
         for &(a, b) in &block_order {
             let start = blocks[&(a.0, b.0)].start;
@@ -107,7 +114,10 @@ impl LinearSystem {
                     if a == b && i < j {
                         continue;
                     }
-                    indices[k] = Pair { row: oa + i, col: ob + j };
+                    indices[k] = Pair {
+                        row: oa + i,
+                        col: ob + j,
+                    };
                     if a == b && i == j {
                         diagonal_slots[oa + i] = k;
                     }

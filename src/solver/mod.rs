@@ -41,10 +41,10 @@ pub struct LmParams {
 }
 
 impl Default for LmParams {
-    /// 100 iterations, cost tolerance 1e-12, gradient 1e-10, step 1e-12, lambda 1e-4 .. 1e16.
+    /// 500 iterations, cost tolerance 1e-12, gradient 1e-10, step 1e-12, lambda 1e-4 .. 1e16.
     fn default() -> Self {
         Self {
-            max_iterations: 100,
+            max_iterations: 500,
             relative_cost_tolerance: 1e-12,
             gradient_tolerance: 1e-10,
             relative_step_tolerance: 1e-12,
@@ -132,7 +132,11 @@ pub struct SolveSummary {
 }
 
 /// Whitened, robust-reweighted linearisation of the whole graph: `H`, `g`, cost.
-pub(crate) fn linearize(graph: &FactorGraph, values: &Values, system: &LinearSystem) -> Option<(Vec<f64>, Vec<f64>, f64)> {
+pub(crate) fn linearize(
+    graph: &FactorGraph,
+    values: &Values,
+    system: &LinearSystem,
+) -> Result<(Vec<f64>, Vec<f64>, f64), String> {
     let mut hessian = system.zero_hessian();
     let mut gradient = vec![0.0; system.dim];
     let mut cost = 0.0;
@@ -143,11 +147,17 @@ pub(crate) fn linearize(graph: &FactorGraph, values: &Values, system: &LinearSys
             .iter()
             .map(|&v| DMatrix::zeros(rows, values.tangent_dim(v)))
             .collect();
-        let residual = factor.evaluate(values, Some(&mut jacobians))?;
+        let describe = |what: &str| {
+            let names: Vec<&str> = variables.iter().map(|&v| values.variable(v).name.as_str()).collect();
+            format!("{} factor on [{}]: {what}", factor.kind(), names.join(", "))
+        };
+        let residual = factor
+            .evaluate(values, Some(&mut jacobians))
+            .ok_or_else(|| describe("model undefined (slack cable)"))?;
         let sigmas = factor.sigmas();
         let s = whitened_squared_norm(&residual, sigmas);
         if !s.is_finite() {
-            return None;
+            return Err(describe("non-finite residual"));
         }
         let kernel = factor.robust_kernel();
         cost += 0.5 * kernel.rho(s);
@@ -162,11 +172,11 @@ pub(crate) fn linearize(graph: &FactorGraph, values: &Values, system: &LinearSys
             }
         }
         if jacobians.iter().any(|j| j.iter().any(|v| !v.is_finite())) {
-            return None;
+            return Err(describe("non-finite Jacobian"));
         }
         system.accumulate(index, variables, &jacobians, &whitened, &mut hessian, &mut gradient);
     }
-    Some((hessian, gradient, cost))
+    Ok((hessian, gradient, cost))
 }
 
 /// Apply a tangent step to every free variable.
@@ -185,7 +195,7 @@ pub(crate) fn retract_all(values: &Values, system: &LinearSystem, step: &[f64]) 
 pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSummary, String> {
     let system = LinearSystem::new(&graph.values, &graph.factors)?;
     let mut values = graph.values.clone();
-    let Some((mut hessian, mut gradient, mut cost)) = linearize(graph, &values, &system) else {
+    let Ok((mut hessian, mut gradient, mut cost)) = linearize(graph, &values, &system) else {
         return Ok(SolveSummary {
             initial_cost: f64::NAN,
             final_cost: f64::NAN,
@@ -266,7 +276,7 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
         });
         values = candidate;
         cost = new_cost;
-        let Some(linearization) = linearize(graph, &values, &system) else {
+        let Ok(linearization) = linearize(graph, &values, &system) else {
             // The accepted point had a finite cost, so this cannot happen; stop safely if it does.
             termination = Termination::DampingExhausted;
             break;

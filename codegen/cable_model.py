@@ -1,0 +1,362 @@
+"""Symbolic cable model of sagcal: catenary, cable geometry and statics (paper Sec. III).
+
+Pure symbolic functions, no code generation here. ``factors.py`` builds the
+residuals from them and ``generate.py`` emits Rust. Equation numbers refer to
+Dindarloo et al., *A Graph-Based Self-Calibration Technique for Cable-Driven
+Robots with Sagging Cable* (``shared/paper``).
+
+Conventions (identical to the hand-written Rust in ``src/model``):
+
+* A pose is ``world_from_platform = (R, p)``; an attachment point ``b`` given in
+  the platform frame is at ``p + R b`` in the world frame.
+* Each cable hangs in the vertical plane through its anchor ``a`` (pulley exit,
+  world frame) and its attachment. In that plane ``x`` runs horizontally from
+  the anchor towards the attachment over the span ``L = ||(p + R b - a)_xy||``.
+* ``f_h > 0`` is the horizontal tension, ``f_v`` the vertical tension at the
+  attachment, positive when the cable pulls the platform up. The force of the
+  cable on the platform is ``-s f_h + z f_v`` with ``s`` the horizontal unit
+  vector from the anchor to the attachment and ``z`` the world's up axis.
+* Every function that can divide by zero or take a square root at zero takes
+  an explicit ``epsilon`` (a small positive number at run time, e.g.
+  ``10 * f64::EPSILON``, SymForce's default).
+
+The cable's material enters only through :class:`CableProperties`, which the
+catenary functions take as an argument: an elastic cable (Irvine's elastic
+catenary, axial stiffness ``EA``) or a pulley radius become new fields there
+and new terms in :func:`catenary_length` / :func:`catenary_drop`, without
+touching the geometry, the statics or the residuals.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import symforce
+
+# generate.py calls this first; every function here takes `epsilon` explicitly anyway.
+try:
+    symforce.set_epsilon_to_symbol()
+except symforce.AlreadyUsedEpsilon:
+    pass
+
+import symforce.symbolic as sf  # noqa: E402  (must follow set_epsilon_to_symbol)
+
+# Number of cables of the suspended robot, and the slot of the reference cable.
+CABLE_COUNT = 4
+REFERENCE_SLOT = 0
+
+UP = sf.V3(0, 0, 1)
+
+
+@dataclasses.dataclass(frozen=True)
+class CableProperties:
+    """Physical properties of a cable, shared by the four cables of the robot.
+
+    Attributes:
+        weight_n_per_m: Cable weight per unit length ``g_c = rho_c g`` in N/m (paper
+            Sec. III-B, after eq. 3); 0 gives the massless straight cable.
+
+    Later models add fields here (each with a neutral default, so existing
+    residuals keep their meaning): ``axial_stiffness_n`` (``EA``) for Irvine's
+    elastic catenary, which adds ``f_h L / EA``-type stretch terms to the length
+    and the drop, and ``pulley_radius_m`` for the wrap of the cable around the
+    pulley, which moves the effective anchor.
+    """
+
+    weight_n_per_m: sf.Scalar
+
+
+def safe_divisor(x: sf.Scalar, epsilon: sf.Scalar) -> sf.Scalar:
+    """Return ``x`` pushed away from zero by ``epsilon``, keeping its sign.
+
+    ``x + sign_no_zero(x) * epsilon`` is branchless (``signum`` in Rust, with
+    ``sign_no_zero(0) = +1``), never zero, and equal to ``x`` up to
+    ``epsilon``. Its derivative is exactly that of ``x``.
+
+    Args:
+        x: The divisor.
+        epsilon: Small positive number.
+
+    Returns:
+        A divisor that is never zero.
+    """
+    return x + sf.sign_no_zero(x) * epsilon
+
+
+def sinhc(y: sf.Scalar, epsilon: sf.Scalar) -> sf.Scalar:
+    """``sinh(y) / y``, finite and accurate for every ``y``, including ``y = 0`` exactly.
+
+    Used by the stable catenary formulas (paper eq. 1 and 4, see
+    :func:`catenary_length`). The division is made safe without a branch:
+    ``y_s = y + sign_no_zero(y) * epsilon`` (:func:`safe_divisor`) and
+    ``sinhc(y) = sinh(y_s) / y_s``. For ``y = 0`` (a massless cable,
+    ``g_c = 0``) this is ``sinh(epsilon) / epsilon``, which is exactly 1.0 in
+    floating point for any ``epsilon < 1e-8``. For ``y != 0`` the shift changes
+    the value by ``sinhc'(y) * epsilon ~ y * epsilon / 3``, far below an ulp.
+    ``sinh`` of a small argument is accurate to an ulp (libm), so no digits are
+    lost in the value. The derivative ``(y cosh y - sinh y) / y^2`` loses
+    digits for tiny ``y``, but every ``dy/d(argument)`` of the catenary is
+    proportional to ``y`` (``y = g_c L / (2 f_h)``), so the absolute error of
+    the chained Jacobian stays at machine precision.
+
+    Args:
+        y: The argument (``lambda / 2`` of the catenary).
+        epsilon: Small positive number.
+
+    Returns:
+        ``sinh(y) / y`` (1 at ``y = 0``).
+    """
+    # Branchless safe division: y_s = y + signum(y) * epsilon is never 0 (signum(0) = +1), and at
+    # y = 0 (g_c = 0) sinh(epsilon) / epsilon == 1.0 exactly, so the massless cable is the straight one.
+    y_safe = safe_divisor(y, epsilon)
+    return sf.sinh(y_safe) / y_safe
+
+
+def horizontal_span(anchor: sf.V3, attachment_world: sf.V3, epsilon: sf.Scalar) -> tuple[sf.Scalar, sf.V3]:
+    """Span and horizontal direction of a cable's vertical plane (paper Sec. III-A).
+
+    ``L = ||b_xy - a_xy||`` (the ``L_i`` of eq. 2) and
+    ``s_c = (b_xy - a_xy) / L`` (the unit vector ``s_c`` of Sec. III-A, eq. 8),
+    with the norm made safe by ``epsilon`` (``sqrt(dx^2 + dy^2 + epsilon)``).
+
+    Args:
+        anchor: Anchor (pulley exit) ``p_a``, world frame, metres.
+        attachment_world: Attachment point ``p + R p_b``, world frame, metres.
+        epsilon: Small positive number.
+
+    Returns:
+        ``(L, s)``: the span in metres and the horizontal unit 3-vector (z = 0)
+        from the anchor towards the attachment.
+    """
+    delta = attachment_world - anchor
+    span = sf.sqrt(delta[0] ** 2 + delta[1] ** 2 + epsilon)
+    direction = sf.V3(delta[0] / span, delta[1] / span, 0)
+    return span, direction
+
+
+def catenary_length(
+    span_m: sf.Scalar,
+    horizontal_tension_n: sf.Scalar,
+    vertical_tension_n: sf.Scalar,
+    cable: CableProperties,
+    epsilon: sf.Scalar,
+) -> sf.Scalar:
+    """Arc length of the catenary from the anchor to the attachment (paper eq. 4), stable form.
+
+    Eq. (4) is ``l_C = f_h/g_c (sinh(g_c/f_h (L + C1)) - sinh(g_c/f_h C1))``
+    with ``C1`` from eq. (2). With ``u = f_v/f_h``, ``lambda = g_c L / f_h``,
+    ``A = asinh(u)`` (so ``g_c C1 / f_h = -(A + lambda)``) and
+    ``sinh(p) - sinh(q) = 2 cosh((p+q)/2) sinh((p-q)/2)`` it becomes the
+    difference-free product of ``src/model/catenary.rs``::
+
+        l_C = L * sinhc(lambda/2) * cosh(A + lambda/2)
+
+    which tends to the straight cable ``L sqrt(1 + u^2)`` as ``g_c -> 0`` and
+    equals it at ``g_c = 0`` (see :func:`sinhc`).
+
+    Args:
+        span_m: Horizontal span ``L``, metres.
+        horizontal_tension_n: ``f_h > 0``, newtons.
+        vertical_tension_n: ``f_v`` at the attachment (upward pull on the platform > 0), newtons.
+        cable: The cable's properties (``g_c``).
+        epsilon: Small positive number.
+
+    Returns:
+        The cable length ``l_C`` in metres.
+    """
+    u = vertical_tension_n / horizontal_tension_n
+    half_lambda = cable.weight_n_per_m * span_m / (2 * horizontal_tension_n)
+    return span_m * sinhc(half_lambda, epsilon) * sf.cosh(sf.asinh(u) + half_lambda)
+
+
+def catenary_drop(
+    span_m: sf.Scalar,
+    horizontal_tension_n: sf.Scalar,
+    vertical_tension_n: sf.Scalar,
+    cable: CableProperties,
+    epsilon: sf.Scalar,
+) -> sf.Scalar:
+    """Height of the anchor above the attachment, ``a_z - z(L)`` (paper eq. 1-3 at ``x = L``), stable form.
+
+    Eq. (1) with the constants of eq. (2)-(3) gives
+    ``z(L) - a_z = f_h/g_c (cosh(g_c/f_h (L + C1)) - cosh(g_c/f_h C1))``; with
+    the substitutions of :func:`catenary_length` and
+    ``cosh(p) - cosh(q) = 2 sinh((p+q)/2) sinh((p-q)/2)``::
+
+        a_z - z(L) = L * sinhc(lambda/2) * sinh(A + lambda/2)
+
+    (``L u`` for the massless cable).
+
+    Args:
+        span_m: Horizontal span ``L``, metres.
+        horizontal_tension_n: ``f_h > 0``, newtons.
+        vertical_tension_n: ``f_v`` at the attachment (upward pull on the platform > 0), newtons.
+        cable: The cable's properties (``g_c``).
+        epsilon: Small positive number.
+
+    Returns:
+        The drop ``a_z - z(L)`` in metres.
+    """
+    u = vertical_tension_n / horizontal_tension_n
+    half_lambda = cable.weight_n_per_m * span_m / (2 * horizontal_tension_n)
+    return span_m * sinhc(half_lambda, epsilon) * sf.sinh(sf.asinh(u) + half_lambda)
+
+
+def attachments_world(position_m: sf.V3, rotation: sf.Rot3, attachments_m: sf.Matrix34) -> list[sf.V3]:
+    """Attachment points in the world frame, ``p + R b_j`` (paper Sec. III-A), in slot order.
+
+    Args:
+        position_m: Platform origin ``p``, world frame, metres.
+        rotation: Platform orientation ``R``.
+        attachments_m: Column ``j`` = attachment ``b_j`` of slot ``j``, platform frame, metres.
+
+    Returns:
+        The four world-frame attachment points.
+    """
+    return [position_m + rotation * attachments_m[:, j] for j in range(CABLE_COUNT)]
+
+
+def platform_wrench(rotation: sf.Rot3, com_offset_m: sf.V3, platform_weight_n: sf.Scalar) -> sf.Matrix:
+    """The wrench the cables must supply, paper eq. (6): ``w = [z; (R b_com) x z] m_e g``.
+
+    The force, and the moment about the platform origin ``p``, in world axes.
+
+    Args:
+        rotation: Platform orientation ``R``.
+        com_offset_m: Centre of mass ``b_com``, platform frame, metres.
+        platform_weight_n: ``m_e g``, newtons.
+
+    Returns:
+        The 6-vector ``[force; moment]``.
+    """
+    moment_arm = rotation * com_offset_m
+    return sf.Matrix.block_matrix([[UP], [moment_arm.cross(UP)]]) * platform_weight_n
+
+
+def solve3(matrix: sf.Matrix33, rhs: sf.V3, epsilon: sf.Scalar) -> sf.V3:
+    """Solve a 3x3 linear system by Cramer's rule with a safe determinant.
+
+    ``x = adj(A) b / det(A)``, with ``det`` pushed away from zero by
+    :func:`safe_divisor`. Only used for the small blocks of eq. (11).
+
+    Args:
+        matrix: ``A``.
+        rhs: ``b``.
+        epsilon: Small positive number.
+
+    Returns:
+        ``x`` with ``A x = b``.
+    """
+    c0, c1, c2 = matrix[:, 0], matrix[:, 1], matrix[:, 2]
+    det = safe_divisor(c0.dot(c1.cross(c2)), epsilon)
+    # Cramer: x_k = det(A with column k replaced by b) / det(A).
+    x0 = rhs.dot(c1.cross(c2))
+    x1 = c0.dot(rhs.cross(c2))
+    x2 = c0.dot(c1.cross(rhs))
+    return sf.V3(x0, x1, x2) / det
+
+
+def cable_tensions_from_reference(
+    position_m: sf.V3,
+    rotation: sf.Rot3,
+    reference_tension_n: sf.V2,
+    anchors_m: sf.Matrix34,
+    attachments_m: sf.Matrix34,
+    com_offset_m: sf.V3,
+    platform_weight_n: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> list[tuple[sf.Scalar, sf.Scalar]]:
+    """Tensions of all cables from the reference cable's, paper eq. (5)-(11), without a 6x6 inverse.
+
+    Eq. (8): the column pair of cable ``j`` in ``J^T`` is
+    ``[[-s_j, z], [-r_j x s_j, r_j x z]]`` with ``r_j = R b_j`` and ``s_j`` its
+    horizontal unit vector (z component 0). Eq. (5) ``J^T f = w`` with eq. (6)
+    ``w = W [z; c x z]`` (``c = R b_com``, ``W = m_e g``), written per row::
+
+        Fx:  sum_j -s_jx f_hj                              = 0
+        Fy:  sum_j -s_jy f_hj                              = 0
+        Mz:  sum_j -(r_jx s_jy - r_jy s_jx) f_hj           = 0        ((r x z)_z = 0, (c x z)_z = 0)
+        Fz:  sum_j f_vj                                    = W
+        Mx:  sum_j ( r_jz s_jy f_hj + r_jy f_vj)           = W c_y    ((r x s)_x = -r_z s_y, (r x z)_x = r_y)
+        My:  sum_j (-r_jz s_jx f_hj - r_jx f_vj)           = -W c_x   ((r x s)_y = r_z s_x, (r x z)_y = -r_x)
+
+    (``s_jz = 0`` was used). The rows ``[Fx, Fy, Mz]`` contain only the
+    horizontal tensions, so eq. (11), ``f_res = (J_res^T)^-1 (w - J_ref^T f_ref)``,
+    is block triangular: after moving the reference cable's (slot 0) terms to
+    the right-hand side,
+
+    1. ``[Fx, Fy, Mz]`` is a 3x3 system in ``f_h1..f_h3`` (columns
+       ``[-s_jx, -s_jy, -(r_j x s_j)_z]``);
+    2. with those known, ``[Fz, Mx, My]`` is a 3x3 system in ``f_v1..f_v3``
+       (columns ``[1, r_jy, -r_jx]``).
+
+    Both are solved with :func:`solve3`. This is exactly eq. (11) when
+    ``J_res^T`` is invertible (its determinant is the product of the two 3x3
+    determinants) and keeps the generated expressions small.
+
+    Args:
+        position_m: Platform origin ``p``, world frame, metres.
+        rotation: Platform orientation ``R``.
+        reference_tension_n: ``[f_h, f_v]`` of the reference cable (slot 0), newtons.
+        anchors_m: Column ``j`` = anchor of slot ``j``, world frame, metres.
+        attachments_m: Column ``j`` = attachment of slot ``j``, platform frame, metres.
+        com_offset_m: Centre of mass ``b_com``, platform frame, metres.
+        platform_weight_n: ``m_e g``, newtons.
+        epsilon: Small positive number.
+
+    Returns:
+        ``[(f_h0, f_v0), ..., (f_h3, f_v3)]`` in slot order; slot 0 is the input.
+    """
+    arms = [rotation * attachments_m[:, j] for j in range(CABLE_COUNT)]
+    directions = []
+    for j in range(CABLE_COUNT):
+        _, direction = horizontal_span(anchors_m[:, j], position_m + arms[j], epsilon)
+        directions.append(direction)
+    wrench = platform_wrench(rotation, com_offset_m, platform_weight_n)
+
+    def horizontal_column(j: int) -> sf.V3:
+        # Rows [Fx, Fy, Mz] of the f_h column of eq. (8).
+        r, s = arms[j], directions[j]
+        return sf.V3(-s[0], -s[1], -(r[0] * s[1] - r[1] * s[0]))
+
+    def vertical_column(j: int) -> sf.V3:
+        # Rows [Fz, Mx, My] of the f_v column of eq. (8).
+        r = arms[j]
+        return sf.V3(1, r[1], -r[0])
+
+    def horizontal_in_vertical_rows(j: int) -> sf.V3:
+        # Rows [Fz, Mx, My] of the f_h column of eq. (8).
+        r, s = arms[j], directions[j]
+        return sf.V3(0, r[2] * s[1], -r[2] * s[0])
+
+    f_h_ref, f_v_ref = reference_tension_n[0], reference_tension_n[1]
+    others = range(1, CABLE_COUNT)
+
+    # Step 1: rows [Fx, Fy, Mz] (wrench rows 0, 1, 5), unknowns f_h of slots 1..3.
+    rhs_h = sf.V3(wrench[0], wrench[1], wrench[5]) - horizontal_column(REFERENCE_SLOT) * f_h_ref
+    a_h = sf.Matrix33.column_stack(*[horizontal_column(j) for j in others])
+    f_h = solve3(a_h, rhs_h, epsilon)
+
+    # Step 2: rows [Fz, Mx, My] (wrench rows 2, 3, 4), unknowns f_v of slots 1..3.
+    rhs_v = sf.V3(wrench[2], wrench[3], wrench[4]) - horizontal_in_vertical_rows(REFERENCE_SLOT) * f_h_ref
+    rhs_v = rhs_v - vertical_column(REFERENCE_SLOT) * f_v_ref
+    for k, j in enumerate(others):
+        rhs_v = rhs_v - horizontal_in_vertical_rows(j) * f_h[k]
+    a_v = sf.Matrix33.column_stack(*[vertical_column(j) for j in others])
+    f_v = solve3(a_v, rhs_v, epsilon)
+
+    return [(f_h_ref, f_v_ref)] + [(f_h[k], f_v[k]) for k in range(CABLE_COUNT - 1)]
+
+
+def straight_cable_length(anchor: sf.V3, attachment_world: sf.V3, epsilon: sf.Scalar) -> sf.Scalar:
+    """Length of a massless (straight) cable, ``||a - (p + R b)||`` (the ``g_c = 0`` limit of eq. 4).
+
+    Args:
+        anchor: Anchor ``p_a``, world frame, metres.
+        attachment_world: Attachment point ``p + R p_b``, world frame, metres.
+        epsilon: Small positive number (inside the square root).
+
+    Returns:
+        The distance in metres.
+    """
+    return (anchor - attachment_world).norm(epsilon=epsilon)

@@ -1,0 +1,342 @@
+"""The residuals of sagcal's factor graph (paper Sec. IV-C, eq. 14-16), built from ``cable_model``.
+
+Each function is pure symbolic: it takes the generated function's arguments
+(same names, same order) and returns the residual as a column matrix.
+``generate.py`` differentiates it (pose Jacobians on SymForce's ``Rot3``
+tangent, i.e. the right perturbation ``R * Exp(dtheta)`` of
+``src/model/pose.rs``) and emits Rust.
+
+Argument conventions:
+
+* ``position_m`` (V3): platform origin ``p`` in the world frame;
+  ``rotation_xyzw`` (V4): its orientation as a quaternion in SymForce storage
+  order ``[x, y, z, w]``, turned into an ``sf.Rot3`` here.
+* Cable slots: slot 0 is the reference cable (the one with the load cell),
+  slots 1..3 the others; the Rust caller permutes the robot's cables.
+  ``anchors_m`` / ``attachments_m`` (3x4): column ``j`` belongs to slot ``j``
+  (world frame / platform frame). ``length_offsets_m``, ``encoder_lengths_m``
+  (V4) are in slot order too.
+* ``reference_tension_n`` (V2): ``[f_h, f_v]`` of the reference cable at its
+  attachment (``f_v > 0``: the cable pulls the platform up).
+* Residuals are not whitened; noise models live in Rust.
+"""
+
+from __future__ import annotations
+
+import symforce
+
+# generate.py calls this first; every function here takes `epsilon` explicitly anyway.
+try:
+    symforce.set_epsilon_to_symbol()
+except symforce.AlreadyUsedEpsilon:
+    pass
+
+import symforce.symbolic as sf  # noqa: E402  (must follow set_epsilon_to_symbol)
+
+import cable_model  # noqa: E402
+from cable_model import CABLE_COUNT  # noqa: E402
+
+
+def rotation_from_storage(rotation_xyzw: sf.V4) -> sf.Rot3:
+    """The ``sf.Rot3`` whose storage (``[x, y, z, w]``) is the given 4-vector.
+
+    Args:
+        rotation_xyzw: Unit quaternion, SymForce storage order.
+
+    Returns:
+        The rotation.
+    """
+    return sf.Rot3.from_storage(list(rotation_xyzw))
+
+
+def cable_tensions_from_reference(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    reference_tension_n: sf.V2,
+    anchors_m: sf.Matrix34,
+    attachments_m: sf.Matrix34,
+    com_offset_m: sf.V3,
+    platform_weight_n: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> sf.Matrix:
+    """Horizontal and vertical tensions of all four cables from the reference cable's (eq. 5-11).
+
+    Eq. (11) solved through its block-triangular structure, see
+    ``cable_model.cable_tensions_from_reference``.
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        reference_tension_n: ``[f_h, f_v]`` of the reference cable (slot 0), newtons.
+        anchors_m: Column ``j`` = anchor of slot ``j``, world frame, metres.
+        attachments_m: Column ``j`` = attachment of slot ``j``, platform frame, metres.
+        com_offset_m: Centre of mass, platform frame, metres.
+        platform_weight_n: Platform weight ``m_e g``, newtons.
+        epsilon: Small positive number (safe divisions).
+
+    Returns:
+        ``[f_h0, f_v0, f_h1, f_v1, f_h2, f_v2, f_h3, f_v3]`` in newtons, slot order
+        (slot 0 = ``reference_tension_n``).
+    """
+    tensions = cable_model.cable_tensions_from_reference(
+        position_m,
+        rotation_from_storage(rotation_xyzw),
+        reference_tension_n,
+        anchors_m,
+        attachments_m,
+        com_offset_m,
+        platform_weight_n,
+        epsilon,
+    )
+    return sf.Matrix([component for pair in tensions for component in pair])
+
+
+def _catenaries(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    reference_tension_n: sf.V2,
+    anchors_m: sf.Matrix34,
+    attachments_m: sf.Matrix34,
+    com_offset_m: sf.V3,
+    platform_weight_n: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> tuple[list[sf.V3], list[sf.Scalar], list[tuple[sf.Scalar, sf.Scalar]]]:
+    """World attachment points, spans and tensions of the four cables (eq. 2, 5-11)."""
+    rotation = rotation_from_storage(rotation_xyzw)
+    attachments = cable_model.attachments_world(position_m, rotation, attachments_m)
+    spans = [cable_model.horizontal_span(anchors_m[:, j], attachments[j], epsilon)[0] for j in range(CABLE_COUNT)]
+    tensions = cable_model.cable_tensions_from_reference(
+        position_m,
+        rotation,
+        reference_tension_n,
+        anchors_m,
+        attachments_m,
+        com_offset_m,
+        platform_weight_n,
+        epsilon,
+    )
+    return attachments, spans, tensions
+
+
+def catenary_length_residual(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    reference_tension_n: sf.V2,
+    anchors_m: sf.Matrix34,
+    attachments_m: sf.Matrix34,
+    com_offset_m: sf.V3,
+    platform_weight_n: sf.Scalar,
+    cable_weight_n_per_m: sf.Scalar,
+    length_offsets_m: sf.V4,
+    encoder_lengths_m: sf.V4,
+    epsilon: sf.Scalar,
+) -> sf.V4:
+    """Catenary length factor, paper eq. (14): ``r_j = l_C,j + l0_j - z_enc,j``.
+
+    ``l_C,j`` is the catenary length of eq. (4) (stable form,
+    ``cable_model.catenary_length``) with the span of slot ``j`` and the
+    tensions of eq. (11) (``cable_model.cable_tensions_from_reference``).
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        reference_tension_n: ``[f_h, f_v]`` of the reference cable (slot 0), newtons.
+        anchors_m: Column ``j`` = anchor of slot ``j``, world frame, metres.
+        attachments_m: Column ``j`` = attachment of slot ``j``, platform frame, metres.
+        com_offset_m: Centre of mass, platform frame, metres.
+        platform_weight_n: Platform weight ``m_e g``, newtons.
+        cable_weight_n_per_m: Cable weight per metre ``g_c``, N/m (0: massless cable).
+        length_offsets_m: Encoder length offsets ``l0_j``, metres, slot order.
+        encoder_lengths_m: Encoder readings ``z_enc,j``, metres, slot order.
+        epsilon: Small positive number (safe divisions, ``sinhc`` at ``g_c = 0``).
+
+    Returns:
+        The 4-vector of length errors in metres, slot order.
+    """
+    _, spans, tensions = _catenaries(
+        position_m,
+        rotation_xyzw,
+        reference_tension_n,
+        anchors_m,
+        attachments_m,
+        com_offset_m,
+        platform_weight_n,
+        epsilon,
+    )
+    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
+    return sf.V4(
+        [
+            cable_model.catenary_length(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
+            + length_offsets_m[j]
+            - encoder_lengths_m[j]
+            for j in range(CABLE_COUNT)
+        ]
+    )
+
+
+def attachment_height_residual(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    reference_tension_n: sf.V2,
+    anchors_m: sf.Matrix34,
+    attachments_m: sf.Matrix34,
+    com_offset_m: sf.V3,
+    platform_weight_n: sf.Scalar,
+    cable_weight_n_per_m: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> sf.V4:
+    """Cable attachment factor, paper eq. (15): ``r_j = (p + R b_j)_z - z_j(L_j)``.
+
+    ``z_j(L_j) = a_j,z - drop_j`` from eq. (1)-(3) (stable form,
+    ``cable_model.catenary_drop``), so ``r_j = (p + R b_j)_z - a_j,z + drop_j``.
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        reference_tension_n: ``[f_h, f_v]`` of the reference cable (slot 0), newtons.
+        anchors_m: Column ``j`` = anchor of slot ``j``, world frame, metres.
+        attachments_m: Column ``j`` = attachment of slot ``j``, platform frame, metres.
+        com_offset_m: Centre of mass, platform frame, metres.
+        platform_weight_n: Platform weight ``m_e g``, newtons.
+        cable_weight_n_per_m: Cable weight per metre ``g_c``, N/m (0: massless cable).
+        epsilon: Small positive number (safe divisions, ``sinhc`` at ``g_c = 0``).
+
+    Returns:
+        The 4-vector of height errors in metres, slot order.
+    """
+    attachments, spans, tensions = _catenaries(
+        position_m,
+        rotation_xyzw,
+        reference_tension_n,
+        anchors_m,
+        attachments_m,
+        com_offset_m,
+        platform_weight_n,
+        epsilon,
+    )
+    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
+    return sf.V4(
+        [
+            attachments[j][2]
+            - anchors_m[2, j]
+            + cable_model.catenary_drop(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
+            for j in range(CABLE_COUNT)
+        ]
+    )
+
+
+def reference_tension_residual(
+    reference_tension_n: sf.V2,
+    measured_tension_n: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> sf.V1:
+    """Force measurement factor, paper eq. (16): ``r = ||[f_h, f_v]|| - f_m``.
+
+    Args:
+        reference_tension_n: ``[f_h, f_v]`` of the reference cable, newtons.
+        measured_tension_n: Load-cell reading ``f_m``, newtons.
+        epsilon: Small positive number (inside the norm's square root).
+
+    Returns:
+        The 1-vector tension error in newtons.
+    """
+    return sf.V1(reference_tension_n.norm(epsilon=epsilon) - measured_tension_n)
+
+
+def rotation_log(rotation: sf.Rot3, epsilon: sf.Scalar) -> sf.V3:
+    """Logarithm of a rotation, ``Log(R)`` (rotation vector, angle <= pi), accurate near the identity.
+
+    Same value as SymForce's ``Rot3.to_tangent`` and nalgebra's
+    ``scaled_axis`` (``PlatformPose::local_coordinates``), computed without
+    cancellation. With the quaternion ``(v, w)`` flipped to ``w >= 0`` and
+    ``n = |v|``, the angle is ``2 atan2(n, w) = 4 atan(n / (1 + w))`` (the
+    half-angle identity, valid for unit quaternions), so::
+
+        Log = v * 4 atan(n / (1 + w)) / n,   n = sqrt(v.v + epsilon)
+
+    ``1 + w >= 1`` and ``n > 0`` keep the value and every derivative free of
+    singularities (also at 180 degrees, unlike the derivative of ``atan2``),
+    and ``atan(t) / n`` is well conditioned for every ``n``; ``epsilon``
+    changes the result by about ``epsilon / 12`` relative. SymForce's
+    ``Rot3.to_tangent`` divides ``acos(w)`` by ``sqrt(1 - w^2)``, which loses
+    about ``1e-16 / angle^2`` relative accuracy (5e-11 at 1 mrad).
+
+    Args:
+        rotation: A unit-quaternion rotation.
+        epsilon: Small positive number.
+
+    Returns:
+        The rotation vector, radians.
+    """
+    q = rotation.q
+    # The same rotation with w >= 0; sign_no_zero has a zero derivative.
+    sign = sf.sign_no_zero(q.w)
+    n = sf.sqrt(q.xyz.squared_norm() + epsilon)
+    return q.xyz * (sign * 4 * sf.atan(n / (1 + q.w * sign)) / n)
+
+
+def pose_prior_residual(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    prior_position_m: sf.V3,
+    prior_rotation_xyzw: sf.V4,
+    epsilon: sf.Scalar,
+) -> sf.V6:
+    """Pose prior factor (paper Sec. IV-C.4): ``[Log(R_prior^-1 R); p - p_prior]``.
+
+    The rotation part is the logarithm of :func:`rotation_log` (the value of
+    SymForce's ``Rot3.to_tangent``, more accurate near the identity), so the
+    residual is ``PlatformPose::local_coordinates`` of ``src/model/pose.rs``
+    from the prior to the pose, the inverse of its retraction.
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        prior_position_m: Measured (prior) platform origin, metres.
+        prior_rotation_xyzw: Measured (prior) orientation, quaternion ``[x, y, z, w]``.
+        epsilon: Small positive number (the logarithm near the identity).
+
+    Returns:
+        The 6-vector ``[rotation error (rad, 3); position error (m, 3)]``.
+    """
+    rotation = rotation_from_storage(rotation_xyzw)
+    prior_rotation = rotation_from_storage(prior_rotation_xyzw)
+    rotation_error = rotation_log(prior_rotation.inverse() * rotation, epsilon)
+    return sf.V6(list(rotation_error) + list(position_m - prior_position_m))
+
+
+def rigid_length_residual(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    anchors_m: sf.Matrix34,
+    attachments_m: sf.Matrix34,
+    length_offsets_m: sf.V4,
+    encoder_lengths_m: sf.V4,
+    epsilon: sf.Scalar,
+) -> sf.V4:
+    """Massless-cable length factor: ``r_j = ||a_j - (p + R b_j)|| + l0_j - z_enc,j``.
+
+    The straight-cable model of the authors' earlier work (paper Sec. VI-A),
+    the ``g_c -> 0`` limit of eq. (14).
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        anchors_m: Column ``j`` = anchor of slot ``j``, world frame, metres.
+        attachments_m: Column ``j`` = attachment of slot ``j``, platform frame, metres.
+        length_offsets_m: Encoder length offsets ``l0_j``, metres, slot order.
+        encoder_lengths_m: Encoder readings ``z_enc,j``, metres, slot order.
+        epsilon: Small positive number (inside the norm's square root).
+
+    Returns:
+        The 4-vector of length errors in metres, slot order.
+    """
+    attachments = cable_model.attachments_world(position_m, rotation_from_storage(rotation_xyzw), attachments_m)
+    return sf.V4(
+        [
+            cable_model.straight_cable_length(anchors_m[:, j], attachments[j], epsilon)
+            + length_offsets_m[j]
+            - encoder_lengths_m[j]
+            for j in range(CABLE_COUNT)
+        ]
+    )

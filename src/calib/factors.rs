@@ -1,0 +1,660 @@
+//! The calibration factors (paper Sec. IV-C): thin wrappers that gather the
+//! variables, call the SymForce-generated residual, and split its Jacobian
+//! into one block per variable.
+//!
+//! The generated functions take the cables in *slot order* (slot 0 = the
+//! reference cable); [`SlotOrder`] maps the robot's cable numbering to slots
+//! once, so the variables (anchors, offsets) keep the robot's numbering.
+
+use std::sync::Arc;
+
+use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, Vector2, Vector3, Vector4};
+
+use crate::generated;
+use crate::graph::{Factor, RobustKernel, Values, VariableId};
+use crate::model::robot::{Robot, CABLE_COUNT};
+
+/// The `epsilon` passed to the generated code (SymForce's default for f64).
+pub const EPSILON: f64 = 10.0 * f64::EPSILON;
+
+/// Robot constants shared by every factor, in slot order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SlotOrder {
+    /// `cables[slot]` = the robot's cable index in that slot; `cables[0]` is the reference cable.
+    pub cables: [usize; CABLE_COUNT],
+    /// Attachment points, platform frame, column = slot.
+    pub attachments_m: Matrix3x4<f64>,
+    /// Centre of mass, platform frame.
+    pub com_offset_m: Vector3<f64>,
+    /// Platform weight, newtons.
+    pub platform_weight_n: f64,
+    /// Cable weight per metre, newtons per metre.
+    pub cable_weight_n_per_m: f64,
+}
+
+impl SlotOrder {
+    /// The slot order of `robot` (reference cable first, then the others in order).
+    pub fn new(robot: &Robot) -> Self {
+        let mut cables = [robot.reference_cable; CABLE_COUNT];
+        let mut slot = 1;
+        for cable in 0..CABLE_COUNT {
+            if cable != robot.reference_cable {
+                cables[slot] = cable;
+                slot += 1;
+            }
+        }
+        let mut attachments_m = Matrix3x4::zeros();
+        for (slot, &cable) in cables.iter().enumerate() {
+            attachments_m.set_column(slot, &robot.attachments_m[cable]);
+        }
+        Self {
+            cables,
+            attachments_m,
+            com_offset_m: robot.com_offset_m,
+            platform_weight_n: robot.platform_weight_n,
+            cable_weight_n_per_m: robot.cable_weight_n_per_m,
+        }
+    }
+
+    /// Permute per-cable values (robot order) into slot order.
+    pub fn to_slots(&self, per_cable: &[f64; CABLE_COUNT]) -> Vector4<f64> {
+        Vector4::from_fn(|slot, _| per_cable[self.cables[slot]])
+    }
+}
+
+/// The variables of the global calibration parameters, in the robot's cable order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CalibrationVariables {
+    /// Anchor `i` (3-vector, world frame, metres).
+    pub anchors: [VariableId; CABLE_COUNT],
+    /// Length offset `i` (1-vector, metres).
+    pub length_offsets: [VariableId; CABLE_COUNT],
+}
+
+/// The variables of one static pose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PoseVariables {
+    /// Platform pose.
+    pub pose: VariableId,
+    /// Reference-cable tension `[f_h, f_v]` at its attachment, newtons.
+    pub reference_tension: VariableId,
+}
+
+fn gather_anchors(values: &Values, slots: &SlotOrder, globals: &CalibrationVariables) -> SMatrix<f64, 3, 4> {
+    let mut anchors = SMatrix::<f64, 3, 4>::zeros();
+    for (slot, &cable) in slots.cables.iter().enumerate() {
+        let a = values.vector(globals.anchors[cable]);
+        anchors.set_column(slot, &Vector3::new(a[0], a[1], a[2]));
+    }
+    anchors
+}
+
+fn gather_offsets(values: &Values, slots: &SlotOrder, globals: &CalibrationVariables) -> Vector4<f64> {
+    Vector4::from_fn(|slot, _| values.vector(globals.length_offsets[slots.cables[slot]])[0])
+}
+
+fn pose_arguments(values: &Values, pose: VariableId) -> (Vector3<f64>, Vector4<f64>) {
+    let pose = values.pose(pose);
+    (pose.position_m, pose.rotation_xyzw())
+}
+
+fn tension_argument(values: &Values, id: VariableId) -> Vector2<f64> {
+    let t = values.vector(id);
+    Vector2::new(t[0], t[1])
+}
+
+/// Variables `[pose, reference tension?, anchors (robot order), offsets (robot order)?]`.
+fn variable_list(
+    pose: &PoseVariables,
+    globals: &CalibrationVariables,
+    with_tension: bool,
+    with_offsets: bool,
+) -> Vec<VariableId> {
+    let mut list = vec![pose.pose];
+    if with_tension {
+        list.push(pose.reference_tension);
+    }
+    list.extend(globals.anchors);
+    if with_offsets {
+        list.extend(globals.length_offsets);
+    }
+    list
+}
+
+/// Copy the slot-ordered anchor Jacobian (`rows x 12`) into per-anchor blocks (robot order).
+fn split_anchor_jacobian<const R: usize>(
+    jacobian: &SMatrix<f64, R, 12>,
+    slots: &SlotOrder,
+    blocks: &mut [DMatrix<f64>],
+) {
+    for (slot, &cable) in slots.cables.iter().enumerate() {
+        blocks[cable].copy_from(&jacobian.fixed_columns::<3>(3 * slot));
+    }
+}
+
+fn split_offset_jacobian(jacobian: &SMatrix<f64, 4, 4>, slots: &SlotOrder, blocks: &mut [DMatrix<f64>]) {
+    for (slot, &cable) in slots.cables.iter().enumerate() {
+        blocks[cable].copy_from(&jacobian.fixed_columns::<1>(slot));
+    }
+}
+
+/// Turn a slot-ordered residual into robot cable order.
+fn slots_to_cables(slots: &SlotOrder, residual: &Vector4<f64>) -> DVector<f64> {
+    let mut out = DVector::zeros(CABLE_COUNT);
+    for (slot, &cable) in slots.cables.iter().enumerate() {
+        out[cable] = residual[slot];
+    }
+    out
+}
+
+/// Reorder the rows of Jacobian blocks from slot order to cable order.
+fn rows_to_cables(slots: &SlotOrder, blocks: &mut [DMatrix<f64>]) {
+    for block in blocks {
+        let copy = block.clone();
+        for (slot, &cable) in slots.cables.iter().enumerate() {
+            block.row_mut(cable).copy_from(&copy.row(slot));
+        }
+    }
+}
+
+/// Catenary length factor (paper eq. 14): `l_C,i + l_i^0 - z_i^enc` for the four
+/// cables of one pose, the tensions of the non-reference cables from eq. (11).
+pub struct CatenaryLengthFactor {
+    variables: Vec<VariableId>,
+    slots: Arc<SlotOrder>,
+    globals: CalibrationVariables,
+    pose: PoseVariables,
+    /// Encoder readings, slot order, metres.
+    encoder_lengths_m: Vector4<f64>,
+    sigmas: DVector<f64>,
+    kernel: RobustKernel,
+}
+
+impl CatenaryLengthFactor {
+    /// `encoder_lengths_m` in the robot's cable order.
+    pub fn new(
+        slots: Arc<SlotOrder>,
+        globals: CalibrationVariables,
+        pose: PoseVariables,
+        encoder_lengths_m: &[f64; CABLE_COUNT],
+        sigma_m: f64,
+        kernel: RobustKernel,
+    ) -> Self {
+        Self {
+            variables: variable_list(&pose, &globals, true, true),
+            encoder_lengths_m: slots.to_slots(encoder_lengths_m),
+            slots,
+            globals,
+            pose,
+            sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
+            kernel,
+        }
+    }
+}
+
+impl Factor for CatenaryLengthFactor {
+    fn variables(&self) -> &[VariableId] {
+        &self.variables
+    }
+    fn residual_dim(&self) -> usize {
+        CABLE_COUNT
+    }
+    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        let (position, rotation) = pose_arguments(values, self.pose.pose);
+        let tension = tension_argument(values, self.pose.reference_tension);
+        let anchors = gather_anchors(values, &self.slots, &self.globals);
+        let offsets = gather_offsets(values, &self.slots, &self.globals);
+        let s = &self.slots;
+        let residual = match jacobians {
+            None => generated::catenary_length_residual(
+                &position,
+                &rotation,
+                &tension,
+                &anchors,
+                &s.attachments_m,
+                &s.com_offset_m,
+                s.platform_weight_n,
+                s.cable_weight_n_per_m,
+                &offsets,
+                &self.encoder_lengths_m,
+                EPSILON,
+                None,
+                None,
+                None,
+                None,
+            ),
+            Some(blocks) => {
+                let mut j_pose = SMatrix::<f64, 4, 6>::zeros();
+                let mut j_tension = SMatrix::<f64, 4, 2>::zeros();
+                let mut j_anchors = SMatrix::<f64, 4, 12>::zeros();
+                let mut j_offsets = SMatrix::<f64, 4, 4>::zeros();
+                let r = generated::catenary_length_residual(
+                    &position,
+                    &rotation,
+                    &tension,
+                    &anchors,
+                    &s.attachments_m,
+                    &s.com_offset_m,
+                    s.platform_weight_n,
+                    s.cable_weight_n_per_m,
+                    &offsets,
+                    &self.encoder_lengths_m,
+                    EPSILON,
+                    Some(&mut j_pose),
+                    Some(&mut j_tension),
+                    Some(&mut j_anchors),
+                    Some(&mut j_offsets),
+                );
+                blocks[0].copy_from(&j_pose);
+                blocks[1].copy_from(&j_tension);
+                split_anchor_jacobian(&j_anchors, s, &mut blocks[2..6]);
+                split_offset_jacobian(&j_offsets, s, &mut blocks[6..10]);
+                rows_to_cables(s, blocks);
+                r
+            }
+        };
+        Some(slots_to_cables(s, &residual))
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn robust_kernel(&self) -> RobustKernel {
+        self.kernel
+    }
+    fn kind(&self) -> &'static str {
+        "catenary_length"
+    }
+}
+
+/// Cable attachment factor (paper eq. 15): the attachment height minus the
+/// height the catenary from each anchor reaches, for the four cables of one pose.
+pub struct AttachmentHeightFactor {
+    variables: Vec<VariableId>,
+    slots: Arc<SlotOrder>,
+    globals: CalibrationVariables,
+    pose: PoseVariables,
+    sigmas: DVector<f64>,
+}
+
+impl AttachmentHeightFactor {
+    /// A height factor with standard deviation `sigma_m` (a model constraint: small).
+    pub fn new(slots: Arc<SlotOrder>, globals: CalibrationVariables, pose: PoseVariables, sigma_m: f64) -> Self {
+        Self {
+            variables: variable_list(&pose, &globals, true, false),
+            slots,
+            globals,
+            pose,
+            sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
+        }
+    }
+}
+
+impl Factor for AttachmentHeightFactor {
+    fn variables(&self) -> &[VariableId] {
+        &self.variables
+    }
+    fn residual_dim(&self) -> usize {
+        CABLE_COUNT
+    }
+    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        let (position, rotation) = pose_arguments(values, self.pose.pose);
+        let tension = tension_argument(values, self.pose.reference_tension);
+        let anchors = gather_anchors(values, &self.slots, &self.globals);
+        let s = &self.slots;
+        let residual = match jacobians {
+            None => generated::attachment_height_residual(
+                &position,
+                &rotation,
+                &tension,
+                &anchors,
+                &s.attachments_m,
+                &s.com_offset_m,
+                s.platform_weight_n,
+                s.cable_weight_n_per_m,
+                EPSILON,
+                None,
+                None,
+                None,
+            ),
+            Some(blocks) => {
+                let mut j_pose = SMatrix::<f64, 4, 6>::zeros();
+                let mut j_tension = SMatrix::<f64, 4, 2>::zeros();
+                let mut j_anchors = SMatrix::<f64, 4, 12>::zeros();
+                let r = generated::attachment_height_residual(
+                    &position,
+                    &rotation,
+                    &tension,
+                    &anchors,
+                    &s.attachments_m,
+                    &s.com_offset_m,
+                    s.platform_weight_n,
+                    s.cable_weight_n_per_m,
+                    EPSILON,
+                    Some(&mut j_pose),
+                    Some(&mut j_tension),
+                    Some(&mut j_anchors),
+                );
+                blocks[0].copy_from(&j_pose);
+                blocks[1].copy_from(&j_tension);
+                split_anchor_jacobian(&j_anchors, s, &mut blocks[2..6]);
+                rows_to_cables(s, blocks);
+                r
+            }
+        };
+        Some(slots_to_cables(s, &residual))
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn kind(&self) -> &'static str {
+        "attachment_height"
+    }
+}
+
+/// Positivity guard: `min(0, f_h,i - f_min)` for every cable of one pose,
+/// with the tensions of eq. (11). Zero (inactive) while all cables are taut;
+/// it only shapes the path of the solver. Undefined (`None`) once a cable
+/// would push, so the solver never steps into a slack configuration.
+pub struct TensionGuardFactor {
+    variables: Vec<VariableId>,
+    slots: Arc<SlotOrder>,
+    globals: CalibrationVariables,
+    pose: PoseVariables,
+    minimum_horizontal_tension_n: f64,
+    sigmas: DVector<f64>,
+}
+
+impl TensionGuardFactor {
+    /// A guard keeping every `f_h` above `minimum_horizontal_tension_n`, stiffness `sigma_n`.
+    pub fn new(
+        slots: Arc<SlotOrder>,
+        globals: CalibrationVariables,
+        pose: PoseVariables,
+        minimum_horizontal_tension_n: f64,
+        sigma_n: f64,
+    ) -> Self {
+        Self {
+            variables: variable_list(&pose, &globals, true, false),
+            slots,
+            globals,
+            pose,
+            minimum_horizontal_tension_n,
+            sigmas: DVector::from_element(CABLE_COUNT, sigma_n),
+        }
+    }
+}
+
+impl Factor for TensionGuardFactor {
+    fn variables(&self) -> &[VariableId] {
+        &self.variables
+    }
+    fn residual_dim(&self) -> usize {
+        CABLE_COUNT
+    }
+    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        let (position, rotation) = pose_arguments(values, self.pose.pose);
+        let tension = tension_argument(values, self.pose.reference_tension);
+        let anchors = gather_anchors(values, &self.slots, &self.globals);
+        let s = &self.slots;
+        let mut j_pose = SMatrix::<f64, 8, 6>::zeros();
+        let mut j_tension = SMatrix::<f64, 8, 2>::zeros();
+        let mut j_anchors = SMatrix::<f64, 8, 12>::zeros();
+        let want = jacobians.is_some();
+        let tensions = generated::cable_tensions_from_reference(
+            &position,
+            &rotation,
+            &tension,
+            &anchors,
+            &s.attachments_m,
+            &s.com_offset_m,
+            s.platform_weight_n,
+            EPSILON,
+            want.then_some(&mut j_pose),
+            want.then_some(&mut j_tension),
+            want.then_some(&mut j_anchors),
+        );
+        let mut residual = Vector4::zeros();
+        let mut active = [false; CABLE_COUNT];
+        for slot in 0..CABLE_COUNT {
+            let f_h = tensions[2 * slot];
+            if !(f_h.is_finite() && f_h > 0.0) {
+                return None;
+            }
+            if f_h < self.minimum_horizontal_tension_n {
+                residual[slot] = f_h - self.minimum_horizontal_tension_n;
+                active[slot] = true;
+            }
+        }
+        if let Some(blocks) = jacobians {
+            for block in blocks.iter_mut() {
+                block.fill(0.0);
+            }
+            for slot in (0..CABLE_COUNT).filter(|&k| active[k]) {
+                let row = 2 * slot;
+                for c in 0..6 {
+                    blocks[0][(slot, c)] = j_pose[(row, c)];
+                }
+                for c in 0..2 {
+                    blocks[1][(slot, c)] = j_tension[(row, c)];
+                }
+                for (anchor_slot, &cable) in s.cables.iter().enumerate() {
+                    for c in 0..3 {
+                        blocks[2 + cable][(slot, c)] = j_anchors[(row, 3 * anchor_slot + c)];
+                    }
+                }
+            }
+            rows_to_cables(s, blocks);
+        }
+        Some(slots_to_cables(s, &residual))
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn kind(&self) -> &'static str {
+        "tension_guard"
+    }
+}
+
+/// Force measurement factor (paper eq. 16): `|(f_h, f_v)| - f_m` of the reference cable.
+pub struct ReferenceTensionFactor {
+    variables: [VariableId; 1],
+    measured_tension_n: f64,
+    sigmas: DVector<f64>,
+    kernel: RobustKernel,
+}
+
+impl ReferenceTensionFactor {
+    /// A load-cell reading `measured_tension_n` with standard deviation `sigma_n`.
+    pub fn new(tension: VariableId, measured_tension_n: f64, sigma_n: f64, kernel: RobustKernel) -> Self {
+        Self {
+            variables: [tension],
+            measured_tension_n,
+            sigmas: DVector::from_element(1, sigma_n),
+            kernel,
+        }
+    }
+}
+
+impl Factor for ReferenceTensionFactor {
+    fn variables(&self) -> &[VariableId] {
+        &self.variables
+    }
+    fn residual_dim(&self) -> usize {
+        1
+    }
+    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        let tension = tension_argument(values, self.variables[0]);
+        let mut j = SMatrix::<f64, 1, 2>::zeros();
+        let want = jacobians.is_some();
+        let r =
+            generated::reference_tension_residual(&tension, self.measured_tension_n, EPSILON, want.then_some(&mut j));
+        if let Some(blocks) = jacobians {
+            blocks[0].copy_from(&j);
+        }
+        Some(DVector::from_element(1, r[0]))
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn robust_kernel(&self) -> RobustKernel {
+        self.kernel
+    }
+    fn kind(&self) -> &'static str {
+        "reference_tension"
+    }
+}
+
+/// Pose prior factor: the localiser's pose. With `orientation` off only the
+/// position rows are kept, so the statics, not the localiser, decide the
+/// orientation (the role of the paper's orientation-correction variable).
+pub struct PosePriorFactor {
+    variables: [VariableId; 1],
+    prior_position_m: Vector3<f64>,
+    prior_rotation_xyzw: Vector4<f64>,
+    with_orientation: bool,
+    sigmas: DVector<f64>,
+    kernel: RobustKernel,
+}
+
+impl PosePriorFactor {
+    /// A prior with position sigma `position_sigma_m` and, if `Some`, orientation sigma (radians).
+    pub fn new(
+        pose: VariableId,
+        prior: &crate::model::PlatformPose,
+        position_sigma_m: f64,
+        orientation_sigma_rad: Option<f64>,
+        kernel: RobustKernel,
+    ) -> Self {
+        let sigmas = match orientation_sigma_rad {
+            Some(rot) => {
+                DVector::from_row_slice(&[rot, rot, rot, position_sigma_m, position_sigma_m, position_sigma_m])
+            }
+            None => DVector::from_element(3, position_sigma_m),
+        };
+        Self {
+            variables: [pose],
+            prior_position_m: prior.position_m,
+            prior_rotation_xyzw: prior.rotation_xyzw(),
+            with_orientation: orientation_sigma_rad.is_some(),
+            sigmas,
+            kernel,
+        }
+    }
+}
+
+impl Factor for PosePriorFactor {
+    fn variables(&self) -> &[VariableId] {
+        &self.variables
+    }
+    fn residual_dim(&self) -> usize {
+        self.sigmas.len()
+    }
+    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        let (position, rotation) = pose_arguments(values, self.variables[0]);
+        let mut j = SMatrix::<f64, 6, 6>::zeros();
+        let want = jacobians.is_some();
+        let r = generated::pose_prior_residual(
+            &position,
+            &rotation,
+            &self.prior_position_m,
+            &self.prior_rotation_xyzw,
+            EPSILON,
+            want.then_some(&mut j),
+        );
+        let first = if self.with_orientation { 0 } else { 3 };
+        if let Some(blocks) = jacobians {
+            blocks[0].copy_from(&j.rows(first, 6 - first));
+        }
+        Some(DVector::from_iterator(6 - first, r.iter().skip(first).copied()))
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn robust_kernel(&self) -> RobustKernel {
+        self.kernel
+    }
+    fn kind(&self) -> &'static str {
+        "pose_prior"
+    }
+}
+
+/// Rigid massless-cable length factor: `|a_i - (p + R b_i)| + l_i^0 - z_i^enc`
+/// (the straight-cable baseline of the paper's Sec. VI-A).
+pub struct RigidLengthFactor {
+    variables: Vec<VariableId>,
+    slots: Arc<SlotOrder>,
+    globals: CalibrationVariables,
+    pose: PoseVariables,
+    encoder_lengths_m: Vector4<f64>,
+    sigmas: DVector<f64>,
+    kernel: RobustKernel,
+}
+
+impl RigidLengthFactor {
+    /// `encoder_lengths_m` in the robot's cable order.
+    pub fn new(
+        slots: Arc<SlotOrder>,
+        globals: CalibrationVariables,
+        pose: PoseVariables,
+        encoder_lengths_m: &[f64; CABLE_COUNT],
+        sigma_m: f64,
+        kernel: RobustKernel,
+    ) -> Self {
+        Self {
+            variables: variable_list(&pose, &globals, false, true),
+            encoder_lengths_m: slots.to_slots(encoder_lengths_m),
+            slots,
+            globals,
+            pose,
+            sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
+            kernel,
+        }
+    }
+}
+
+impl Factor for RigidLengthFactor {
+    fn variables(&self) -> &[VariableId] {
+        &self.variables
+    }
+    fn residual_dim(&self) -> usize {
+        CABLE_COUNT
+    }
+    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        let (position, rotation) = pose_arguments(values, self.pose.pose);
+        let anchors = gather_anchors(values, &self.slots, &self.globals);
+        let offsets = gather_offsets(values, &self.slots, &self.globals);
+        let s = &self.slots;
+        let mut j_pose = SMatrix::<f64, 4, 6>::zeros();
+        let mut j_anchors = SMatrix::<f64, 4, 12>::zeros();
+        let mut j_offsets = SMatrix::<f64, 4, 4>::zeros();
+        let want = jacobians.is_some();
+        let r = generated::rigid_length_residual(
+            &position,
+            &rotation,
+            &anchors,
+            &s.attachments_m,
+            &offsets,
+            &self.encoder_lengths_m,
+            EPSILON,
+            want.then_some(&mut j_pose),
+            want.then_some(&mut j_anchors),
+            want.then_some(&mut j_offsets),
+        );
+        if let Some(blocks) = jacobians {
+            blocks[0].copy_from(&j_pose);
+            split_anchor_jacobian(&j_anchors, s, &mut blocks[1..5]);
+            split_offset_jacobian(&j_offsets, s, &mut blocks[5..9]);
+            rows_to_cables(s, blocks);
+        }
+        Some(slots_to_cables(s, &r))
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn robust_kernel(&self) -> RobustKernel {
+        self.kernel
+    }
+    fn kind(&self) -> &'static str {
+        "rigid_length"
+    }
+}

@@ -1,0 +1,829 @@
+//! Self-calibration (paper Sec. IV): estimate the four anchors and the four
+//! encoder length offsets from the robot's own sensors at static poses.
+//!
+//! The factor graph has, per pose `k`, the platform pose `X_k` and the
+//! reference-cable tension `(f_h, f_v)_k`, and globally the anchors `p_a,i`
+//! and offsets `l_i^0`. Factors: catenary length (eq. 14), attachment height
+//! (eq. 15), reference tension (eq. 16), pose prior, and a positivity guard
+//! on every cable's horizontal tension (inactive at the optimum).
+//!
+//! **Orientation.** The paper adds an orientation-correction variable
+//! `Delta R_k` so that the statics, not the localiser's orientation, decide
+//! how the platform hangs. sagcal's pose variable already carries the full
+//! orientation; by default the pose prior constrains only the *position*
+//! ([`CalibrationOptions::orientation_prior`] = false), which is exactly the
+//! paper's `Delta R` with no prior on it. A tight orientation prior would fight
+//! the statics wherever the localiser's orientation is off (the RecurDyn log
+//! is ~1.9 degrees off the equilibria) and bias the anchors.
+//!
+//! **Initialisation** ([`calibrate`]): (1) a rigid massless-cable calibration
+//! from the initial guess (a benign trilateration-like problem), (2) a per-pose
+//! warm-up: the statics (problem (a)) at each measured position and load-cell
+//! tension with the stage-1 anchors gives every pose a consistent orientation
+//! and tension, (3) the full catenary graph. Eq. (17)-(18) alone often start
+//! with negative tensions in other cables; this sequence does not.
+
+pub mod factors;
+
+use std::sync::Arc;
+
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::graph::{whitened_squared_norm, FactorGraph, RobustKernel, VariableId, VariableValue};
+use crate::io::measurements::PoseMeasurement;
+use crate::model::pose::PlatformPose;
+use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::sensors::SensorNoise;
+use crate::model::statics::{self, CableTension, Equilibrium, StaticsOptions};
+use crate::solver::{marginal_covariance, optimize, Covariance, LmParams, SolveSummary, UnobservableDirection};
+
+use factors::{
+    AttachmentHeightFactor, CalibrationVariables, CatenaryLengthFactor, PosePriorFactor, PoseVariables,
+    ReferenceTensionFactor, RigidLengthFactor, SlotOrder, TensionGuardFactor,
+};
+
+/// The cable model of the length factor.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CableModel {
+    /// Heavy inextensible cable (paper eq. 1-4, 14-16). The default.
+    Catenary,
+    /// Massless straight cable (the paper's Sec. VI-A baseline).
+    Rigid,
+}
+
+impl CableModel {
+    /// Parse `catenary` or `rigid`.
+    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+        match text {
+            "catenary" => Ok(CableModel::Catenary),
+            "rigid" => Ok(CableModel::Rigid),
+            other => Err(format!("unknown cable model `{other}` (catenary, rigid)")),
+        }
+    }
+}
+
+/// Robust kernels per factor type.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct RobustKernels {
+    /// On the encoder (length) factors.
+    pub encoder: RobustKernel,
+    /// On the load-cell factor.
+    pub load_cell: RobustKernel,
+    /// On the pose priors.
+    pub pose_prior: RobustKernel,
+}
+
+/// How to calibrate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CalibrationOptions {
+    /// Cable model of the final stage.
+    pub model: CableModel,
+    /// Sensor sigmas used as the factors' noise.
+    pub noise: SensorNoise,
+    /// Constrain the orientation by the localiser too (default: position only, see the module docs).
+    /// The rigid model always uses it: without statics nothing else fixes the orientation.
+    pub orientation_prior: bool,
+    /// Sigma of the attachment-height constraint, metres (a model equation: tight).
+    pub height_sigma_m: f64,
+    /// Robust kernels.
+    pub robust: RobustKernels,
+    /// Solver settings.
+    pub lm: LmParams,
+}
+
+impl CalibrationOptions {
+    /// Catenary model, position-only pose priors, 0.1 mm height constraint, no robust kernels.
+    pub fn new(noise: SensorNoise) -> Self {
+        Self {
+            model: CableModel::Catenary,
+            noise,
+            orientation_prior: false,
+            height_sigma_m: 1e-4,
+            robust: RobustKernels::default(),
+            lm: LmParams::default(),
+        }
+    }
+}
+
+/// One solver stage of a calibration.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StageSummary {
+    /// `rigid`, `catenary`.
+    pub name: String,
+    /// The solver's account.
+    pub summary: SolveSummary,
+}
+
+/// Normalised residuals `r / sigma` of one factor type at the solution.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FactorStatistics {
+    /// Factor type.
+    pub kind: String,
+    /// Number of factors.
+    pub factors: usize,
+    /// Number of residual components.
+    pub components: usize,
+    /// Root mean square of `r / sigma` (about 1 when the stated noise is right).
+    pub rms: f64,
+    /// Largest `|r / sigma|`.
+    pub max_abs: f64,
+    /// Sum of `(r / sigma)^2`.
+    pub chi_square: f64,
+}
+
+/// What the data say about the calibrated parameters' uncertainty.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum ParameterUncertainty {
+    /// The information matrix is full rank.
+    Full {
+        /// Per anchor, its 3x3 covariance, m^2 (row-major).
+        anchor_covariance_m2: Vec<[[f64; 3]; 3]>,
+        /// Per anchor, the 1-sigma of x, y, z, metres.
+        anchor_sigma_m: Vec<[f64; 3]>,
+        /// Per offset, its 1-sigma, metres.
+        offset_sigma_m: Vec<f64>,
+    },
+    /// Some directions of parameter space are not observable from these poses.
+    RankDeficient {
+        /// The unobservable directions.
+        directions: Vec<UnobservableDirection>,
+    },
+}
+
+/// The result of a calibration.
+#[derive(Debug, Clone)]
+pub struct CalibrationResult {
+    /// The calibrated robot (anchors and length offsets replaced).
+    pub robot: Robot,
+    /// Uncertainty of anchors and offsets.
+    pub uncertainty: ParameterUncertainty,
+    /// Solver stages in order.
+    pub stages: Vec<StageSummary>,
+    /// Residual statistics per factor type at the solution.
+    pub factor_statistics: Vec<FactorStatistics>,
+    /// Estimated platform poses.
+    pub poses: Vec<PlatformPose>,
+    /// Estimated reference tensions `(f_h, f_v)` (catenary model), newtons.
+    pub reference_tensions_n: Vec<[f64; 2]>,
+    /// Indices (into the measurements) of poses left out of the final stage:
+    /// no positive-tension equilibrium near them with the calibrated anchors.
+    pub excluded_poses: Vec<usize>,
+}
+
+impl CalibrationResult {
+    /// The last stage's summary.
+    pub fn final_stage(&self) -> &SolveSummary {
+        &self
+            .stages
+            .last()
+            .expect("a calibration has at least one stage")
+            .summary
+    }
+
+    /// Whether the last stage stopped at a minimum.
+    pub fn converged(&self) -> bool {
+        self.final_stage().termination.converged()
+    }
+}
+
+/// The minimum number of poses: each adds 8 unknowns (pose, reference tension)
+/// and 12 equations (4 encoders, 1 load cell, 3 position priors, 4 heights),
+/// so `4 N >= 16` global unknowns.
+pub const MIN_POSES: usize = 4;
+
+/// Check the measurements before building a problem.
+pub fn validate_measurements(measurements: &[PoseMeasurement]) -> Result<()> {
+    if measurements.len() < MIN_POSES {
+        return Err(Error::InvalidInput(format!(
+            "{} poses cannot determine 12 anchor coordinates and 4 offsets: each pose adds 4 independent equations, so at least {MIN_POSES} distinct poses are needed (the paper uses 9 to 35)",
+            measurements.len()
+        )));
+    }
+    let first = Vector3::from(measurements[0].position_m);
+    let spread = measurements
+        .iter()
+        .map(|m| (Vector3::from(m.position_m) - first).norm())
+        .fold(0.0, f64::max);
+    if spread < 1e-3 {
+        return Err(Error::InvalidInput(format!(
+            "all {} poses are at the same position ({:?}): the anchors are not observable from one place; move the platform across the workspace",
+            measurements.len(),
+            measurements[0].position_m
+        )));
+    }
+    for m in measurements {
+        let fields = m
+            .position_m
+            .iter()
+            .chain(&m.encoder_lengths_m)
+            .chain([&m.roll_deg, &m.pitch_deg, &m.yaw_deg]);
+        if fields.into_iter().any(|v| !v.is_finite())
+            || !(m.reference_tension_n.is_finite() && m.reference_tension_n > 0.0)
+        {
+            return Err(Error::InvalidInput(format!(
+                "pose at line {}: values must be finite and the tension positive",
+                m.line
+            )));
+        }
+    }
+    Ok(())
+}
+
+fn measured_pose(m: &PoseMeasurement) -> PlatformPose {
+    PlatformPose::from_roll_pitch_yaw_deg(Vector3::from(m.position_m), m.roll_deg, m.pitch_deg, m.yaw_deg)
+}
+
+/// The graph and its variable ids.
+pub struct CalibrationGraph {
+    /// The graph.
+    pub graph: FactorGraph,
+    /// Anchors and offsets.
+    pub globals: CalibrationVariables,
+    /// Per pose.
+    pub poses: Vec<PoseVariables>,
+}
+
+/// Build the graph for `model` with initial values: anchors/offsets from
+/// `robot`, poses from `poses`, reference tensions from `tensions`.
+pub fn build_graph(
+    robot: &Robot,
+    measurements: &[PoseMeasurement],
+    poses: &[PlatformPose],
+    tensions: &[CableTension],
+    model: CableModel,
+    options: &CalibrationOptions,
+) -> CalibrationGraph {
+    let mut graph = FactorGraph::new();
+    let anchors = std::array::from_fn(|i| {
+        graph.values.insert(
+            format!("anchor {}", i + 1),
+            VariableValue::Vector(DVector::from_column_slice(robot.anchors_m[i].as_slice())),
+        )
+    });
+    let length_offsets = std::array::from_fn(|i| {
+        graph.values.insert(
+            format!("length offset {}", i + 1),
+            VariableValue::Vector(DVector::from_element(1, robot.length_offsets_m[i])),
+        )
+    });
+    let globals = CalibrationVariables {
+        anchors,
+        length_offsets,
+    };
+    let slots = Arc::new(SlotOrder::new(robot));
+    let noise = &options.noise;
+    let mut pose_variables = Vec::with_capacity(measurements.len());
+    for (k, m) in measurements.iter().enumerate() {
+        let pose = graph
+            .values
+            .insert(format!("pose {}", k + 1), VariableValue::Pose(poses[k]));
+        let reference_tension = graph.values.insert(
+            format!("reference tension {}", k + 1),
+            VariableValue::Vector(DVector::from_row_slice(&[
+                tensions[k].horizontal_n,
+                tensions[k].vertical_n,
+            ])),
+        );
+        let vars = PoseVariables {
+            pose,
+            reference_tension,
+        };
+        let orientation_sigma =
+            (options.orientation_prior || model == CableModel::Rigid).then_some(noise.orientation_sigma_rad);
+        graph.add(PosePriorFactor::new(
+            pose,
+            &measured_pose(m),
+            noise.position_sigma_m,
+            orientation_sigma,
+            options.robust.pose_prior,
+        ));
+        match model {
+            CableModel::Rigid => {
+                graph.values.set_fixed(reference_tension, true);
+                graph.add(RigidLengthFactor::new(
+                    slots.clone(),
+                    globals,
+                    vars,
+                    &m.encoder_lengths_m,
+                    noise.encoder_sigma_m,
+                    options.robust.encoder,
+                ));
+            }
+            CableModel::Catenary => {
+                graph.add(CatenaryLengthFactor::new(
+                    slots.clone(),
+                    globals,
+                    vars,
+                    &m.encoder_lengths_m,
+                    noise.encoder_sigma_m,
+                    options.robust.encoder,
+                ));
+                graph.add(AttachmentHeightFactor::new(
+                    slots.clone(),
+                    globals,
+                    vars,
+                    options.height_sigma_m,
+                ));
+                graph.add(ReferenceTensionFactor::new(
+                    reference_tension,
+                    m.reference_tension_n,
+                    noise.load_cell_sigma_n,
+                    options.robust.load_cell,
+                ));
+                graph.add(TensionGuardFactor::new(
+                    slots.clone(),
+                    globals,
+                    vars,
+                    0.01 * robot.platform_weight_n / CABLE_COUNT as f64,
+                    0.01 * robot.platform_weight_n / CABLE_COUNT as f64,
+                ));
+            }
+        }
+        pose_variables.push(vars);
+    }
+    CalibrationGraph {
+        graph,
+        globals,
+        poses: pose_variables,
+    }
+}
+
+/// The robot with the graph's current anchors and offsets.
+pub fn robot_from_graph(template: &Robot, built: &CalibrationGraph) -> Robot {
+    let mut robot = template.clone();
+    for i in 0..CABLE_COUNT {
+        let a = built.graph.values.vector(built.globals.anchors[i]);
+        robot.anchors_m[i] = Vector3::new(a[0], a[1], a[2]);
+        robot.length_offsets_m[i] = built.graph.values.vector(built.globals.length_offsets[i])[0];
+    }
+    robot
+}
+
+/// Eq. (17)-(18): `f_v = m_e g / 4`, `f_h = f_v / tan(alpha)`, alpha the angle
+/// between the reference cable's chord and the horizontal. Only a fallback.
+fn paper_initial_tension(robot: &Robot, pose: &PlatformPose) -> CableTension {
+    let geometry = statics::cable_geometry(robot, pose)[robot.reference_cable];
+    let vertical = robot.platform_weight_n / CABLE_COUNT as f64;
+    let alpha = geometry.height_difference_m.atan2(geometry.span_m).max(1e-3);
+    CableTension {
+        horizontal_n: vertical / alpha.tan(),
+        vertical_n: vertical,
+    }
+}
+
+/// The per-pose warm-up: a start for every pose.
+struct WarmUp {
+    poses: Vec<PlatformPose>,
+    tensions: Vec<CableTension>,
+    /// Poses without an equilibrium (their start is the measured pose and eq. 17-18).
+    failures: Vec<usize>,
+    equilibria: Vec<Option<Equilibrium>>,
+    /// Poses with an equilibrium, filled by the caller.
+    feasible: Vec<usize>,
+}
+
+/// Per-pose warm-up: the static equilibrium at each measured position and
+/// load-cell tension for `robot`'s current anchors (or, where that tension has
+/// none, the nearest tension that has one). Poses without any start from the
+/// measured pose and eq. (17)-(18) and are listed as failures.
+fn warm_up(robot: &Robot, measurements: &[PoseMeasurement]) -> WarmUp {
+    let options = StaticsOptions::default();
+    let mut warm = WarmUp {
+        poses: Vec::with_capacity(measurements.len()),
+        tensions: Vec::with_capacity(measurements.len()),
+        failures: Vec::new(),
+        equilibria: Vec::with_capacity(measurements.len()),
+        feasible: Vec::new(),
+    };
+    for (k, m) in measurements.iter().enumerate() {
+        let measured = measured_pose(m);
+        let solved = statics::solve_with_reference_tension(
+            robot,
+            measured.position_m,
+            m.reference_tension_n,
+            Some(measured.rotation),
+            &options,
+        )
+        .or_else(|_| {
+            statics::feasible_start(robot, measured.position_m, Some(measured.rotation), &options).map(|(_, eq)| eq)
+        });
+        match solved {
+            Ok(eq) => {
+                warm.poses.push(eq.pose);
+                warm.tensions.push(eq.tensions[robot.reference_cable]);
+                warm.equilibria.push(Some(eq));
+            }
+            Err(_) => {
+                warm.failures.push(k);
+                warm.poses.push(measured);
+                warm.tensions.push(paper_initial_tension(robot, &measured));
+                warm.equilibria.push(None);
+            }
+        }
+    }
+    warm
+}
+
+fn solve_stage(name: &str, built: &mut CalibrationGraph, lm: &LmParams) -> Result<StageSummary> {
+    let summary = optimize(&mut built.graph, lm).map_err(|e| Error::InvalidInput(format!("{name} stage: {e}")))?;
+    Ok(StageSummary {
+        name: name.to_string(),
+        summary,
+    })
+}
+
+/// Closed-form length offsets for fixed geometry: the offsets enter the
+/// encoder factors linearly, so the least-squares value is the mean of
+/// `encoder - catenary length` over the poses.
+fn offsets_in_closed_form(
+    robot: &Robot,
+    measurements: &[PoseMeasurement],
+    equilibria: &[Option<Equilibrium>],
+) -> [f64; CABLE_COUNT] {
+    std::array::from_fn(|i| {
+        let differences: Vec<f64> = measurements
+            .iter()
+            .zip(equilibria)
+            .filter_map(|(m, eq)| eq.as_ref().map(|eq| m.encoder_lengths_m[i] - eq.cable_lengths_m[i]))
+            .collect();
+        if differences.is_empty() {
+            robot.length_offsets_m[i]
+        } else {
+            differences.iter().sum::<f64>() / differences.len() as f64
+        }
+    })
+}
+
+/// Calibrate anchors and length offsets from `measurements`, starting from `initial`.
+///
+/// Stages (see the module docs): for the catenary model, (1) per-pose statics
+/// at the initial anchors and the closed-form offsets, (2) the full graph. If
+/// the initial anchors are so far off that most poses have no equilibrium, a
+/// rigid-cable calibration first moves them closer. For the rigid model, the
+/// rigid graph alone.
+pub fn calibrate(
+    initial: &Robot,
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+) -> Result<CalibrationResult> {
+    validate_measurements(measurements)?;
+    let measured: Vec<PlatformPose> = measurements.iter().map(measured_pose).collect();
+    let mut stages = Vec::new();
+    if options.model == CableModel::Rigid {
+        let placeholder: Vec<CableTension> = measured.iter().map(|p| paper_initial_tension(initial, p)).collect();
+        let mut start = initial.clone();
+        let chords: Vec<Option<Equilibrium>> = vec![None; measurements.len()];
+        start.length_offsets_m = rigid_offsets_in_closed_form(initial, measurements, &measured, &chords);
+        let mut rigid = build_graph(
+            &start,
+            measurements,
+            &measured,
+            &placeholder,
+            CableModel::Rigid,
+            options,
+        );
+        stages.push(solve_stage("rigid", &mut rigid, &options.lm)?);
+        return finish(initial, rigid, stages, Vec::new());
+    }
+    // Two candidate starts: the initial guess, and a rigid-cable calibration
+    // from it (close on robots whose cables barely sag, biased where they sag
+    // a lot). Each is warmed up (per-pose statics, closed-form offsets); the
+    // one with the lower relaxed catenary cost wins.
+    let relaxed_options = CalibrationOptions {
+        height_sigma_m: options.height_sigma_m.max(options.noise.encoder_sigma_m),
+        ..*options
+    };
+    let placeholder: Vec<CableTension> = measured.iter().map(|p| paper_initial_tension(initial, p)).collect();
+    let mut rigid_start = initial.clone();
+    rigid_start.length_offsets_m = rigid_offsets_in_closed_form(initial, measurements, &measured, &[]);
+    let mut rigid = build_graph(
+        &rigid_start,
+        measurements,
+        &measured,
+        &placeholder,
+        CableModel::Rigid,
+        options,
+    );
+    let rigid_stage = solve_stage("rigid", &mut rigid, &options.lm)?;
+    let rigid_robot = robot_from_graph(initial, &rigid);
+    let mut best: Option<(f64, Robot, WarmUp)> = None;
+    for candidate in [initial.clone(), rigid_robot] {
+        let mut warm = warm_up(&candidate, measurements);
+        let mut start = candidate;
+        start.length_offsets_m = offsets_in_closed_form(&start, measurements, &warm.equilibria);
+        let feasible: Vec<usize> = (0..measurements.len())
+            .filter(|k| warm.equilibria[*k].is_some())
+            .collect();
+        if feasible.len() < MIN_POSES {
+            continue;
+        }
+        let chosen: Vec<PoseMeasurement> = feasible.iter().map(|&k| measurements[k]).collect();
+        let poses: Vec<PlatformPose> = feasible.iter().map(|&k| warm.poses[k]).collect();
+        let tensions: Vec<CableTension> = feasible.iter().map(|&k| warm.tensions[k]).collect();
+        let graph = build_graph(
+            &start,
+            &chosen,
+            &poses,
+            &tensions,
+            CableModel::Catenary,
+            &relaxed_options,
+        );
+        // Compare per pose, so that a start with more feasible poses is not penalised.
+        let Some(cost) = graph.graph.cost(&graph.graph.values) else {
+            continue;
+        };
+        let score = cost / feasible.len() as f64 * (1.0 + (measurements.len() - feasible.len()) as f64);
+        warm.feasible = feasible;
+        if best.as_ref().is_none_or(|(b, _, _)| score < *b) {
+            best = Some((score, start, warm));
+        }
+    }
+    stages.push(rigid_stage);
+    let Some((_, start, warm)) = best else {
+        return Err(Error::NoEquilibrium(format!(
+            "fewer than {MIN_POSES} of {} poses have a positive-tension equilibrium at the initial anchors or at a rigid-cable calibration of them: the initial guess is too far off",
+            measurements.len()
+        )));
+    };
+    let WarmUp {
+        poses,
+        tensions,
+        feasible,
+        ..
+    } = warm;
+    // Continuation on the statics constraint: a tight attachment-height sigma
+    // makes the cost a narrow curved valley that Gauss-Newton follows in tiny
+    // steps from far away; solving first with it relaxed to the encoder sigma
+    // brings the estimate close, then the tight constraint converges in a few
+    // steps. Poses without an equilibrium at the initial anchors sit out the
+    // relaxed stage and are warmed up again with its anchors.
+    let subset = |indices: &[usize]| -> (Vec<PoseMeasurement>, Vec<PlatformPose>, Vec<CableTension>) {
+        (
+            indices.iter().map(|&k| measurements[k]).collect(),
+            indices.iter().map(|&k| poses[k]).collect(),
+            indices.iter().map(|&k| tensions[k]).collect(),
+        )
+    };
+    let (relaxed_measurements, relaxed_poses, relaxed_tensions) = subset(&feasible);
+    let mut relaxed = build_graph(
+        &start,
+        &relaxed_measurements,
+        &relaxed_poses,
+        &relaxed_tensions,
+        CableModel::Catenary,
+        &relaxed_options,
+    );
+    stages.push(solve_stage("catenary (relaxed statics)", &mut relaxed, &options.lm)?);
+    let relaxed_robot = robot_from_graph(initial, &relaxed);
+    // Final stage: the relaxed solution, plus the poses that sat out, warmed up
+    // with the relaxed anchors (left out if they still have no equilibrium).
+    let WarmUp {
+        poses: rewarmed_poses,
+        tensions: rewarmed_tensions,
+        failures: still_failing,
+        ..
+    } = warm_up(&relaxed_robot, measurements);
+    let mut final_poses = Vec::new();
+    let mut final_tensions = Vec::new();
+    let mut final_measurements = Vec::new();
+    let mut excluded = Vec::new();
+    for k in 0..measurements.len() {
+        if let Some(slot) = feasible.iter().position(|&f| f == k) {
+            let vars = relaxed.poses[slot];
+            let t = relaxed.graph.values.vector(vars.reference_tension);
+            final_poses.push(*relaxed.graph.values.pose(vars.pose));
+            final_tensions.push(CableTension {
+                horizontal_n: t[0],
+                vertical_n: t[1],
+            });
+        } else if still_failing.contains(&k) {
+            excluded.push(k);
+            continue;
+        } else {
+            final_poses.push(rewarmed_poses[k]);
+            final_tensions.push(rewarmed_tensions[k]);
+        }
+        final_measurements.push(measurements[k]);
+    }
+    if final_measurements.len() < MIN_POSES {
+        return Err(Error::NoEquilibrium(format!(
+            "only {} of {} poses have a positive-tension equilibrium at the calibrated anchors",
+            final_measurements.len(),
+            measurements.len()
+        )));
+    }
+    let mut full = build_graph(
+        &relaxed_robot,
+        &final_measurements,
+        &final_poses,
+        &final_tensions,
+        CableModel::Catenary,
+        options,
+    );
+    stages.push(solve_stage("catenary", &mut full, &options.lm)?);
+    finish(initial, full, stages, excluded)
+}
+
+/// Closed-form offsets for the straight-cable model: mean of `encoder - chord`.
+fn rigid_offsets_in_closed_form(
+    robot: &Robot,
+    measurements: &[PoseMeasurement],
+    poses: &[PlatformPose],
+    _equilibria: &[Option<Equilibrium>],
+) -> [f64; CABLE_COUNT] {
+    std::array::from_fn(|i| {
+        measurements
+            .iter()
+            .zip(poses)
+            .map(|(m, p)| {
+                let attachment = p.position_m + p.rotation_matrix() * robot.attachments_m[i];
+                m.encoder_lengths_m[i] - (robot.anchors_m[i] - attachment).norm()
+            })
+            .sum::<f64>()
+            / measurements.len() as f64
+    })
+}
+
+fn finish(
+    template: &Robot,
+    built: CalibrationGraph,
+    stages: Vec<StageSummary>,
+    excluded_poses: Vec<usize>,
+) -> Result<CalibrationResult> {
+    let robot = robot_from_graph(template, &built);
+    let uncertainty = parameter_uncertainty(&built)?;
+    let factor_statistics = factor_statistics(&built.graph);
+    let poses = built.poses.iter().map(|p| *built.graph.values.pose(p.pose)).collect();
+    let reference_tensions_n = built
+        .poses
+        .iter()
+        .map(|p| {
+            let t = built.graph.values.vector(p.reference_tension);
+            [t[0], t[1]]
+        })
+        .collect();
+    Ok(CalibrationResult {
+        robot,
+        uncertainty,
+        stages,
+        factor_statistics,
+        poses,
+        reference_tensions_n,
+        excluded_poses,
+    })
+}
+
+/// Marginal covariance of anchors and offsets at the graph's current values.
+pub fn parameter_uncertainty(built: &CalibrationGraph) -> Result<ParameterUncertainty> {
+    let selected: Vec<VariableId> = built
+        .globals
+        .anchors
+        .iter()
+        .chain(&built.globals.length_offsets)
+        .copied()
+        .collect();
+    let covariance = marginal_covariance(&built.graph, &selected).map_err(Error::InvalidInput)?;
+    Ok(match covariance {
+        Covariance::Full(c) => uncertainty_from_covariance(&c),
+        Covariance::RankDeficient(directions) => ParameterUncertainty::RankDeficient { directions },
+    })
+}
+
+fn uncertainty_from_covariance(c: &DMatrix<f64>) -> ParameterUncertainty {
+    let anchor_covariance_m2: Vec<[[f64; 3]; 3]> = (0..CABLE_COUNT)
+        .map(|i| std::array::from_fn(|r| std::array::from_fn(|col| c[(3 * i + r, 3 * i + col)])))
+        .collect();
+    let anchor_sigma_m = anchor_covariance_m2
+        .iter()
+        .map(|m| std::array::from_fn(|k| m[k][k].max(0.0).sqrt()))
+        .collect();
+    let offset_sigma_m = (0..CABLE_COUNT).map(|i| c[(12 + i, 12 + i)].max(0.0).sqrt()).collect();
+    ParameterUncertainty::Full {
+        anchor_covariance_m2,
+        anchor_sigma_m,
+        offset_sigma_m,
+    }
+}
+
+/// Per factor type: count, RMS and max of the normalised residuals.
+pub fn factor_statistics(graph: &FactorGraph) -> Vec<FactorStatistics> {
+    let mut stats: Vec<FactorStatistics> = Vec::new();
+    for factor in &graph.factors {
+        let Some(residual) = factor.evaluate(&graph.values, None) else {
+            continue;
+        };
+        let sigmas = factor.sigmas();
+        let s = whitened_squared_norm(&residual, sigmas);
+        let max_abs = residual
+            .iter()
+            .zip(sigmas.iter())
+            .map(|(r, s)| (r / s).abs())
+            .fold(0.0, f64::max);
+        let entry = match stats.iter_mut().find(|e| e.kind == factor.kind()) {
+            Some(e) => e,
+            None => {
+                stats.push(FactorStatistics {
+                    kind: factor.kind().to_string(),
+                    factors: 0,
+                    components: 0,
+                    rms: 0.0,
+                    max_abs: 0.0,
+                    chi_square: 0.0,
+                });
+                stats.last_mut().expect("just pushed")
+            }
+        };
+        entry.factors += 1;
+        entry.components += residual.len();
+        entry.chi_square += s;
+        entry.max_abs = entry.max_abs.max(max_abs);
+    }
+    for e in &mut stats {
+        e.rms = (e.chi_square / e.components.max(1) as f64).sqrt();
+    }
+    stats
+}
+
+/// The Cramer-Rao bound of anchors and offsets: the inverse Fisher information
+/// `(J^T Sigma^-1 J)^-1` at the true parameters and true equilibria, for the
+/// factors of `options` (no robust kernels).
+pub fn cramer_rao_bound(
+    truth: &Robot,
+    equilibria: &[Equilibrium],
+    options: &CalibrationOptions,
+) -> Result<ParameterUncertainty> {
+    let measurements: Vec<PoseMeasurement> = equilibria
+        .iter()
+        .map(|eq| {
+            let (roll_deg, pitch_deg, yaw_deg) = eq.pose.roll_pitch_yaw_deg();
+            PoseMeasurement {
+                line: 0,
+                position_m: eq.pose.position_m.into(),
+                roll_deg,
+                pitch_deg,
+                yaw_deg,
+                encoder_lengths_m: std::array::from_fn(|i| eq.cable_lengths_m[i] + truth.length_offsets_m[i]),
+                reference_tension_n: eq.tensions[truth.reference_cable].magnitude_n(),
+            }
+        })
+        .collect();
+    let poses: Vec<PlatformPose> = equilibria.iter().map(|e| e.pose).collect();
+    let tensions: Vec<CableTension> = equilibria.iter().map(|e| e.tensions[truth.reference_cable]).collect();
+    let plain = CalibrationOptions {
+        robust: RobustKernels::default(),
+        ..*options
+    };
+    let built = build_graph(truth, &measurements, &poses, &tensions, options.model, &plain);
+    parameter_uncertainty(&built)
+}
+
+/// Anchor and offset errors of a calibrated robot against the truth.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CalibrationError {
+    /// Mean over anchors of the Euclidean error, metres (the authors' program's metric).
+    pub anchor_mean_euclidean_m: f64,
+    /// Mean absolute error over the 12 anchor coordinates, metres.
+    pub anchor_coordinate_mae_m: f64,
+    /// Largest Euclidean anchor error, metres.
+    pub anchor_max_euclidean_m: f64,
+    /// Mean absolute offset error, metres.
+    pub offset_mae_m: f64,
+}
+
+impl CalibrationError {
+    /// Compare `estimate` with `truth`.
+    pub fn between(estimate: &Robot, truth: &Robot) -> Self {
+        let anchor: Vec<Vector3<f64>> = (0..CABLE_COUNT)
+            .map(|i| estimate.anchors_m[i] - truth.anchors_m[i])
+            .collect();
+        let euclid: Vec<f64> = anchor.iter().map(|d| d.norm()).collect();
+        Self {
+            anchor_mean_euclidean_m: euclid.iter().sum::<f64>() / CABLE_COUNT as f64,
+            anchor_coordinate_mae_m: anchor.iter().map(|d| d.abs().sum()).sum::<f64>() / (3 * CABLE_COUNT) as f64,
+            anchor_max_euclidean_m: euclid.iter().copied().fold(0.0, f64::max),
+            offset_mae_m: (0..CABLE_COUNT)
+                .map(|i| (estimate.length_offsets_m[i] - truth.length_offsets_m[i]).abs())
+                .sum::<f64>()
+                / CABLE_COUNT as f64,
+        }
+    }
+}
+
+/// Per anchor, `sqrt(trace Sigma_i)`: the RMS Euclidean error the bound allows, metres.
+pub fn anchor_rms_bound_m(uncertainty: &ParameterUncertainty) -> Option<Vec<f64>> {
+    match uncertainty {
+        ParameterUncertainty::Full {
+            anchor_covariance_m2, ..
+        } => Some(
+            anchor_covariance_m2
+                .iter()
+                .map(|m| Matrix3::from_fn(|r, c| m[r][c]).trace().max(0.0).sqrt())
+                .collect(),
+        ),
+        ParameterUncertainty::RankDeficient { .. } => None,
+    }
+}

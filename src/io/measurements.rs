@@ -1,0 +1,565 @@
+//! sagcal's own measurement file: one static pose per row, the input of the
+//! calibration. [`read_measurements`] also reads RecurDyn logs (see
+//! [`crate::io::recurdyn`]) and converts them to the same measurements.
+//!
+//! # Format
+//!
+//! A CSV table with exactly this header:
+//!
+//! ```text
+//! x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,l1_m,l2_m,l3_m,l4_m,f_ref_n
+//! ```
+//!
+//! and one row per static pose:
+//!
+//! | columns | meaning | unit |
+//! |---|---|---|
+//! | `x_m`, `y_m`, `z_m` | localiser position of the platform frame origin in the world frame | m |
+//! | `roll_deg`, `pitch_deg`, `yaw_deg` | localiser orientation, `R = Rz(yaw) Ry(pitch) Rx(roll)` | degrees |
+//! | `l1_m` .. `l4_m` | encoder reading of cable 1..4: the true cable length plus an unknown per-cable offset | m |
+//! | `f_ref_n` | load-cell tension of the reference cable at the platform attachment | N |
+//!
+//! * Every value is a plain finite number (`12`, `-0.5`, `1.25e-3`; no quotes,
+//!   no `NaN`, no `inf`). Surrounding spaces are ignored.
+//! * Encoder readings carry an unknown offset, so any finite value is allowed,
+//!   zero and negative ones included.
+//! * `f_ref_n` is a tension magnitude and must be positive.
+//! * Lines whose first non-blank character is `#` are comments, anywhere in
+//!   the file, before the header too (`# simulated by sagcal, seed 7`). Blank
+//!   lines are ignored. Line endings may be `\n` or `\r\n`, and a UTF-8
+//!   byte-order mark at the start is ignored.
+//! * The file must hold at least one row.
+//!
+//! Example:
+//!
+//! ```text
+//! # simulated by sagcal, seed 7
+//! x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,l1_m,l2_m,l3_m,l4_m,f_ref_n
+//! 9.94283158474076,9.93145571155357,15.9060269359906,-1.06322173025346,-0.19122393512445,0.971850603803798,183.324069126233,169.162981532604,155.642263929178,170.927219368362,698.722056942942
+//! ```
+//!
+//! Errors name the file, the line (1-based, comments and blank lines counted)
+//! and the column. [`write_measurements`] writes numbers with full
+//! round-trip precision, so writing and reading back gives bit-identical values.
+//!
+//! # RecurDyn logs
+//!
+//! [`read_measurements`] recognises the RecurDyn header
+//! (`x,y,z,pitch,roll,yaw,L1,..,L4,fc1,fz1,fh1,..,fc4,fz4,fh4,`) and reads the
+//! file with [`read_recurdyn`]: position and angles as logged, the encoder
+//! readings are the simulated cable lengths (offset zero), and the reference
+//! tension is the total tension `fc` of the reference cable
+//! ([`ReadOptions::reference_cable`]). Rows the RecurDyn loader rejects, and
+//! rows without a tension for the reference cable, are listed in
+//! [`MeasurementSet::rejected`] with the reason.
+
+use std::ffi::OsString;
+use std::fs::{File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::io::recurdyn::{looks_like_recurdyn, read_recurdyn, LoadOptions, RecurDynRow, RejectedRow};
+
+/// The header of a sagcal measurement file, in column order.
+pub const MEASUREMENT_HEADER: [&str; 11] = [
+    "x_m",
+    "y_m",
+    "z_m",
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "l1_m",
+    "l2_m",
+    "l3_m",
+    "l4_m",
+    "f_ref_n",
+];
+
+/// Number of columns of a sagcal measurement file.
+const N_COLUMNS: usize = MEASUREMENT_HEADER.len();
+/// Index of `f_ref_n`.
+const F_REF: usize = 10;
+/// Number of cables (RecurDyn tension columns).
+const N_CABLES: usize = 4;
+/// The start of the RecurDyn header, for messages.
+const RECURDYN_HEADER: &str = "x,y,z,pitch,roll,yaw,L1,L2,L3,L4,fc1,fz1,fh1,fc2,fz2,fh2,fc3,fz3,fh3,fc4,fz4,fh4,";
+/// At most this many rejection reasons are quoted when every row is rejected.
+const MAX_QUOTED_REASONS: usize = 3;
+
+/// One static pose: localiser pose, encoder readings and load-cell tension.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PoseMeasurement {
+    /// 1-based line in the file it was read from (comments and blank lines
+    /// counted, the header of a comment-free file is line 1); 0 for in-memory data.
+    pub line: usize,
+    /// Localiser position of the platform frame origin in the world frame, metres.
+    pub position_m: [f64; 3],
+    /// Roll angle (rotation about x, applied first), degrees.
+    pub roll_deg: f64,
+    /// Pitch angle (rotation about y), degrees.
+    pub pitch_deg: f64,
+    /// Yaw angle (rotation about z, applied last), degrees: `R = Rz(yaw) Ry(pitch) Rx(roll)`.
+    pub yaw_deg: f64,
+    /// Encoder readings of cables 1..4, metres: true cable length plus an
+    /// unknown per-cable offset (any finite value).
+    pub encoder_lengths_m: [f64; 4],
+    /// Load-cell tension of the reference cable at the platform attachment, newtons (positive).
+    pub reference_tension_n: f64,
+}
+
+/// The format a measurement file was read from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum MeasurementFormat {
+    /// sagcal's own measurement file (this module).
+    Sagcal,
+    /// A RecurDyn finite-element log ([`crate::io::recurdyn`]).
+    RecurDyn,
+}
+
+/// The measurements of one file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasurementSet {
+    /// The file that was read.
+    pub path: PathBuf,
+    /// The format it was in.
+    pub format: MeasurementFormat,
+    /// The poses, in file order; never empty.
+    pub poses: Vec<PoseMeasurement>,
+    /// Rows left out, with the reason, in file order (RecurDyn logs only;
+    /// empty for sagcal files, where every problem is an error).
+    pub rejected: Vec<RejectedRow>,
+}
+
+/// Options of [`read_measurements`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ReadOptions {
+    /// 0-based index of the cable whose RecurDyn tension column is the load
+    /// cell (0: `fc1`). Must be below 4; only used for RecurDyn logs.
+    pub reference_cable: usize,
+    /// Keep RecurDyn rows that are rounded hand transcriptions (see
+    /// [`LoadOptions::keep_rounded`]); ignored for sagcal files.
+    pub keep_rounded: bool,
+}
+
+/// Read a measurement file, sagcal's own format or a RecurDyn log, told apart
+/// by the header (the first line that is neither blank nor a comment).
+///
+/// Malformed input is an error naming the file (and the line and column when
+/// the problem is in one value): [`Error::Io`] when the file cannot be read,
+/// [`Error::Format`] for a header of neither format or a file without rows,
+/// [`Error::Field`] for a row with the wrong number of fields, a value that is
+/// not a finite number, or a tension that is not positive.
+/// [`Error::InvalidInput`] when `options.reference_cable` is not below 4.
+pub fn read_measurements(path: &Path, options: &ReadOptions) -> Result<MeasurementSet> {
+    if options.reference_cable >= N_CABLES {
+        return Err(Error::InvalidInput(format!(
+            "reference cable index {} is out of range: cables are numbered 0..{} (0-based)",
+            options.reference_cable,
+            N_CABLES - 1
+        )));
+    }
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = bytes.strip_prefix(b"\xef\xbb\xbf".as_slice()).unwrap_or(&bytes);
+    let mut lines = bytes
+        .split(|b| *b == b'\n')
+        .map(|l| l.strip_suffix(b"\r").unwrap_or(l))
+        .enumerate()
+        .map(|(i, l)| (i + 1, l));
+
+    let mut first_comment = None;
+    let (header_line, header) = loop {
+        match lines.next() {
+            None => {
+                return Err(format_error(
+                    path,
+                    format!(
+                        "empty file: expected the header `{}` of a sagcal measurement file (or a RecurDyn log)",
+                        MEASUREMENT_HEADER.join(",")
+                    ),
+                ));
+            }
+            Some((_, l)) if is_blank(l) => {}
+            Some((n, l)) if is_comment(l) => {
+                first_comment.get_or_insert(n);
+            }
+            Some(found) => break found,
+        }
+    };
+    let header_text = String::from_utf8_lossy(header);
+    let header_fields: Vec<&str> = header_text.split(',').collect();
+
+    if let Some(why) = sagcal_header_mismatch(&header_fields) {
+        if looks_like_recurdyn(&header_fields) {
+            if let Some(comment) = first_comment {
+                return Err(format_error(
+                    path,
+                    format!(
+                        "line {header_line} is a RecurDyn log header, but RecurDyn logs cannot hold comments: remove \
+                         line {comment} and the other comment lines before the header"
+                    ),
+                ));
+            }
+            return read_recurdyn_measurements(path, options);
+        }
+        return Err(format_error(
+            path,
+            format!(
+                "line {header_line}: not a measurement file header ({why}): expected the sagcal header `{}`; \
+                 RecurDyn logs (header `{RECURDYN_HEADER}`) are accepted too; found `{}`",
+                MEASUREMENT_HEADER.join(","),
+                header_text.escape_debug()
+            ),
+        ));
+    }
+
+    let mut poses = Vec::new();
+    for (line, text) in lines {
+        if is_blank(text) || is_comment(text) {
+            continue;
+        }
+        poses.push(parse_row(text, line, path)?);
+    }
+    if poses.is_empty() {
+        return Err(format_error(
+            path,
+            format!("no measurements: the file holds the header (line {header_line}) but no data rows"),
+        ));
+    }
+    Ok(MeasurementSet {
+        path: path.to_path_buf(),
+        format: MeasurementFormat::Sagcal,
+        poses,
+        rejected: Vec::new(),
+    })
+}
+
+/// Write `poses` as a sagcal measurement file, `comments` first as `# ...`
+/// lines (a comment with line breaks becomes several comment lines).
+///
+/// Every value is checked first (finite; reference tension positive; at
+/// least one pose): invalid data is an [`Error::InvalidInput`] naming the
+/// file, the row and the column, and nothing is written. The file is written
+/// to a temporary file in the same directory and renamed over `path`, so on
+/// any error `path` is left as it was and no temporary file remains. Numbers
+/// are written with Rust's shortest round-trip representation, so
+/// [`read_measurements`] gives back bit-identical values.
+pub fn write_measurements(path: &Path, comments: &[String], poses: &[PoseMeasurement]) -> Result<()> {
+    validate_for_writing(path, poses)?;
+
+    let mut text = String::new();
+    for comment in comments {
+        // `str::lines` drops a final empty line: keep an empty comment as one `#` line.
+        let mut parts: Vec<&str> = comment.lines().collect();
+        if parts.is_empty() {
+            parts.push("");
+        }
+        for part in parts {
+            if part.is_empty() {
+                text.push_str("#\n");
+            } else {
+                text.push_str("# ");
+                text.push_str(part);
+                text.push('\n');
+            }
+        }
+    }
+    text.push_str(&MEASUREMENT_HEADER.join(","));
+    text.push('\n');
+    for pose in poses {
+        let values = pose_values(pose);
+        let fields: Vec<String> = values.iter().map(|v| format!("{v}")).collect();
+        text.push_str(&fields.join(","));
+        text.push('\n');
+    }
+    write_atomically(path, text.as_bytes())
+}
+
+/// The 11 values of a pose, in column order.
+fn pose_values(pose: &PoseMeasurement) -> [f64; N_COLUMNS] {
+    let [x, y, z] = pose.position_m;
+    let [l1, l2, l3, l4] = pose.encoder_lengths_m;
+    [
+        x,
+        y,
+        z,
+        pose.roll_deg,
+        pose.pitch_deg,
+        pose.yaw_deg,
+        l1,
+        l2,
+        l3,
+        l4,
+        pose.reference_tension_n,
+    ]
+}
+
+/// Refuse data that [`read_measurements`] would not read back.
+fn validate_for_writing(path: &Path, poses: &[PoseMeasurement]) -> Result<()> {
+    if poses.is_empty() {
+        return Err(Error::InvalidInput(format!(
+            "refusing to write {}: no measurements (a measurement file needs at least one row)",
+            path.display()
+        )));
+    }
+    for (i, pose) in poses.iter().enumerate() {
+        for (column, value) in MEASUREMENT_HEADER.iter().zip(pose_values(pose)) {
+            let problem = if !value.is_finite() {
+                Some(format!("not a finite number: {value}"))
+            } else if *column == MEASUREMENT_HEADER[F_REF] {
+                tension_problem(value)
+            } else {
+                None
+            };
+            if let Some(problem) = problem {
+                let source = if pose.line > 0 {
+                    format!(" (line {} of its source)", pose.line)
+                } else {
+                    String::new()
+                };
+                return Err(Error::InvalidInput(format!(
+                    "refusing to write {}: row {} of {}{source}, field `{column}`: {problem}",
+                    path.display(),
+                    i + 1,
+                    poses.len()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// What is wrong with a reference tension, if anything (`value` is finite).
+fn tension_problem(value: f64) -> Option<String> {
+    if value == 0.0 {
+        Some("zero tension: the reference tension must be positive".to_string())
+    } else if value < 0.0 {
+        Some(format!(
+            "negative tension: the reference tension must be positive, got {value} N"
+        ))
+    } else {
+        None
+    }
+}
+
+/// Distinguishes temporary files of concurrent writers in one process.
+static TEMP_COUNTER: AtomicUsize = AtomicUsize::new(0);
+
+/// Write `bytes` to a new temporary file next to `path`, then rename it to `path`.
+fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    let Some(file_name) = path.file_name() else {
+        return Err(Error::InvalidInput(format!(
+            "cannot write measurements to {}: not a file path",
+            path.display()
+        )));
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+
+    let (temp_path, file) = create_temp(&dir, file_name, path)?;
+    let result = write_and_sync(file, bytes).and_then(|()| std::fs::rename(&temp_path, path));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&temp_path);
+        return Err(Error::io(path, e));
+    }
+    // Make the rename durable where the platform allows it; failure here does
+    // not undo the write, so it is not an error.
+    if let Ok(d) = File::open(&dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+/// Create a fresh temporary file `.<name>.<pid>.<n>.tmp` in `dir`.
+fn create_temp(dir: &Path, file_name: &std::ffi::OsStr, path: &Path) -> Result<(PathBuf, File)> {
+    let mut attempts = 0;
+    loop {
+        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+        let mut name = OsString::from(".");
+        name.push(file_name);
+        name.push(format!(".{}.{n}.tmp", std::process::id()));
+        let temp_path = dir.join(name);
+        match OpenOptions::new().write(true).create_new(true).open(&temp_path) {
+            Ok(file) => return Ok((temp_path, file)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && attempts < 100 => attempts += 1,
+            Err(e) => return Err(Error::io(path, e)),
+        }
+    }
+}
+
+/// Write everything and flush it to disk.
+fn write_and_sync(mut file: File, bytes: &[u8]) -> std::io::Result<()> {
+    file.write_all(bytes)?;
+    file.sync_all()
+}
+
+/// Read a RecurDyn log and convert its rows to measurements.
+fn read_recurdyn_measurements(path: &Path, options: &ReadOptions) -> Result<MeasurementSet> {
+    let log = read_recurdyn(
+        path,
+        &LoadOptions {
+            keep_rounded: options.keep_rounded,
+        },
+    )?;
+    let c = options.reference_cable;
+    let mut poses = Vec::with_capacity(log.rows.len());
+    let mut rejected = log.rejected;
+    for row in &log.rows {
+        match from_recurdyn(row, c) {
+            Some(pose) => poses.push(pose),
+            None => rejected.push(RejectedRow {
+                line: row.line,
+                reason: format!(
+                    "no tension logged for the reference cable {} (columns fc{k},fz{k},fh{k} are empty)",
+                    c + 1,
+                    k = c + 1
+                ),
+            }),
+        }
+    }
+    rejected.sort_by_key(|r| r.line);
+    if poses.is_empty() {
+        let quoted: Vec<String> = rejected
+            .iter()
+            .take(MAX_QUOTED_REASONS)
+            .map(|r| format!("line {}: {}", r.line, r.reason))
+            .collect();
+        let more = rejected.len().saturating_sub(MAX_QUOTED_REASONS);
+        return Err(format_error(
+            path,
+            format!(
+                "no measurements: every row of the RecurDyn log was rejected ({} rejected: {}{})",
+                rejected.len(),
+                quoted.join("; "),
+                if more > 0 {
+                    format!("; and {more} more")
+                } else {
+                    String::new()
+                }
+            ),
+        ));
+    }
+    Ok(MeasurementSet {
+        path: log.path,
+        format: MeasurementFormat::RecurDyn,
+        poses,
+        rejected,
+    })
+}
+
+/// The measurement of a RecurDyn row, or `None` when the reference cable has no tension.
+fn from_recurdyn(row: &RecurDynRow, reference_cable: usize) -> Option<PoseMeasurement> {
+    let tension = row.tensions.get(reference_cable).copied().flatten()?;
+    Some(PoseMeasurement {
+        line: row.line,
+        position_m: row.position_m,
+        roll_deg: row.roll_deg,
+        pitch_deg: row.pitch_deg,
+        yaw_deg: row.yaw_deg,
+        encoder_lengths_m: row.cable_lengths_m,
+        reference_tension_n: tension.total_n,
+    })
+}
+
+/// Why `fields` is not the sagcal header, or `None` when it is.
+fn sagcal_header_mismatch(fields: &[&str]) -> Option<String> {
+    for (i, expected) in MEASUREMENT_HEADER.iter().enumerate() {
+        match fields.get(i).map(|f| f.trim()) {
+            None => return Some(format!("column {} `{expected}` is missing", i + 1)),
+            Some(found) if found != *expected => {
+                return Some(format!(
+                    "column {} is `{}`, expected `{expected}`",
+                    i + 1,
+                    found.escape_debug()
+                ));
+            }
+            Some(_) => {}
+        }
+    }
+    (fields.len() != N_COLUMNS).then(|| format!("{} columns, expected {N_COLUMNS}", fields.len()))
+}
+
+/// Parse one data row (line `line`, without its line ending).
+fn parse_row(text: &[u8], line: usize, path: &Path) -> Result<PoseMeasurement> {
+    let fields: Vec<&[u8]> = text.split(|b| *b == b',').collect();
+    let n = fields.len();
+    if n != N_COLUMNS {
+        let (field, what) = if n < N_COLUMNS {
+            (
+                MEASUREMENT_HEADER[n].to_string(),
+                format!("`{}` and the columns after it are missing", MEASUREMENT_HEADER[n]),
+            )
+        } else {
+            (
+                format!("column {}", N_COLUMNS + 1),
+                format!("column {} and the ones after it are extra", N_COLUMNS + 1),
+            )
+        };
+        return Err(Error::Field {
+            path: path.to_path_buf(),
+            row: line,
+            field,
+            message: format!("wrong number of fields: expected {N_COLUMNS}, found {n} ({what})"),
+        });
+    }
+    let mut values = [0.0; N_COLUMNS];
+    for (index, (raw, slot)) in fields.iter().zip(values.iter_mut()).enumerate() {
+        let err = |message: String| Error::Field {
+            path: path.to_path_buf(),
+            row: line,
+            field: MEASUREMENT_HEADER[index].to_string(),
+            message,
+        };
+        let text = std::str::from_utf8(raw)
+            .map_err(|_| err("not valid UTF-8 text".to_string()))?
+            .trim();
+        if text.is_empty() {
+            return Err(err("value is empty".to_string()));
+        }
+        let value: f64 = text
+            .parse()
+            .map_err(|_| err(format!("not a number: `{}`", text.escape_debug())))?;
+        if !value.is_finite() {
+            return Err(err(format!("not a finite number: `{text}`")));
+        }
+        if index == F_REF {
+            if let Some(problem) = tension_problem(value) {
+                return Err(err(problem));
+            }
+        }
+        *slot = value;
+    }
+    let [x, y, z, roll, pitch, yaw, l1, l2, l3, l4, f_ref] = values;
+    Ok(PoseMeasurement {
+        line,
+        position_m: [x, y, z],
+        roll_deg: roll,
+        pitch_deg: pitch,
+        yaw_deg: yaw,
+        encoder_lengths_m: [l1, l2, l3, l4],
+        reference_tension_n: f_ref,
+    })
+}
+
+/// A line holding only whitespace.
+fn is_blank(line: &[u8]) -> bool {
+    line.iter().all(u8::is_ascii_whitespace)
+}
+
+/// A comment line: `#` after optional leading whitespace.
+fn is_comment(line: &[u8]) -> bool {
+    line.trim_ascii_start().starts_with(b"#")
+}
+
+/// An [`Error::Format`] for `path`.
+fn format_error(path: &Path, message: String) -> Error {
+    Error::Format {
+        path: path.to_path_buf(),
+        message,
+    }
+}

@@ -1,0 +1,131 @@
+//! Simulated calibration data from the closed-form kineto-static model.
+//!
+//! Poses are drawn uniformly in a workspace box; at each position the robot's
+//! static equilibrium is one member of the one-parameter family (see
+//! [`crate::model::statics`]): sagcal takes the most level one
+//! ([`statics::solve_level`]) with its reference tension scaled by a random
+//! factor in `[0.98, 1.02]`, which keeps the platform within a few degrees of
+//! level and the tensions as even as in the RecurDyn log. Positions without a
+//! positive-tension equilibrium are redrawn.
+
+use nalgebra::{Vector3, Vector6};
+use rand::Rng;
+use rand_distr::{Distribution, Normal};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::io::measurements::PoseMeasurement;
+use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::sensors::SensorNoise;
+use crate::model::statics::{self, Equilibrium, StaticsOptions};
+
+/// An axis-aligned box of platform positions, metres.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Workspace {
+    /// Lower corner.
+    pub min_m: [f64; 3],
+    /// Upper corner.
+    pub max_m: [f64; 3],
+}
+
+impl Workspace {
+    /// The default box for a robot: the RecurDyn log's range on the large
+    /// robot scaled to the anchors' footprint: x, y within 24 % / 27 % of the
+    /// anchors' half-extent around their centre, z from 2 % to 58 % of the
+    /// anchors' height.
+    pub fn default_for(robot: &Robot) -> Self {
+        let min = robot
+            .anchors_m
+            .iter()
+            .fold(Vector3::repeat(f64::INFINITY), |m, a| m.inf(a));
+        let max = robot
+            .anchors_m
+            .iter()
+            .fold(Vector3::repeat(f64::NEG_INFINITY), |m, a| m.sup(a));
+        let centre = (min + max) / 2.0;
+        let half = (max - min) / 2.0;
+        let top = min.z;
+        Self {
+            min_m: [centre.x - 0.24 * half.x, centre.y - 0.27 * half.y, 0.02 * top],
+            max_m: [centre.x + 0.24 * half.x, centre.y + 0.27 * half.y, 0.58 * top],
+        }
+    }
+}
+
+/// Draw `count` static equilibria spread over `workspace`.
+pub fn sample_equilibria(
+    robot: &Robot,
+    workspace: &Workspace,
+    count: usize,
+    rng: &mut impl Rng,
+) -> Result<Vec<Equilibrium>> {
+    let options = StaticsOptions::default();
+    let mut poses = Vec::with_capacity(count);
+    let mut attempts = 0;
+    while poses.len() < count {
+        attempts += 1;
+        if attempts > 100 * count + 1000 {
+            return Err(Error::InvalidInput(format!(
+                "only {} of {count} reachable static poses found in the workspace {workspace:?}",
+                poses.len()
+            )));
+        }
+        let position = Vector3::from_fn(|i, _| rng.random_range(workspace.min_m[i]..=workspace.max_m[i]));
+        let Ok(level) = statics::solve_level(robot, position, &options) else {
+            continue;
+        };
+        let magnitude = level.tensions[robot.reference_cable].magnitude_n() * rng.random_range(0.98..=1.02);
+        if let Ok(eq) =
+            statics::solve_with_reference_tension(robot, position, magnitude, Some(level.pose.rotation), &options)
+        {
+            poses.push(eq);
+        }
+    }
+    Ok(poses)
+}
+
+fn normal(sigma: f64) -> Normal<f64> {
+    // sigma = 0 is a valid "no noise" setting; Normal::new only rejects negative or NaN.
+    Normal::new(0.0, sigma.max(0.0)).unwrap_or_else(|_| Normal::new(0.0, 0.0).expect("zero sigma is valid"))
+}
+
+/// What the robot's sensors read at these equilibria: encoder = catenary
+/// length + the robot's length offset + noise; load cell = reference tension
+/// + noise; localiser pose = true pose perturbed on its tangent space.
+pub fn measure(
+    robot: &Robot,
+    equilibria: &[Equilibrium],
+    noise: &SensorNoise,
+    rng: &mut impl Rng,
+) -> Vec<PoseMeasurement> {
+    let encoder = normal(noise.encoder_sigma_m);
+    let load_cell = normal(noise.load_cell_sigma_n);
+    let position = normal(noise.position_sigma_m);
+    let orientation = normal(noise.orientation_sigma_rad);
+    equilibria
+        .iter()
+        .map(|eq| {
+            let xi = Vector6::new(
+                orientation.sample(rng),
+                orientation.sample(rng),
+                orientation.sample(rng),
+                position.sample(rng),
+                position.sample(rng),
+                position.sample(rng),
+            );
+            let pose = eq.pose.retract(&xi);
+            let (roll_deg, pitch_deg, yaw_deg) = pose.roll_pitch_yaw_deg();
+            let encoder_lengths_m: [f64; CABLE_COUNT] =
+                std::array::from_fn(|i| eq.cable_lengths_m[i] + robot.length_offsets_m[i] + encoder.sample(rng));
+            PoseMeasurement {
+                line: 0,
+                position_m: pose.position_m.into(),
+                roll_deg,
+                pitch_deg,
+                yaw_deg,
+                encoder_lengths_m,
+                reference_tension_n: eq.tensions[robot.reference_cable].magnitude_n() + load_cell.sample(rng),
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,804 @@
+//! The generated residuals (`generated/`, from `codegen/`) against independent computations.
+//!
+//! * Every Jacobian of every generated function against central finite
+//!   differences (5-point stencil), the pose perturbed through
+//!   [`PlatformPose::retract`] and the other arguments additively, at random
+//!   points of two regimes: the large robot (`robots/large.toml`) and the
+//!   small robot (`robots/small.toml`).
+//! * The values against hand-written Rust: eq. (11) against a 6x6 LU solve of
+//!   the full statics `J^T f = w`, the catenary length and drop against
+//!   [`Catenary`], the straight cable, the load cell and the pose prior.
+//! * The massless limit `g_c = 0`.
+
+use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, UnitQuaternion, Vector2, Vector3, Vector4, Vector6};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use sagcal::generated;
+use sagcal::model::{Catenary, PlatformPose, Robot};
+
+/// SymForce's default epsilon (`sym::kDefaultEpsilon`).
+const EPSILON: f64 = 10.0 * f64::EPSILON;
+/// Random points per regime.
+const SAMPLES: usize = 120;
+/// `max |analytic - fd| <= TOLERANCE * max(1, max |fd|)` per Jacobian block.
+const TOLERANCE: f64 = 1e-6;
+
+/// Sampling ranges of one regime.
+struct Regime {
+    name: &'static str,
+    robot: Robot,
+    x_m: f64,
+    y_m: f64,
+    z_m: (f64, f64),
+    max_angle_deg: f64,
+    horizontal_tension_n: (f64, f64),
+    vertical_tension_n: (f64, f64),
+    /// Random displacement of each anchor coordinate, metres.
+    anchor_jitter_m: f64,
+}
+
+fn large() -> Regime {
+    Regime {
+        name: "large",
+        robot: Robot::builtin("large").unwrap(),
+        x_m: 30.0,
+        y_m: 30.0,
+        z_m: (0.0, 25.0),
+        max_angle_deg: 5.0,
+        horizontal_tension_n: (400.0, 1000.0),
+        vertical_tension_n: (30.0, 200.0),
+        anchor_jitter_m: 1.0,
+    }
+}
+
+fn small() -> Regime {
+    Regime {
+        name: "small",
+        robot: Robot::builtin("small").unwrap(),
+        x_m: 3.0,
+        y_m: 1.0,
+        z_m: (3.0, 18.0),
+        max_angle_deg: 5.0,
+        horizontal_tension_n: (10.0, 30.0),
+        vertical_tension_n: (2.0, 15.0),
+        anchor_jitter_m: 0.1,
+    }
+}
+
+/// The robot's cable indices in slot order: the reference cable first, then the others.
+fn slot_order(robot: &Robot) -> [usize; 4] {
+    let mut order = [robot.reference_cable; 4];
+    let mut next = 1;
+    for cable in 0..4 {
+        if cable != robot.reference_cable {
+            order[next] = cable;
+            next += 1;
+        }
+    }
+    order
+}
+
+/// All arguments of the generated functions.
+#[derive(Clone, Debug)]
+struct Point {
+    pose: PlatformPose,
+    reference_tension_n: Vector2<f64>,
+    anchors_m: Matrix3x4<f64>,
+    attachments_m: Matrix3x4<f64>,
+    com_offset_m: Vector3<f64>,
+    platform_weight_n: f64,
+    cable_weight_n_per_m: f64,
+    length_offsets_m: Vector4<f64>,
+    encoder_lengths_m: Vector4<f64>,
+    prior: PlatformPose,
+    measured_tension_n: f64,
+}
+
+fn random_rotation(rng: &mut ChaCha8Rng, max_angle_deg: f64) -> UnitQuaternion<f64> {
+    let axis = Vector3::new(
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+    );
+    let angle = rng.random_range(0.0..max_angle_deg).to_radians();
+    UnitQuaternion::from_scaled_axis(axis.normalize() * angle)
+}
+
+fn random_point(regime: &Regime, rng: &mut ChaCha8Rng) -> Point {
+    let robot = &regime.robot;
+    let order = slot_order(robot);
+    let jitter = regime.anchor_jitter_m;
+    let anchors_m = Matrix3x4::from_columns(&order.map(|c| {
+        robot.anchors_m[c]
+            + Vector3::new(
+                rng.random_range(-jitter..jitter),
+                rng.random_range(-jitter..jitter),
+                rng.random_range(-jitter..jitter),
+            )
+    }));
+    let attachments_m = Matrix3x4::from_columns(&order.map(|c| robot.attachments_m[c]));
+    let position = Vector3::new(
+        rng.random_range(-regime.x_m..regime.x_m),
+        rng.random_range(-regime.y_m..regime.y_m),
+        rng.random_range(regime.z_m.0..regime.z_m.1),
+    );
+    let pose = PlatformPose::new(position, random_rotation(rng, regime.max_angle_deg));
+    let prior_tangent = Vector6::new(
+        rng.random_range(-0.05..0.05),
+        rng.random_range(-0.05..0.05),
+        rng.random_range(-0.05..0.05),
+        rng.random_range(-0.1..0.1),
+        rng.random_range(-0.1..0.1),
+        rng.random_range(-0.1..0.1),
+    );
+    let reference_tension_n = Vector2::new(
+        rng.random_range(regime.horizontal_tension_n.0..regime.horizontal_tension_n.1),
+        rng.random_range(regime.vertical_tension_n.0..regime.vertical_tension_n.1),
+    );
+    Point {
+        pose,
+        reference_tension_n,
+        anchors_m,
+        attachments_m,
+        com_offset_m: robot.com_offset_m,
+        platform_weight_n: robot.platform_weight_n,
+        cable_weight_n_per_m: robot.cable_weight_n_per_m,
+        length_offsets_m: Vector4::from_fn(|_, _| rng.random_range(-2.0..2.0)),
+        encoder_lengths_m: Vector4::from_fn(|_, _| rng.random_range(5.0..200.0)),
+        prior: pose.retract(&prior_tangent),
+        measured_tension_n: reference_tension_n.norm() + rng.random_range(-5.0..5.0),
+    }
+}
+
+/// The differentiated argument blocks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Block {
+    Pose,
+    ReferenceTension,
+    Anchors,
+    LengthOffsets,
+}
+
+impl Block {
+    fn dimension(self) -> usize {
+        match self {
+            Block::Pose => 6,
+            Block::ReferenceTension => 2,
+            Block::Anchors => 12,
+            Block::LengthOffsets => 4,
+        }
+    }
+
+    /// Finite-difference step of tangent coordinate `k` at `point`.
+    fn step(self, k: usize, point: &Point) -> f64 {
+        match self {
+            Block::Pose if k < 3 => 1e-4,
+            Block::Pose => 1e-3,
+            Block::ReferenceTension => 1e-4 * point.reference_tension_n[k].abs().max(1.0),
+            Block::Anchors | Block::LengthOffsets => 1e-3,
+        }
+    }
+
+    /// `point` moved by `t` along tangent coordinate `k` of this block.
+    fn perturb(self, point: &Point, k: usize, t: f64) -> Point {
+        let mut moved = point.clone();
+        match self {
+            Block::Pose => {
+                let mut tangent = Vector6::zeros();
+                tangent[k] = t;
+                moved.pose = point.pose.retract(&tangent);
+            }
+            Block::ReferenceTension => moved.reference_tension_n[k] += t,
+            Block::Anchors => moved.anchors_m[(k % 3, k / 3)] += t,
+            Block::LengthOffsets => moved.length_offsets_m[k] += t,
+        }
+        moved
+    }
+}
+
+/// Value and Jacobians (in the order of `blocks`) of one generated function.
+type Evaluation = (DVector<f64>, Vec<DMatrix<f64>>);
+
+struct Function {
+    name: &'static str,
+    blocks: &'static [Block],
+    evaluate: fn(&Point) -> Evaluation,
+}
+
+fn dynamic<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> DMatrix<f64> {
+    DMatrix::from_column_slice(R, C, m.as_slice())
+}
+
+/// Every Jacobian starts as NaN: the generated code must overwrite every entry.
+fn nan<const R: usize, const C: usize>() -> SMatrix<f64, R, C> {
+    SMatrix::from_element(f64::NAN)
+}
+
+fn tensions(p: &Point) -> Evaluation {
+    let (mut pose, mut reference, mut anchors) = (nan::<8, 6>(), nan::<8, 2>(), nan::<8, 12>());
+    let value = generated::cable_tensions_from_reference(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.reference_tension_n,
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.com_offset_m,
+        p.platform_weight_n,
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut reference),
+        Some(&mut anchors),
+    );
+    let value = DVector::from_column_slice(value.as_slice());
+    (value, vec![dynamic(&pose), dynamic(&reference), dynamic(&anchors)])
+}
+
+fn catenary_length(p: &Point) -> Evaluation {
+    let (mut pose, mut reference, mut anchors, mut offsets) =
+        (nan::<4, 6>(), nan::<4, 2>(), nan::<4, 12>(), nan::<4, 4>());
+    let value = generated::catenary_length_residual(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.reference_tension_n,
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.com_offset_m,
+        p.platform_weight_n,
+        p.cable_weight_n_per_m,
+        &p.length_offsets_m,
+        &p.encoder_lengths_m,
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut reference),
+        Some(&mut anchors),
+        Some(&mut offsets),
+    );
+    let value = DVector::from_column_slice(value.as_slice());
+    (
+        value,
+        vec![
+            dynamic(&pose),
+            dynamic(&reference),
+            dynamic(&anchors),
+            dynamic(&offsets),
+        ],
+    )
+}
+
+fn attachment_height(p: &Point) -> Evaluation {
+    let (mut pose, mut reference, mut anchors) = (nan::<4, 6>(), nan::<4, 2>(), nan::<4, 12>());
+    let value = generated::attachment_height_residual(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.reference_tension_n,
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.com_offset_m,
+        p.platform_weight_n,
+        p.cable_weight_n_per_m,
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut reference),
+        Some(&mut anchors),
+    );
+    let value = DVector::from_column_slice(value.as_slice());
+    (value, vec![dynamic(&pose), dynamic(&reference), dynamic(&anchors)])
+}
+
+fn reference_tension(p: &Point) -> Evaluation {
+    let mut reference = nan::<1, 2>();
+    let value = generated::reference_tension_residual(
+        &p.reference_tension_n,
+        p.measured_tension_n,
+        EPSILON,
+        Some(&mut reference),
+    );
+    (DVector::from_column_slice(value.as_slice()), vec![dynamic(&reference)])
+}
+
+fn pose_prior(p: &Point) -> Evaluation {
+    let mut pose = nan::<6, 6>();
+    let value = generated::pose_prior_residual(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.prior.position_m,
+        &p.prior.rotation_xyzw(),
+        EPSILON,
+        Some(&mut pose),
+    );
+    (DVector::from_column_slice(value.as_slice()), vec![dynamic(&pose)])
+}
+
+fn rigid_length(p: &Point) -> Evaluation {
+    let (mut pose, mut anchors, mut offsets) = (nan::<4, 6>(), nan::<4, 12>(), nan::<4, 4>());
+    let value = generated::rigid_length_residual(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.length_offsets_m,
+        &p.encoder_lengths_m,
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut anchors),
+        Some(&mut offsets),
+    );
+    let value = DVector::from_column_slice(value.as_slice());
+    (value, vec![dynamic(&pose), dynamic(&anchors), dynamic(&offsets)])
+}
+
+const FUNCTIONS: [Function; 6] = [
+    Function {
+        name: "cable_tensions_from_reference",
+        blocks: &[Block::Pose, Block::ReferenceTension, Block::Anchors],
+        evaluate: tensions,
+    },
+    Function {
+        name: "catenary_length_residual",
+        blocks: &[
+            Block::Pose,
+            Block::ReferenceTension,
+            Block::Anchors,
+            Block::LengthOffsets,
+        ],
+        evaluate: catenary_length,
+    },
+    Function {
+        name: "attachment_height_residual",
+        blocks: &[Block::Pose, Block::ReferenceTension, Block::Anchors],
+        evaluate: attachment_height,
+    },
+    Function {
+        name: "reference_tension_residual",
+        blocks: &[Block::ReferenceTension],
+        evaluate: reference_tension,
+    },
+    Function {
+        name: "pose_prior_residual",
+        blocks: &[Block::Pose],
+        evaluate: pose_prior,
+    },
+    Function {
+        name: "rigid_length_residual",
+        blocks: &[Block::Pose, Block::Anchors, Block::LengthOffsets],
+        evaluate: rigid_length,
+    },
+];
+
+/// Central 5-point finite-difference Jacobian of `function` with respect to `block`.
+///
+/// Each column is evaluated with the steps `h, h/10, h/100, h/1000` (`h` from
+/// [`Block::step`]) and the estimate of the two consecutive steps that agree best
+/// is kept: large steps suffer from truncation where the tensions of eq. (11) are
+/// sensitive to the pose, small ones from rounding.
+fn finite_difference(function: &Function, block: Block, point: &Point) -> DMatrix<f64> {
+    let rows = (function.evaluate)(point).0.len();
+    let mut jacobian = DMatrix::zeros(rows, block.dimension());
+    for k in 0..block.dimension() {
+        let at = |t: f64| (function.evaluate)(&block.perturb(point, k, t)).0;
+        let estimates: Vec<DVector<f64>> = (0..4)
+            .map(|i| {
+                let h = block.step(k, point) / 10f64.powi(i);
+                (at(-2.0 * h) - at(2.0 * h) + (at(h) - at(-h)) * 8.0) / (12.0 * h)
+            })
+            .collect();
+        let best = (0..3)
+            .min_by(|&a, &b| {
+                let spread = |i: usize| (&estimates[i] - &estimates[i + 1]).amax();
+                spread(a).total_cmp(&spread(b))
+            })
+            .unwrap();
+        jacobian.set_column(k, &estimates[best + 1]);
+    }
+    jacobian
+}
+
+/// Worst case of one Jacobian block over the points of a regime.
+#[derive(Default, Clone, Copy)]
+struct Worst {
+    error: f64,
+    scale: f64,
+    ratio: f64,
+    sample: usize,
+}
+
+/// `max |analytic - fd| / max(1, max |fd|)` of every block of every function over `points`.
+fn worst_jacobian_errors(points: &[Point]) -> Vec<(&'static str, Block, Worst)> {
+    let mut worst = Vec::new();
+    for function in &FUNCTIONS {
+        for (b, &block) in function.blocks.iter().enumerate() {
+            let mut w = Worst::default();
+            for (sample, point) in points.iter().enumerate() {
+                let analytic = &(function.evaluate)(point).1[b];
+                assert!(
+                    analytic.iter().all(|x| x.is_finite()),
+                    "{} d/d{block:?}: non-finite entry at sample {sample}",
+                    function.name
+                );
+                let fd = finite_difference(function, block, point);
+                assert!(
+                    fd.iter().all(|x| x.is_finite()),
+                    "{} d/d{block:?}: non-finite finite difference at sample {sample}",
+                    function.name
+                );
+                let error = (analytic - &fd).amax();
+                let scale = fd.amax().max(1.0);
+                // A NaN anywhere counts as the worst possible agreement.
+                let ratio = if error.is_nan() { f64::INFINITY } else { error / scale };
+                if ratio > w.ratio || sample == 0 {
+                    w = Worst {
+                        error,
+                        scale,
+                        ratio,
+                        sample,
+                    };
+                }
+            }
+            worst.push((function.name, block, w));
+        }
+    }
+    worst
+}
+
+/// Random points of a regime whose cables all pull (eq. 11 gives every `f_h` at least 5 % of the
+/// regime's smallest reference `f_h`, and every `f_v > 0`).
+///
+/// Random reference tensions and rotations are mostly not an equilibrium of the large robot:
+/// the moment about the vertical (eq. 8, row `Mz`) has arms of a few centimetres, so eq. (11)
+/// often gives a slack or pushing cable there, where the catenary is meaningless.
+fn physical_points(regime: &Regime, seed: u64, count: usize) -> Vec<Point> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut points = Vec::with_capacity(count);
+    let mut rejected = 0;
+    while points.len() < count {
+        let point = random_point(regime, &mut rng);
+        let tensions = independent_tensions(&point);
+        if tensions
+            .iter()
+            .all(|&(h, v)| h > 0.05 * regime.horizontal_tension_n.0 && v > 0.0)
+        {
+            points.push(point);
+        } else {
+            rejected += 1;
+            assert!(rejected < 50 * count, "{}: no physical points", regime.name);
+        }
+    }
+    println!(
+        "{}: {count} points ({rejected} rejected with a slack or pushing cable)",
+        regime.name
+    );
+    points
+}
+
+fn check_jacobians(regime: &Regime, seed: u64) {
+    let points = physical_points(regime, seed, SAMPLES);
+    let worst = worst_jacobian_errors(&points);
+    println!(
+        "{}: worst max|analytic - fd| per Jacobian block over {} points",
+        regime.name,
+        points.len()
+    );
+    let mut failures = Vec::new();
+    for (name, block, w) in &worst {
+        println!(
+            "  {name:<30} {:<18} error {:.3e}  scale {:.3e}  ratio {:.3e}  (sample {})",
+            format!("{block:?}"),
+            w.error,
+            w.scale,
+            w.ratio,
+            w.sample
+        );
+        if w.ratio > TOLERANCE {
+            failures.push(format!("{name} d/d{block:?}: ratio {:.3e}", w.ratio));
+        }
+    }
+    assert!(failures.is_empty(), "{}: {failures:?}", regime.name);
+}
+
+#[test]
+fn jacobians_match_finite_differences_large_robot() {
+    check_jacobians(&large(), 0x5a6c_a101);
+}
+
+#[test]
+fn jacobians_match_finite_differences_small_robot() {
+    check_jacobians(&small(), 0x5a6c_a202);
+}
+
+#[test]
+fn jacobians_match_finite_differences_massless_cable() {
+    for (regime, seed) in [(large(), 11), (small(), 12)] {
+        let mut points = physical_points(&regime, seed, 20);
+        for point in &mut points {
+            point.cable_weight_n_per_m = 0.0;
+        }
+        for (name, block, w) in worst_jacobian_errors(&points) {
+            println!("  g_c = 0 {}: {name} d/d{block:?} ratio {:.3e}", regime.name, w.ratio);
+            assert!(
+                w.ratio <= TOLERANCE,
+                "{name} d/d{block:?} at g_c = 0: ratio {:.3e}",
+                w.ratio
+            );
+        }
+    }
+}
+
+// -------------------------------------------------------------------------------------------------
+// Values against independent hand-written computations
+// -------------------------------------------------------------------------------------------------
+
+/// Geometry of slot `j`: world attachment, moment arm `R b`, horizontal span and unit direction.
+fn cable_geometry(p: &Point, j: usize) -> (Vector3<f64>, Vector3<f64>, f64, Vector3<f64>) {
+    let arm = p.pose.rotation * p.attachments_m.column(j).into_owned();
+    let attachment = p.pose.position_m + arm;
+    let delta = attachment - p.anchors_m.column(j);
+    let span = delta.x.hypot(delta.y);
+    (attachment, arm, span, Vector3::new(delta.x / span, delta.y / span, 0.0))
+}
+
+/// Eq. (11) by a 6x6 LU solve of the full statics `J^T f = w` (eq. 5, 6, 8), in slot order.
+fn independent_tensions(p: &Point) -> [(f64, f64); 4] {
+    let z = Vector3::z();
+    let mut structure = SMatrix::<f64, 6, 8>::zeros();
+    for j in 0..4 {
+        let (_, arm, _, s) = cable_geometry(p, j);
+        let mut column_h = nalgebra::Vector6::zeros();
+        column_h.fixed_rows_mut::<3>(0).copy_from(&-s);
+        column_h.fixed_rows_mut::<3>(3).copy_from(&-arm.cross(&s));
+        let mut column_v = nalgebra::Vector6::zeros();
+        column_v.fixed_rows_mut::<3>(0).copy_from(&z);
+        column_v.fixed_rows_mut::<3>(3).copy_from(&arm.cross(&z));
+        structure.set_column(2 * j, &column_h);
+        structure.set_column(2 * j + 1, &column_v);
+    }
+    let com = p.pose.rotation * p.com_offset_m;
+    let mut wrench = nalgebra::Vector6::zeros();
+    wrench.fixed_rows_mut::<3>(0).copy_from(&(z * p.platform_weight_n));
+    wrench
+        .fixed_rows_mut::<3>(3)
+        .copy_from(&(com.cross(&z) * p.platform_weight_n));
+    let rhs = wrench - structure.column(0) * p.reference_tension_n[0] - structure.column(1) * p.reference_tension_n[1];
+    let rest = structure.fixed_columns::<6>(2).into_owned();
+    let solution = rest.lu().solve(&rhs).expect("J_res^T is invertible");
+    [
+        (p.reference_tension_n[0], p.reference_tension_n[1]),
+        (solution[0], solution[1]),
+        (solution[2], solution[3]),
+        (solution[4], solution[5]),
+    ]
+}
+
+fn relative_error(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs().max(1.0)
+}
+
+#[test]
+fn values_match_independent_computations() {
+    for (regime, seed) in [(large(), 21), (small(), 22)] {
+        let mut worst = [0.0_f64; 6];
+        for p in physical_points(&regime, seed, 100) {
+            let expected = independent_tensions(&p);
+            let tensions = tensions(&p).0;
+            let catenary = catenary_length(&p).0;
+            let height = attachment_height(&p).0;
+            let rigid = rigid_length(&p).0;
+            for (j, &(f_h, f_v)) in expected.iter().enumerate() {
+                worst[0] = worst[0].max(relative_error(tensions[2 * j], f_h));
+                worst[0] = worst[0].max(relative_error(tensions[2 * j + 1], f_v));
+                let (attachment, _, span, _) = cable_geometry(&p, j);
+                let cable = Catenary {
+                    span_m: span,
+                    horizontal_tension_n: f_h,
+                    vertical_tension_n: f_v,
+                    cable_weight_n_per_m: p.cable_weight_n_per_m,
+                };
+                let length = catenary[j] - p.length_offsets_m[j] + p.encoder_lengths_m[j];
+                worst[1] = worst[1].max(relative_error(length, cable.length_m()));
+                let drop = height[j] - attachment.z + p.anchors_m[(2, j)];
+                worst[2] = worst[2].max(relative_error(drop, cable.drop_m()));
+                let straight = (p.anchors_m.column(j) - attachment).norm();
+                let rigid_length = rigid[j] - p.length_offsets_m[j] + p.encoder_lengths_m[j];
+                worst[3] = worst[3].max(relative_error(rigid_length, straight));
+            }
+            let load_cell = reference_tension(&p).0[0];
+            let expected_load_cell = p.reference_tension_n.norm() - p.measured_tension_n;
+            worst[4] = worst[4].max((load_cell - expected_load_cell).abs());
+            let prior = pose_prior(&p).0;
+            let expected_prior = p.prior.local_coordinates(&p.pose);
+            worst[5] = worst[5].max((prior - expected_prior).amax());
+        }
+        println!(
+            "{}: tensions {:.1e}, catenary length {:.1e}, drop {:.1e}, rigid {:.1e}, load cell {:.1e}, prior {:.1e}",
+            regime.name, worst[0], worst[1], worst[2], worst[3], worst[4], worst[5]
+        );
+        assert!(
+            worst[0] < 1e-9,
+            "eq. (11) tensions differ from the 6x6 LU solve: {:e}",
+            worst[0]
+        );
+        assert!(
+            worst[1] < 1e-11,
+            "catenary length differs from Catenary::length_m: {:e}",
+            worst[1]
+        );
+        assert!(worst[2] < 1e-11, "drop differs from Catenary::drop_m: {:e}", worst[2]);
+        assert!(
+            worst[3] < 1e-12,
+            "rigid length differs from the distance: {:e}",
+            worst[3]
+        );
+        assert!(worst[4] < 1e-12, "load-cell residual differs: {:e}", worst[4]);
+        assert!(
+            worst[5] < 1e-12,
+            "pose prior differs from local_coordinates: {:e}",
+            worst[5]
+        );
+    }
+}
+
+#[test]
+fn tensions_satisfy_the_statics() {
+    // J^T f = w with the generated tensions, residual relative to the weight.
+    for (regime, seed) in [(large(), 31), (small(), 32)] {
+        for p in physical_points(&regime, seed, 50) {
+            let f = tensions(&p).0;
+            let z = Vector3::z();
+            let mut force = Vector3::zeros();
+            let mut moment = Vector3::zeros();
+            for j in 0..4 {
+                let (_, arm, _, s) = cable_geometry(&p, j);
+                let cable_force = -s * f[2 * j] + z * f[2 * j + 1];
+                force += cable_force;
+                moment += arm.cross(&cable_force);
+            }
+            let weight = p.platform_weight_n;
+            let com = p.pose.rotation * p.com_offset_m;
+            assert!((force - z * weight).amax() < 1e-9 * weight, "force balance {force}");
+            assert!(
+                (moment - com.cross(&z) * weight).amax() < 1e-9 * weight,
+                "moment balance {moment}"
+            );
+        }
+    }
+}
+
+#[test]
+fn massless_cable_is_straight() {
+    // g_c = 0 exactly: sinhc(0) must be 1 (no 0/0), length = L sqrt(1 + u^2), drop = L u.
+    for (regime, seed) in [(large(), 41), (small(), 42)] {
+        for mut p in physical_points(&regime, seed, 50) {
+            p.cable_weight_n_per_m = 0.0;
+            let f = tensions(&p).0;
+            let catenary = catenary_length(&p).0;
+            let height = attachment_height(&p).0;
+            for j in 0..4 {
+                let (attachment, _, span, _) = cable_geometry(&p, j);
+                let u = f[2 * j + 1] / f[2 * j];
+                let length = catenary[j] - p.length_offsets_m[j] + p.encoder_lengths_m[j];
+                assert!(length.is_finite() && height[j].is_finite());
+                assert!(relative_error(length, span * (1.0 + u * u).sqrt()) < 1e-13, "{length}");
+                let drop = height[j] - attachment.z + p.anchors_m[(2, j)];
+                assert!(relative_error(drop, span * u) < 1e-13, "{drop} vs {}", span * u);
+            }
+        }
+    }
+}
+
+#[test]
+fn massless_catenary_equals_rigid_cable_at_a_symmetric_equilibrium() {
+    // Platform centred below symmetric anchors, level, centre of mass on the vertical axis:
+    // every cable is straight with tension t along it and 4 t_z = W; eq. (11) must give the
+    // same for the three other cables, and then the catenary residual (g_c = 0) equals the
+    // rigid one and the attachment heights agree.
+    for robot in [Robot::builtin("large").unwrap(), Robot::builtin("small").unwrap()] {
+        let order = slot_order(&robot);
+        for z in [2.0, 10.0, 20.0] {
+            let pose = PlatformPose::from_position(Vector3::new(0.0, 0.0, z));
+            let anchors_m = Matrix3x4::from_columns(&order.map(|c| robot.anchors_m[c]));
+            let attachments_m = Matrix3x4::from_columns(&order.map(|c| robot.attachments_m[c]));
+            let cable = anchors_m.column(0) - (pose.position_m + attachments_m.column(0));
+            let tension = robot.platform_weight_n / 4.0 / (cable.z / cable.norm());
+            let direction = cable / cable.norm();
+            let p = Point {
+                pose,
+                reference_tension_n: Vector2::new(tension * direction.xy().norm(), tension * direction.z),
+                anchors_m,
+                attachments_m,
+                com_offset_m: robot.com_offset_m,
+                platform_weight_n: robot.platform_weight_n,
+                cable_weight_n_per_m: 0.0,
+                length_offsets_m: Vector4::new(0.1, -0.2, 0.3, -0.4),
+                encoder_lengths_m: Vector4::new(100.0, 110.0, 120.0, 130.0),
+                prior: pose,
+                measured_tension_n: tension,
+            };
+            let f = tensions(&p).0;
+            for j in 1..4 {
+                assert!(relative_error(f[2 * j], f[0]) < 1e-12, "{}: {f}", robot.name);
+                assert!(relative_error(f[2 * j + 1], f[1]) < 1e-12, "{}: {f}", robot.name);
+            }
+            let catenary = catenary_length(&p).0;
+            let rigid = rigid_length(&p).0;
+            let height = attachment_height(&p).0;
+            for j in 0..4 {
+                assert!(
+                    (catenary[j] - rigid[j]).abs() < 1e-11,
+                    "{}: {catenary} vs {rigid}",
+                    robot.name
+                );
+                assert!(height[j].abs() < 1e-11, "{}: height residual {height}", robot.name);
+            }
+            assert!(reference_tension(&p).0[0].abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn catenary_residual_of_a_heavy_cable_is_longer_than_rigid() {
+    // Sanity of the sign conventions: with the same tensions, sag makes the cable longer.
+    let regime = large();
+    for p in physical_points(&regime, 51, 20) {
+        let catenary = catenary_length(&p).0;
+        let f = tensions(&p).0;
+        for j in 0..4 {
+            let (_, _, span, _) = cable_geometry(&p, j);
+            let u = f[2 * j + 1] / f[2 * j];
+            let massless = span * (1.0 + u * u).sqrt();
+            let length = catenary[j] - p.length_offsets_m[j] + p.encoder_lengths_m[j];
+            assert!(length > massless, "slot {j}: {length} <= {massless}");
+        }
+    }
+}
+
+#[test]
+fn outputs_do_not_depend_on_the_requested_jacobians() {
+    let p = physical_points(&large(), 61, 1).remove(0);
+    let without = generated::catenary_length_residual(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.reference_tension_n,
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.com_offset_m,
+        p.platform_weight_n,
+        p.cable_weight_n_per_m,
+        &p.length_offsets_m,
+        &p.encoder_lengths_m,
+        EPSILON,
+        None,
+        None,
+        None,
+        None,
+    );
+    assert_eq!(DVector::from_column_slice(without.as_slice()), catenary_length(&p).0);
+}
+
+#[test]
+fn pose_prior_is_well_behaved_at_and_near_the_prior() {
+    // A calibration starts with every pose at its measurement: the logarithm at the identity
+    // (clamped with epsilon in SymForce's Rot3) must give a zero residual and an identity Jacobian.
+    let mut p = physical_points(&small(), 71, 1).remove(0);
+    p.prior = p.pose;
+    let (value, jacobians) = pose_prior(&p);
+    assert!(value.amax() < 1e-15, "{value}");
+    assert!(
+        (&jacobians[0] - DMatrix::<f64>::identity(6, 6)).amax() < 1e-7,
+        "{}",
+        jacobians[0]
+    );
+    for angle in [1e-9, 1e-7, 1e-5, 1e-3] {
+        p.prior = p
+            .pose
+            .retract(&Vector6::new(angle, -0.5 * angle, 0.3 * angle, 1e-3, 0.0, -1e-3));
+        let value = pose_prior(&p).0;
+        let expected = DVector::from_column_slice(p.prior.local_coordinates(&p.pose).as_slice());
+        println!(
+            "angle {angle:e}: relative error of the rotation part {:.1e}",
+            (&value - &expected).rows(0, 3).amax() / angle
+        );
+        assert!(
+            (&value - &expected).amax() < 1e-12 * angle.max(1e-3),
+            "angle {angle}: {value} vs {expected}"
+        );
+    }
+}
