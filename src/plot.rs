@@ -44,9 +44,7 @@
 //! ```
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 /// One anchor (pulley) to draw: its nominal, initial, estimated and true position.
 #[derive(Debug, Clone, PartialEq)]
@@ -180,34 +178,7 @@ pub fn anchor_plot_svg(plot: &AnchorPlot) -> String {
 ///
 /// Errors are [`crate::Error::Io`] naming `path`; on error no file is left behind.
 pub fn write_svg(path: &Path, svg: &str) -> crate::Result<()> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let file_name = path.file_name().ok_or_else(|| {
-        crate::Error::io(
-            path,
-            std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file path"),
-        )
-    })?;
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let tmp = dir.join(format!(
-        ".{}.{}.{}.tmp",
-        file_name.to_string_lossy(),
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let result = (|| -> std::io::Result<()> {
-        let mut f = std::fs::File::create_new(&tmp)?;
-        f.write_all(svg.as_bytes())?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(|e| crate::Error::io(path, e))
+    crate::io::write_atomically(path, svg.as_bytes())
 }
 
 // ---------------------------------------------------------------------------

@@ -24,6 +24,7 @@
 //! with negative tensions in other cables; this sequence does not.
 
 pub mod factors;
+pub mod report;
 
 use std::sync::Arc;
 

@@ -1,7 +1,10 @@
 //! Command-line parsing and dispatch. Every command returns a `Result`; errors
 //! are printed once, to stderr, with exit code 1 (2 for usage errors).
 
+mod calibrate;
+mod demo;
 mod output;
+mod simulate;
 mod verify;
 
 use std::path::PathBuf;
@@ -13,13 +16,152 @@ use clap::{Parser, Subcommand, ValueEnum};
 #[command(name = "sagcal", version, about, long_about = None)]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
 }
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Simulate the built-in large robot, calibrate it from a perturbed guess, plot the anchors (the default).
+    Demo(DemoArgs),
+    /// Estimate anchors and encoder length offsets from measurements.
+    Calibrate(CalibrateArgs),
+    /// Write simulated measurements of a robot (sagcal's CSV format).
+    Simulate(SimulateArgs),
     /// Check the kineto-static model against measured data (the paper's Table I).
     Verify(VerifyArgs),
+}
+
+/// Options of the calibration solver shared by the commands that calibrate.
+#[derive(Debug, Clone, clap::Args)]
+struct SolverArgs {
+    /// Cable model: `catenary` (heavy cable, the default) or `rigid` (massless straight cable).
+    #[arg(long, default_value = "catenary", value_parser = sagcal::calib::CableModel::parse)]
+    model: sagcal::calib::CableModel,
+    /// Sensor noise used as factor weights: `paper` (10 mm, 5 N / 1 N, 5 mm, 0.01 rad) or `authors`.
+    #[arg(long, default_value = "paper", value_parser = sagcal::model::sensors::NoisePreset::parse)]
+    noise: sagcal::model::sensors::NoisePreset,
+    /// Override the encoder sigma, metres.
+    #[arg(long)]
+    encoder_sigma_m: Option<f64>,
+    /// Override the load-cell sigma, newtons.
+    #[arg(long)]
+    load_cell_sigma_n: Option<f64>,
+    /// Override the localiser position sigma, metres.
+    #[arg(long)]
+    position_sigma_m: Option<f64>,
+    /// Also trust the localiser's orientation (prior with the noise's orientation sigma).
+    /// By default the statics decide the orientation.
+    #[arg(long)]
+    orientation_prior: bool,
+    /// Robust kernel on the encoder factors: none, huber[:k], cauchy[:c].
+    #[arg(long, default_value = "none", value_parser = sagcal::graph::RobustKernel::parse)]
+    robust_encoder: sagcal::graph::RobustKernel,
+    /// Robust kernel on the load-cell factors.
+    #[arg(long, default_value = "none", value_parser = sagcal::graph::RobustKernel::parse)]
+    robust_load_cell: sagcal::graph::RobustKernel,
+    /// Robust kernel on the pose priors.
+    #[arg(long, default_value = "none", value_parser = sagcal::graph::RobustKernel::parse)]
+    robust_pose: sagcal::graph::RobustKernel,
+}
+
+impl SolverArgs {
+    fn options(&self, robot: &sagcal::model::Robot) -> sagcal::Result<sagcal::calib::CalibrationOptions> {
+        let mut noise = self.noise.sigmas(robot.platform_weight_n);
+        for (value, target, name) in [
+            (self.encoder_sigma_m, &mut noise.encoder_sigma_m, "--encoder-sigma-m"),
+            (
+                self.load_cell_sigma_n,
+                &mut noise.load_cell_sigma_n,
+                "--load-cell-sigma-n",
+            ),
+            (self.position_sigma_m, &mut noise.position_sigma_m, "--position-sigma-m"),
+        ] {
+            if let Some(v) = value {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(sagcal::Error::InvalidInput(format!(
+                        "{name} must be a positive number, got {v}"
+                    )));
+                }
+                *target = v;
+            }
+        }
+        if [noise.encoder_sigma_m, noise.load_cell_sigma_n, noise.position_sigma_m]
+            .iter()
+            .any(|s| *s <= 0.0)
+        {
+            return Err(sagcal::Error::InvalidInput(
+                "sensor sigmas must be positive to weight the factors".into(),
+            ));
+        }
+        let mut options = sagcal::calib::CalibrationOptions::new(noise);
+        options.model = self.model;
+        options.orientation_prior = self.orientation_prior;
+        options.robust = sagcal::calib::RobustKernels {
+            encoder: self.robust_encoder,
+            load_cell: self.robust_load_cell,
+            pose_prior: self.robust_pose,
+        };
+        Ok(options)
+    }
+}
+
+#[derive(Debug, clap::Args)]
+struct CalibrateArgs {
+    /// Nominal robot description (TOML): the initial guess of anchors and offsets.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Measurements: sagcal CSV (see README) or a RecurDyn log.
+    #[arg(long)]
+    data: PathBuf,
+    /// Write the calibrated robot (TOML) here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Write an SVG plot of nominal and calibrated anchors with error ellipses here.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    solver: SolverArgs,
+}
+
+#[derive(Debug, clap::Args)]
+struct SimulateArgs {
+    /// The true robot (TOML): anchors and length offsets of the simulation.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Number of static poses.
+    #[arg(long)]
+    poses: usize,
+    /// Random seed (the same seed gives the same file).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Sensor noise: paper, authors or none.
+    #[arg(long, default_value = "paper", value_parser = sagcal::model::sensors::NoisePreset::parse)]
+    noise: sagcal::model::sensors::NoisePreset,
+    /// Output measurement file (CSV).
+    #[arg(long)]
+    out: PathBuf,
+    /// Also write the truth (robot TOML with offsets) here.
+    #[arg(long)]
+    truth: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone, clap::Args)]
+struct DemoArgs {
+    /// Random seed of the simulation and of the perturbed initial guess.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Number of static poses.
+    #[arg(long, default_value_t = 35)]
+    poses: usize,
+    /// Folder for the demo's files (data.csv, truth.toml, calibrated.toml, anchors.svg).
+    #[arg(long, default_value = "sagcal-demo")]
+    out_dir: PathBuf,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
 }
 
 /// Which measurement closes the statics in `verify`.
@@ -61,7 +203,16 @@ pub fn run() -> i32 {
         }
     };
     let result = match cli.command {
-        Command::Verify(args) => verify::run(&args),
+        None => demo::run(&DemoArgs {
+            seed: 1,
+            poses: 35,
+            out_dir: PathBuf::from("sagcal-demo"),
+            json: false,
+        }),
+        Some(Command::Demo(args)) => demo::run(&args),
+        Some(Command::Calibrate(args)) => calibrate::run(&args),
+        Some(Command::Simulate(args)) => simulate::run(&args),
+        Some(Command::Verify(args)) => verify::run(&args),
     };
     match result {
         Ok(()) => 0,

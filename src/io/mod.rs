@@ -1,6 +1,9 @@
 //! Files: robot descriptions and measurement logs. The lowest layer: it knows
 //! formats and validation of single values, no physics.
 
+pub mod atomic;
 pub mod measurements;
 pub mod recurdyn;
 pub mod robot_file;
+
+pub use atomic::write_atomically;

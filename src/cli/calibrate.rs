@@ -1,0 +1,201 @@
+//! `sagcal calibrate`: anchors and offsets from a measurement file.
+
+use std::path::Path;
+
+use sagcal::calib::report::CalibrationReport;
+use sagcal::calib::{calibrate, CalibrationOptions, CalibrationResult, ParameterUncertainty};
+use sagcal::io::measurements::{read_measurements, ReadOptions};
+use sagcal::model::Robot;
+use sagcal::plot::{anchor_plot_svg, write_svg, AnchorPlot, AnchorPlotEntry};
+
+use super::output::{print_json, Table};
+use super::CalibrateArgs;
+
+pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
+    let nominal = Robot::from_file(&args.robot)?;
+    let data = read_measurements(
+        &args.data,
+        &ReadOptions {
+            reference_cable: nominal.reference_cable,
+            keep_rounded: false,
+        },
+    )?;
+    let options = args.solver.options(&nominal)?;
+    let result = calibrate(&nominal, &data.poses, &options)?;
+    let lines: Vec<usize> = data.poses.iter().map(|p| p.line).collect();
+    let report = CalibrationReport::new(&result, &nominal, options.model, &lines, None);
+    // Write files only after everything succeeded, each atomically.
+    if let Some(out) = &args.out {
+        write_robot(out, &result.robot)?;
+    }
+    if let Some(plot) = &args.plot {
+        let positions: Vec<[f64; 3]> = data.poses.iter().map(|p| p.position_m).collect();
+        write_plot(
+            plot,
+            &nominal,
+            None,
+            &result,
+            &positions,
+            &format!("sagcal calibrate --data {}", args.data.display()),
+        )?;
+    }
+    if args.json {
+        print_json(&report)
+    } else {
+        print!("{}", render(&report, &options));
+        if let Some(out) = &args.out {
+            println!("calibrated robot written to {}", out.display());
+        }
+        if let Some(plot) = &args.plot {
+            println!("plot written to {}", plot.display());
+        }
+        Ok(())
+    }
+}
+
+/// Write a robot TOML atomically.
+pub fn write_robot(path: &Path, robot: &Robot) -> sagcal::Result<()> {
+    let text = robot.to_file_contents().to_toml()?;
+    let header = "# Calibrated by sagcal: anchors and encoder length offsets estimated from measurements.\n";
+    sagcal::io::write_atomically(path, format!("{header}{text}").as_bytes())
+}
+
+/// The anchor plot of a calibration.
+pub fn write_plot(
+    path: &Path,
+    nominal: &Robot,
+    truth: Option<&Robot>,
+    result: &CalibrationResult,
+    positions: &[[f64; 3]],
+    caption: &str,
+) -> sagcal::Result<()> {
+    let covariances = match &result.uncertainty {
+        ParameterUncertainty::Full {
+            anchor_covariance_m2, ..
+        } => Some(anchor_covariance_m2.clone()),
+        ParameterUncertainty::RankDeficient { .. } => None,
+    };
+    let plot = AnchorPlot {
+        title: format!(
+            "sagcal: calibrated anchors of `{}` ({} poses)",
+            nominal.name,
+            result.poses.len()
+        ),
+        caption: caption.to_string(),
+        anchors: (0..4)
+            .map(|i| AnchorPlotEntry {
+                label: format!("anchor {}", i + 1),
+                nominal_m: nominal.anchors_m[i].into(),
+                initial_m: Some(nominal.anchors_m[i].into()),
+                estimate_m: result.robot.anchors_m[i].into(),
+                covariance_m2: covariances.as_ref().map(|c| c[i]),
+                truth_m: truth.map(|t| t.anchors_m[i].into()),
+            })
+            .collect(),
+        platform_positions_m: positions.to_vec(),
+    };
+    write_svg(path, &anchor_plot_svg(&plot))
+}
+
+fn sigma(value: Option<f64>) -> String {
+    value.map_or_else(|| "n/a".to_string(), |s| format!("{s:.3}"))
+}
+
+/// The human-readable calibration report.
+pub fn render(report: &CalibrationReport, options: &CalibrationOptions) -> String {
+    let mut out = String::new();
+    let n = &options.noise;
+    out += &format!(
+        "sagcal calibrate: robot `{}`, {:?} cable model, {} poses\nnoise: encoders {:.4} m, load cell {:.2} N, position {:.4} m, orientation {}\n\n",
+        report.robot,
+        report.model,
+        report.poses_used,
+        n.encoder_sigma_m,
+        n.load_cell_sigma_n,
+        n.position_sigma_m,
+        if options.orientation_prior { format!("{:.4} rad", n.orientation_sigma_rad) } else { "decided by the statics (no prior)".into() }
+    );
+    let mut anchors = Table::new([
+        "anchor",
+        "x m",
+        "y m",
+        "z m",
+        "1-sigma x,y,z m",
+        "change from nominal m",
+    ]);
+    for (i, a) in report.anchors_m.iter().enumerate() {
+        let s = report.anchor_sigma_m.as_ref().map(|s| s[i]);
+        let d = report.anchor_change_m[i];
+        anchors.row([
+            format!("{}", i + 1),
+            format!("{:.3}", a[0]),
+            format!("{:.3}", a[1]),
+            format!("{:.3}", a[2]),
+            s.map_or("n/a".into(), |s| format!("{:.3} {:.3} {:.3}", s[0], s[1], s[2])),
+            format!("{:+.3} {:+.3} {:+.3}", d[0], d[1], d[2]),
+        ]);
+    }
+    out += &anchors.to_string();
+    out += "\n";
+    let mut offsets = Table::new(["cable", "length offset m", "1-sigma m"]);
+    for (i, o) in report.length_offsets_m.iter().enumerate() {
+        offsets.row([
+            format!("{}", i + 1),
+            format!("{o:.4}"),
+            sigma(report.offset_sigma_m.as_ref().map(|s| s[i])),
+        ]);
+    }
+    out += &offsets.to_string();
+    if let ParameterUncertainty::RankDeficient { directions } = &report.uncertainty {
+        out += "\nNOT OBSERVABLE from these poses (add poses spread over the workspace):\n";
+        for d in directions {
+            let parts: Vec<String> = d
+                .components
+                .iter()
+                .take(6)
+                .map(|(name, c, w)| format!("{w:+.2} {name}[{}]", ["x", "y", "z"].get(*c).unwrap_or(&"?")))
+                .collect();
+            out += &format!("  direction: {}\n", parts.join(" "));
+        }
+    }
+    out += "\nnormalised residuals r/sigma per factor type (rms ~ 1 when the stated noise is right):\n";
+    let mut stats = Table::new(["factor", "count", "rms", "max |r/sigma|"]);
+    for s in &report.factor_statistics {
+        stats.row([
+            s.kind.clone(),
+            s.factors.to_string(),
+            format!("{:.3}", s.rms),
+            format!("{:.2}", s.max_abs),
+        ]);
+    }
+    out += &stats.to_string();
+    out += "\nsolver:\n";
+    let mut stages = Table::new(["stage", "iterations", "initial cost", "final cost", "termination"]);
+    for s in &report.stages {
+        stages.row([
+            s.name.clone(),
+            s.summary.iterations.to_string(),
+            format!("{:.4e}", s.summary.initial_cost),
+            format!("{:.4e}", s.summary.final_cost),
+            s.summary.termination.to_string(),
+        ]);
+    }
+    out += &stages.to_string();
+    if !report.excluded_poses.is_empty() {
+        out += &format!(
+            "\nWARNING: {} poses left out (no positive-tension equilibrium near them): lines {:?}\n",
+            report.excluded_poses.len(),
+            report.excluded_poses
+        );
+    }
+    if !report.converged {
+        out += &format!("\nWARNING: the solver did not converge ({})\n", report.termination);
+    }
+    if let Some(e) = &report.error_against_truth {
+        out += &format!(
+            "\nerror against the truth: anchors {:.3} m mean Euclidean ({:.3} m per coordinate, max {:.3} m), offsets {:.3} m\n",
+            e.anchor_mean_euclidean_m, e.anchor_coordinate_mae_m, e.anchor_max_euclidean_m, e.offset_mae_m
+        );
+    }
+    out
+}
