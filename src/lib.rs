@@ -27,6 +27,7 @@
 
 pub mod calib;
 pub mod error;
+pub mod experiment;
 #[path = "../generated/mod.rs"]
 #[allow(missing_docs, clippy::all)]
 pub mod generated;

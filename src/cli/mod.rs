@@ -3,6 +3,7 @@
 
 mod calibrate;
 mod demo;
+mod experiment;
 mod output;
 mod simulate;
 mod verify;
@@ -29,6 +30,76 @@ enum Command {
     Simulate(SimulateArgs),
     /// Check the kineto-static model against measured data (the paper's Table I).
     Verify(VerifyArgs),
+    /// Reproduce the paper's experiments.
+    #[command(subcommand)]
+    Experiment(ExperimentCommand),
+}
+
+#[derive(Debug, Subcommand)]
+enum ExperimentCommand {
+    /// The paper's Table II calibration protocol with the Cramer-Rao bound.
+    Table2(Table2Args),
+}
+
+fn parse_pose_counts(text: &str) -> Result<Vec<usize>, String> {
+    text.split(',')
+        .map(|p| {
+            p.trim()
+                .parse::<usize>()
+                .map_err(|_| format!("`{p}` is not a pose count"))
+        })
+        .collect()
+}
+
+fn parse_source(text: &str) -> Result<sagcal::experiment::Source, String> {
+    match text {
+        "log" => Ok(sagcal::experiment::Source::Log),
+        "model" => Ok(sagcal::experiment::Source::Model),
+        other => Err(format!("unknown source `{other}` (log, model)")),
+    }
+}
+
+#[derive(Debug, clap::Args)]
+struct Table2Args {
+    /// The true robot (TOML).
+    #[arg(long)]
+    robot: PathBuf,
+    /// The log whose poses are sampled (RecurDyn or sagcal CSV).
+    #[arg(long)]
+    data: PathBuf,
+    /// Pose counts, comma separated.
+    #[arg(long, default_value = "9,18,35", value_parser = parse_pose_counts)]
+    poses: std::vec::Vec<usize>,
+    /// Trials per pose count.
+    #[arg(long, default_value_t = 100)]
+    trials: usize,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Cable model of the calibration: catenary or rigid.
+    #[arg(long, default_value = "catenary", value_parser = sagcal::calib::CableModel::parse)]
+    model: sagcal::calib::CableModel,
+    /// Noise reading: paper (the paper's text) or authors (the authors' program).
+    #[arg(long, default_value = "paper", value_parser = sagcal::model::sensors::NoisePreset::parse)]
+    noise: sagcal::model::sensors::NoisePreset,
+    /// `log`: the log's own lengths and tensions; `model`: the model's equilibria at the logged poses.
+    #[arg(long, default_value = "log", value_parser = parse_source)]
+    source: sagcal::experiment::Source,
+    /// Anchor perturbation of the initial guess, m (default 10, 1 for light robots).
+    #[arg(long)]
+    anchor_perturbation_m: Option<f64>,
+    /// Offset perturbation of the initial guess, m (default 80, 10 for light robots).
+    #[arg(long)]
+    offset_perturbation_m: Option<f64>,
+    /// Right-basin radius: every anchor within it, m (default 0.3 x the anchor perturbation; unlimited for rigid).
+    #[arg(long)]
+    basin_radius_m: Option<f64>,
+    /// Add the localiser's orientation as a prior.
+    #[arg(long)]
+    orientation_prior: bool,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
 }
 
 /// Options of the calibration solver shared by the commands that calibrate.
@@ -213,6 +284,7 @@ pub fn run() -> i32 {
         Some(Command::Calibrate(args)) => calibrate::run(&args),
         Some(Command::Simulate(args)) => simulate::run(&args),
         Some(Command::Verify(args)) => verify::run(&args),
+        Some(Command::Experiment(ExperimentCommand::Table2(args))) => experiment::run(&args),
     };
     match result {
         Ok(()) => 0,

@@ -1,0 +1,422 @@
+//! The paper's Table II protocol (Sec. V-B), and its Cramer-Rao bound.
+//!
+//! For each pose count and trial: pick that many poses of the log at random,
+//! add the sensor noise to the encoders (lengths + true offsets, zero here),
+//! the load cell and the localiser's pose, perturb the initial guess (every
+//! anchor by `anchor_perturbation_m` in a random direction, every offset by
+//! `+-offset_perturbation_m`), calibrate, and compare with the truth (the
+//! robot file's anchors, zero offsets).
+//!
+//! The poses come either from the log itself (`Source::Log`: RecurDyn's
+//! finite-element lengths and tensions, model mismatch included) or from the
+//! model at the log's positions (`Source::Model`: the closed-form equilibrium
+//! at each logged position and reference tension; no mismatch, so the
+//! Cramer-Rao bound describes the best achievable error).
+//!
+//! Every trial has its own random stream, seeded from `(seed, pose count,
+//! trial)`, so results do not depend on the number of threads.
+
+use nalgebra::{Matrix3, Vector3, Vector6};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::calib::{
+    calibrate, cramer_rao_bound, CableModel, CalibrationError, CalibrationOptions, ParameterUncertainty,
+};
+use crate::error::{Error, Result};
+use crate::io::measurements::PoseMeasurement;
+use crate::model::pose::PlatformPose;
+use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::sensors::{NoisePreset, SensorNoise};
+use crate::model::statics::{self, Equilibrium, StaticsOptions};
+
+/// Where the measured quantities come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Source {
+    /// The log's own lengths and tensions.
+    Log,
+    /// The closed-form model's equilibrium at each logged position and tension.
+    Model,
+}
+
+/// One pose of the experiment's pool: what the sensors would read without noise, and the truth.
+#[derive(Debug, Clone)]
+pub struct PoolPose {
+    /// Line in the log.
+    pub line: usize,
+    /// The pose the localiser measures (before noise).
+    pub pose: PlatformPose,
+    /// True cable lengths, metres.
+    pub cable_lengths_m: [f64; CABLE_COUNT],
+    /// True reference tension magnitude, newtons.
+    pub reference_tension_n: f64,
+    /// The model's equilibrium at this pose (for the Cramer-Rao bound).
+    pub equilibrium: Equilibrium,
+}
+
+/// Build the pool from a log's measurements (encoder readings = true lengths).
+pub fn pose_pool(robot: &Robot, measurements: &[PoseMeasurement], source: Source) -> Result<Vec<PoolPose>> {
+    let options = StaticsOptions::default();
+    let mut pool = Vec::with_capacity(measurements.len());
+    for m in measurements {
+        let logged =
+            PlatformPose::from_roll_pitch_yaw_deg(Vector3::from(m.position_m), m.roll_deg, m.pitch_deg, m.yaw_deg);
+        let equilibrium = statics::solve_with_reference_tension(
+            robot,
+            logged.position_m,
+            m.reference_tension_n,
+            Some(logged.rotation),
+            &options,
+        )
+        .map_err(|e| Error::InvalidInput(format!("line {}: {e}", m.line)))?;
+        let pose = match source {
+            Source::Log => PoolPose {
+                line: m.line,
+                pose: logged,
+                cable_lengths_m: m.encoder_lengths_m,
+                reference_tension_n: m.reference_tension_n,
+                equilibrium,
+            },
+            Source::Model => PoolPose {
+                line: m.line,
+                pose: equilibrium.pose,
+                cable_lengths_m: equilibrium.cable_lengths_m,
+                reference_tension_n: equilibrium.tensions[robot.reference_cable].magnitude_n(),
+                equilibrium,
+            },
+        };
+        pool.push(pose);
+    }
+    Ok(pool)
+}
+
+/// The protocol's settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Protocol {
+    /// Noise added to the data (and used as the factors' weights).
+    pub noise: NoisePreset,
+    /// Cable model of the calibration.
+    pub model: CableModel,
+    /// Anchor perturbation of the initial guess, metres (10 on the large robot, 1 on the small).
+    pub anchor_perturbation_m: f64,
+    /// Offset perturbation of the initial guess, metres (80 / 10).
+    pub offset_perturbation_m: f64,
+    /// A trial converged to the right basin when the solver stopped at a minimum
+    /// and every anchor is within this distance of the truth, or else the solve
+    /// started at the truth reaches the same minimum (anchors within 1 cm), metres.
+    pub basin_radius_m: f64,
+    /// Add the localiser's orientation as a prior.
+    pub orientation_prior: bool,
+}
+
+/// One trial.
+#[derive(Debug, Clone, Serialize)]
+pub struct TrialResult {
+    /// Trial index.
+    pub trial: usize,
+    /// Log lines of the poses used.
+    pub lines: Vec<usize>,
+    /// Whether it reached the right basin.
+    pub converged: bool,
+    /// Errors against the truth (`None` if the calibration failed outright).
+    pub error: Option<CalibrationError>,
+    /// Why it failed or did not converge, if it did not.
+    pub failure: Option<String>,
+    /// Wall time of the calibration, milliseconds.
+    pub solve_ms: f64,
+    /// Expected mean Euclidean anchor error under the Cramer-Rao bound, metres.
+    pub anchor_crlb_m: Option<f64>,
+    /// Expected offset mean absolute error under the bound, metres.
+    pub offset_crlb_m: Option<f64>,
+}
+
+/// The summary for one pose count.
+#[derive(Debug, Clone, Serialize)]
+pub struct PoseCountResult {
+    /// Poses per trial.
+    pub poses: usize,
+    /// Trials run.
+    pub trials: usize,
+    /// Trials that reached the right basin.
+    pub converged: usize,
+    /// Mean over converged trials of the mean Euclidean anchor error, metres.
+    pub anchor_mae_m: f64,
+    /// Standard error of that mean over the trials, metres.
+    pub anchor_mae_standard_error_m: f64,
+    /// Mean over converged trials of the per-coordinate anchor MAE, metres.
+    pub anchor_coord_mae_m: f64,
+    /// Mean over converged trials of the offset MAE, metres.
+    pub offset_mae_m: f64,
+    /// Mean over trials of the bound's expected mean Euclidean anchor error, metres.
+    pub anchor_crlb_m: f64,
+    /// Mean over trials of the bound's expected offset MAE, metres.
+    pub offset_crlb_m: f64,
+    /// Median calibration time, milliseconds.
+    pub median_solve_ms: f64,
+    /// The trials that did not converge, with the reason.
+    pub not_converged: Vec<TrialResult>,
+}
+
+/// Expected `E|e|` of a zero-mean Gaussian with covariance `c` (3x3), by a
+/// fixed-seed Monte Carlo of 4000 draws (exact enough for a report).
+fn expected_norm(c: &[[f64; 3]; 3]) -> Option<f64> {
+    let m = Matrix3::from_fn(|r, col| c[r][col]);
+    let l = m.cholesky()?.l();
+    let mut rng = ChaCha8Rng::seed_from_u64(0x5eed);
+    let draws = 4000;
+    let mut sum = 0.0;
+    for _ in 0..draws {
+        let z = Vector3::from_fn(|_, _| StandardNormal.sample(&mut rng));
+        sum += (l * z).norm();
+    }
+    Some(sum / draws as f64)
+}
+
+fn bound_summary(bound: &ParameterUncertainty) -> (Option<f64>, Option<f64>) {
+    match bound {
+        ParameterUncertainty::Full {
+            anchor_covariance_m2,
+            offset_sigma_m,
+            ..
+        } => {
+            let anchors: Option<Vec<f64>> = anchor_covariance_m2.iter().map(expected_norm).collect();
+            let anchor = anchors.map(|a| a.iter().sum::<f64>() / a.len() as f64);
+            // E|x| = sqrt(2/pi) sigma for a Gaussian.
+            let offset = offset_sigma_m
+                .iter()
+                .map(|s| s * (2.0 / std::f64::consts::PI).sqrt())
+                .sum::<f64>()
+                / offset_sigma_m.len() as f64;
+            (anchor, Some(offset))
+        }
+        ParameterUncertainty::RankDeficient { .. } => (None, None),
+    }
+}
+
+/// Measurements of `chosen` pool poses with `noise`.
+fn noisy_measurements(
+    pool: &[PoolPose],
+    chosen: &[usize],
+    noise: &SensorNoise,
+    rng: &mut impl Rng,
+) -> Vec<PoseMeasurement> {
+    let mut normal = |sigma: f64| -> f64 {
+        let z: f64 = StandardNormal.sample(rng);
+        sigma * z
+    };
+    chosen
+        .iter()
+        .map(|&k| {
+            let p = &pool[k];
+            let xi = Vector6::new(
+                normal(noise.orientation_sigma_rad),
+                normal(noise.orientation_sigma_rad),
+                normal(noise.orientation_sigma_rad),
+                normal(noise.position_sigma_m),
+                normal(noise.position_sigma_m),
+                normal(noise.position_sigma_m),
+            );
+            let pose = p.pose.retract(&xi);
+            let (roll_deg, pitch_deg, yaw_deg) = pose.roll_pitch_yaw_deg();
+            let encoder_lengths_m: [f64; CABLE_COUNT] =
+                std::array::from_fn(|i| p.cable_lengths_m[i] + normal(noise.encoder_sigma_m));
+            PoseMeasurement {
+                line: p.line,
+                position_m: pose.position_m.into(),
+                roll_deg,
+                pitch_deg,
+                yaw_deg,
+                encoder_lengths_m,
+                reference_tension_n: p.reference_tension_n + normal(noise.load_cell_sigma_n),
+            }
+        })
+        .collect()
+}
+
+fn perturbed_guess(truth: &Robot, protocol: &Protocol, rng: &mut impl Rng) -> Robot {
+    let mut guess = truth.clone();
+    for i in 0..CABLE_COUNT {
+        let direction = loop {
+            let v = Vector3::from_fn(|_, _| StandardNormal.sample(&mut *rng));
+            if v.norm() > 1e-3 {
+                break v.normalize();
+            }
+        };
+        guess.anchors_m[i] += protocol.anchor_perturbation_m * direction;
+        guess.length_offsets_m[i] += if rng.random_bool(0.5) {
+            protocol.offset_perturbation_m
+        } else {
+            -protocol.offset_perturbation_m
+        };
+    }
+    guess
+}
+
+/// Run one trial.
+pub fn run_trial(
+    truth: &Robot,
+    pool: &[PoolPose],
+    poses: usize,
+    trial: usize,
+    seed: u64,
+    protocol: &Protocol,
+) -> TrialResult {
+    let stream = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ ((poses as u64) << 32) ^ trial as u64;
+    let mut rng = ChaCha8Rng::seed_from_u64(stream);
+    let mut indices: Vec<usize> = (0..pool.len()).collect();
+    for i in 0..poses {
+        let j = rng.random_range(i..indices.len());
+        indices.swap(i, j);
+    }
+    let chosen = &indices[..poses];
+    let noise = protocol.noise.sigmas(truth.platform_weight_n);
+    let data = noisy_measurements(pool, chosen, &noise, &mut rng);
+    let guess = perturbed_guess(truth, protocol, &mut rng);
+    let mut options = CalibrationOptions::new(noise);
+    options.model = protocol.model;
+    options.orientation_prior = protocol.orientation_prior;
+    let equilibria: Vec<Equilibrium> = chosen.iter().map(|&k| pool[k].equilibrium.clone()).collect();
+    let (anchor_crlb_m, offset_crlb_m) =
+        cramer_rao_bound(truth, &equilibria, &options).map_or((None, None), |b| bound_summary(&b));
+    let lines = chosen.iter().map(|&k| pool[k].line).collect();
+    let started = std::time::Instant::now();
+    let result = calibrate(&guess, &data, &options);
+    let solve_ms = started.elapsed().as_secs_f64() * 1e3;
+    match result {
+        Ok(result) => {
+            let error = CalibrationError::between(&result.robot, truth);
+            let radius = protocol.basin_radius_m;
+            // Right basin: the solver stopped at a minimum, and it is the data's own
+            // minimum: within the radius of the truth, or, if farther (few poses make
+            // the bound itself large), the same minimum a solve started at the truth finds.
+            let in_basin = error.anchor_max_euclidean_m < radius || {
+                let from_truth = truth.clone();
+                calibrate(&from_truth, &data, &options).is_ok_and(|reference| {
+                    (0..CABLE_COUNT).all(|i| (reference.robot.anchors_m[i] - result.robot.anchors_m[i]).norm() < 0.01)
+                })
+            };
+            let converged = result.converged() && in_basin;
+            let failure = (!converged).then(|| {
+                if !result.converged() {
+                    format!("solver: {}", result.final_stage().termination)
+                } else {
+                    format!(
+                        "wrong basin: an anchor is {:.2} m from the truth and the solve started at the truth ends elsewhere",
+                        error.anchor_max_euclidean_m
+                    )
+                }
+            });
+            TrialResult {
+                trial,
+                lines,
+                converged,
+                error: Some(error),
+                failure,
+                solve_ms,
+                anchor_crlb_m,
+                offset_crlb_m,
+            }
+        }
+        Err(e) => TrialResult {
+            trial,
+            lines,
+            converged: false,
+            error: None,
+            failure: Some(e.to_string()),
+            solve_ms,
+            anchor_crlb_m,
+            offset_crlb_m,
+        },
+    }
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 {
+        f64::NAN
+    } else {
+        sum / n as f64
+    }
+}
+
+/// Summarise the trials of one pose count.
+pub fn summarise(poses: usize, trials: Vec<TrialResult>) -> PoseCountResult {
+    let ok: Vec<&CalibrationError> = trials
+        .iter()
+        .filter(|t| t.converged)
+        .filter_map(|t| t.error.as_ref())
+        .collect();
+    let mut times: Vec<f64> = trials.iter().map(|t| t.solve_ms).collect();
+    times.sort_by(f64::total_cmp);
+    PoseCountResult {
+        poses,
+        trials: trials.len(),
+        converged: ok.len(),
+        anchor_mae_m: mean(ok.iter().map(|e| e.anchor_mean_euclidean_m)),
+        anchor_mae_standard_error_m: {
+            let m = mean(ok.iter().map(|e| e.anchor_mean_euclidean_m));
+            let var = mean(ok.iter().map(|e| (e.anchor_mean_euclidean_m - m).powi(2)));
+            (var / (ok.len().max(2) - 1) as f64).sqrt()
+        },
+        anchor_coord_mae_m: mean(ok.iter().map(|e| e.anchor_coordinate_mae_m)),
+        offset_mae_m: mean(ok.iter().map(|e| e.offset_mae_m)),
+        anchor_crlb_m: mean(trials.iter().filter_map(|t| t.anchor_crlb_m)),
+        offset_crlb_m: mean(trials.iter().filter_map(|t| t.offset_crlb_m)),
+        median_solve_ms: times.get(times.len() / 2).copied().unwrap_or(f64::NAN),
+        not_converged: trials.into_iter().filter(|t| !t.converged).collect(),
+    }
+}
+
+/// Run `trials` trials for every pose count in parallel; `progress` is called once per finished trial.
+pub fn run_protocol(
+    truth: &Robot,
+    pool: &[PoolPose],
+    pose_counts: &[usize],
+    trials: usize,
+    seed: u64,
+    protocol: &Protocol,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<PoseCountResult>> {
+    for &n in pose_counts {
+        if n > pool.len() {
+            return Err(Error::InvalidInput(format!(
+                "{n} poses requested but the data has only {} usable poses",
+                pool.len()
+            )));
+        }
+        if n < crate::calib::MIN_POSES {
+            return Err(Error::InvalidInput(format!(
+                "{n} poses per trial: at least {} are needed",
+                crate::calib::MIN_POSES
+            )));
+        }
+    }
+    let jobs: Vec<(usize, usize)> = pose_counts
+        .iter()
+        .flat_map(|&n| (0..trials).map(move |t| (n, t)))
+        .collect();
+    let results: Vec<(usize, TrialResult)> = jobs
+        .par_iter()
+        .map(|&(n, t)| {
+            let r = run_trial(truth, pool, n, t, seed, protocol);
+            progress();
+            (n, r)
+        })
+        .collect();
+    Ok(pose_counts
+        .iter()
+        .map(|&n| {
+            let mut of_n: Vec<TrialResult> = results
+                .iter()
+                .filter(|(m, _)| *m == n)
+                .map(|(_, r)| r.clone())
+                .collect();
+            of_n.sort_by_key(|r| r.trial);
+            summarise(n, of_n)
+        })
+        .collect())
+}
