@@ -39,7 +39,10 @@ fn verify_beats_table_one_on_the_recurdyn_data() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["rows_kept"], 57);
-    assert_eq!(report["rows_rejected"].as_array().unwrap().len(), 35);
+    let rejected = report["rows_rejected"].as_array().unwrap();
+    assert_eq!(rejected.len(), 35);
+    let line18 = rejected.iter().find(|r| r["row"] == 18).expect("line 18 is rejected");
+    assert!(line18["reason"].as_str().unwrap().contains("fc1"), "{line18}");
     assert_eq!(report["rows_unsolved"].as_array().unwrap().len(), 0);
     let mpe_l = report["mpe_length_pct"].as_f64().unwrap();
     let mpe_f = report["mpe_force_pct"].as_f64().unwrap();

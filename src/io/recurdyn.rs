@@ -105,7 +105,8 @@ pub struct RecurDynRow {
 /// A row left out for a data-quality reason.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RejectedRow {
-    /// 1-based line number in the file (the header is line 1).
+    /// 1-based line number in the file (the header is line 1); `row` in JSON.
+    #[serde(rename = "row")]
     pub line: usize,
     /// Why the row was left out.
     pub reason: String,
