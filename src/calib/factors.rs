@@ -205,54 +205,35 @@ impl Factor for CatenaryLengthFactor {
         let anchors = gather_anchors(values, &self.slots, &self.globals);
         let offsets = gather_offsets(values, &self.slots, &self.globals);
         let s = &self.slots;
-        let residual = match jacobians {
-            None => generated::catenary_length_residual(
-                &position,
-                &rotation,
-                &tension,
-                &anchors,
-                &s.attachments_m,
-                &s.com_offset_m,
-                s.platform_weight_n,
-                s.cable_weight_n_per_m,
-                &offsets,
-                &self.encoder_lengths_m,
-                EPSILON,
-                None,
-                None,
-                None,
-                None,
-            ),
-            Some(blocks) => {
-                let mut j_pose = SMatrix::<f64, 4, 6>::zeros();
-                let mut j_tension = SMatrix::<f64, 4, 2>::zeros();
-                let mut j_anchors = SMatrix::<f64, 4, 12>::zeros();
-                let mut j_offsets = SMatrix::<f64, 4, 4>::zeros();
-                let r = generated::catenary_length_residual(
-                    &position,
-                    &rotation,
-                    &tension,
-                    &anchors,
-                    &s.attachments_m,
-                    &s.com_offset_m,
-                    s.platform_weight_n,
-                    s.cable_weight_n_per_m,
-                    &offsets,
-                    &self.encoder_lengths_m,
-                    EPSILON,
-                    Some(&mut j_pose),
-                    Some(&mut j_tension),
-                    Some(&mut j_anchors),
-                    Some(&mut j_offsets),
-                );
-                blocks[0].copy_from(&j_pose);
-                blocks[1].copy_from(&j_tension);
-                split_anchor_jacobian(&j_anchors, s, &mut blocks[2..6]);
-                split_offset_jacobian(&j_offsets, s, &mut blocks[6..10]);
-                rows_to_cables(s, blocks);
-                r
-            }
-        };
+        let mut j_pose = SMatrix::<f64, 4, 6>::zeros();
+        let mut j_tension = SMatrix::<f64, 4, 2>::zeros();
+        let mut j_anchors = SMatrix::<f64, 4, 12>::zeros();
+        let mut j_offsets = SMatrix::<f64, 4, 4>::zeros();
+        let want = jacobians.is_some();
+        let residual = generated::catenary_length_residual(
+            &position,
+            &rotation,
+            &tension,
+            &anchors,
+            &s.attachments_m,
+            &s.com_offset_m,
+            s.platform_weight_n,
+            s.cable_weight_n_per_m,
+            &offsets,
+            &self.encoder_lengths_m,
+            EPSILON,
+            want.then_some(&mut j_pose),
+            want.then_some(&mut j_tension),
+            want.then_some(&mut j_anchors),
+            want.then_some(&mut j_offsets),
+        );
+        if let Some(blocks) = jacobians {
+            blocks[0].copy_from(&j_pose);
+            blocks[1].copy_from(&j_tension);
+            split_anchor_jacobian(&j_anchors, s, &mut blocks[2..6]);
+            split_offset_jacobian(&j_offsets, s, &mut blocks[6..10]);
+            rows_to_cables(s, blocks);
+        }
         Some(slots_to_cables(s, &residual))
     }
     fn sigmas(&self) -> &DVector<f64> {
@@ -301,46 +282,30 @@ impl Factor for AttachmentHeightFactor {
         let tension = tension_argument(values, self.pose.reference_tension);
         let anchors = gather_anchors(values, &self.slots, &self.globals);
         let s = &self.slots;
-        let residual = match jacobians {
-            None => generated::attachment_height_residual(
-                &position,
-                &rotation,
-                &tension,
-                &anchors,
-                &s.attachments_m,
-                &s.com_offset_m,
-                s.platform_weight_n,
-                s.cable_weight_n_per_m,
-                EPSILON,
-                None,
-                None,
-                None,
-            ),
-            Some(blocks) => {
-                let mut j_pose = SMatrix::<f64, 4, 6>::zeros();
-                let mut j_tension = SMatrix::<f64, 4, 2>::zeros();
-                let mut j_anchors = SMatrix::<f64, 4, 12>::zeros();
-                let r = generated::attachment_height_residual(
-                    &position,
-                    &rotation,
-                    &tension,
-                    &anchors,
-                    &s.attachments_m,
-                    &s.com_offset_m,
-                    s.platform_weight_n,
-                    s.cable_weight_n_per_m,
-                    EPSILON,
-                    Some(&mut j_pose),
-                    Some(&mut j_tension),
-                    Some(&mut j_anchors),
-                );
-                blocks[0].copy_from(&j_pose);
-                blocks[1].copy_from(&j_tension);
-                split_anchor_jacobian(&j_anchors, s, &mut blocks[2..6]);
-                rows_to_cables(s, blocks);
-                r
-            }
-        };
+        let mut j_pose = SMatrix::<f64, 4, 6>::zeros();
+        let mut j_tension = SMatrix::<f64, 4, 2>::zeros();
+        let mut j_anchors = SMatrix::<f64, 4, 12>::zeros();
+        let want = jacobians.is_some();
+        let residual = generated::attachment_height_residual(
+            &position,
+            &rotation,
+            &tension,
+            &anchors,
+            &s.attachments_m,
+            &s.com_offset_m,
+            s.platform_weight_n,
+            s.cable_weight_n_per_m,
+            EPSILON,
+            want.then_some(&mut j_pose),
+            want.then_some(&mut j_tension),
+            want.then_some(&mut j_anchors),
+        );
+        if let Some(blocks) = jacobians {
+            blocks[0].copy_from(&j_pose);
+            blocks[1].copy_from(&j_tension);
+            split_anchor_jacobian(&j_anchors, s, &mut blocks[2..6]);
+            rows_to_cables(s, blocks);
+        }
         Some(slots_to_cables(s, &residual))
     }
     fn sigmas(&self) -> &DVector<f64> {
