@@ -256,6 +256,34 @@ fn perturbed_guess(truth: &Robot, protocol: &Protocol, rng: &mut impl Rng) -> Ro
     guess
 }
 
+/// The inputs of one trial: the chosen pool indices, the noisy measurements,
+/// the perturbed initial guess and the calibration options. Reproducible from
+/// `(seed, poses, trial)`.
+pub fn trial_inputs(
+    truth: &Robot,
+    pool: &[PoolPose],
+    poses: usize,
+    trial: usize,
+    seed: u64,
+    protocol: &Protocol,
+) -> (Vec<usize>, Vec<PoseMeasurement>, Robot, CalibrationOptions) {
+    let stream = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ ((poses as u64) << 32) ^ trial as u64;
+    let mut rng = ChaCha8Rng::seed_from_u64(stream);
+    let mut indices: Vec<usize> = (0..pool.len()).collect();
+    for i in 0..poses {
+        let j = rng.random_range(i..indices.len());
+        indices.swap(i, j);
+    }
+    indices.truncate(poses);
+    let noise = protocol.noise.sigmas(truth.platform_weight_n);
+    let data = noisy_measurements(pool, &indices, &noise, &mut rng);
+    let guess = perturbed_guess(truth, protocol, &mut rng);
+    let mut options = CalibrationOptions::new(noise);
+    options.model = protocol.model;
+    options.orientation_prior = protocol.orientation_prior;
+    (indices, data, guess, options)
+}
+
 /// Run one trial.
 pub fn run_trial(
     truth: &Robot,
@@ -265,20 +293,7 @@ pub fn run_trial(
     seed: u64,
     protocol: &Protocol,
 ) -> TrialResult {
-    let stream = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ ((poses as u64) << 32) ^ trial as u64;
-    let mut rng = ChaCha8Rng::seed_from_u64(stream);
-    let mut indices: Vec<usize> = (0..pool.len()).collect();
-    for i in 0..poses {
-        let j = rng.random_range(i..indices.len());
-        indices.swap(i, j);
-    }
-    let chosen = &indices[..poses];
-    let noise = protocol.noise.sigmas(truth.platform_weight_n);
-    let data = noisy_measurements(pool, chosen, &noise, &mut rng);
-    let guess = perturbed_guess(truth, protocol, &mut rng);
-    let mut options = CalibrationOptions::new(noise);
-    options.model = protocol.model;
-    options.orientation_prior = protocol.orientation_prior;
+    let (chosen, data, guess, options) = trial_inputs(truth, pool, poses, trial, seed, protocol);
     let equilibria: Vec<Equilibrium> = chosen.iter().map(|&k| pool[k].equilibrium.clone()).collect();
     let (anchor_crlb_m, offset_crlb_m) =
         cramer_rao_bound(truth, &equilibria, &options).map_or((None, None), |b| bound_summary(&b));

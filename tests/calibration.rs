@@ -39,23 +39,13 @@ fn noise_free_data_recovers_the_truth_to_a_micrometre() {
     for (name, anchor_m, offset_m) in [("large", 10.0, 80.0), ("small", 1.0, 10.0)] {
         let truth = truth(name, 3);
         let mut rng = ChaCha8Rng::seed_from_u64(11);
-        // The small robot's default workspace (+-1.5 m x +-0.6 m under 28.5 m high anchors) leaves
-        // the anchors nearly unobservable (Cramer-Rao bound of metres); use half its footprint.
-        let mut workspace = Workspace::default_for(&truth);
-        if name == "small" {
-            workspace.min_m[..2].copy_from_slice(&[-3.1, -1.1]);
-            workspace.max_m[..2].copy_from_slice(&[3.1, 1.1]);
-        }
+        let workspace = Workspace::default_for(&truth);
         let equilibria = sample_equilibria(&truth, &workspace, 12, &mut rng).unwrap();
         let noise = NoisePreset::None.sigmas(truth.platform_weight_n);
         let data = measure(&truth, &equilibria, &noise, &mut rng);
         let initial = perturbed(&truth, anchor_m, offset_m, &mut rng);
         // Weights from the paper's sigmas; the data are exact.
-        let mut options = CalibrationOptions::new(NoisePreset::Paper.sigmas(truth.platform_weight_n));
-        options.orientation_prior = name == "small";
-        // Exact data: run to the bottom of the (flat, for the small robot) valley.
-        options.lm.relative_cost_tolerance = 1e-20;
-        options.lm.max_iterations = 2000;
+        let options = CalibrationOptions::new(NoisePreset::Paper.sigmas(truth.platform_weight_n));
         let result = calibrate(&initial, &data, &options).unwrap();
         let error = CalibrationError::between(&result.robot, &truth);
         eprintln!(
@@ -67,11 +57,17 @@ fn noise_free_data_recovers_the_truth_to_a_micrometre() {
                 .collect::<Vec<_>>()
         );
         assert!(result.converged());
-        // The large robot is recovered to 1e-11 m. The small robot's anchors have a Cramer-Rao
-        // bound of ~0.3 m at 12 poses (nearly vertical cables); along that nearly flat direction
-        // the solver stops within a millimetre, 1/300 of the bound.
-        let tolerance = if name == "large" { 1e-6 } else { 1e-3 };
-        assert!(error.anchor_max_euclidean_m < 3.0 * tolerance, "{name}: {error:?}");
+        // Default solver settings, no orientation prior. The small robot's anchors are weakly
+        // observable (nearly vertical cables: a Cramer-Rao bound of ~0.5 m at 12 poses), which
+        // without the solver's per-pose refinement left LM creeping along the statics valley for
+        // hundreds of iterations; with it every stage takes a few dozen.
+        let final_iterations = result.final_stage().iterations;
+        assert!(
+            final_iterations < 100,
+            "{name}: {final_iterations} iterations in the final stage"
+        );
+        let tolerance = 1e-6;
+        assert!(error.anchor_max_euclidean_m < tolerance, "{name}: {error:?}");
         assert!(error.offset_mae_m < tolerance, "{name}: {error:?}");
     }
 }

@@ -22,6 +22,14 @@
 //! tension with the stage-1 anchors gives every pose a consistent orientation
 //! and tension, (3) the full catenary graph. Eq. (17)-(18) alone often start
 //! with negative tensions in other cables; this sequence does not.
+//!
+//! **Solving.** Each pose's variables (platform pose, reference tension) form
+//! a local group of the graph: after every trial step the solver re-fits each
+//! pose to its own factors with the anchors and offsets held, so a step of
+//! the anchors is judged with every pose back on its statics. Without it the
+//! 0.1 mm attachment-height constraint bends the valley so sharply that LM
+//! creeps along it (the small robot, with its nearly vertical cables, hit
+//! 500 iterations in most trials).
 
 pub mod factors;
 pub mod report;
@@ -345,6 +353,7 @@ pub fn build_graph(
             }
         }
         pose_variables.push(vars);
+        graph.local_groups.push(vec![vars.pose, vars.reference_tension]);
     }
     CalibrationGraph {
         graph,
@@ -596,11 +605,13 @@ pub fn calibrate(
         if let Some(slot) = feasible.iter().position(|&f| f == k) {
             let vars = relaxed.poses[slot];
             let t = relaxed.graph.values.vector(vars.reference_tension);
-            final_poses.push(*relaxed.graph.values.pose(vars.pose));
-            final_tensions.push(CableTension {
+            let pose = *relaxed.graph.values.pose(vars.pose);
+            let tension = CableTension {
                 horizontal_n: t[0],
                 vertical_n: t[1],
-            });
+            };
+            final_poses.push(pose);
+            final_tensions.push(tension);
         } else if still_failing.contains(&k) {
             excluded.push(k);
             continue;

@@ -44,6 +44,19 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
         sagcal::io::write_atomically(path, text.as_bytes())?;
     }
     write_measurements(&args.out, &comments, &data)?;
+    let range = |values: &mut dyn Iterator<Item = f64>| {
+        values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)))
+    };
+    let (length_min, length_max) = range(&mut equilibria.iter().flat_map(|eq| eq.cable_lengths_m));
+    let (tension_min, tension_max) = range(
+        &mut equilibria
+            .iter()
+            .flat_map(|eq| eq.tensions.iter().map(|t| t.magnitude_n())),
+    );
+    println!(
+        "workspace {:?} .. {:?} m: cable lengths {length_min:.1} .. {length_max:.1} m, tensions {tension_min:.1} .. {tension_max:.1} N",
+        workspace.min_m, workspace.max_m
+    );
     println!(
         "seed {}: {} poses of robot `{}` with {} noise written to {}",
         args.seed,

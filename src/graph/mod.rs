@@ -46,6 +46,11 @@ pub struct FactorGraph {
     pub values: Values,
     /// The factors.
     pub factors: Vec<Box<dyn Factor>>,
+    /// Groups of *local* variables (e.g. one pose and its reference tension):
+    /// each group shares factors only with itself and with variables outside
+    /// every group. The solver re-minimises each group with the others fixed
+    /// after every step (see [`crate::solver`]); empty: no local refinement.
+    pub local_groups: Vec<Vec<VariableId>>,
 }
 
 impl FactorGraph {
@@ -76,4 +81,54 @@ impl FactorGraph {
 /// `|r / sigma|^2`.
 pub fn whitened_squared_norm(residual: &DVector<f64>, sigmas: &DVector<f64>) -> f64 {
     residual.iter().zip(sigmas.iter()).map(|(r, s)| (r / s) * (r / s)).sum()
+}
+
+/// One factor linearised for a Gauss-Newton system: residual and Jacobian
+/// blocks whitened by its sigmas and reweighted by its robust kernel
+/// (`sqrt(w) r / sigma`, `sqrt(w) J / sigma`), and its cost `1/2 rho(s)`.
+pub struct WhitenedLinearization {
+    /// Whitened, reweighted residual.
+    pub residual: Vec<f64>,
+    /// Whitened, reweighted Jacobian blocks, one per variable.
+    pub jacobians: Vec<DMatrix<f64>>,
+    /// The factor's cost `1/2 rho(|r / sigma|^2)`.
+    pub cost: f64,
+}
+
+/// Linearise one factor at `values`; `Err` names what went wrong (the model is
+/// undefined there, or a residual or Jacobian entry is not finite).
+pub fn linearize_factor(factor: &dyn Factor, values: &Values) -> Result<WhitenedLinearization, &'static str> {
+    let rows = factor.residual_dim();
+    let mut jacobians: Vec<DMatrix<f64>> = factor
+        .variables()
+        .iter()
+        .map(|&v| DMatrix::zeros(rows, values.tangent_dim(v)))
+        .collect();
+    let residual = factor
+        .evaluate(values, Some(&mut jacobians))
+        .ok_or("model undefined (slack cable)")?;
+    let sigmas = factor.sigmas();
+    let s = whitened_squared_norm(&residual, sigmas);
+    if !s.is_finite() {
+        return Err("non-finite residual");
+    }
+    let kernel = factor.robust_kernel();
+    let scale = kernel.weight(s).sqrt();
+    let whitened: Vec<f64> = (0..rows).map(|r| residual[r] / sigmas[r] * scale).collect();
+    for jac in &mut jacobians {
+        for r in 0..rows {
+            let w = scale / sigmas[r];
+            for c in 0..jac.ncols() {
+                jac[(r, c)] *= w;
+            }
+        }
+    }
+    if jacobians.iter().any(|j| j.iter().any(|v| !v.is_finite())) {
+        return Err("non-finite Jacobian");
+    }
+    Ok(WhitenedLinearization {
+        residual: whitened,
+        jacobians,
+        cost: 0.5 * kernel.rho(s),
+    })
 }

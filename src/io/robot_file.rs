@@ -10,6 +10,10 @@
 //! [[cables]]                       # one table per cable, in cable order
 //! anchor_m = [-125.0, -110.0, 48.0]      # pulley exit point, world frame
 //! attachment_m = [-0.21, -0.21, -0.011]  # attachment point, platform frame
+//!
+//! [workspace]                      # optional: where calibration poses are drawn
+//! min_m = [-30.0, -30.0, 1.0]
+//! max_m = [30.0, 30.0, 28.0]
 //! ```
 
 use std::path::Path;
@@ -47,6 +51,20 @@ pub struct RobotFile {
     /// Encoder length offsets `l_i^0`, metres (absent in a nominal robot: zero).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub length_offsets_m: Option<Vec<f64>>,
+    /// The box of platform positions the robot is calibrated over (optional;
+    /// absent: sagcal derives one from the anchors).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub workspace: Option<WorkspaceEntry>,
+}
+
+/// The `[workspace]` table of a robot file: an axis-aligned box of platform positions.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorkspaceEntry {
+    /// Lower corner, world frame, metres.
+    pub min_m: [f64; 3],
+    /// Upper corner, world frame, metres.
+    pub max_m: [f64; 3],
 }
 
 impl RobotFile {

@@ -3,9 +3,10 @@
 use std::path::{Path, PathBuf};
 
 use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::io::robot_file::{CableEntry, RobotFile};
+use crate::io::robot_file::{CableEntry, RobotFile, WorkspaceEntry};
 
 /// Number of cables of the suspended robot modelled by sagcal.
 pub const CABLE_COUNT: usize = 4;
@@ -29,6 +30,18 @@ pub struct Robot {
     pub reference_cable: usize,
     /// Encoder length offsets `l_i^0`, metres (zero for a nominal robot).
     pub length_offsets_m: [f64; CABLE_COUNT],
+    /// The box of platform positions calibration poses are drawn from, if the
+    /// robot file gives one.
+    pub workspace: Option<Workspace>,
+}
+
+/// An axis-aligned box of platform positions, world frame, metres.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Workspace {
+    /// Lower corner.
+    pub min_m: [f64; 3],
+    /// Upper corner.
+    pub max_m: [f64; 3],
 }
 
 impl Robot {
@@ -110,6 +123,17 @@ impl Robot {
                 )))
             }
         };
+        let workspace = match file.workspace {
+            None => None,
+            Some(WorkspaceEntry { min_m, max_m }) => {
+                if !(0..3).all(|k| min_m[k].is_finite() && max_m[k].is_finite() && min_m[k] <= max_m[k]) {
+                    return Err(fail(format!(
+                        "field `workspace`: `min_m` {min_m:?} must be finite and <= `max_m` {max_m:?} on every axis"
+                    )));
+                }
+                Some(Workspace { min_m, max_m })
+            }
+        };
         Ok(Robot {
             name: file.name,
             anchors_m,
@@ -119,6 +143,7 @@ impl Robot {
             cable_weight_n_per_m: file.cable_weight_n_per_m,
             reference_cable: file.reference_cable - 1,
             length_offsets_m,
+            workspace,
         })
     }
 
@@ -141,6 +166,10 @@ impl Robot {
             } else {
                 Some(self.length_offsets_m.to_vec())
             },
+            workspace: self.workspace.map(|w| WorkspaceEntry {
+                min_m: w.min_m,
+                max_m: w.max_m,
+            }),
         }
     }
 

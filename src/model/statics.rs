@@ -389,14 +389,16 @@ pub fn solve_with_reference_tension(
 }
 
 /// The most level equilibrium at `position_m`: the member of the
-/// one-parameter family whose platform tilt (angle between the platform's and
-/// the world's z axes) is smallest. This is how a robot that commands its
-/// cable lengths for a level platform hangs; the search runs over the
-/// reference-tension magnitude (a grid from 0.5 to 2 times the straight-cable
-/// guess, then golden-section refinement).
+/// one-parameter family whose orientation is closest to the nominal one
+/// (smallest rotation angle: tilt and yaw together; at the centre of the
+/// workspace the family is a pure yaw twist, so tilt alone would not choose).
+/// This is how a robot that commands its cable lengths for a level, unrotated
+/// platform hangs; the search runs over the reference-tension magnitude (a
+/// grid from 0.5 to 2 times the straight-cable guess, then golden-section
+/// refinement).
 pub fn solve_level(robot: &Robot, position_m: Vector3<f64>, options: &StaticsOptions) -> Result<Equilibrium> {
     let guess = reference_tension_magnitude_guess(robot, position_m);
-    let tilt = |eq: &Equilibrium| (eq.pose.rotation * Vector3::z()).z.clamp(-1.0, 1.0).acos();
+    let tilt = |eq: &Equilibrium| eq.pose.rotation.angle();
     let evaluate = |magnitude: f64| solve_with_reference_tension(robot, position_m, magnitude, None, options).ok();
     let mut best: Option<(f64, f64)> = None;
     let step = 0.05;

@@ -11,7 +11,6 @@
 use nalgebra::{Vector3, Vector6};
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
-use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::io::measurements::PoseMeasurement;
@@ -19,21 +18,19 @@ use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::SensorNoise;
 use crate::model::statics::{self, Equilibrium, StaticsOptions};
 
-/// An axis-aligned box of platform positions, metres.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Workspace {
-    /// Lower corner.
-    pub min_m: [f64; 3],
-    /// Upper corner.
-    pub max_m: [f64; 3],
-}
+pub use crate::model::robot::Workspace;
 
 impl Workspace {
+    /// The robot file's `[workspace]` if it has one, else [`Workspace::around_anchors`].
+    pub fn default_for(robot: &Robot) -> Self {
+        robot.workspace.unwrap_or_else(|| Self::around_anchors(robot))
+    }
+
     /// The default box for a robot: the RecurDyn log's range on the large
     /// robot scaled to the anchors' footprint: x, y within 24 % / 27 % of the
     /// anchors' half-extent around their centre, z from 2 % to 58 % of the
     /// anchors' height.
-    pub fn default_for(robot: &Robot) -> Self {
+    pub fn around_anchors(robot: &Robot) -> Self {
         let min = robot
             .anchors_m
             .iter()

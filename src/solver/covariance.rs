@@ -45,8 +45,9 @@ pub enum Covariance {
 ///    components in the selected variables.
 pub fn marginal_covariance(graph: &FactorGraph, selected: &[VariableId]) -> Result<Covariance, String> {
     let system = LinearSystem::new(&graph.values, &graph.factors)?;
-    let (hessian, _, _) =
-        linearize(graph, &graph.values, &system).map_err(|e| format!("covariance at the solution: {e}"))?;
+    let hessian = linearize(graph, &graph.values, &system)
+        .map_err(|e| format!("covariance at the solution: {e}"))?
+        .hessian;
     let mut columns = Vec::new();
     let mut labels = Vec::new();
     for &id in selected {

@@ -11,17 +11,25 @@
 //! factorisation it grows by `nu`, `nu` doubling (Madsen, Nielsen & Tingleff,
 //! *Methods for Non-Linear Least Squares Problems*, 2004, Sec. 3.2). A
 //! rejected step reuses the linearisation.
+//!
+//! Graphs may name groups of *local* variables
+//! ([`FactorGraph::local_groups`]); every trial point then has each group
+//! re-minimised with the rest held before its cost is judged (nonlinear
+//! elimination, see the `local` module), which keeps long steps of the global
+//! variables on the curved valley of a tight model constraint.
 
 mod covariance;
 mod linear_system;
+mod local;
+
+use local::LocalGroups;
 
 pub use covariance::{marginal_covariance, Covariance, UnobservableDirection};
-pub use linear_system::LinearSystem;
+pub use linear_system::{DampedFactorization, LinearSystem};
 
-use nalgebra::DMatrix;
 use serde::Serialize;
 
-use crate::graph::{whitened_squared_norm, FactorGraph, Values};
+use crate::graph::{linearize_factor, FactorGraph, Values};
 
 /// Stopping rules and damping limits.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -131,52 +139,42 @@ pub struct SolveSummary {
     pub history: Vec<IterationSummary>,
 }
 
-/// Whitened, robust-reweighted linearisation of the whole graph: `H`, `g`, cost.
-pub(crate) fn linearize(
-    graph: &FactorGraph,
-    values: &Values,
-    system: &LinearSystem,
-) -> Result<(Vec<f64>, Vec<f64>, f64), String> {
+/// Whitened, robust-reweighted linearisation of the whole graph.
+pub(crate) struct Linearization {
+    /// `H = J^T J` in the pattern of the [`LinearSystem`].
+    pub hessian: Vec<f64>,
+    /// `g = J^T r`.
+    pub gradient: Vec<f64>,
+    /// `sum 1/2 rho(|r / sigma|^2)`.
+    pub cost: f64,
+}
+
+/// Linearise every factor at `values`.
+pub(crate) fn linearize(graph: &FactorGraph, values: &Values, system: &LinearSystem) -> Result<Linearization, String> {
     let mut hessian = system.zero_hessian();
     let mut gradient = vec![0.0; system.dim];
     let mut cost = 0.0;
     for (index, factor) in graph.factors.iter().enumerate() {
         let variables = factor.variables();
-        let rows = factor.residual_dim();
-        let mut jacobians: Vec<DMatrix<f64>> = variables
-            .iter()
-            .map(|&v| DMatrix::zeros(rows, values.tangent_dim(v)))
-            .collect();
-        let describe = |what: &str| {
+        let linearized = linearize_factor(factor.as_ref(), values).map_err(|what| {
             let names: Vec<&str> = variables.iter().map(|&v| values.variable(v).name.as_str()).collect();
             format!("{} factor on [{}]: {what}", factor.kind(), names.join(", "))
-        };
-        let residual = factor
-            .evaluate(values, Some(&mut jacobians))
-            .ok_or_else(|| describe("model undefined (slack cable)"))?;
-        let sigmas = factor.sigmas();
-        let s = whitened_squared_norm(&residual, sigmas);
-        if !s.is_finite() {
-            return Err(describe("non-finite residual"));
-        }
-        let kernel = factor.robust_kernel();
-        cost += 0.5 * kernel.rho(s);
-        let scale = kernel.weight(s).sqrt();
-        let whitened: Vec<f64> = (0..rows).map(|r| residual[r] / sigmas[r] * scale).collect();
-        for jac in &mut jacobians {
-            for r in 0..rows {
-                let w = scale / sigmas[r];
-                for c in 0..jac.ncols() {
-                    jac[(r, c)] *= w;
-                }
-            }
-        }
-        if jacobians.iter().any(|j| j.iter().any(|v| !v.is_finite())) {
-            return Err(describe("non-finite Jacobian"));
-        }
-        system.accumulate(index, variables, &jacobians, &whitened, &mut hessian, &mut gradient);
+        })?;
+        cost += linearized.cost;
+        system.accumulate(
+            index,
+            variables,
+            &linearized.jacobians,
+            &linearized.residual,
+            &mut hessian,
+            &mut gradient,
+        );
     }
-    Ok((hessian, gradient, cost))
+    Ok(Linearization {
+        hessian,
+        gradient,
+        cost,
+    })
 }
 
 /// Apply a tangent step to every free variable.
@@ -194,8 +192,12 @@ pub(crate) fn retract_all(values: &Values, system: &LinearSystem, step: &[f64]) 
 /// Minimise the graph's cost from its current values; the values are updated in place.
 pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSummary, String> {
     let system = LinearSystem::new(&graph.values, &graph.factors)?;
+    let groups = LocalGroups::new(graph);
     let mut values = graph.values.clone();
-    let Ok((mut hessian, mut gradient, mut cost)) = linearize(graph, &values, &system) else {
+    if !groups.is_empty() {
+        groups.refine(graph, &mut values);
+    }
+    let Ok(mut linearization) = linearize(graph, &values, &system) else {
         return Ok(SolveSummary {
             initial_cost: f64::NAN,
             final_cost: f64::NAN,
@@ -204,37 +206,51 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
             history: Vec::new(),
         });
     };
-    let initial_cost = cost;
+    let initial_cost = linearization.cost;
     let mut damping = params.initial_damping;
     let mut nu = 2.0;
     let mut history = Vec::new();
     let mut termination = Termination::MaxIterations;
     for iteration in 1..=params.max_iterations {
+        let cost = linearization.cost;
+        let gradient = &linearization.gradient;
         if gradient.iter().fold(0.0f64, |m, g| m.max(g.abs())) < params.gradient_tolerance {
             termination = Termination::GradientConverged;
             break;
         }
-        let diagonal: Vec<f64> = system.diagonal(&hessian).iter().map(|d| d.clamp(1e-6, 1e32)).collect();
+        let diagonal: Vec<f64> = system
+            .diagonal(&linearization.hessian)
+            .iter()
+            .map(|d| d.clamp(1e-6, 1e32))
+            .collect();
         let rhs: Vec<f64> = gradient.iter().map(|g| -g).collect();
         let mut trials = 0;
         let mut accepted = None;
         while damping <= params.max_damping {
             trials += 1;
             let damp: Vec<f64> = diagonal.iter().map(|d| damping * d).collect();
-            let Some(step) = system.solve(&hessian, &damp, &rhs) else {
+            let Some((factorization, velocity)) = system
+                .factorize(&linearization.hessian, &damp)
+                .and_then(|f| f.solve(&rhs).map(|v| (f, v)))
+            else {
                 damping *= nu;
                 nu *= 2.0;
                 continue;
             };
-            // Predicted decrease of 1/2|r + J dx|^2: -g.dx - 1/2 dx.H dx = 1/2 dx.(lambda D dx - g).
-            let predicted: f64 = 0.5
-                * step
-                    .iter()
-                    .zip(&damp)
-                    .zip(&gradient)
-                    .map(|((dx, d), g)| dx * (d * dx - g))
-                    .sum::<f64>();
-            let candidate = retract_all(&values, &system, &step);
+            let step = velocity;
+            // Decrease predicted by the model: -g.s - 1/2 s.H s.
+            let product = factorization.multiply(&step);
+            let curvature: f64 = step
+                .iter()
+                .zip(&product)
+                .zip(&damp)
+                .map(|((s, hs), d)| s * hs - d * s * s)
+                .sum();
+            let predicted = -step.iter().zip(gradient).map(|(s, g)| s * g).sum::<f64>() - 0.5 * curvature;
+            let mut candidate = retract_all(&values, &system, &step);
+            if !groups.is_empty() {
+                groups.refine(graph, &mut candidate);
+            }
             let new_cost = graph.cost(&candidate);
             match new_cost {
                 Some(new_cost) if new_cost < cost && predicted > 0.0 => {
@@ -275,13 +291,12 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
             trials,
         });
         values = candidate;
-        cost = new_cost;
-        let Ok(linearization) = linearize(graph, &values, &system) else {
+        let Ok(next) = linearize(graph, &values, &system) else {
             // The accepted point had a finite cost, so this cannot happen; stop safely if it does.
             termination = Termination::DampingExhausted;
             break;
         };
-        (hessian, gradient, _) = linearization;
+        linearization = next;
         if relative_decrease < params.relative_cost_tolerance {
             termination = Termination::CostConverged;
             break;
@@ -291,10 +306,11 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
             break;
         }
     }
+    let final_cost = linearization.cost;
     graph.values = values;
     Ok(SolveSummary {
         initial_cost,
-        final_cost: cost,
+        final_cost,
         iterations: history.len(),
         termination,
         history,
