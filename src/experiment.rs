@@ -24,7 +24,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::calib::{
-    calibrate, cramer_rao_bound, CableModel, CalibrationError, CalibrationOptions, ParameterUncertainty,
+    calibrate, cramer_rao_bound, CableModel, CalibrationError, CalibrationOptions, OrientationPrior,
+    ParameterUncertainty,
 };
 use crate::error::{Error, Result};
 use crate::io::measurements::PoseMeasurement;
@@ -109,8 +110,8 @@ pub struct Protocol {
     /// and every anchor is within this distance of the truth, or else the solve
     /// started at the truth reaches the same minimum (anchors within 1 cm), metres.
     pub basin_radius_m: f64,
-    /// Add the localiser's orientation as a prior.
-    pub orientation_prior: bool,
+    /// Whether the localiser's orientation is a prior (see [`OrientationPrior`]).
+    pub orientation_prior: OrientationPrior,
 }
 
 /// One trial.
@@ -132,6 +133,8 @@ pub struct TrialResult {
     pub anchor_crlb_m: Option<f64>,
     /// Expected offset mean absolute error under the bound, metres.
     pub offset_crlb_m: Option<f64>,
+    /// With `--orientation-prior auto`: whether the calibration kept the orientation prior.
+    pub orientation_prior_used: Option<bool>,
 }
 
 /// The summary for one pose count.
@@ -157,6 +160,8 @@ pub struct PoseCountResult {
     pub offset_crlb_m: f64,
     /// Median calibration time, milliseconds.
     pub median_solve_ms: f64,
+    /// Trials whose calibration kept the orientation prior (always all with `on`, none with `off`).
+    pub orientation_prior_kept: usize,
     /// The trials that did not converge, with the reason.
     pub not_converged: Vec<TrialResult>,
 }
@@ -295,12 +300,22 @@ pub fn run_trial(
 ) -> TrialResult {
     let (chosen, data, guess, options) = trial_inputs(truth, pool, poses, trial, seed, protocol);
     let equilibria: Vec<Equilibrium> = chosen.iter().map(|&k| pool[k].equilibrium.clone()).collect();
-    let (anchor_crlb_m, offset_crlb_m) =
-        cramer_rao_bound(truth, &equilibria, &options).map_or((None, None), |b| bound_summary(&b));
     let lines = chosen.iter().map(|&k| pool[k].line).collect();
     let started = std::time::Instant::now();
     let result = calibrate(&guess, &data, &options);
     let solve_ms = started.elapsed().as_secs_f64() * 1e3;
+    // The bound of the estimator actually used: with the orientation prior if
+    // the calibration kept it.
+    let orientation_prior_used = result
+        .as_ref()
+        .ok()
+        .and_then(|r| r.orientation_check.map(|c| c.prior_used));
+    let bound_options = match &result {
+        Ok(r) => options.as_used_by(r),
+        Err(_) => options,
+    };
+    let (anchor_crlb_m, offset_crlb_m) =
+        cramer_rao_bound(truth, &equilibria, &bound_options).map_or((None, None), |b| bound_summary(&b));
     match result {
         Ok(result) => {
             let error = CalibrationError::between(&result.robot, truth);
@@ -334,6 +349,7 @@ pub fn run_trial(
                 solve_ms,
                 anchor_crlb_m,
                 offset_crlb_m,
+                orientation_prior_used,
             }
         }
         Err(e) => TrialResult {
@@ -345,6 +361,7 @@ pub fn run_trial(
             solve_ms,
             anchor_crlb_m,
             offset_crlb_m,
+            orientation_prior_used,
         },
     }
 }
@@ -382,6 +399,7 @@ pub fn summarise(poses: usize, trials: Vec<TrialResult>) -> PoseCountResult {
         anchor_crlb_m: mean(trials.iter().filter_map(|t| t.anchor_crlb_m)),
         offset_crlb_m: mean(trials.iter().filter_map(|t| t.offset_crlb_m)),
         median_solve_ms: times.get(times.len() / 2).copied().unwrap_or(f64::NAN),
+        orientation_prior_kept: trials.iter().filter(|t| t.orientation_prior_used == Some(true)).count(),
         not_converged: trials.into_iter().filter(|t| !t.converged).collect(),
     }
 }

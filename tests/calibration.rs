@@ -99,3 +99,66 @@ fn paper_noise_from_the_paper_perturbation() {
     eprintln!("rigid: {rigid_error:?}");
     assert!(rigid_error.anchor_mean_euclidean_m > 2.0 * error.anchor_mean_euclidean_m);
 }
+
+#[test]
+fn chi_square_quantile_matches_tables() {
+    // 99.9 % points of chi-square (Abramowitz & Stegun, Table 26.8).
+    for (k, table) in [(10, 29.588), (30, 59.703), (100, 149.449)] {
+        let q = sagcal::calib::chi_square_quantile_999(k);
+        assert!((q - table).abs() / table < 0.01, "k = {k}: {q} vs {table}");
+    }
+}
+
+#[test]
+fn automatic_orientation_prior_keeps_consistent_and_drops_biased_orientations() {
+    use sagcal::calib::OrientationPrior;
+    let truth = truth("large", 7);
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), 18, &mut rng).unwrap();
+    let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
+    let data = measure(&truth, &equilibria, &noise, &mut rng);
+    let initial = perturbed(&truth, 10.0, 80.0, &mut rng);
+    let options = CalibrationOptions::new(noise);
+    assert_eq!(options.orientation_prior, OrientationPrior::Auto);
+    let consistent = calibrate(&initial, &data, &options).unwrap();
+    let check = consistent.orientation_check.unwrap();
+    eprintln!("consistent: {check:?}");
+    assert!(check.prior_used && check.chi_square < check.limit, "{check:?}");
+    // The localiser's roll reads 2 degrees off at every pose (the RecurDyn log is ~1.9 degrees
+    // off the equilibria): 3.5 sigma per pose, the test must reject the prior.
+    let mut biased = data.clone();
+    for m in &mut biased {
+        m.roll_deg += 2.0;
+    }
+    let dropped = calibrate(&initial, &biased, &options).unwrap();
+    let check = dropped.orientation_check.unwrap();
+    eprintln!("biased: {check:?}");
+    assert!(!check.prior_used && check.chi_square > check.limit, "{check:?}");
+    // Dropping it is the same as calibrating without it.
+    let off = calibrate(
+        &initial,
+        &biased,
+        &CalibrationOptions {
+            orientation_prior: OrientationPrior::Off,
+            ..options
+        },
+    )
+    .unwrap();
+    for i in 0..4 {
+        assert!((off.robot.anchors_m[i] - dropped.robot.anchors_m[i]).norm() < 1e-9);
+    }
+    // ...and much better than keeping the biased prior.
+    let forced = calibrate(
+        &initial,
+        &biased,
+        &CalibrationOptions {
+            orientation_prior: OrientationPrior::On,
+            ..options
+        },
+    )
+    .unwrap();
+    let error_dropped = CalibrationError::between(&dropped.robot, &truth).anchor_mean_euclidean_m;
+    let error_forced = CalibrationError::between(&forced.robot, &truth).anchor_mean_euclidean_m;
+    eprintln!("anchor error: prior dropped {error_dropped:.3} m, biased prior kept {error_forced:.3} m");
+    assert!(error_forced > 1.5 * error_dropped);
+}

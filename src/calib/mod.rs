@@ -10,11 +10,17 @@
 //! **Orientation.** The paper adds an orientation-correction variable
 //! `Delta R_k` so that the statics, not the localiser's orientation, decide
 //! how the platform hangs. sagcal's pose variable already carries the full
-//! orientation; by default the pose prior constrains only the *position*
-//! ([`CalibrationOptions::orientation_prior`] = false), which is exactly the
-//! paper's `Delta R` with no prior on it. A tight orientation prior would fight
-//! the statics wherever the localiser's orientation is off (the RecurDyn log
-//! is ~1.9 degrees off the equilibria) and bias the anchors.
+//! orientation, and the pose prior's orientation part is switchable
+//! ([`OrientationPrior`]). Where the localiser's orientation agrees with the
+//! statics it is information (on the small robot it halves the anchor error);
+//! where it does not (the RecurDyn log is ~1.9 degrees off the model's
+//! equilibria, 3 sigma under the paper's noise and 20 under the authors') a
+//! tight prior would fight the statics and bias the anchors by metres. The
+//! default, [`OrientationPrior::Auto`], decides from the data: it calibrates
+//! with the prior, tests the orientation residuals by chi-square, and if they
+//! are inconsistent calibrates again without it, which is the paper's
+//! `Delta R` with no prior on it. The decision is in
+//! [`CalibrationResult::orientation_check`].
 //!
 //! **Initialisation** ([`calibrate`]): (1) a rigid massless-cable calibration
 //! from the initial guess (a benign trilateration-like problem), (2) a per-pose
@@ -74,6 +80,61 @@ impl CableModel {
     }
 }
 
+/// Whether the localiser's orientation enters the calibration as a prior.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OrientationPrior {
+    /// Position-only pose priors: the statics alone decide the orientation
+    /// (the paper's orientation correction `Delta R` with no prior on it).
+    Off,
+    /// Full pose priors with the noise's orientation sigma.
+    On,
+    /// Calibrate with the orientation prior, test whether the localiser's
+    /// orientations agree with the fitted statics (chi-square of the
+    /// orientation residuals at 99.9 %), and drop the prior if they do not.
+    /// The default.
+    Auto,
+}
+
+impl OrientationPrior {
+    /// Parse `auto`, `on` or `off`.
+    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+        match text {
+            "auto" => Ok(OrientationPrior::Auto),
+            "on" => Ok(OrientationPrior::On),
+            "off" => Ok(OrientationPrior::Off),
+            other => Err(format!("unknown orientation prior `{other}` (auto, on, off)")),
+        }
+    }
+}
+
+impl std::fmt::Display for OrientationPrior {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            OrientationPrior::Off => "off",
+            OrientationPrior::On => "on",
+            OrientationPrior::Auto => "auto",
+        })
+    }
+}
+
+/// The consistency test of the localiser's orientations with the fitted
+/// statics, and what the calibration did with it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct OrientationCheck {
+    /// Whether the final calibration used the orientation prior.
+    pub prior_used: bool,
+    /// `sum |log(R_measured^T R_fitted)|^2 / sigma^2` over the poses, with the prior on.
+    pub chi_square: f64,
+    /// Number of orientation residual components (3 per pose).
+    pub components: usize,
+    /// The 99.9 % quantile of chi-square with `components` degrees of freedom
+    /// (Wilson-Hilferty); above it the orientations are declared inconsistent.
+    pub limit: f64,
+    /// Mean angle between measured and fitted orientations, degrees.
+    pub mean_angle_deg: f64,
+}
+
 /// Robust kernels per factor type.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct RobustKernels {
@@ -92,9 +153,10 @@ pub struct CalibrationOptions {
     pub model: CableModel,
     /// Sensor sigmas used as the factors' noise.
     pub noise: SensorNoise,
-    /// Constrain the orientation by the localiser too (default: position only, see the module docs).
-    /// The rigid model always uses it: without statics nothing else fixes the orientation.
-    pub orientation_prior: bool,
+    /// Constrain the orientation by the localiser too (default: decide by a
+    /// consistency test, see the module docs). The rigid model always uses
+    /// it: without statics nothing else fixes the orientation.
+    pub orientation_prior: OrientationPrior,
     /// Sigma of the attachment-height constraint, metres (a model equation: tight).
     pub height_sigma_m: f64,
     /// Robust kernels.
@@ -104,12 +166,12 @@ pub struct CalibrationOptions {
 }
 
 impl CalibrationOptions {
-    /// Catenary model, position-only pose priors, 0.1 mm height constraint, no robust kernels.
+    /// Catenary model, automatic orientation prior, 0.1 mm height constraint, no robust kernels.
     pub fn new(noise: SensorNoise) -> Self {
         Self {
             model: CableModel::Catenary,
             noise,
-            orientation_prior: false,
+            orientation_prior: OrientationPrior::Auto,
             height_sigma_m: 1e-4,
             robust: RobustKernels::default(),
             lm: LmParams::default(),
@@ -181,6 +243,9 @@ pub struct CalibrationResult {
     /// Indices (into the measurements) of poses left out of the final stage:
     /// no positive-tension equilibrium near them with the calibrated anchors.
     pub excluded_poses: Vec<usize>,
+    /// The orientation consistency test (catenary model with
+    /// [`OrientationPrior::Auto`]; `None` otherwise).
+    pub orientation_check: Option<OrientationCheck>,
 }
 
 impl CalibrationResult {
@@ -301,8 +366,8 @@ pub fn build_graph(
             pose,
             reference_tension,
         };
-        let orientation_sigma =
-            (options.orientation_prior || model == CableModel::Rigid).then_some(noise.orientation_sigma_rad);
+        let orientation_sigma = (options.orientation_prior == OrientationPrior::On || model == CableModel::Rigid)
+            .then_some(noise.orientation_sigma_rad);
         graph.add(PosePriorFactor::new(
             pose,
             &measured_pose(m),
@@ -481,6 +546,86 @@ pub fn calibrate(
     options: &CalibrationOptions,
 ) -> Result<CalibrationResult> {
     validate_measurements(measurements)?;
+    if options.orientation_prior != OrientationPrior::Auto || options.model == CableModel::Rigid {
+        return calibrate_once(initial, measurements, options);
+    }
+    let with_prior = CalibrationOptions {
+        orientation_prior: OrientationPrior::On,
+        ..*options
+    };
+    let without_prior = CalibrationOptions {
+        orientation_prior: OrientationPrior::Off,
+        ..*options
+    };
+    let Ok(mut result) = calibrate_once(initial, measurements, &with_prior) else {
+        return calibrate_once(initial, measurements, &without_prior);
+    };
+    let mut check = orientation_check(&result, measurements, options.noise.orientation_sigma_rad);
+    if check.chi_square <= check.limit {
+        result.orientation_check = Some(check);
+        return Ok(result);
+    }
+    let mut result = calibrate_once(initial, measurements, &without_prior)?;
+    check.prior_used = false;
+    result.orientation_check = Some(check);
+    Ok(result)
+}
+
+/// Chi-square of the localiser's orientations against the fitted poses of a
+/// calibration made with the orientation prior. Conservative: the fitted
+/// orientation is pulled towards the measured one, so consistent data give
+/// less than the `3 N` degrees of freedom tested against.
+fn orientation_check(result: &CalibrationResult, measurements: &[PoseMeasurement], sigma_rad: f64) -> OrientationCheck {
+    let used = (0..measurements.len()).filter(|k| !result.excluded_poses.contains(k));
+    let angles: Vec<f64> = used
+        .zip(&result.poses)
+        .map(|(k, fitted)| measured_pose(&measurements[k]).rotation.angle_to(&fitted.rotation))
+        .collect();
+    let chi_square = angles.iter().map(|a| (a / sigma_rad).powi(2)).sum();
+    let components = 3 * angles.len();
+    OrientationCheck {
+        prior_used: true,
+        chi_square,
+        components,
+        limit: chi_square_quantile_999(components),
+        mean_angle_deg: angles.iter().sum::<f64>() / angles.len().max(1) as f64 * 180.0 / std::f64::consts::PI,
+    }
+}
+
+/// The 99.9 % quantile of chi-square with `k` degrees of freedom by the
+/// Wilson-Hilferty cube-root normal approximation
+/// `k (1 - 2/(9k) + z sqrt(2/(9k)))^3`, `z = 3.0902` (relative error below
+/// 1 % for k >= 3; Johnson, Kotz & Balakrishnan, *Continuous Univariate
+/// Distributions*, vol. 1, 1994, eq. 18.24).
+pub fn chi_square_quantile_999(k: usize) -> f64 {
+    let k = k.max(1) as f64;
+    let c = 2.0 / (9.0 * k);
+    k * (1.0 - c + 3.0902 * c.sqrt()).powi(3)
+}
+
+impl CalibrationOptions {
+    /// These options with [`OrientationPrior::Auto`] resolved to what `result`
+    /// used (`On` if it kept the prior, else `Off`): the options under which
+    /// to compare `result` with its Cramer-Rao bound.
+    pub fn as_used_by(&self, result: &CalibrationResult) -> CalibrationOptions {
+        let orientation_prior = match (self.orientation_prior, result.orientation_check) {
+            (OrientationPrior::Auto, Some(check)) if check.prior_used => OrientationPrior::On,
+            (OrientationPrior::Auto, _) => OrientationPrior::Off,
+            (other, _) => other,
+        };
+        CalibrationOptions {
+            orientation_prior,
+            ..*self
+        }
+    }
+}
+
+/// One calibration with the orientation prior as given (`Auto` counts as `Off`).
+fn calibrate_once(
+    initial: &Robot,
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+) -> Result<CalibrationResult> {
     let measured: Vec<PlatformPose> = measurements.iter().map(measured_pose).collect();
     let mut stages = Vec::new();
     if options.model == CableModel::Rigid {
@@ -686,6 +831,7 @@ fn finish(
         poses,
         reference_tensions_n,
         excluded_poses,
+        orientation_check: None,
     })
 }
 

@@ -2,7 +2,10 @@
 
 use serde::Serialize;
 
-use super::{CableModel, CalibrationError, CalibrationResult, FactorStatistics, ParameterUncertainty, StageSummary};
+use super::{
+    CableModel, CalibrationError, CalibrationResult, FactorStatistics, OrientationCheck, ParameterUncertainty,
+    StageSummary,
+};
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::solver::Termination;
 
@@ -43,6 +46,8 @@ pub struct CalibrationReport {
     pub converged: bool,
     /// Error against the truth, when it is known (simulations).
     pub error_against_truth: Option<CalibrationError>,
+    /// The test of the localiser's orientations against the statics (`--orientation-prior auto`).
+    pub orientation_check: Option<OrientationCheck>,
 }
 
 impl CalibrationReport {
@@ -90,6 +95,7 @@ impl CalibrationReport {
             termination: final_stage.termination,
             converged: result.converged(),
             error_against_truth: truth.map(|t| CalibrationError::between(&result.robot, t)),
+            orientation_check: result.orientation_check,
         }
     }
 }

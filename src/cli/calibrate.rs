@@ -3,7 +3,9 @@
 use std::path::Path;
 
 use sagcal::calib::report::CalibrationReport;
-use sagcal::calib::{calibrate, CalibrationOptions, CalibrationResult, ParameterUncertainty};
+use sagcal::calib::{
+    calibrate, CableModel, CalibrationOptions, CalibrationResult, OrientationPrior, ParameterUncertainty,
+};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::model::Robot;
 use sagcal::plot::{anchor_plot_svg, write_svg, AnchorPlot, AnchorPlotEntry};
@@ -101,6 +103,25 @@ fn sigma(value: Option<f64>) -> String {
     value.map_or_else(|| "n/a".to_string(), |s| format!("{s:.3}"))
 }
 
+/// How the orientation was handled, in words.
+fn orientation_text(report: &CalibrationReport, options: &CalibrationOptions) -> String {
+    let sigma = options.noise.orientation_sigma_rad;
+    if options.model == CableModel::Rigid || options.orientation_prior == OrientationPrior::On {
+        return format!("{sigma:.4} rad prior");
+    }
+    match report.orientation_check {
+        None => "decided by the statics (no prior)".into(),
+        Some(check) if check.prior_used => format!(
+            "{sigma:.4} rad prior, kept: the localiser's orientations agree with the statics (chi-square {:.1} for {} components, 99.9 % limit {:.1}; mean angle {:.2} deg)",
+            check.chi_square, check.components, check.limit, check.mean_angle_deg
+        ),
+        Some(check) => format!(
+            "decided by the statics: the localiser's orientations disagree with them (chi-square {:.1} for {} components, 99.9 % limit {:.1}; mean angle {:.2} deg), so the {sigma:.4} rad prior was dropped",
+            check.chi_square, check.components, check.limit, check.mean_angle_deg
+        ),
+    }
+}
+
 /// The human-readable calibration report.
 pub fn render(report: &CalibrationReport, options: &CalibrationOptions) -> String {
     let mut out = String::new();
@@ -113,7 +134,7 @@ pub fn render(report: &CalibrationReport, options: &CalibrationOptions) -> Strin
         n.encoder_sigma_m,
         n.load_cell_sigma_n,
         n.position_sigma_m,
-        if options.orientation_prior { format!("{:.4} rad", n.orientation_sigma_rad) } else { "decided by the statics (no prior)".into() }
+        orientation_text(report, options)
     );
     let mut anchors = Table::new([
         "anchor",

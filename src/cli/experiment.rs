@@ -1,7 +1,7 @@
 //! `sagcal experiment table2`: the paper's calibration protocol.
 
 use indicatif::{ProgressBar, ProgressStyle};
-use sagcal::calib::CableModel;
+use sagcal::calib::{CableModel, OrientationPrior};
 use sagcal::experiment::{pose_pool, run_protocol, PoseCountResult, Protocol, Source};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::model::sensors::NoisePreset;
@@ -26,7 +26,7 @@ struct Table2Report {
     anchor_perturbation_m: f64,
     offset_perturbation_m: f64,
     basin_radius_m: f64,
-    orientation_prior: bool,
+    orientation_prior: sagcal::calib::OrientationPrior,
     pool_size: usize,
     results: Vec<PoseCountResult>,
 }
@@ -108,7 +108,7 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         return print_json(&report);
     }
     println!(
-        "Table II protocol: robot `{}`, {} data, {} noise, {:?} cable model, seed {}, initial guess {} m / {} m off",
+        "Table II protocol: robot `{}`, {} data, {} noise, {:?} cable model, orientation prior {}, seed {}, initial guess {} m / {} m off",
         report.robot,
         match args.source {
             Source::Log => "logged (RecurDyn)",
@@ -116,6 +116,7 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         },
         args.noise,
         args.model,
+        args.orientation_prior,
         args.seed,
         anchor_perturbation_m,
         offset_perturbation_m
@@ -129,6 +130,7 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         "CRLB anchor m",
         "CRLB offset m",
         "paper anchor / offset m",
+        "orientation prior kept",
         "median ms",
     ]);
     for r in &report.results {
@@ -142,11 +144,16 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
             format!("{:.3}", r.anchor_crlb_m),
             format!("{:.3}", r.offset_crlb_m),
             paper.map_or("-".into(), |(a, o)| format!("{a:.3} / {o:.3}")),
+            match args.orientation_prior {
+                OrientationPrior::Auto => format!("{}/{}", r.orientation_prior_kept, r.trials),
+                OrientationPrior::On => "all".into(),
+                OrientationPrior::Off => "none".into(),
+            },
             format!("{:.0}", r.median_solve_ms),
         ]);
     }
     print!("{table}");
-    println!("(CRLB: the error an unbiased estimator cannot beat on average, at the truth, for the same poses and noise;\n anchor errors are the mean Euclidean distance per anchor, as in the authors' program, +- the standard error of the mean over trials)");
+    println!("(CRLB: the error an unbiased estimator cannot beat on average, at the truth, for the same poses, noise and orientation prior;\n anchor errors are the mean Euclidean distance per anchor, as in the authors' program, +- the standard error of the mean over trials)");
     for r in &report.results {
         if let Some((paper_anchor, _)) = paper_numbers(&truth, r.poses) {
             let verdict = if paper_anchor < r.anchor_crlb_m {

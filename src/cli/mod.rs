@@ -94,9 +94,10 @@ struct Table2Args {
     /// Right-basin radius: every anchor within it, m (default 0.3 x the anchor perturbation; unlimited for rigid).
     #[arg(long)]
     basin_radius_m: Option<f64>,
-    /// Add the localiser's orientation as a prior.
-    #[arg(long)]
-    orientation_prior: bool,
+    /// The localiser's orientation as a prior: `auto` (used unless a chi-square test finds it
+    /// inconsistent with the statics), `on` or `off` (the statics decide).
+    #[arg(long, default_value = "auto", value_parser = sagcal::calib::OrientationPrior::parse)]
+    orientation_prior: sagcal::calib::OrientationPrior,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -120,10 +121,10 @@ struct SolverArgs {
     /// Override the localiser position sigma, metres.
     #[arg(long)]
     position_sigma_m: Option<f64>,
-    /// Also trust the localiser's orientation (prior with the noise's orientation sigma).
-    /// By default the statics decide the orientation.
-    #[arg(long)]
-    orientation_prior: bool,
+    /// The localiser's orientation as a prior: `auto` (used unless a chi-square test finds it
+    /// inconsistent with the fitted statics), `on` or `off` (the statics decide).
+    #[arg(long, default_value = "auto", value_parser = sagcal::calib::OrientationPrior::parse)]
+    orientation_prior: sagcal::calib::OrientationPrior,
     /// Robust kernel on the encoder factors: none, huber[:k], cauchy[:c].
     #[arg(long, default_value = "none", value_parser = sagcal::graph::RobustKernel::parse)]
     robust_encoder: sagcal::graph::RobustKernel,
