@@ -3,5 +3,12 @@
 mod cli;
 
 fn main() {
+    // Rust ignores SIGPIPE, so printing into a closed pipe (`sagcal ... | head`)
+    // would panic; a command-line tool should end quietly like any other.
+    #[cfg(unix)]
+    // SAFETY: called first thing in main, before any thread exists; SIG_DFL is a valid action.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     std::process::exit(cli::run());
 }

@@ -145,6 +145,7 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
             format!("{:.3}", r.offset_crlb_m),
             paper.map_or("-".into(), |(a, o)| format!("{a:.3} / {o:.3}")),
             match args.orientation_prior {
+                _ if args.model == CableModel::Rigid => "all (rigid model)".into(),
                 OrientationPrior::Auto => format!("{}/{}", r.orientation_prior_kept, r.trials),
                 OrientationPrior::On => "all".into(),
                 OrientationPrior::Off => "none".into(),

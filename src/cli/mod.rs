@@ -215,9 +215,17 @@ struct SimulateArgs {
     /// Output measurement file (CSV).
     #[arg(long)]
     out: PathBuf,
-    /// Also write the truth (robot TOML with offsets) here.
+    /// Also write the truth (robot TOML with offsets, and `[effects]` with `--effect`) here.
     #[arg(long)]
     truth: Option<PathBuf>,
+    /// A physical effect the closed-form model lacks, `NAME:PARAM=VALUE[,PARAM=VALUE...]`
+    /// (repeatable): elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4,
+    /// loadcell:bias_n,gain, com:dx_m,dy_m,dz_m. The data then come from the discretised simulator.
+    #[arg(long = "effect", value_name = "SPEC")]
+    effects: Vec<String>,
+    /// Segments per cable of the discretised simulator (only used with effects).
+    #[arg(long, default_value_t = 100)]
+    segments: usize,
 }
 
 #[derive(Debug, Clone, clap::Args)]

@@ -1,28 +1,66 @@
-//! `sagcal simulate`: measurements of a robot from the closed-form model.
+//! `sagcal simulate`: measurements of a robot from the closed-form model, or,
+//! with `--effect` (or a robot file with `[effects]`), from the discretised
+//! simulator with those effects acting.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sagcal::io::measurements::write_measurements;
 use sagcal::model::Robot;
 use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
+use sagcal::sim::discretised::MAX_SEGMENTS;
+use sagcal::sim::effects::measure_with_effects;
 
 use super::SimulateArgs;
 
 pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
-    let truth = Robot::from_file(&args.robot)?;
+    let mut truth = Robot::from_file(&args.robot)?;
     if args.poses == 0 {
         return Err(sagcal::Error::InvalidInput("--poses must be at least 1".into()));
+    }
+    // The robot file's `[effects]` (if any), then every `--effect` in order.
+    let from_file = !truth.effects.is_none();
+    for spec in &args.effects {
+        truth
+            .effects
+            .apply_spec(spec)
+            .map_err(|e| sagcal::Error::InvalidInput(format!("--effect `{spec}`: {e}")))?;
+    }
+    let effects = truth.effects;
+    if !effects.is_none() && !(1..=MAX_SEGMENTS).contains(&args.segments) {
+        return Err(sagcal::Error::InvalidInput(format!(
+            "--segments must be between 1 and {MAX_SEGMENTS}, got {}",
+            args.segments
+        )));
     }
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     let workspace = Workspace::default_for(&truth);
     let equilibria = sample_equilibria(&truth, &workspace, args.poses, &mut rng)?;
     let noise = args.noise.sigmas(truth.platform_weight_n);
-    let data = measure(&truth, &equilibria, &noise, &mut rng);
-    let comments = vec![
+    let data = if effects.is_none() {
+        measure(&truth, &equilibria, &noise, &mut rng)
+    } else {
+        println!(
+            "effects{}: {effects}; seed {}; discretised simulator, {} segments per cable",
+            if from_file {
+                " (robot file's [effects] included)"
+            } else {
+                ""
+            },
+            args.seed,
+            args.segments
+        );
+        measure_with_effects(&truth, &effects, &equilibria, &noise, args.segments, &mut rng)?
+    };
+    let model = if effects.is_none() {
+        "closed-form catenary model".to_string()
+    } else {
         format!(
-            "simulated by sagcal {} (closed-form catenary model)",
-            env!("CARGO_PKG_VERSION")
-        ),
+            "discretised elastic-chain model, {} segments per cable, commanded to closed-form equilibria",
+            args.segments
+        )
+    };
+    let mut comments = vec![
+        format!("simulated by sagcal {} ({model})", env!("CARGO_PKG_VERSION")),
         format!(
             "robot {} ({}), {} poses, seed {}, noise {}",
             truth.name,
@@ -33,9 +71,17 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
         ),
         format!("workspace {:?} .. {:?} m", workspace.min_m, workspace.max_m),
     ];
+    if !effects.is_none() {
+        comments.push(format!("effects {effects}"));
+    }
     if let Some(path) = &args.truth {
+        let effects_note = if effects.is_none() {
+            String::new()
+        } else {
+            format!(", effects {effects} ({} segments)", args.segments)
+        };
         let text = format!(
-            "# The truth of a sagcal simulation: seed {}, {} poses, noise {}.\n{}",
+            "# The truth of a sagcal simulation: seed {}, {} poses, noise {}{effects_note}.\n{}",
             args.seed,
             args.poses,
             args.noise,

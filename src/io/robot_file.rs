@@ -14,6 +14,9 @@
 //! [workspace]                      # optional: where calibration poses are drawn
 //! min_m = [-30.0, -30.0, 1.0]
 //! max_m = [30.0, 30.0, 28.0]
+//!
+//! [effects]                        # optional: effects beyond the closed-form model
+//! axial_stiffness_n = 3e6          # (written by `simulate --truth`; the calibration ignores it)
 //! ```
 
 use std::path::Path;
@@ -21,6 +24,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::model::effects::Effects;
 
 /// One cable of a robot file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -55,6 +59,10 @@ pub struct RobotFile {
     /// absent: sagcal derives one from the anchors).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub workspace: Option<WorkspaceEntry>,
+    /// Effects known to act on this robot beyond the closed-form model
+    /// (optional; written by `simulate --truth`; the calibration ignores it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub effects: Option<Effects>,
 }
 
 /// The `[workspace]` table of a robot file: an axis-aligned box of platform positions.

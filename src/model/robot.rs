@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::io::robot_file::{CableEntry, RobotFile, WorkspaceEntry};
+use crate::model::effects::Effects;
 
 /// Number of cables of the suspended robot modelled by sagcal.
 pub const CABLE_COUNT: usize = 4;
@@ -33,6 +34,10 @@ pub struct Robot {
     /// The box of platform positions calibration poses are drawn from, if the
     /// robot file gives one.
     pub workspace: Option<Workspace>,
+    /// Effects known to act on this robot beyond the closed-form model (the
+    /// robot file's optional `[effects]`, written by `simulate --truth`; the
+    /// calibration ignores it). Default: none.
+    pub effects: Effects,
 }
 
 /// An axis-aligned box of platform positions, world frame, metres.
@@ -134,6 +139,8 @@ impl Robot {
                 Some(Workspace { min_m, max_m })
             }
         };
+        let effects = file.effects.unwrap_or_default();
+        effects.validate().map_err(|e| fail(format!("table `effects`: {e}")))?;
         Ok(Robot {
             name: file.name,
             anchors_m,
@@ -144,6 +151,7 @@ impl Robot {
             reference_cable: file.reference_cable - 1,
             length_offsets_m,
             workspace,
+            effects,
         })
     }
 
@@ -170,6 +178,7 @@ impl Robot {
                 min_m: w.min_m,
                 max_m: w.max_m,
             }),
+            effects: (!self.effects.is_none()).then_some(self.effects),
         }
     }
 

@@ -14,6 +14,7 @@ use rand_distr::{Distribution, Normal};
 
 use crate::error::{Error, Result};
 use crate::io::measurements::PoseMeasurement;
+use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::SensorNoise;
 use crate::model::statics::{self, Equilibrium, StaticsOptions};
@@ -86,6 +87,58 @@ fn normal(sigma: f64) -> Normal<f64> {
     Normal::new(0.0, sigma.max(0.0)).unwrap_or_else(|_| Normal::new(0.0, 0.0).expect("zero sigma is valid"))
 }
 
+/// The sensors' noise, ready to draw: what a noise-free reading becomes.
+pub struct SensorSampler {
+    encoder: Normal<f64>,
+    load_cell: Normal<f64>,
+    position: Normal<f64>,
+    orientation: Normal<f64>,
+}
+
+impl SensorSampler {
+    /// Samplers for these sigmas (zero sigmas give exact readings).
+    pub fn new(noise: &SensorNoise) -> Self {
+        Self {
+            encoder: normal(noise.encoder_sigma_m),
+            load_cell: normal(noise.load_cell_sigma_n),
+            position: normal(noise.position_sigma_m),
+            orientation: normal(noise.orientation_sigma_rad),
+        }
+    }
+
+    /// One pose's readings: the localiser's pose is `true_pose` perturbed on its
+    /// tangent space, the encoders and load cell get additive noise. Draws in a
+    /// fixed order (orientation, position, encoders, load cell).
+    pub fn read(
+        &self,
+        true_pose: &PlatformPose,
+        encoder_lengths_m: [f64; CABLE_COUNT],
+        reference_tension_n: f64,
+        rng: &mut impl Rng,
+    ) -> PoseMeasurement {
+        let xi = Vector6::new(
+            self.orientation.sample(rng),
+            self.orientation.sample(rng),
+            self.orientation.sample(rng),
+            self.position.sample(rng),
+            self.position.sample(rng),
+            self.position.sample(rng),
+        );
+        let pose = true_pose.retract(&xi);
+        let (roll_deg, pitch_deg, yaw_deg) = pose.roll_pitch_yaw_deg();
+        let encoder_lengths_m = encoder_lengths_m.map(|l| l + self.encoder.sample(rng));
+        PoseMeasurement {
+            line: 0,
+            position_m: pose.position_m.into(),
+            roll_deg,
+            pitch_deg,
+            yaw_deg,
+            encoder_lengths_m,
+            reference_tension_n: reference_tension_n + self.load_cell.sample(rng),
+        }
+    }
+}
+
 /// What the robot's sensors read at these equilibria: encoder = catenary
 /// length + the robot's length offset + noise; load cell = reference tension
 /// + noise; localiser pose = true pose perturbed on its tangent space.
@@ -95,34 +148,12 @@ pub fn measure(
     noise: &SensorNoise,
     rng: &mut impl Rng,
 ) -> Vec<PoseMeasurement> {
-    let encoder = normal(noise.encoder_sigma_m);
-    let load_cell = normal(noise.load_cell_sigma_n);
-    let position = normal(noise.position_sigma_m);
-    let orientation = normal(noise.orientation_sigma_rad);
+    let sensors = SensorSampler::new(noise);
     equilibria
         .iter()
         .map(|eq| {
-            let xi = Vector6::new(
-                orientation.sample(rng),
-                orientation.sample(rng),
-                orientation.sample(rng),
-                position.sample(rng),
-                position.sample(rng),
-                position.sample(rng),
-            );
-            let pose = eq.pose.retract(&xi);
-            let (roll_deg, pitch_deg, yaw_deg) = pose.roll_pitch_yaw_deg();
-            let encoder_lengths_m: [f64; CABLE_COUNT] =
-                std::array::from_fn(|i| eq.cable_lengths_m[i] + robot.length_offsets_m[i] + encoder.sample(rng));
-            PoseMeasurement {
-                line: 0,
-                position_m: pose.position_m.into(),
-                roll_deg,
-                pitch_deg,
-                yaw_deg,
-                encoder_lengths_m,
-                reference_tension_n: eq.tensions[robot.reference_cable].magnitude_n() + load_cell.sample(rng),
-            }
+            let lengths = std::array::from_fn(|i| eq.cable_lengths_m[i] + robot.length_offsets_m[i]);
+            sensors.read(&eq.pose, lengths, eq.tensions[robot.reference_cable].magnitude_n(), rng)
         })
         .collect()
 }

@@ -1,0 +1,360 @@
+//! Physical effects beyond the closed-form catenary model.
+//!
+//! sagcal's calibration model ([`crate::model::catenary`],
+//! [`crate::model::statics`]) has inextensible cables leaving point anchors,
+//! ideal encoders and load cell, and a known centre of mass. [`Effects`]
+//! describes what a real robot may add; `sagcal simulate --effect` generates
+//! data with them through the discretised simulator
+//! ([`crate::sim::effects::measure_with_effects`]) so the calibration's
+//! sensitivity to model mismatch can be studied. The calibration ignores them.
+//!
+//! Each effect is given on the command line as `NAME:PARAM=VALUE[,PARAM=VALUE...]`
+//! ([`Effects::apply_spec`]):
+//!
+//! | effect | parameters |
+//! |---|---|
+//! | `elastic` | `ea_n` (axial stiffness EA, N, > 0) |
+//! | `pulley` | `radius_m` (pulley radius, m, >= 0) |
+//! | `encoder-scale` | `gain` (all four encoders) or `gain1` .. `gain4` (> 0) |
+//! | `loadcell` | `bias_n` (N), `gain` (> 0) |
+//! | `com` | `dx_m`, `dy_m`, `dz_m` (platform frame, m) |
+
+use serde::{Deserialize, Serialize};
+
+use crate::model::robot::CABLE_COUNT;
+
+/// Effects acting on a robot beyond the closed-form model. [`Default`]: none.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Effects {
+    /// Axial stiffness `EA` of every cable, newtons (`elastic:ea_n`); `None`: inextensible.
+    ///
+    /// An elastic cable is Irvine's elastic catenary: an element of unstretched
+    /// length `ds` under tension `T` is `ds (1 + T / EA)` long, so the cable's
+    /// free span is longer than its paid-out (unstretched) length by about
+    /// `L T / EA` and the platform hangs lower than the inextensible model puts it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axial_stiffness_n: Option<f64>,
+    /// Pulley radius `r`, metres (`pulley:radius_m`); 0: the cable leaves at the anchor point.
+    ///
+    /// Pulley wrap geometry: the pulley swivels about the vertical axis through
+    /// the anchor, the cable enters the groove at the anchor, wraps over the top
+    /// and leaves tangentially; the exit point moves with the cable's direction
+    /// (by up to `2 r` from the anchor) and the wrapped arc `r wrap` is paid out
+    /// but not part of the free span.
+    pub pulley_radius_m: f64,
+    /// Encoder scale factor per cable (`encoder-scale:gain` for all four, or `gain1` .. `gain4`); 1: exact.
+    ///
+    /// A drum radius error: an encoder counting drum revolutions reads
+    /// `gain * paid_out` with `gain = r_true / r_nominal`.
+    pub encoder_gain: [f64; CABLE_COUNT],
+    /// Load-cell bias, newtons (`loadcell:bias_n`): the reading is `bias + gain * |T_ref|`.
+    ///
+    /// A zero-point error of the load cell on the reference cable.
+    pub load_cell_bias_n: f64,
+    /// Load-cell gain (`loadcell:gain`), 1: exact.
+    ///
+    /// A calibration (sensitivity) error of the load cell on the reference cable.
+    pub load_cell_gain: f64,
+    /// Shift of the centre of mass from the robot's `com_offset_m`, platform frame, metres (`com:dx_m,dy_m,dz_m`).
+    ///
+    /// A centre of mass offset: the payload's true centre of mass differs from
+    /// the nominal one, which tilts the platform and redistributes the tensions.
+    pub com_shift_m: [f64; 3],
+}
+
+impl Default for Effects {
+    /// No effect: inextensible cables, point pulleys, exact sensors, the nominal centre of mass.
+    fn default() -> Self {
+        Self {
+            axial_stiffness_n: None,
+            pulley_radius_m: 0.0,
+            encoder_gain: [1.0; CABLE_COUNT],
+            load_cell_bias_n: 0.0,
+            load_cell_gain: 1.0,
+            com_shift_m: [0.0; 3],
+        }
+    }
+}
+
+/// The effect names accepted by [`Effects::apply_spec`], with their parameters.
+pub const EFFECT_NAMES: &str =
+    "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m";
+
+impl Effects {
+    /// True when no effect is present (the closed-form model describes the robot).
+    pub fn is_none(&self) -> bool {
+        *self == Self::default()
+    }
+
+    /// Apply one `NAME:PARAM=VALUE[,PARAM=VALUE...]` specification, e.g.
+    /// `elastic:ea_n=3e6`, `encoder-scale:gain1=1.001,gain3=0.999` or
+    /// `com:dx_m=0.02,dz_m=-0.05`. Parameters not given keep their values.
+    /// On error `self` is unchanged and the message names the effect and parameter.
+    pub fn apply_spec(&mut self, spec: &str) -> Result<(), String> {
+        let spec = spec.trim();
+        let (name, params) = spec.split_once(':').ok_or_else(|| {
+            format!("effect `{spec}`: expected NAME:PARAM=VALUE[,PARAM=VALUE...] (effects: {EFFECT_NAMES})")
+        })?;
+        let name = name.trim();
+        let known: &[&str] = match name {
+            "elastic" => &["ea_n"],
+            "pulley" => &["radius_m"],
+            "encoder-scale" => &["gain", "gain1", "gain2", "gain3", "gain4"],
+            "loadcell" => &["bias_n", "gain"],
+            "com" => &["dx_m", "dy_m", "dz_m"],
+            other => return Err(format!("unknown effect `{other}` (effects: {EFFECT_NAMES})")),
+        };
+        if params.trim().is_empty() {
+            return Err(format!(
+                "effect `{name}`: no parameters given (parameters: {})",
+                known.join(", ")
+            ));
+        }
+        let mut next = *self;
+        for param in params.split(',') {
+            let param = param.trim();
+            let (key, value) = param
+                .split_once('=')
+                .ok_or_else(|| format!("effect `{name}`: parameter `{param}` has no `=VALUE`"))?;
+            let key = key.trim();
+            if !known.contains(&key) {
+                return Err(format!(
+                    "effect `{name}`: unknown parameter `{key}` (parameters: {})",
+                    known.join(", ")
+                ));
+            }
+            let value: f64 = value
+                .trim()
+                .parse()
+                .map_err(|_| format!("effect `{name}`: parameter `{key}`: `{}` is not a number", value.trim()))?;
+            if !value.is_finite() {
+                return Err(format!(
+                    "effect `{name}`: parameter `{key}` must be finite, got {value}"
+                ));
+            }
+            let positive = |what: &str| {
+                if value > 0.0 {
+                    Ok(value)
+                } else {
+                    Err(format!(
+                        "effect `{name}`: parameter `{key}` ({what}) must be > 0, got {value}"
+                    ))
+                }
+            };
+            match (name, key) {
+                ("elastic", _) => next.axial_stiffness_n = Some(positive("axial stiffness EA, N")?),
+                ("pulley", _) => {
+                    if value < 0.0 {
+                        return Err(format!(
+                            "effect `{name}`: parameter `{key}` (pulley radius, m) must be >= 0, got {value}"
+                        ));
+                    }
+                    next.pulley_radius_m = value;
+                }
+                ("encoder-scale", "gain") => next.encoder_gain = [positive("encoder gain")?; CABLE_COUNT],
+                ("encoder-scale", k) => {
+                    let cable: usize = k["gain".len()..].parse().expect("gain1..gain4");
+                    next.encoder_gain[cable - 1] = positive("encoder gain")?;
+                }
+                ("loadcell", "bias_n") => next.load_cell_bias_n = value,
+                ("loadcell", _) => next.load_cell_gain = positive("load-cell gain")?,
+                ("com", k) => {
+                    let axis = ["dx_m", "dy_m", "dz_m"]
+                        .iter()
+                        .position(|a| *a == k)
+                        .expect("known axis");
+                    next.com_shift_m[axis] = value;
+                }
+                _ => unreachable!("parameter names are checked above"),
+            }
+        }
+        *self = next;
+        Ok(())
+    }
+
+    /// Check values read from a file: the same rules as [`Effects::apply_spec`].
+    pub fn validate(&self) -> Result<(), String> {
+        if let Some(ea) = self.axial_stiffness_n {
+            if !(ea.is_finite() && ea > 0.0) {
+                return Err(format!("`axial_stiffness_n` must be a finite EA > 0 N, got {ea}"));
+            }
+        }
+        if !(self.pulley_radius_m.is_finite() && self.pulley_radius_m >= 0.0) {
+            return Err(format!(
+                "`pulley_radius_m` must be finite and >= 0, got {}",
+                self.pulley_radius_m
+            ));
+        }
+        if let Some(g) = self.encoder_gain.iter().find(|g| !(g.is_finite() && **g > 0.0)) {
+            return Err(format!("`encoder_gain` must be finite and > 0, got {g}"));
+        }
+        if !self.load_cell_bias_n.is_finite() {
+            return Err(format!(
+                "`load_cell_bias_n` must be finite, got {}",
+                self.load_cell_bias_n
+            ));
+        }
+        if !(self.load_cell_gain.is_finite() && self.load_cell_gain > 0.0) {
+            return Err(format!(
+                "`load_cell_gain` must be finite and > 0, got {}",
+                self.load_cell_gain
+            ));
+        }
+        if !self.com_shift_m.iter().all(|x| x.is_finite()) {
+            return Err(format!("`com_shift_m` must be finite, got {:?}", self.com_shift_m));
+        }
+        Ok(())
+    }
+
+    /// The effects present, as specifications [`Effects::apply_spec`] accepts (empty: none).
+    pub fn specs(&self) -> Vec<String> {
+        let none = Self::default();
+        let mut specs = Vec::new();
+        if let Some(ea) = self.axial_stiffness_n {
+            specs.push(format!("elastic:ea_n={ea:e}"));
+        }
+        if self.pulley_radius_m != none.pulley_radius_m {
+            specs.push(format!("pulley:radius_m={}", self.pulley_radius_m));
+        }
+        if self.encoder_gain != none.encoder_gain {
+            let g = self.encoder_gain;
+            if g.iter().all(|x| *x == g[0]) {
+                specs.push(format!("encoder-scale:gain={}", g[0]));
+            } else {
+                let parts: Vec<String> = g
+                    .iter()
+                    .enumerate()
+                    .map(|(i, x)| format!("gain{}={x}", i + 1))
+                    .collect();
+                specs.push(format!("encoder-scale:{}", parts.join(",")));
+            }
+        }
+        if self.load_cell_bias_n != none.load_cell_bias_n || self.load_cell_gain != none.load_cell_gain {
+            specs.push(format!(
+                "loadcell:bias_n={},gain={}",
+                self.load_cell_bias_n, self.load_cell_gain
+            ));
+        }
+        if self.com_shift_m != none.com_shift_m {
+            let [x, y, z] = self.com_shift_m;
+            specs.push(format!("com:dx_m={x},dy_m={y},dz_m={z}"));
+        }
+        specs
+    }
+}
+
+impl std::fmt::Display for Effects {
+    /// `none`, or the specifications joined by spaces.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let specs = self.specs();
+        if specs.is_empty() {
+            f.write_str("none")
+        } else {
+            f.write_str(&specs.join(" "))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parsed(specs: &[&str]) -> Result<Effects, String> {
+        let mut effects = Effects::default();
+        for spec in specs {
+            effects.apply_spec(spec)?;
+        }
+        Ok(effects)
+    }
+
+    #[test]
+    fn default_is_none() {
+        assert!(Effects::default().is_none());
+        assert_eq!(Effects::default().to_string(), "none");
+        assert!(!parsed(&["loadcell:bias_n=0.5"]).unwrap().is_none());
+    }
+
+    #[test]
+    fn parses_every_effect() {
+        let e = parsed(&[
+            "elastic:ea_n=3e6",
+            "pulley:radius_m=0.2",
+            "encoder-scale:gain=1.002",
+            "encoder-scale:gain1=1.001,gain3=0.999",
+            "loadcell:bias_n=3,gain=1.01",
+            "com:dx_m=0.02,dz_m=-0.05",
+        ])
+        .unwrap();
+        assert_eq!(e.axial_stiffness_n, Some(3e6));
+        assert_eq!(e.pulley_radius_m, 0.2);
+        assert_eq!(e.encoder_gain, [1.001, 1.002, 0.999, 1.002]);
+        assert_eq!(e.load_cell_bias_n, 3.0);
+        assert_eq!(e.load_cell_gain, 1.01);
+        assert_eq!(e.com_shift_m, [0.02, 0.0, -0.05]);
+        // The specifications parse back to the same effects.
+        let specs = e.specs();
+        let again = parsed(&specs.iter().map(String::as_str).collect::<Vec<_>>()).unwrap();
+        assert_eq!(again, e);
+    }
+
+    #[test]
+    fn errors_name_the_effect_and_parameter() {
+        let cases = [
+            ("stretchy:ea_n=1", &["unknown effect `stretchy`"][..]),
+            ("elastic", &["effect `elastic`", "NAME:PARAM=VALUE"]),
+            ("elastic:", &["effect `elastic`", "no parameters"]),
+            (
+                "elastic:ea=3e6",
+                &["effect `elastic`", "unknown parameter `ea`", "ea_n"],
+            ),
+            ("elastic:ea_n", &["effect `elastic`", "`ea_n` has no `=VALUE`"]),
+            ("elastic:ea_n=abc", &["`ea_n`", "`abc` is not a number"]),
+            ("elastic:ea_n=inf", &["`ea_n` must be finite"]),
+            ("elastic:ea_n=NaN", &["`ea_n` must be finite"]),
+            ("elastic:ea_n=0", &["effect `elastic`", "`ea_n`", "must be > 0"]),
+            ("elastic:ea_n=-1e6", &["`ea_n`", "must be > 0"]),
+            ("pulley:radius_m=-0.1", &["effect `pulley`", "`radius_m`", ">= 0"]),
+            ("encoder-scale:gain=0", &["effect `encoder-scale`", "`gain`", "> 0"]),
+            ("encoder-scale:gain5=1", &["unknown parameter `gain5`"]),
+            ("loadcell:gain=-1", &["effect `loadcell`", "`gain`", "> 0"]),
+            (
+                "loadcell:bias_n=3,offset=1",
+                &["effect `loadcell`", "unknown parameter `offset`"],
+            ),
+            ("com:dx=0.1", &["effect `com`", "unknown parameter `dx`"]),
+        ];
+        for (spec, needles) in cases {
+            let mut effects = Effects::default();
+            let message = effects.apply_spec(spec).expect_err(spec);
+            for needle in needles {
+                assert!(message.contains(needle), "{spec}: `{message}` lacks `{needle}`");
+            }
+            assert!(effects.is_none(), "{spec}: a failed spec must not change the effects");
+        }
+    }
+
+    #[test]
+    fn pulley_radius_zero_is_allowed_and_later_specs_override() {
+        let e = parsed(&["pulley:radius_m=0", "loadcell:gain=2", "loadcell:gain=1.5"]).unwrap();
+        assert_eq!(e.pulley_radius_m, 0.0);
+        assert_eq!(e.load_cell_gain, 1.5);
+    }
+
+    #[test]
+    fn toml_round_trip_and_validation() {
+        let e = parsed(&["elastic:ea_n=3e6", "com:dy_m=0.01"]).unwrap();
+        let text = toml::to_string(&e).unwrap();
+        assert_eq!(toml::from_str::<Effects>(&text).unwrap(), e);
+        let partial: Effects = toml::from_str("pulley_radius_m = 0.1").unwrap();
+        assert_eq!(partial.pulley_radius_m, 0.1);
+        assert_eq!(partial.encoder_gain, [1.0; 4]);
+        assert!(toml::from_str::<Effects>("radius = 0.1").is_err());
+        let bad = Effects {
+            load_cell_gain: 0.0,
+            ..Effects::default()
+        };
+        assert!(bad.validate().unwrap_err().contains("load_cell_gain"));
+        assert!(e.validate().is_ok());
+    }
+}
