@@ -750,13 +750,11 @@ fn calibrate_once(
         if let Some(slot) = feasible.iter().position(|&f| f == k) {
             let vars = relaxed.poses[slot];
             let t = relaxed.graph.values.vector(vars.reference_tension);
-            let pose = *relaxed.graph.values.pose(vars.pose);
-            let tension = CableTension {
+            final_poses.push(*relaxed.graph.values.pose(vars.pose));
+            final_tensions.push(CableTension {
                 horizontal_n: t[0],
                 vertical_n: t[1],
-            };
-            final_poses.push(pose);
-            final_tensions.push(tension);
+            });
         } else if still_failing.contains(&k) {
             excluded.push(k);
             continue;

@@ -196,24 +196,16 @@ impl LinearSystem {
 
     /// Solve `(H + diag(damping)) x = rhs`; `None` if the matrix is not positive definite.
     pub fn solve(&self, hessian: &[f64], damping: &[f64], rhs: &[f64]) -> Option<Vec<f64>> {
-        self.factorize(hessian, damping)?.solve(rhs)
-    }
-
-    /// Numeric Cholesky factorisation of `H + diag(damping)` on the symbolic
-    /// analysis done once in [`LinearSystem::new`]; `None` if the matrix is
-    /// not positive definite.
-    pub fn factorize(&self, hessian: &[f64], damping: &[f64]) -> Option<DampedFactorization> {
         let mut values = hessian.to_vec();
         for (i, &k) in self.diagonal_slots.iter().enumerate() {
             values[k] += damping[i];
         }
         let matrix = SparseColMat::new_from_argsort(self.pattern.clone(), &self.argsort, &values).ok()?;
         let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), matrix.as_ref(), Side::Lower).ok()?;
-        Some(DampedFactorization {
-            llt,
-            matrix,
-            dim: self.dim,
-        })
+        let mut x = Mat::<f64>::from_fn(self.dim, 1, |i, _| rhs[i]);
+        llt.solve_in_place_with_conj(Conj::No, x.as_mut());
+        let solution: Vec<f64> = (0..self.dim).map(|i| x[(i, 0)]).collect();
+        solution.iter().all(|v| v.is_finite()).then_some(solution)
     }
 
     /// `H` as a dense symmetric matrix (for the rank analysis of small problems).
@@ -231,39 +223,5 @@ impl LinearSystem {
             }
         }
         dense
-    }
-}
-
-/// A numeric Cholesky factorisation of the damped normal matrix `H + diag(damping)`,
-/// kept with the matrix (lower triangle) for the model's predicted decrease.
-pub struct DampedFactorization {
-    llt: Llt<usize, f64>,
-    /// Lower triangle of `H + diag(damping)`.
-    matrix: SparseColMat<usize, f64>,
-    dim: usize,
-}
-
-impl DampedFactorization {
-    /// Solve for one right-hand side; `None` if the solution is not finite.
-    pub fn solve(&self, rhs: &[f64]) -> Option<Vec<f64>> {
-        let mut x = Mat::<f64>::from_fn(self.dim, 1, |i, _| rhs[i]);
-        self.llt.solve_in_place_with_conj(Conj::No, x.as_mut());
-        let solution: Vec<f64> = (0..self.dim).map(|i| x[(i, 0)]).collect();
-        solution.iter().all(|v| v.is_finite()).then_some(solution)
-    }
-
-    /// `(H + diag(damping)) x` from the stored lower triangle.
-    pub fn multiply(&self, x: &[f64]) -> Vec<f64> {
-        let mut y = vec![0.0; self.dim];
-        let matrix = self.matrix.as_ref();
-        for j in 0..self.dim {
-            for (i, v) in matrix.row_idx_of_col(j).zip(matrix.val_of_col(j)) {
-                y[i] += v * x[j];
-                if i != j {
-                    y[j] += v * x[i];
-                }
-            }
-        }
-        y
     }
 }

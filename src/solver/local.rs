@@ -129,6 +129,11 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values) {
         let Some((hessian, gradient)) = linearize_group(graph, group, values) else {
             return;
         };
+        let originals: Vec<_> = group
+            .variables
+            .iter()
+            .map(|&v| values.variable(v).value.clone())
+            .collect();
         let mut improved = false;
         while damping < 1e8 {
             let mut damped = hessian.clone();
@@ -139,11 +144,6 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values) {
                 damping *= 10.0;
                 continue;
             };
-            let originals: Vec<_> = group
-                .variables
-                .iter()
-                .map(|&v| values.variable(v).value.clone())
-                .collect();
             for (k, &v) in group.variables.iter().enumerate() {
                 let slice = &step.as_slice()[group.offsets[k]..group.offsets[k + 1]];
                 values.set(v, originals[k].retract(slice));

@@ -25,7 +25,7 @@ mod local;
 use local::LocalGroups;
 
 pub use covariance::{marginal_covariance, Covariance, UnobservableDirection};
-pub use linear_system::{DampedFactorization, LinearSystem};
+pub use linear_system::LinearSystem;
 
 use serde::Serialize;
 
@@ -229,24 +229,19 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
         while damping <= params.max_damping {
             trials += 1;
             let damp: Vec<f64> = diagonal.iter().map(|d| damping * d).collect();
-            let Some((factorization, velocity)) = system
-                .factorize(&linearization.hessian, &damp)
-                .and_then(|f| f.solve(&rhs).map(|v| (f, v)))
-            else {
+            let Some(step) = system.solve(&linearization.hessian, &damp, &rhs) else {
                 damping *= nu;
                 nu *= 2.0;
                 continue;
             };
-            let step = velocity;
-            // Decrease predicted by the model: -g.s - 1/2 s.H s.
-            let product = factorization.multiply(&step);
-            let curvature: f64 = step
-                .iter()
-                .zip(&product)
-                .zip(&damp)
-                .map(|((s, hs), d)| s * hs - d * s * s)
-                .sum();
-            let predicted = -step.iter().zip(gradient).map(|(s, g)| s * g).sum::<f64>() - 0.5 * curvature;
+            // Predicted decrease of 1/2|r + J dx|^2: -g.dx - 1/2 dx.H dx = 1/2 dx.(lambda D dx - g).
+            let predicted: f64 = 0.5
+                * step
+                    .iter()
+                    .zip(&damp)
+                    .zip(gradient)
+                    .map(|((dx, d), g)| dx * (d * dx - g))
+                    .sum::<f64>();
             let mut candidate = retract_all(&values, &system, &step);
             if !groups.is_empty() {
                 groups.refine(graph, &mut candidate);
