@@ -199,6 +199,7 @@ fn no_effect_agrees_with_the_closed_form_data() {
             assert!((a - b).abs() < 1e-3, "angle {a} vs {b} deg");
         }
         let rel = (d.reference_tension_n / c.reference_tension_n - 1.0).abs();
+        eprintln!("no effect vs closed form: position {dp:.2e} m, reference tension {rel:.2e} relative");
         assert!(rel < 1e-3, "reference tension differs by {rel}");
     }
 }
@@ -250,6 +251,12 @@ fn elastic_cables_lower_the_platform_by_the_stretch() {
         let simulated = e.pose.position_m - n.pose.position_m;
         assert!(simulated.z < -0.01, "elastic platform not lower: {simulated:?}");
         let error = (simulated - predicted).norm();
+        eprintln!(
+            "EA = 3e6 N: platform {:.3} m lower (hand estimate {:.3} m, difference {:.1} %)",
+            -simulated.z,
+            -predicted.z,
+            100.0 * error / predicted.norm()
+        );
         assert!(
             error < 0.05 * predicted.norm(),
             "simulated shift {simulated:?} m vs hand estimate {predicted:?} m"
