@@ -66,6 +66,181 @@ class CableProperties:
     weight_n_per_m: sf.Scalar
 
 
+@dataclasses.dataclass(frozen=True)
+class CableExtensions:
+    """The physical effects of the extended model (``sagcal diagnose``, issue 4), all neutral at 0.
+
+    Attributes:
+        axial_compliance_per_n: ``1 / EA`` of every cable, 1/N (Irvine's elastic
+            catenary, :func:`elastic_free_length`); 0: inextensible.
+        pulley_radius_m: Radius ``r`` of the swivelling pulley at every anchor, metres
+            (:func:`pulley_exit`); 0: the cable leaves at the anchor point.
+    """
+
+    axial_compliance_per_n: sf.Scalar
+    pulley_radius_m: sf.Scalar
+
+
+def top_tension(
+    free_length_m: sf.Scalar, horizontal_tension_n: sf.Scalar, vertical_tension_n: sf.Scalar, cable: CableProperties
+) -> tuple[sf.Scalar, sf.Scalar]:
+    """Vertical tension and tension magnitude at the upper end of a hanging cable.
+
+    The vertical force grows by the weight of the cable below (paper eq. 1-3:
+    ``T_v(s) = f_v + g_c s`` along the arc from the attachment), so at the top
+    ``V_top = f_v + g_c l`` and ``T_top = sqrt(f_h^2 + V_top^2)`` (``f_h > 0``
+    keeps the root away from zero).
+
+    Args:
+        free_length_m: Arc length ``l`` of the hanging cable, metres.
+        horizontal_tension_n: ``f_h > 0``, newtons.
+        vertical_tension_n: ``f_v`` at the attachment, newtons.
+        cable: The cable's properties (``g_c``).
+
+    Returns:
+        ``(V_top, T_top)`` in newtons.
+    """
+    v_top = vertical_tension_n + cable.weight_n_per_m * free_length_m
+    return v_top, sf.sqrt(horizontal_tension_n**2 + v_top**2)
+
+
+def pulley_exit(
+    anchor_span_m: sf.Scalar,
+    horizontal_tension_n: sf.Scalar,
+    vertical_tension_n: sf.Scalar,
+    cable: CableProperties,
+    pulley_radius_m: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> tuple[sf.Scalar, sf.Scalar, sf.Scalar]:
+    """Where the cable leaves a swivelling pulley of radius ``r`` (pulley wrap geometry).
+
+    The pulley swivels about the vertical axis through the anchor ``a``; the
+    cable comes up that axis, enters the groove at ``a``, wraps over the top and
+    leaves tangentially towards the platform (the geometry of
+    ``src/sim/discretised.rs``). In the cable's vertical plane, with ``s`` the
+    horizontal direction towards the attachment and the cable leaving along the
+    top tension ``(-f_h s, V_top) / T_top`` (:func:`top_tension`), the circle's
+    tangent point is::
+
+        e = a + r [ (1 + c) s + h z ],   c = V_top / T_top,  h = f_h / T_top
+        wrap = pi - atan2(f_h, V_top) = pi/2 + atan(V_top / f_h)
+
+    The top tension depends on the free length, which depends on the exit
+    point; two fixed-point passes starting from the anchor (``r = 0``) leave an
+    error of order ``r (g_c r / T)^2``, far below a micrometre for these robots.
+
+    Args:
+        anchor_span_m: Horizontal span from the anchor to the attachment, metres.
+        horizontal_tension_n: ``f_h > 0``, newtons.
+        vertical_tension_n: ``f_v`` at the attachment, newtons.
+        cable: The cable's properties (``g_c``).
+        pulley_radius_m: ``r``, metres (0: the exit point is the anchor).
+        epsilon: Small positive number.
+
+    Returns:
+        ``(span, rise, wrap)``: the horizontal span from the exit point to the
+        attachment (m), the exit point's height above the anchor (m) and the
+        wrap angle (rad).
+    """
+    span = anchor_span_m
+    v_top = vertical_tension_n
+    t_top = sf.sqrt(horizontal_tension_n**2 + v_top**2)
+    for _ in range(2):
+        free_length = catenary_length(span, horizontal_tension_n, vertical_tension_n, cable, epsilon)
+        v_top, t_top = top_tension(free_length, horizontal_tension_n, vertical_tension_n, cable)
+        span = anchor_span_m - pulley_radius_m * (1 + v_top / t_top)
+    wrap = sf.pi / 2 + sf.atan(v_top / horizontal_tension_n)
+    return span, pulley_radius_m * horizontal_tension_n / t_top, wrap
+
+
+def elastic_free_length(
+    span_m: sf.Scalar,
+    horizontal_tension_n: sf.Scalar,
+    vertical_tension_n: sf.Scalar,
+    cable: CableProperties,
+    axial_compliance_per_n: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> tuple[sf.Scalar, sf.Scalar, sf.Scalar]:
+    """Unstretched length and drop of an elastic catenary, first order in ``1/EA`` (Irvine).
+
+    Irvine's elastic catenary (*Cable Structures*, 1981, eq. 2.23-2.24), with
+    the arc coordinate ``s`` of the unstretched cable (length ``L0``, weight
+    ``g_c`` per unstretched metre) measured from the attachment, end forces
+    ``f_h, f_v`` there and ``k = 1/EA``::
+
+        span(L0) = k f_h L0 + X(L0),   rise(L0) = k (f_v L0 + g_c L0^2 / 2) + Z(L0)
+
+    where ``X``, ``Z`` are the inextensible catenary's. For the span ``L`` of the
+    geometry, ``X(l) = L`` at the inextensible length ``l`` (:func:`catenary_length`);
+    one Newton step in ``L0`` (``X' = f_h / T_top``, ``Z' = V_top / T_top``) gives::
+
+        L0   = l (1 - k T_top) + O(k^2)
+        drop = drop_inextensible(L) - k g_c l^2 / 2 + O(k^2)
+
+    For a massless cable this is the spring ``L0 = l / (1 + k T)`` to first
+    order; the neglected term is ``l (k T)^2``, 1e-5 m for a 20 m cable at
+    ``T / EA = 1e-3``.
+
+    Args:
+        span_m: Horizontal span from the cable's upper end to the attachment, metres.
+        horizontal_tension_n: ``f_h > 0``, newtons.
+        vertical_tension_n: ``f_v`` at the attachment, newtons.
+        cable: The cable's properties (``g_c``).
+        axial_compliance_per_n: ``k = 1/EA``, 1/N (0: inextensible).
+        epsilon: Small positive number.
+
+    Returns:
+        ``(L0, drop, T_top)``: the unstretched free length (m), the upper end's
+        height above the attachment (m) and the tension at the upper end (N).
+    """
+    free_length = catenary_length(span_m, horizontal_tension_n, vertical_tension_n, cable, epsilon)
+    drop = catenary_drop(span_m, horizontal_tension_n, vertical_tension_n, cable, epsilon)
+    _, t_top = top_tension(free_length, horizontal_tension_n, vertical_tension_n, cable)
+    unstretched = free_length * (1 - axial_compliance_per_n * t_top)
+    drop = drop - axial_compliance_per_n * cable.weight_n_per_m * free_length**2 / 2
+    return unstretched, drop, t_top
+
+
+def extended_cable(
+    anchor_span_m: sf.Scalar,
+    horizontal_tension_n: sf.Scalar,
+    vertical_tension_n: sf.Scalar,
+    cable: CableProperties,
+    extensions: CableExtensions,
+    epsilon: sf.Scalar,
+) -> tuple[sf.Scalar, sf.Scalar]:
+    """Paid-out length and drop of a cable with pulley wrap and elasticity.
+
+    The free span runs from the pulley exit point (:func:`pulley_exit`) to the
+    attachment as an elastic catenary (:func:`elastic_free_length`); the drum
+    pays out the free cable plus the arc on the groove, which is under the top
+    tension: ``paid_out = L0 + r wrap / (1 + k T_top)``. With ``r = 0`` and
+    ``k = 0`` this is exactly :func:`catenary_length` and :func:`catenary_drop`.
+
+    Args:
+        anchor_span_m: Horizontal span from the anchor to the attachment, metres.
+        horizontal_tension_n: ``f_h > 0``, newtons.
+        vertical_tension_n: ``f_v`` at the attachment, newtons.
+        cable: The cable's properties (``g_c``).
+        extensions: Compliance and pulley radius.
+        epsilon: Small positive number.
+
+    Returns:
+        ``(paid_out, drop)``: the length paid out past the anchor (m) and the
+        anchor's height above the attachment implied by the cable (m).
+    """
+    radius = extensions.pulley_radius_m
+    span, rise, wrap = pulley_exit(
+        anchor_span_m, horizontal_tension_n, vertical_tension_n, cable, radius, epsilon
+    )
+    compliance = extensions.axial_compliance_per_n
+    unstretched, drop, t_top = elastic_free_length(
+        span, horizontal_tension_n, vertical_tension_n, cable, compliance, epsilon
+    )
+    paid_out = unstretched + radius * wrap / (1 + compliance * t_top)
+    return paid_out, drop - rise
+
+
 def safe_divisor(x: sf.Scalar, epsilon: sf.Scalar) -> sf.Scalar:
     """Return ``x`` pushed away from zero by ``epsilon``, keeping its sign.
 

@@ -340,3 +340,119 @@ def rigid_length_residual(
             for j in range(CABLE_COUNT)
         ]
     )
+
+
+
+def cable_geometry(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    reference_tension_n: sf.V2,
+    anchors_m: sf.Matrix34,
+    attachments_m: sf.Matrix34,
+    com_offset_m: sf.V3,
+    platform_weight_n: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> sf.Matrix:
+    """Per cable, what its catenary depends on: span, end tensions and the anchor's height (eq. 2, 5-11).
+
+    The extended model's factors (``src/calib/effect_factors.rs``) chain these
+    through :func:`extended_cable`, so the effects' terms are derived once per
+    cable instead of once per pose.
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        reference_tension_n: ``[f_h, f_v]`` of the reference cable (slot 0), newtons.
+        anchors_m: Column ``j`` = anchor of slot ``j``, world frame, metres.
+        attachments_m: Column ``j`` = attachment of slot ``j``, platform frame, metres.
+        com_offset_m: Centre of mass, platform frame, metres.
+        platform_weight_n: Platform weight ``m_e g``, newtons.
+        epsilon: Small positive number (safe divisions).
+
+    Returns:
+        ``[L_0, f_h0, f_v0, h_0, L_1, ...]`` (16): per slot the horizontal span
+        ``L`` (m), the tensions at the attachment (N) and the anchor's height
+        above the attachment ``h = a_z - (p + R b)_z`` (m).
+    """
+    attachments, spans, tensions = _catenaries(
+        position_m,
+        rotation_xyzw,
+        reference_tension_n,
+        anchors_m,
+        attachments_m,
+        com_offset_m,
+        platform_weight_n,
+        epsilon,
+    )
+    values = []
+    for j in range(CABLE_COUNT):
+        values += [spans[j], tensions[j][0], tensions[j][1], anchors_m[2, j] - attachments[j][2]]
+    return sf.Matrix(values)
+
+
+def extended_cable(
+    span_m: sf.Scalar,
+    horizontal_tension_n: sf.Scalar,
+    vertical_tension_n: sf.Scalar,
+    cable_weight_n_per_m: sf.Scalar,
+    axial_compliance_per_mn: sf.Scalar,
+    pulley_radius_m: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> sf.V2:
+    """Paid-out length and implied drop of one cable with pulley wrap and elasticity.
+
+    ``cable_model.extended_cable``: Irvine's elastic catenary to first order in
+    ``1/EA`` from the swivelling pulley's exit point, plus the arc wrapped on
+    the pulley. The extended length factor is ``(1 + g_j) paid_out_j + l0_j -
+    z_enc,j`` (eq. 14 with an encoder scale error ``g_j``), the extended
+    attachment factor ``drop_j - h_j`` (eq. 15, ``h_j`` from
+    :func:`cable_geometry`). With both effect parameters 0 the outputs are
+    exactly eq. (4) and the drop of eq. (1)-(3).
+
+    Args:
+        span_m: Horizontal span ``L`` from the anchor to the attachment, metres.
+        horizontal_tension_n: ``f_h > 0``, newtons.
+        vertical_tension_n: ``f_v`` at the attachment, newtons.
+        cable_weight_n_per_m: Cable weight per metre ``g_c``, N/m (0: massless cable).
+        axial_compliance_per_mn: ``1e6 / EA`` of the cable, 1/MN (0: inextensible).
+        pulley_radius_m: Pulley radius ``r``, metres (0: point anchor).
+        epsilon: Small positive number (safe divisions, ``sinhc`` at ``g_c = 0``).
+
+    Returns:
+        ``[paid_out, drop]``: the length paid out past the anchor and the
+        anchor's height above the attachment the cable implies, metres.
+    """
+    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
+    extensions = cable_model.CableExtensions(
+        axial_compliance_per_n=axial_compliance_per_mn * sf.Rational(1, 10**6),
+        pulley_radius_m=pulley_radius_m,
+    )
+    paid_out, drop = cable_model.extended_cable(
+        span_m, horizontal_tension_n, vertical_tension_n, cable, extensions, epsilon
+    )
+    return sf.V2(paid_out, drop)
+
+def load_cell_residual(
+    reference_tension_n: sf.V2,
+    load_cell_bias_n: sf.Scalar,
+    load_cell_gain_error: sf.Scalar,
+    measured_tension_n: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> sf.V1:
+    """Force factor with a load-cell model: ``r = b + (1 + g) ||[f_h, f_v]|| - f_m`` (eq. 16 extended).
+
+    A load cell with zero-point error ``b`` and sensitivity error ``g`` reads
+    ``b + (1 + g) T``; with ``b = g = 0`` this is :func:`reference_tension_residual`.
+
+    Args:
+        reference_tension_n: ``[f_h, f_v]`` of the reference cable, newtons.
+        load_cell_bias_n: Zero-point error ``b``, newtons.
+        load_cell_gain_error: Sensitivity error ``g`` (dimensionless).
+        measured_tension_n: Load-cell reading ``f_m``, newtons.
+        epsilon: Small positive number (inside the norm's square root).
+
+    Returns:
+        The 1-vector tension error in newtons.
+    """
+    tension = reference_tension_n.norm(epsilon=epsilon)
+    return sf.V1(load_cell_bias_n + (1 + load_cell_gain_error) * tension - measured_tension_n)

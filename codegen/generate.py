@@ -98,7 +98,8 @@ class SagcalRustCodePrinter(rust_code_printer.RustCodePrinter):
     Every replacement is parenthesised (it may sit inside a product or a
     quotient), and parentheses around a whole statement are removed
     (rustc's ``unused_parens``). Also fixed with respect to SymForce 0.12 /
-    SymPy 1.14: ``sign_no_zero(a + b)`` printed as ``a + b.signum()`` (the
+    SymPy 1.14: sums inside products with a fractional coefficient printed
+    without their parentheses (``_print_Mul``), ``sign_no_zero(a + b)`` printed as ``a + b.signum()`` (the
     receiver was not parenthesised), ``Min``/``Max`` rewritten into
     ``if (..) {..} else {..}`` (now ``a.min(b)``), ``sign`` printed with
     parentheses around the ``if`` condition, and exact rationals printed as
@@ -158,6 +159,21 @@ class SagcalRustCodePrinter(rust_code_printer.RustCodePrinter):
                 return f"({one} / {power})"
             return f"({power})" if " * " in power else power
         return super()._print_Pow(expr, rational)
+
+    def _print_Mul(self, expr):  # type: ignore[no-untyped-def]
+        # SymPy 1.14's Rust printer rebuilds a product that has a non-integer number among
+        # its factors with every factor cast to float, and the cast sums lose their
+        # parentheses: -a*b*(2*a*c + d)/2 printed as `-0.5*a*b*2*a*c + d`. Print such sums
+        # through placeholders and parenthesise them here.
+        sums = [arg for arg in expr.args if arg.is_Add]
+        if not sums or not any(arg.is_number and not arg.is_integer for arg in expr.args):
+            return super()._print_Mul(expr)
+        placeholders = {arg: sympy.Symbol(f"sagcal_sum_{k}") for k, arg in enumerate(sums)}
+        code = super()._print_Mul(expr.xreplace(placeholders))
+        for arg, symbol in placeholders.items():
+            printed = f"({_strip_outer_parentheses(self._print(arg))})"
+            code = re.sub(rf"\b{symbol.name}\b", lambda _match, text=printed: text, code)
+        return code
 
     def _print_Rational(self, expr: sympy.Rational) -> str:
         value = float(expr)
@@ -242,6 +258,13 @@ ARGUMENT_TYPES: dict[str, type] = {
     "platform_weight_n": sf.Symbol,
     "cable_weight_n_per_m": sf.Symbol,
     "measured_tension_n": sf.Symbol,
+    "axial_compliance_per_mn": sf.Symbol,
+    "pulley_radius_m": sf.Symbol,
+    "span_m": sf.Symbol,
+    "horizontal_tension_n": sf.Symbol,
+    "vertical_tension_n": sf.Symbol,
+    "load_cell_bias_n": sf.Symbol,
+    "load_cell_gain_error": sf.Symbol,
     "epsilon": sf.Symbol,
 }
 
@@ -254,6 +277,14 @@ JACOBIAN_BLOCKS: dict[str, tuple[str, str]] = {
     "reference_tension_n": ("jacobian_reference_tension", "`reference_tension_n`, columns `[f_h, f_v]`"),
     "anchors_m": ("jacobian_anchors", "`anchors_m`, columns `[slot 0 x, y, z, slot 1 x, y, z, ...]`"),
     "length_offsets_m": ("jacobian_length_offsets", "`length_offsets_m`, columns in slot order"),
+    "com_offset_m": ("jacobian_com_offset", "`com_offset_m`, columns `[x, y, z]`"),
+    "axial_compliance_per_mn": ("jacobian_axial_compliance", "`axial_compliance_per_mn`"),
+    "pulley_radius_m": ("jacobian_pulley_radius", "`pulley_radius_m`"),
+    "span_m": ("jacobian_span", "`span_m`"),
+    "horizontal_tension_n": ("jacobian_horizontal_tension", "`horizontal_tension_n`"),
+    "vertical_tension_n": ("jacobian_vertical_tension", "`vertical_tension_n`"),
+    "load_cell_bias_n": ("jacobian_load_cell_bias", "`load_cell_bias_n`"),
+    "load_cell_gain_error": ("jacobian_load_cell_gain_error", "`load_cell_gain_error`"),
 }
 
 
@@ -282,6 +313,21 @@ FUNCTIONS = (
     FunctionSpec(factors.reference_tension_residual, "residual", ("reference_tension_n",)),
     FunctionSpec(factors.pose_prior_residual, "residual", ("pose",)),
     FunctionSpec(factors.rigid_length_residual, "residual", ("pose", "anchors_m", "length_offsets_m")),
+    FunctionSpec(
+        factors.cable_geometry,
+        "geometry",
+        ("pose", "reference_tension_n", "anchors_m", "com_offset_m"),
+    ),
+    FunctionSpec(
+        factors.extended_cable,
+        "cable",
+        ("span_m", "horizontal_tension_n", "vertical_tension_n", "axial_compliance_per_mn", "pulley_radius_m"),
+    ),
+    FunctionSpec(
+        factors.load_cell_residual,
+        "residual",
+        ("reference_tension_n", "load_cell_bias_n", "load_cell_gain_error"),
+    ),
 )
 
 
@@ -300,6 +346,8 @@ def jacobian(expr: sf.Matrix, inputs: Values, block: str) -> sf.Matrix:
         rotation = sf.Rot3.from_storage(list(inputs["rotation_xyzw"]))
         # Rot3 tangent: d expr / d dtheta of R * Exp(dtheta) at dtheta = 0 (right perturbation).
         return expr.jacobian(rotation).row_join(expr.jacobian(inputs["position_m"]))
+    if isinstance(inputs[block], sf.Symbol):
+        return expr.jacobian(sf.V1(inputs[block]))
     return expr.jacobian(inputs[block])
 
 

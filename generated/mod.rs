@@ -5,15 +5,21 @@
 //! returns its value and fills the Jacobians that are requested (`Some`).
 
 mod attachment_height_residual;
+mod cable_geometry;
 mod cable_tensions_from_reference;
 mod catenary_length_residual;
+mod extended_cable;
+mod load_cell_residual;
 mod pose_prior_residual;
 mod reference_tension_residual;
 mod rigid_length_residual;
 
 pub use attachment_height_residual::attachment_height_residual;
+pub use cable_geometry::cable_geometry;
 pub use cable_tensions_from_reference::cable_tensions_from_reference;
 pub use catenary_length_residual::catenary_length_residual;
+pub use extended_cable::extended_cable;
+pub use load_cell_residual::load_cell_residual;
 pub use pose_prior_residual::pose_prior_residual;
 pub use reference_tension_residual::reference_tension_residual;
 pub use rigid_length_residual::rigid_length_residual;

@@ -26,6 +26,7 @@
 #![warn(missing_docs)]
 
 pub mod calib;
+pub mod diagnose;
 pub mod error;
 pub mod experiment;
 #[path = "../generated/mod.rs"]
@@ -35,6 +36,7 @@ pub mod graph;
 pub mod io;
 pub mod model;
 pub mod plot;
+pub mod plot_residuals;
 pub mod sim;
 pub mod solver;
 pub mod verify;

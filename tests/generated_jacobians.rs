@@ -4,10 +4,16 @@
 //!   differences (5-point stencil), the pose perturbed through
 //!   [`PlatformPose::retract`] and the other arguments additively, at random
 //!   points of two regimes: the large robot (`robots/large.toml`) and the
-//!   small robot (`robots/small.toml`).
+//!   small robot (`robots/small.toml`). `extended_cable` is evaluated for the
+//!   four cables of a point (spans and tensions from `cable_geometry` there)
+//!   with compliance in [0, 2] 1/MN and pulley radius in [0, 0.3] m: both
+//!   exactly 0 at a quarter of the points, one of them 0 at two other quarters.
 //! * The values against hand-written Rust: eq. (11) against a 6x6 LU solve of
 //!   the full statics `J^T f = w`, the catenary length and drop against
-//!   [`Catenary`], the straight cable, the load cell and the pose prior.
+//!   [`Catenary`], the straight cable, the load cell and the pose prior;
+//!   `extended_cable` against [`Catenary`] without effects, Irvine's first
+//!   order elastic catenary, the spring `l (1 - k T)` of a massless cable and
+//!   a massless cable's pulley exit in closed form.
 //! * The massless limit `g_c = 0`.
 
 use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, UnitQuaternion, Vector2, Vector3, Vector4, Vector6};
@@ -92,6 +98,17 @@ struct Point {
     encoder_lengths_m: Vector4<f64>,
     prior: PlatformPose,
     measured_tension_n: f64,
+    /// Per slot the scalar arguments of `extended_cable`: span (m), `f_h`, `f_v` (N); taken
+    /// from `cable_geometry` at this point by [`physical_points`].
+    cable_spans_m: Vector4<f64>,
+    cable_horizontal_tensions_n: Vector4<f64>,
+    cable_vertical_tensions_n: Vector4<f64>,
+    /// `1e6 / EA`, 1/MN, shared by the four cables.
+    axial_compliance_per_mn: f64,
+    /// Pulley radius, metres, shared by the four pulleys.
+    pulley_radius_m: f64,
+    load_cell_bias_n: f64,
+    load_cell_gain_error: f64,
 }
 
 fn random_rotation(rng: &mut ChaCha8Rng, max_angle_deg: f64) -> UnitQuaternion<f64> {
@@ -147,7 +164,36 @@ fn random_point(regime: &Regime, rng: &mut ChaCha8Rng) -> Point {
         encoder_lengths_m: Vector4::from_fn(|_, _| rng.random_range(5.0..200.0)),
         prior: pose.retract(&prior_tangent),
         measured_tension_n: reference_tension_n.norm() + rng.random_range(-5.0..5.0),
+        // Filled by `with_effects` (its own generator, so that the points above do not change).
+        cable_spans_m: Vector4::zeros(),
+        cable_horizontal_tensions_n: Vector4::zeros(),
+        cable_vertical_tensions_n: Vector4::zeros(),
+        axial_compliance_per_mn: 0.0,
+        pulley_radius_m: 0.0,
+        load_cell_bias_n: 0.0,
+        load_cell_gain_error: 0.0,
     }
+}
+
+/// `point` with the arguments of the extended model's functions: the cables' spans and
+/// tensions from `cable_geometry` at the point, and effect parameters drawn by `rng`:
+/// compliance in [0, 2] 1/MN, pulley radius in [0, 0.3] m, where `index % 4` selects
+/// both 0 (the inextensible catenary from the anchor point), compliance 0, radius 0 or
+/// neither, load-cell bias in [-5, 5] N and gain error in [-0.05, 0.05].
+fn with_effects(mut point: Point, index: usize, rng: &mut ChaCha8Rng) -> Point {
+    let geometry = geometry(&point).0;
+    for j in 0..4 {
+        point.cable_spans_m[j] = geometry[4 * j];
+        point.cable_horizontal_tensions_n[j] = geometry[4 * j + 1];
+        point.cable_vertical_tensions_n[j] = geometry[4 * j + 2];
+    }
+    let compliance = rng.random_range(0.0..=2.0);
+    let radius = rng.random_range(0.0..=0.3);
+    point.axial_compliance_per_mn = if index % 4 < 2 { 0.0 } else { compliance };
+    point.pulley_radius_m = if index % 2 == 0 { 0.0 } else { radius };
+    point.load_cell_bias_n = rng.random_range(-5.0..5.0);
+    point.load_cell_gain_error = rng.random_range(-0.05..0.05);
+    point
 }
 
 /// The differentiated argument blocks.
@@ -157,6 +203,17 @@ enum Block {
     ReferenceTension,
     Anchors,
     LengthOffsets,
+    ComOffset,
+    /// The four cables' spans (`extended_cable`'s `span_m`, one column per slot).
+    Span,
+    /// The four cables' `f_h` (`extended_cable`'s `horizontal_tension_n`).
+    HorizontalTension,
+    /// The four cables' `f_v` (`extended_cable`'s `vertical_tension_n`).
+    VerticalTension,
+    AxialCompliance,
+    PulleyRadius,
+    LoadCellBias,
+    LoadCellGain,
 }
 
 impl Block {
@@ -166,6 +223,9 @@ impl Block {
             Block::ReferenceTension => 2,
             Block::Anchors => 12,
             Block::LengthOffsets => 4,
+            Block::ComOffset => 3,
+            Block::Span | Block::HorizontalTension | Block::VerticalTension => 4,
+            Block::AxialCompliance | Block::PulleyRadius | Block::LoadCellBias | Block::LoadCellGain => 1,
         }
     }
 
@@ -176,6 +236,12 @@ impl Block {
             Block::Pose => 1e-3,
             Block::ReferenceTension => 1e-4 * point.reference_tension_n[k].abs().max(1.0),
             Block::Anchors | Block::LengthOffsets => 1e-3,
+            Block::ComOffset => 1e-4,
+            Block::Span => 1e-4 * point.cable_spans_m[k].abs().max(1.0),
+            Block::HorizontalTension => 1e-4 * point.cable_horizontal_tensions_n[k].abs().max(1.0),
+            Block::VerticalTension => 1e-4 * point.cable_vertical_tensions_n[k].abs().max(1.0),
+            Block::AxialCompliance | Block::LoadCellBias => 1e-3,
+            Block::PulleyRadius | Block::LoadCellGain => 1e-4,
         }
     }
 
@@ -191,6 +257,14 @@ impl Block {
             Block::ReferenceTension => moved.reference_tension_n[k] += t,
             Block::Anchors => moved.anchors_m[(k % 3, k / 3)] += t,
             Block::LengthOffsets => moved.length_offsets_m[k] += t,
+            Block::ComOffset => moved.com_offset_m[k] += t,
+            Block::Span => moved.cable_spans_m[k] += t,
+            Block::HorizontalTension => moved.cable_horizontal_tensions_n[k] += t,
+            Block::VerticalTension => moved.cable_vertical_tensions_n[k] += t,
+            Block::AxialCompliance => moved.axial_compliance_per_mn += t,
+            Block::PulleyRadius => moved.pulley_radius_m += t,
+            Block::LoadCellBias => moved.load_cell_bias_n += t,
+            Block::LoadCellGain => moved.load_cell_gain_error += t,
         }
         moved
     }
@@ -327,7 +401,94 @@ fn rigid_length(p: &Point) -> Evaluation {
     (value, vec![dynamic(&pose), dynamic(&anchors), dynamic(&offsets)])
 }
 
-const FUNCTIONS: [Function; 6] = [
+fn geometry(p: &Point) -> Evaluation {
+    let (mut pose, mut reference, mut anchors, mut com) =
+        (nan::<16, 6>(), nan::<16, 2>(), nan::<16, 12>(), nan::<16, 3>());
+    let value = generated::cable_geometry(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.reference_tension_n,
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.com_offset_m,
+        p.platform_weight_n,
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut reference),
+        Some(&mut anchors),
+        Some(&mut com),
+    );
+    let value = DVector::from_column_slice(value.as_slice());
+    (
+        value,
+        vec![dynamic(&pose), dynamic(&reference), dynamic(&anchors), dynamic(&com)],
+    )
+}
+
+/// `extended_cable` of the four slots stacked: `[paid_out_0, drop_0, paid_out_1, ...]` (8).
+///
+/// The per-cable blocks (span, `f_h`, `f_v`) are block diagonal, 8x4, from the 2x1 Jacobians of
+/// each slot; the compliance and radius are shared, 8x1.
+fn extended(p: &Point) -> Evaluation {
+    let mut value = DVector::zeros(8);
+    let mut jacobians = vec![
+        DMatrix::zeros(8, 4),
+        DMatrix::zeros(8, 4),
+        DMatrix::zeros(8, 4),
+        DMatrix::zeros(8, 1),
+        DMatrix::zeros(8, 1),
+    ];
+    for j in 0..4 {
+        let (mut span, mut horizontal, mut vertical, mut compliance, mut radius) = (
+            nan::<2, 1>(),
+            nan::<2, 1>(),
+            nan::<2, 1>(),
+            nan::<2, 1>(),
+            nan::<2, 1>(),
+        );
+        let cable = generated::extended_cable(
+            p.cable_spans_m[j],
+            p.cable_horizontal_tensions_n[j],
+            p.cable_vertical_tensions_n[j],
+            p.cable_weight_n_per_m,
+            p.axial_compliance_per_mn,
+            p.pulley_radius_m,
+            EPSILON,
+            Some(&mut span),
+            Some(&mut horizontal),
+            Some(&mut vertical),
+            Some(&mut compliance),
+            Some(&mut radius),
+        );
+        value.rows_mut(2 * j, 2).copy_from(&cable);
+        for (b, derivative) in [span, horizontal, vertical].iter().enumerate() {
+            jacobians[b].view_mut((2 * j, j), (2, 1)).copy_from(derivative);
+        }
+        jacobians[3].view_mut((2 * j, 0), (2, 1)).copy_from(&compliance);
+        jacobians[4].view_mut((2 * j, 0), (2, 1)).copy_from(&radius);
+    }
+    (value, jacobians)
+}
+
+fn load_cell(p: &Point) -> Evaluation {
+    let (mut reference, mut bias, mut gain) = (nan::<1, 2>(), nan::<1, 1>(), nan::<1, 1>());
+    let value = generated::load_cell_residual(
+        &p.reference_tension_n,
+        p.load_cell_bias_n,
+        p.load_cell_gain_error,
+        p.measured_tension_n,
+        EPSILON,
+        Some(&mut reference),
+        Some(&mut bias),
+        Some(&mut gain),
+    );
+    (
+        DVector::from_column_slice(value.as_slice()),
+        vec![dynamic(&reference), dynamic(&bias), dynamic(&gain)],
+    )
+}
+
+const FUNCTIONS: [Function; 9] = [
     Function {
         name: "cable_tensions_from_reference",
         blocks: &[Block::Pose, Block::ReferenceTension, Block::Anchors],
@@ -362,6 +523,27 @@ const FUNCTIONS: [Function; 6] = [
         name: "rigid_length_residual",
         blocks: &[Block::Pose, Block::Anchors, Block::LengthOffsets],
         evaluate: rigid_length,
+    },
+    Function {
+        name: "cable_geometry",
+        blocks: &[Block::Pose, Block::ReferenceTension, Block::Anchors, Block::ComOffset],
+        evaluate: geometry,
+    },
+    Function {
+        name: "extended_cable",
+        blocks: &[
+            Block::Span,
+            Block::HorizontalTension,
+            Block::VerticalTension,
+            Block::AxialCompliance,
+            Block::PulleyRadius,
+        ],
+        evaluate: extended,
+    },
+    Function {
+        name: "load_cell_residual",
+        blocks: &[Block::ReferenceTension, Block::LoadCellBias, Block::LoadCellGain],
+        evaluate: load_cell,
     },
 ];
 
@@ -448,6 +630,7 @@ fn worst_jacobian_errors(points: &[Point]) -> Vec<(&'static str, Block, Worst)> 
 /// often gives a slack or pushing cable there, where the catenary is meaningless.
 fn physical_points(regime: &Regime, seed: u64, count: usize) -> Vec<Point> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut effects_rng = ChaCha8Rng::seed_from_u64(seed ^ 0x0eff_ec75);
     let mut points = Vec::with_capacity(count);
     let mut rejected = 0;
     while points.len() < count {
@@ -457,7 +640,8 @@ fn physical_points(regime: &Regime, seed: u64, count: usize) -> Vec<Point> {
             .iter()
             .all(|&(h, v)| h > 0.05 * regime.horizontal_tension_n.0 && v > 0.0)
         {
-            points.push(point);
+            let index = points.len();
+            points.push(with_effects(point, index, &mut effects_rng));
         } else {
             rejected += 1;
             assert!(rejected < 50 * count, "{}: no physical points", regime.name);
@@ -636,6 +820,165 @@ fn values_match_independent_computations() {
     }
 }
 
+/// `extended_cable` of slot `j` of `p` with the given effect parameters, `(paid_out, drop)`.
+fn extended_cable_at(p: &Point, j: usize, compliance_per_mn: f64, radius_m: f64) -> (f64, f64) {
+    let cable = generated::extended_cable(
+        p.cable_spans_m[j],
+        p.cable_horizontal_tensions_n[j],
+        p.cable_vertical_tensions_n[j],
+        p.cable_weight_n_per_m,
+        compliance_per_mn,
+        radius_m,
+        EPSILON,
+        None,
+        None,
+        None,
+        None,
+        None,
+    );
+    (cable[0], cable[1])
+}
+
+fn catenary_of_slot(p: &Point, j: usize) -> Catenary {
+    Catenary {
+        span_m: p.cable_spans_m[j],
+        horizontal_tension_n: p.cable_horizontal_tensions_n[j],
+        vertical_tension_n: p.cable_vertical_tensions_n[j],
+        cable_weight_n_per_m: p.cable_weight_n_per_m,
+    }
+}
+
+#[test]
+fn new_functions_match_independent_computations() {
+    // cable_geometry against the 6x6 LU solve and the hand-written geometry, load_cell_residual
+    // against b + (1 + g) T - f_m.
+    for (regime, seed) in [(large(), 81), (small(), 82)] {
+        let (mut tension, mut geometry_error, mut load_cell_error) = (0.0_f64, 0.0_f64, 0.0_f64);
+        for p in physical_points(&regime, seed, 100) {
+            let value = geometry(&p).0;
+            for (j, &(f_h, f_v)) in independent_tensions(&p).iter().enumerate() {
+                let (attachment, _, span, _) = cable_geometry(&p, j);
+                tension = tension.max(relative_error(value[4 * j + 1], f_h));
+                tension = tension.max(relative_error(value[4 * j + 2], f_v));
+                geometry_error = geometry_error.max(relative_error(value[4 * j], span));
+                let height = p.anchors_m[(2, j)] - attachment.z;
+                geometry_error = geometry_error.max(relative_error(value[4 * j + 3], height));
+            }
+            let expected = p.load_cell_bias_n + (1.0 + p.load_cell_gain_error) * p.reference_tension_n.norm()
+                - p.measured_tension_n;
+            load_cell_error = load_cell_error.max((load_cell(&p).0[0] - expected).abs());
+        }
+        println!(
+            "{}: cable_geometry tensions {tension:.1e}, span/height {geometry_error:.1e}, load cell {load_cell_error:.1e}",
+            regime.name
+        );
+        assert!(
+            tension < 1e-9,
+            "cable_geometry tensions differ from the LU solve: {tension:e}"
+        );
+        assert!(
+            geometry_error < 1e-12,
+            "cable_geometry span/height differ: {geometry_error:e}"
+        );
+        assert!(
+            load_cell_error < 1e-12,
+            "load_cell_residual differs: {load_cell_error:e}"
+        );
+    }
+}
+
+#[test]
+fn extended_cable_closed_forms() {
+    for (regime, seed) in [(large(), 91), (small(), 92)] {
+        let mut worst = [0.0_f64; 4];
+        for p in physical_points(&regime, seed, 100) {
+            for j in 0..4 {
+                let catenary = catenary_of_slot(&p, j);
+                // No effect: exactly eq. (4) and the drop of eq. (1)-(3), as `Catenary` computes them.
+                let (paid_out, drop) = extended_cable_at(&p, j, 0.0, 0.0);
+                worst[0] = worst[0].max((paid_out - catenary.length_m()).abs() / catenary.length_m());
+                worst[0] = worst[0].max((drop - catenary.drop_m()).abs() / catenary.drop_m().abs());
+
+                // Elastic, point anchor: Irvine to first order from the inextensible catenary,
+                // L0 = l (1 - k T_top), drop - k g_c l^2 / 2.
+                let k = 1e-6 * p.axial_compliance_per_mn;
+                let l = catenary.length_m();
+                let top = catenary
+                    .horizontal_tension_n
+                    .hypot(catenary.anchor_vertical_tension_n());
+                let (paid_out, drop) = extended_cable_at(&p, j, p.axial_compliance_per_mn, 0.0);
+                worst[1] = worst[1].max((paid_out - l * (1.0 - k * top)).abs() / l);
+                let expected_drop = catenary.drop_m() - k * p.cable_weight_n_per_m * l * l / 2.0;
+                worst[1] = worst[1].max((drop - expected_drop).abs() / expected_drop.abs());
+
+                // Massless cable, point anchor: the spring l / (1 + k T) to first order,
+                // l = span sqrt(1 + u^2), T = sqrt(f_h^2 + f_v^2); the drop stays span u.
+                let mut massless = p.clone();
+                massless.cable_weight_n_per_m = 0.0;
+                let (span, f_h, f_v) = (
+                    catenary.span_m,
+                    catenary.horizontal_tension_n,
+                    catenary.vertical_tension_n,
+                );
+                let u = f_v / f_h;
+                let l = span * (1.0 + u * u).sqrt();
+                let t = (f_h * f_h + f_v * f_v).sqrt();
+                for compliance in [0.0, 0.5, 2.0, p.axial_compliance_per_mn] {
+                    let (paid_out, drop) = extended_cable_at(&massless, j, compliance, 0.0);
+                    let expected = l * (1.0 - t * 1e-6 * compliance);
+                    worst[2] = worst[2].max((paid_out - expected).abs() / expected);
+                    worst[2] = worst[2].max((drop - span * u).abs() / (span * u));
+                }
+
+                // Massless cable on a pulley: the top tension does not depend on the free length,
+                // so the exit point is exact: span' = L - r (1 + f_v / T), rise r f_h / T, wrap
+                // pi/2 + atan(u), paid_out = span' sqrt(1 + u^2) (1 - k T) + r wrap / (1 + k T).
+                for radius in [0.05, 0.3, p.pulley_radius_m] {
+                    let compliance = p.axial_compliance_per_mn;
+                    let k = 1e-6 * compliance;
+                    let free_span = span - radius * (1.0 + f_v / t);
+                    let wrap = std::f64::consts::FRAC_PI_2 + u.atan();
+                    let expected = free_span * (1.0 + u * u).sqrt() * (1.0 - k * t) + radius * wrap / (1.0 + k * t);
+                    let expected_drop = free_span * u - radius * f_h / t;
+                    let (paid_out, drop) = extended_cable_at(&massless, j, compliance, radius);
+                    worst[3] = worst[3].max((paid_out - expected).abs() / expected);
+                    worst[3] = worst[3].max((drop - expected_drop).abs() / expected_drop.abs());
+                }
+
+                // Sanity of the sign: a stretching cable needs less unstretched length.
+                if p.axial_compliance_per_mn > 0.0 {
+                    let stretched = extended_cable_at(&p, j, p.axial_compliance_per_mn, 0.0).0;
+                    assert!(
+                        stretched < catenary.length_m(),
+                        "slot {j}: {stretched} >= {}",
+                        catenary.length_m()
+                    );
+                }
+            }
+        }
+        println!(
+            "{}: extended_cable vs Catenary {:.1e}, elastic {:.1e}, massless spring {:.1e}, massless pulley {:.1e}",
+            regime.name, worst[0], worst[1], worst[2], worst[3]
+        );
+        assert!(
+            worst[0] < 1e-12,
+            "extended_cable(k = 0, r = 0) differs from Catenary: {:e}",
+            worst[0]
+        );
+        assert!(
+            worst[1] < 1e-12,
+            "elastic catenary differs from l (1 - k T_top): {:e}",
+            worst[1]
+        );
+        assert!(
+            worst[2] < 1e-12,
+            "massless elastic cable differs from l (1 - k T): {:e}",
+            worst[2]
+        );
+        assert!(worst[3] < 1e-12, "massless cable on a pulley differs: {:e}", worst[3]);
+    }
+}
+
 #[test]
 fn tensions_satisfy_the_statics() {
     // J^T f = w with the generated tensions, residual relative to the weight.
@@ -711,6 +1054,13 @@ fn massless_catenary_equals_rigid_cable_at_a_symmetric_equilibrium() {
                 encoder_lengths_m: Vector4::new(100.0, 110.0, 120.0, 130.0),
                 prior: pose,
                 measured_tension_n: tension,
+                cable_spans_m: Vector4::zeros(),
+                cable_horizontal_tensions_n: Vector4::zeros(),
+                cable_vertical_tensions_n: Vector4::zeros(),
+                axial_compliance_per_mn: 0.0,
+                pulley_radius_m: 0.0,
+                load_cell_bias_n: 0.0,
+                load_cell_gain_error: 0.0,
             };
             let f = tensions(&p).0;
             for j in 1..4 {

@@ -44,6 +44,9 @@ fn generated_sources() {
             "rigid_length_residual",
             include_str!("../generated/rigid_length_residual.rs"),
         ),
+        ("cable_geometry", include_str!("../generated/cable_geometry.rs")),
+        ("extended_cable", include_str!("../generated/extended_cable.rs")),
+        ("load_cell_residual", include_str!("../generated/load_cell_residual.rs")),
     ];
     for (name, source) in sources {
         insta::assert_snapshot!(format!("source_{name}"), source);
@@ -63,6 +66,10 @@ struct Inputs {
     length_offsets_m: Vector4<f64>,
     encoder_lengths_m: Vector4<f64>,
     measured_tension_n: f64,
+    axial_compliance_per_mn: f64,
+    pulley_radius_m: f64,
+    load_cell_bias_n: f64,
+    load_cell_gain_error: f64,
 }
 
 fn inputs() -> Inputs {
@@ -84,6 +91,10 @@ fn inputs() -> Inputs {
         length_offsets_m: Vector4::new(0.5, -0.3, 0.2, 0.1),
         encoder_lengths_m: Vector4::new(175.0, 170.0, 160.0, 165.0),
         measured_tension_n: 610.0,
+        axial_compliance_per_mn: 0.8,
+        pulley_radius_m: 0.12,
+        load_cell_bias_n: 1.5,
+        load_cell_gain_error: -0.02,
     }
 }
 
@@ -247,5 +258,108 @@ fn rigid_length_residual_outputs() {
     format_block(&mut out, "jacobian_pose", &pose);
     format_block(&mut out, "jacobian_anchors", &anchors);
     format_block(&mut out, "jacobian_length_offsets", &offsets);
+    insta::assert_snapshot!(out);
+}
+
+#[test]
+fn cable_geometry_outputs() {
+    let x = inputs();
+    let (mut pose, mut reference, mut anchors, mut com) =
+        (nan::<16, 6>(), nan::<16, 2>(), nan::<16, 12>(), nan::<16, 3>());
+    let value = generated::cable_geometry(
+        &x.pose.position_m,
+        &x.pose.rotation_xyzw(),
+        &x.reference_tension_n,
+        &x.anchors_m,
+        &x.attachments_m,
+        &x.com_offset_m,
+        x.platform_weight_n,
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut reference),
+        Some(&mut anchors),
+        Some(&mut com),
+    );
+    let mut out = String::new();
+    format_block(&mut out, "geometry", &value);
+    format_block(&mut out, "jacobian_pose", &pose);
+    format_block(&mut out, "jacobian_reference_tension", &reference);
+    format_block(&mut out, "jacobian_anchors", &anchors);
+    format_block(&mut out, "jacobian_com_offset", &com);
+    insta::assert_snapshot!(out);
+}
+
+/// Every slot's cable at the fixed configuration (span and tensions from `cable_geometry`), with
+/// the fixed compliance and pulley radius.
+#[test]
+fn extended_cable_outputs() {
+    let x = inputs();
+    let geometry = generated::cable_geometry(
+        &x.pose.position_m,
+        &x.pose.rotation_xyzw(),
+        &x.reference_tension_n,
+        &x.anchors_m,
+        &x.attachments_m,
+        &x.com_offset_m,
+        x.platform_weight_n,
+        EPSILON,
+        None,
+        None,
+        None,
+        None,
+    );
+    let mut out = String::new();
+    for slot in 0..4 {
+        let (mut span, mut horizontal, mut vertical, mut compliance, mut radius) = (
+            nan::<2, 1>(),
+            nan::<2, 1>(),
+            nan::<2, 1>(),
+            nan::<2, 1>(),
+            nan::<2, 1>(),
+        );
+        let value = generated::extended_cable(
+            geometry[4 * slot],
+            geometry[4 * slot + 1],
+            geometry[4 * slot + 2],
+            x.cable_weight_n_per_m,
+            x.axial_compliance_per_mn,
+            x.pulley_radius_m,
+            EPSILON,
+            Some(&mut span),
+            Some(&mut horizontal),
+            Some(&mut vertical),
+            Some(&mut compliance),
+            Some(&mut radius),
+        );
+        writeln!(out, "slot {slot}:").unwrap();
+        format_block(&mut out, "cable", &value);
+        format_block(&mut out, "jacobian_span", &span);
+        format_block(&mut out, "jacobian_horizontal_tension", &horizontal);
+        format_block(&mut out, "jacobian_vertical_tension", &vertical);
+        format_block(&mut out, "jacobian_axial_compliance", &compliance);
+        format_block(&mut out, "jacobian_pulley_radius", &radius);
+    }
+    insta::assert_snapshot!(out);
+}
+
+#[test]
+fn load_cell_residual_outputs() {
+    let x = inputs();
+    let (mut reference, mut bias, mut gain) = (nan::<1, 2>(), nan::<1, 1>(), nan::<1, 1>());
+    let value = generated::load_cell_residual(
+        &x.reference_tension_n,
+        x.load_cell_bias_n,
+        x.load_cell_gain_error,
+        x.measured_tension_n,
+        EPSILON,
+        Some(&mut reference),
+        Some(&mut bias),
+        Some(&mut gain),
+    );
+    let mut out = String::new();
+    format_block(&mut out, "residual", &value);
+    format_block(&mut out, "jacobian_reference_tension", &reference);
+    format_block(&mut out, "jacobian_load_cell_bias", &bias);
+    format_block(&mut out, "jacobian_load_cell_gain_error", &gain);
     insta::assert_snapshot!(out);
 }

@@ -80,7 +80,7 @@ pub struct PoseVariables {
     pub reference_tension: VariableId,
 }
 
-fn gather_anchors(values: &Values, slots: &SlotOrder, globals: &CalibrationVariables) -> SMatrix<f64, 3, 4> {
+pub(super) fn gather_anchors(values: &Values, slots: &SlotOrder, globals: &CalibrationVariables) -> SMatrix<f64, 3, 4> {
     let mut anchors = SMatrix::<f64, 3, 4>::zeros();
     for (slot, &cable) in slots.cables.iter().enumerate() {
         let a = values.vector(globals.anchors[cable]);
@@ -89,22 +89,22 @@ fn gather_anchors(values: &Values, slots: &SlotOrder, globals: &CalibrationVaria
     anchors
 }
 
-fn gather_offsets(values: &Values, slots: &SlotOrder, globals: &CalibrationVariables) -> Vector4<f64> {
+pub(super) fn gather_offsets(values: &Values, slots: &SlotOrder, globals: &CalibrationVariables) -> Vector4<f64> {
     Vector4::from_fn(|slot, _| values.vector(globals.length_offsets[slots.cables[slot]])[0])
 }
 
-fn pose_arguments(values: &Values, pose: VariableId) -> (Vector3<f64>, Vector4<f64>) {
+pub(super) fn pose_arguments(values: &Values, pose: VariableId) -> (Vector3<f64>, Vector4<f64>) {
     let pose = values.pose(pose);
     (pose.position_m, pose.rotation_xyzw())
 }
 
-fn tension_argument(values: &Values, id: VariableId) -> Vector2<f64> {
+pub(super) fn tension_argument(values: &Values, id: VariableId) -> Vector2<f64> {
     let t = values.vector(id);
     Vector2::new(t[0], t[1])
 }
 
 /// Variables `[pose, reference tension?, anchors (robot order), offsets (robot order)?]`.
-fn variable_list(
+pub(super) fn variable_list(
     pose: &PoseVariables,
     globals: &CalibrationVariables,
     with_tension: bool,
@@ -122,7 +122,7 @@ fn variable_list(
 }
 
 /// Copy the slot-ordered anchor Jacobian (`rows x 12`) into per-anchor blocks (robot order).
-fn split_anchor_jacobian<const R: usize>(
+pub(super) fn split_anchor_jacobian<const R: usize>(
     jacobian: &SMatrix<f64, R, 12>,
     slots: &SlotOrder,
     blocks: &mut [DMatrix<f64>],
@@ -139,7 +139,7 @@ fn split_offset_jacobian(jacobian: &SMatrix<f64, 4, 4>, slots: &SlotOrder, block
 }
 
 /// Turn a slot-ordered residual into robot cable order.
-fn slots_to_cables(slots: &SlotOrder, residual: &Vector4<f64>) -> DVector<f64> {
+pub(super) fn slots_to_cables(slots: &SlotOrder, residual: &Vector4<f64>) -> DVector<f64> {
     let mut out = DVector::zeros(CABLE_COUNT);
     for (slot, &cable) in slots.cables.iter().enumerate() {
         out[cable] = residual[slot];
@@ -148,7 +148,7 @@ fn slots_to_cables(slots: &SlotOrder, residual: &Vector4<f64>) -> DVector<f64> {
 }
 
 /// Reorder the rows of Jacobian blocks from slot order to cable order.
-fn rows_to_cables(slots: &SlotOrder, blocks: &mut [DMatrix<f64>]) {
+pub(super) fn rows_to_cables(slots: &SlotOrder, blocks: &mut [DMatrix<f64>]) {
     for block in blocks {
         let copy = block.clone();
         for (slot, &cable) in slots.cables.iter().enumerate() {

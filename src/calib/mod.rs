@@ -37,6 +37,7 @@
 //! creeps along it (the small robot, with its nearly vertical cables, hit
 //! 500 iterations in most trials).
 
+pub mod effect_factors;
 pub mod factors;
 pub mod report;
 
@@ -46,14 +47,16 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::graph::{whitened_squared_norm, FactorGraph, RobustKernel, VariableId, VariableValue};
+use crate::graph::{whitened_squared_norm, FactorGraph, RobustKernel, Values, VariableId, VariableValue};
 use crate::io::measurements::PoseMeasurement;
+use crate::model::effects::{EffectKind, Effects};
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::SensorNoise;
 use crate::model::statics::{self, CableTension, Equilibrium, StaticsOptions};
 use crate::solver::{marginal_covariance, optimize, Covariance, LmParams, SolveSummary, UnobservableDirection};
 
+use effect_factors::{EffectVariables, ExtendedHeightFactor, ExtendedLengthFactor, LoadCellFactor};
 use factors::{
     AttachmentHeightFactor, CalibrationVariables, CatenaryLengthFactor, PosePriorFactor, PoseVariables,
     ReferenceTensionFactor, RigidLengthFactor, SlotOrder, TensionGuardFactor,
@@ -163,6 +166,10 @@ pub struct CalibrationOptions {
     pub robust: RobustKernels,
     /// Solver settings.
     pub lm: LmParams,
+    /// An effect of the catalogue whose parameters are estimated too (the
+    /// extended model, [`effect_factors`]); `None`: the effects of the robot
+    /// file (`[effects]`, default none) are known inputs, held fixed.
+    pub free_effect: Option<EffectKind>,
 }
 
 impl CalibrationOptions {
@@ -175,6 +182,7 @@ impl CalibrationOptions {
             height_sigma_m: 1e-4,
             robust: RobustKernels::default(),
             lm: LmParams::default(),
+            free_effect: None,
         }
     }
 }
@@ -246,6 +254,21 @@ pub struct CalibrationResult {
     /// The orientation consistency test (catenary model with
     /// [`OrientationPrior::Auto`]; `None` otherwise).
     pub orientation_check: Option<OrientationCheck>,
+    /// The estimated effect ([`CalibrationOptions::free_effect`]), with 1-sigma.
+    pub effect_estimate: Option<EffectEstimate>,
+}
+
+/// An effect's estimated parameters with their 1-sigma uncertainty.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EffectEstimate {
+    /// The effect.
+    pub effect: EffectKind,
+    /// Parameter names ([`EffectKind::parameter_names`]).
+    pub names: Vec<String>,
+    /// Estimates, in the units of the names (gains as `1 + error`).
+    pub values: Vec<f64>,
+    /// 1-sigma of each estimate (NaN where the information matrix is singular).
+    pub sigmas: Vec<f64>,
 }
 
 impl CalibrationResult {
@@ -319,6 +342,9 @@ pub struct CalibrationGraph {
     pub globals: CalibrationVariables,
     /// Per pose.
     pub poses: Vec<PoseVariables>,
+    /// The effect parameters, when the graph uses the extended model (the
+    /// robot has `[effects]`, or one is estimated); `None`: the baseline factors.
+    pub effects: Option<EffectVariables>,
 }
 
 /// Build the graph for `model` with initial values: anchors/offsets from
@@ -348,6 +374,8 @@ pub fn build_graph(
         anchors,
         length_offsets,
     };
+    let extended = model == CableModel::Catenary && (!robot.effects.is_none() || options.free_effect.is_some());
+    let effect_variables = extended.then(|| insert_effect_variables(&mut graph.values, robot, options.free_effect));
     let slots = Arc::new(SlotOrder::new(robot));
     let noise = &options.noise;
     let mut pose_variables = Vec::with_capacity(measurements.len());
@@ -388,26 +416,52 @@ pub fn build_graph(
                 ));
             }
             CableModel::Catenary => {
-                graph.add(CatenaryLengthFactor::new(
-                    slots.clone(),
-                    globals,
-                    vars,
-                    &m.encoder_lengths_m,
-                    noise.encoder_sigma_m,
-                    options.robust.encoder,
-                ));
-                graph.add(AttachmentHeightFactor::new(
-                    slots.clone(),
-                    globals,
-                    vars,
-                    options.height_sigma_m,
-                ));
-                graph.add(ReferenceTensionFactor::new(
-                    reference_tension,
-                    m.reference_tension_n,
-                    noise.load_cell_sigma_n,
-                    options.robust.load_cell,
-                ));
+                if let Some(effects) = effect_variables {
+                    graph.add(ExtendedLengthFactor::new(
+                        slots.clone(),
+                        globals,
+                        effects,
+                        vars,
+                        &m.encoder_lengths_m,
+                        noise.encoder_sigma_m,
+                        options.robust.encoder,
+                    ));
+                    graph.add(ExtendedHeightFactor::new(
+                        slots.clone(),
+                        globals,
+                        effects,
+                        vars,
+                        options.height_sigma_m,
+                    ));
+                    graph.add(LoadCellFactor::new(
+                        reference_tension,
+                        effects.load_cell,
+                        m.reference_tension_n,
+                        noise.load_cell_sigma_n,
+                        options.robust.load_cell,
+                    ));
+                } else {
+                    graph.add(CatenaryLengthFactor::new(
+                        slots.clone(),
+                        globals,
+                        vars,
+                        &m.encoder_lengths_m,
+                        noise.encoder_sigma_m,
+                        options.robust.encoder,
+                    ));
+                    graph.add(AttachmentHeightFactor::new(
+                        slots.clone(),
+                        globals,
+                        vars,
+                        options.height_sigma_m,
+                    ));
+                    graph.add(ReferenceTensionFactor::new(
+                        reference_tension,
+                        m.reference_tension_n,
+                        noise.load_cell_sigma_n,
+                        options.robust.load_cell,
+                    ));
+                }
                 graph.add(TensionGuardFactor::new(
                     slots.clone(),
                     globals,
@@ -424,7 +478,49 @@ pub fn build_graph(
         graph,
         globals,
         poses: pose_variables,
+        effects: effect_variables,
     }
+}
+
+/// The effect-parameter variables with the values of `robot.effects`, all
+/// fixed except those of `free`.
+fn insert_effect_variables(values: &mut Values, robot: &Robot, free: Option<EffectKind>) -> EffectVariables {
+    let e = &robot.effects;
+    let mut vector =
+        |name: &str, data: &[f64]| values.insert(name, VariableValue::Vector(DVector::from_column_slice(data)));
+    let variables = EffectVariables {
+        axial_compliance: vector("axial compliance (1/MN)", &[e.axial_compliance_per_mn()]),
+        pulley_radius: vector("pulley radius", &[e.pulley_radius_m]),
+        encoder_gain_errors: vector("encoder gain errors", &e.encoder_gain.map(|g| g - 1.0)),
+        load_cell: vector(
+            "load cell bias and gain error",
+            &[e.load_cell_bias_n, e.load_cell_gain - 1.0],
+        ),
+        com_shift: vector("centre of mass shift", &e.com_shift_m),
+    };
+    for kind in EffectKind::ALL {
+        values.set_fixed(variables.of(kind), Some(kind) != free);
+    }
+    variables
+}
+
+/// The effects held in the graph's effect variables (the inverse of
+/// [`insert_effect_variables`]); a compliance `<= 0` reads as an inextensible cable.
+pub fn effects_from_graph(built: &CalibrationGraph) -> Option<Effects> {
+    let vars = built.effects?;
+    let values = &built.graph.values;
+    let compliance = values.vector(vars.axial_compliance)[0];
+    let gains = values.vector(vars.encoder_gain_errors);
+    let cell = values.vector(vars.load_cell);
+    let com = values.vector(vars.com_shift);
+    Some(Effects {
+        axial_stiffness_n: (compliance > 0.0).then(|| 1e6 / compliance),
+        pulley_radius_m: values.vector(vars.pulley_radius)[0],
+        encoder_gain: std::array::from_fn(|i| 1.0 + gains[i]),
+        load_cell_bias_n: cell[0],
+        load_cell_gain: 1.0 + cell[1],
+        com_shift_m: [com[0], com[1], com[2]],
+    })
 }
 
 /// The robot with the graph's current anchors and offsets.
@@ -434,6 +530,9 @@ pub fn robot_from_graph(template: &Robot, built: &CalibrationGraph) -> Robot {
         let a = built.graph.values.vector(built.globals.anchors[i]);
         robot.anchors_m[i] = Vector3::new(a[0], a[1], a[2]);
         robot.length_offsets_m[i] = built.graph.values.vector(built.globals.length_offsets[i])[0];
+    }
+    if let Some(effects) = effects_from_graph(built) {
+        robot.effects = effects;
     }
     robot
 }
@@ -830,6 +929,79 @@ fn finish(
         reference_tensions_n,
         excluded_poses,
         orientation_check: None,
+        effect_estimate: None,
+    })
+}
+
+/// Re-estimate anchors, offsets and the parameters of `options.free_effect`
+/// with the extended model, starting from `baseline` (its anchors, offsets,
+/// poses and tensions; its excluded poses stay out). `options` should be the
+/// ones `baseline` was made with, resolved by [`CalibrationOptions::as_used_by`].
+pub fn refine_with_effect(
+    baseline: &CalibrationResult,
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+) -> Result<CalibrationResult> {
+    let kind = options
+        .free_effect
+        .ok_or_else(|| Error::InvalidInput("refine_with_effect: no effect to estimate".into()))?;
+    let used: Vec<PoseMeasurement> = (0..measurements.len())
+        .filter(|k| !baseline.excluded_poses.contains(k))
+        .map(|k| measurements[k])
+        .collect();
+    if used.len() != baseline.poses.len() {
+        return Err(Error::InvalidInput(format!(
+            "refine_with_effect: {} measurements used but the baseline has {} poses",
+            used.len(),
+            baseline.poses.len()
+        )));
+    }
+    let tensions: Vec<CableTension> = baseline
+        .reference_tensions_n
+        .iter()
+        .map(|t| CableTension {
+            horizontal_n: t[0],
+            vertical_n: t[1],
+        })
+        .collect();
+    let mut built = build_graph(
+        &baseline.robot,
+        &used,
+        &baseline.poses,
+        &tensions,
+        CableModel::Catenary,
+        options,
+    );
+    let mut stages = baseline.stages.clone();
+    stages.push(solve_stage(&format!("extended ({kind})"), &mut built, &options.lm)?);
+    let estimate = effect_estimate(&built, kind)?;
+    let mut result = finish(&baseline.robot, built, stages, baseline.excluded_poses.clone())?;
+    result.orientation_check = baseline.orientation_check;
+    result.effect_estimate = Some(estimate);
+    Ok(result)
+}
+
+/// The fitted parameters of `kind` in `built` with 1-sigma from the marginal covariance.
+fn effect_estimate(built: &CalibrationGraph, kind: EffectKind) -> Result<EffectEstimate> {
+    let vars = built
+        .effects
+        .ok_or_else(|| Error::InvalidInput("the graph has no effect parameters".into()))?;
+    let id = vars.of(kind);
+    let raw = built.graph.values.vector(id).clone();
+    let values: Vec<f64> = match kind {
+        EffectKind::EncoderScale => raw.iter().map(|g| 1.0 + g).collect(),
+        EffectKind::LoadCell => vec![raw[0], 1.0 + raw[1]],
+        _ => raw.iter().copied().collect(),
+    };
+    let sigmas = match marginal_covariance(&built.graph, &[id]).map_err(Error::InvalidInput)? {
+        Covariance::Full(c) => (0..raw.len()).map(|k| c[(k, k)].max(0.0).sqrt()).collect(),
+        Covariance::RankDeficient(_) => vec![f64::NAN; raw.len()],
+    };
+    Ok(EffectEstimate {
+        effect: kind,
+        names: kind.parameter_names().iter().map(|n| n.to_string()).collect(),
+        values,
+        sigmas,
     })
 }
 

@@ -3,6 +3,7 @@
 
 mod calibrate;
 mod demo;
+mod diagnose;
 mod experiment;
 mod output;
 mod simulate;
@@ -30,6 +31,8 @@ enum Command {
     Simulate(SimulateArgs),
     /// Check the kineto-static model against measured data (the paper's Table I).
     Verify(VerifyArgs),
+    /// Find what the model gets wrong: test residuals, fit the catalogue of effects, report the gain.
+    Diagnose(DiagnoseArgs),
     /// Reproduce the paper's experiments.
     #[command(subcommand)]
     Experiment(ExperimentCommand),
@@ -199,6 +202,36 @@ struct CalibrateArgs {
 }
 
 #[derive(Debug, clap::Args)]
+struct DiagnoseArgs {
+    /// Nominal robot description (TOML): the initial guess; its `[effects]` are known inputs.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Measurements: sagcal CSV or a RecurDyn log.
+    #[arg(long)]
+    data: PathBuf,
+    /// The true robot (TOML, e.g. from `sagcal simulate --truth`): report anchor and offset errors.
+    #[arg(long)]
+    truth: Option<PathBuf>,
+    /// Write the plot of the residual against the winning driver (before and after) into this folder.
+    #[arg(long)]
+    plots: Option<PathBuf>,
+    /// Candidate effects, comma separated (default: elastic,pulley,encoder-scale,loadcell,com).
+    #[arg(long)]
+    candidates: Option<String>,
+    /// Folds of the cross-validation over poses.
+    #[arg(long, default_value_t = 5)]
+    folds: usize,
+    /// Declare an effect only if it lowers the BIC by at least this much.
+    #[arg(long, default_value_t = 10.0)]
+    min_bic_drop: f64,
+    /// Print the diagnosis as JSON.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    solver: SolverArgs,
+}
+
+#[derive(Debug, clap::Args)]
 struct SimulateArgs {
     /// The true robot (TOML): anchors and length offsets of the simulation.
     #[arg(long)]
@@ -293,6 +326,7 @@ pub fn run() -> i32 {
         Some(Command::Calibrate(args)) => calibrate::run(&args),
         Some(Command::Simulate(args)) => simulate::run(&args),
         Some(Command::Verify(args)) => verify::run(&args),
+        Some(Command::Diagnose(args)) => diagnose::run(&args),
         Some(Command::Experiment(ExperimentCommand::Table2(args))) => experiment::run(&args),
     };
     match result {

@@ -82,6 +82,12 @@ pub const EFFECT_NAMES: &str =
     "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m";
 
 impl Effects {
+    /// The cables' axial compliance `1e6 / EA` in 1/MN (0: inextensible), the
+    /// parameter the extended model fits.
+    pub fn axial_compliance_per_mn(&self) -> f64 {
+        self.axial_stiffness_n.map_or(0.0, |ea| 1e6 / ea)
+    }
+
     /// True when no effect is present (the closed-form model describes the robot).
     pub fn is_none(&self) -> bool {
         *self == Self::default()
@@ -241,6 +247,91 @@ impl Effects {
             specs.push(format!("com:dx_m={x},dy_m={y},dz_m={z}"));
         }
         specs
+    }
+}
+
+/// One effect of the catalogue, as a model extension `sagcal diagnose` can fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EffectKind {
+    /// Finite axial stiffness (Irvine's elastic catenary); parameter the compliance `1e6 / EA` (1/MN).
+    Elastic,
+    /// Pulley radius (exit-point motion and wrapped arc); parameter `r`.
+    Pulley,
+    /// Per-cable encoder gain (drum radius error); four parameters.
+    EncoderScale,
+    /// Bias and gain of the reference cable's load cell; two parameters.
+    LoadCell,
+    /// Centre-of-mass shift from the nominal one; three parameters.
+    Com,
+}
+
+impl EffectKind {
+    /// Every effect of the catalogue, in report order.
+    pub const ALL: [EffectKind; 5] = [
+        EffectKind::Elastic,
+        EffectKind::Pulley,
+        EffectKind::EncoderScale,
+        EffectKind::LoadCell,
+        EffectKind::Com,
+    ];
+
+    /// The name used on the command line and in reports (`elastic`, `encoder-scale`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            EffectKind::Elastic => "elastic",
+            EffectKind::Pulley => "pulley",
+            EffectKind::EncoderScale => "encoder-scale",
+            EffectKind::LoadCell => "loadcell",
+            EffectKind::Com => "com",
+        }
+    }
+
+    /// Parse [`EffectKind::name`].
+    pub fn parse(text: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == text.trim())
+            .ok_or_else(|| format!("unknown effect `{text}` (effects: {EFFECT_NAMES})"))
+    }
+
+    /// Names of the fitted parameters, in the order of [`EffectKind::parameters`].
+    pub fn parameter_names(self) -> &'static [&'static str] {
+        match self {
+            EffectKind::Elastic => &["compliance_per_mn"],
+            EffectKind::Pulley => &["radius_m"],
+            EffectKind::EncoderScale => &["gain1", "gain2", "gain3", "gain4"],
+            EffectKind::LoadCell => &["bias_n", "gain"],
+            EffectKind::Com => &["dx_m", "dy_m", "dz_m"],
+        }
+    }
+
+    /// Number of fitted parameters.
+    pub fn parameter_count(self) -> usize {
+        self.parameter_names().len()
+    }
+
+    /// This effect's parameters in `effects`, in the units of
+    /// [`EffectKind::parameter_names`] (compliance 0 for an inextensible cable).
+    pub fn parameters(self, effects: &Effects) -> Vec<f64> {
+        match self {
+            EffectKind::Elastic => vec![effects.axial_compliance_per_mn()],
+            EffectKind::Pulley => vec![effects.pulley_radius_m],
+            EffectKind::EncoderScale => effects.encoder_gain.to_vec(),
+            EffectKind::LoadCell => vec![effects.load_cell_bias_n, effects.load_cell_gain],
+            EffectKind::Com => effects.com_shift_m.to_vec(),
+        }
+    }
+
+    /// Whether `effects` contains this effect (a parameter away from its neutral value).
+    pub fn present_in(self, effects: &Effects) -> bool {
+        self.parameters(effects) != self.parameters(&Effects::default())
+    }
+}
+
+impl std::fmt::Display for EffectKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 

@@ -1,0 +1,406 @@
+//! Factors of the extended model (issue 4): the calibration factors with the
+//! physical effects of [`crate::model::effects`] as extra parameter variables
+//! ([`EffectVariables`]). The length and attachment factors chain two
+//! generated functions (derived in `codegen/factors.py`):
+//! `generated::cable_geometry` (each cable's span, end tensions and anchor
+//! height from the pose, eq. 2 and 5-11) and `generated::extended_cable` (the
+//! paid-out length and drop of an elastic catenary leaving a pulley); the
+//! load-cell factor wraps `generated::load_cell_residual`.
+//!
+//! With every effect parameter at its neutral value (0) they equal the
+//! baseline factors of [`super::factors`] (tested in `tests/extended_model.rs`).
+
+use std::sync::Arc;
+
+use nalgebra::{DMatrix, DVector, SMatrix, Vector2, Vector3, Vector4};
+
+use super::factors::{
+    gather_anchors, gather_offsets, pose_arguments, rows_to_cables, slots_to_cables, split_anchor_jacobian,
+    tension_argument, variable_list, CalibrationVariables, PoseVariables, SlotOrder, EPSILON,
+};
+use crate::generated;
+use crate::graph::{Factor, RobustKernel, Values, VariableId};
+use crate::model::effects::EffectKind;
+use crate::model::robot::CABLE_COUNT;
+
+/// The effect parameters of the extended model, one variable per effect.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EffectVariables {
+    /// `[1e6 / EA]`, the cables' axial compliance in 1/MN (0: inextensible).
+    pub axial_compliance: VariableId,
+    /// `[r]`, the pulley radius, metres.
+    pub pulley_radius: VariableId,
+    /// `[g_1 .. g_4]`, encoder scale errors (reading = `(1 + g_i)` x paid-out length), robot cable order.
+    pub encoder_gain_errors: VariableId,
+    /// `[bias_n, gain_error]` of the load cell (reading = `bias + (1 + gain_error) |T|`).
+    pub load_cell: VariableId,
+    /// `[dx, dy, dz]`, the centre-of-mass shift from the nominal one, platform frame, metres.
+    pub com_shift: VariableId,
+}
+
+impl EffectVariables {
+    /// The variable holding `kind`'s parameters.
+    pub fn of(&self, kind: EffectKind) -> VariableId {
+        match kind {
+            EffectKind::Elastic => self.axial_compliance,
+            EffectKind::Pulley => self.pulley_radius,
+            EffectKind::EncoderScale => self.encoder_gain_errors,
+            EffectKind::LoadCell => self.load_cell,
+            EffectKind::Com => self.com_shift,
+        }
+    }
+}
+
+/// The effect parameters read from `values`, in the generated functions' form.
+struct EffectArguments {
+    compliance_per_mn: f64,
+    pulley_radius_m: f64,
+    /// Slot order.
+    gain_errors: Vector4<f64>,
+    /// Nominal centre of mass plus the shift, platform frame.
+    com_offset_m: Vector3<f64>,
+}
+
+fn effect_arguments(values: &Values, slots: &SlotOrder, effects: &EffectVariables) -> EffectArguments {
+    let gains = values.vector(effects.encoder_gain_errors);
+    let shift = values.vector(effects.com_shift);
+    EffectArguments {
+        compliance_per_mn: values.vector(effects.axial_compliance)[0],
+        pulley_radius_m: values.vector(effects.pulley_radius)[0],
+        gain_errors: Vector4::from_fn(|slot, _| gains[slots.cables[slot]]),
+        com_offset_m: slots.com_offset_m + Vector3::new(shift[0], shift[1], shift[2]),
+    }
+}
+
+/// Number of geometry columns chained through `generated::extended_cable`:
+/// pose (6), reference tension (2), anchors (12, slot order), centre of mass (3),
+/// then compliance (1) and pulley radius (1).
+const CHAIN_COLUMNS: usize = 25;
+
+/// The extended cable model of one pose: per slot the paid-out length and
+/// `drop - h` (the attachment residual), with Jacobians by the chain rule
+/// through `generated::cable_geometry` and `generated::extended_cable`.
+struct ExtendedCables {
+    /// Paid-out length per slot, metres.
+    paid_out_m: Vector4<f64>,
+    /// Attachment residual `drop - h` per slot, metres.
+    height_residual_m: Vector4<f64>,
+    /// `d paid_out / d [pose, tension, anchors, com, compliance, radius]`.
+    d_paid_out: SMatrix<f64, 4, CHAIN_COLUMNS>,
+    /// `d height_residual / d [...]`, same columns.
+    d_height: SMatrix<f64, 4, CHAIN_COLUMNS>,
+}
+
+fn extended_cables(
+    values: &Values,
+    slots: &SlotOrder,
+    globals: &CalibrationVariables,
+    pose: &PoseVariables,
+    effects: &EffectArguments,
+    want_jacobians: bool,
+) -> ExtendedCables {
+    let (position, rotation) = pose_arguments(values, pose.pose);
+    let tension = tension_argument(values, pose.reference_tension);
+    let anchors = gather_anchors(values, slots, globals);
+    let mut j_pose = SMatrix::<f64, 16, 6>::zeros();
+    let mut j_tension = SMatrix::<f64, 16, 2>::zeros();
+    let mut j_anchors = SMatrix::<f64, 16, 12>::zeros();
+    let mut j_com = SMatrix::<f64, 16, 3>::zeros();
+    let w = want_jacobians;
+    let geometry = generated::cable_geometry(
+        &position,
+        &rotation,
+        &tension,
+        &anchors,
+        &slots.attachments_m,
+        &effects.com_offset_m,
+        slots.platform_weight_n,
+        EPSILON,
+        w.then_some(&mut j_pose),
+        w.then_some(&mut j_tension),
+        w.then_some(&mut j_anchors),
+        w.then_some(&mut j_com),
+    );
+    let mut out = ExtendedCables {
+        paid_out_m: Vector4::zeros(),
+        height_residual_m: Vector4::zeros(),
+        d_paid_out: SMatrix::zeros(),
+        d_height: SMatrix::zeros(),
+    };
+    for slot in 0..CABLE_COUNT {
+        let row = 4 * slot;
+        let (mut d_span, mut d_fh, mut d_fv) = (Vector2::zeros(), Vector2::zeros(), Vector2::zeros());
+        let (mut d_compliance, mut d_radius) = (Vector2::zeros(), Vector2::zeros());
+        let cable = generated::extended_cable(
+            geometry[row],
+            geometry[row + 1],
+            geometry[row + 2],
+            slots.cable_weight_n_per_m,
+            effects.compliance_per_mn,
+            effects.pulley_radius_m,
+            EPSILON,
+            w.then_some(&mut d_span),
+            w.then_some(&mut d_fh),
+            w.then_some(&mut d_fv),
+            w.then_some(&mut d_compliance),
+            w.then_some(&mut d_radius),
+        );
+        out.paid_out_m[slot] = cable[0];
+        out.height_residual_m[slot] = cable[1] - geometry[row + 3];
+        if !w {
+            continue;
+        }
+        // Columns of the geometry rows [L, f_h, f_v, h] of this slot.
+        let geometry_row = |k: usize| -> SMatrix<f64, 1, 23> {
+            let mut r = SMatrix::<f64, 1, 23>::zeros();
+            r.fixed_columns_mut::<6>(0).copy_from(&j_pose.row(row + k));
+            r.fixed_columns_mut::<2>(6).copy_from(&j_tension.row(row + k));
+            r.fixed_columns_mut::<12>(8).copy_from(&j_anchors.row(row + k));
+            r.fixed_columns_mut::<3>(20).copy_from(&j_com.row(row + k));
+            r
+        };
+        let (g_span, g_fh, g_fv, g_h) = (geometry_row(0), geometry_row(1), geometry_row(2), geometry_row(3));
+        let paid = g_span * d_span[0] + g_fh * d_fh[0] + g_fv * d_fv[0];
+        let height = g_span * d_span[1] + g_fh * d_fh[1] + g_fv * d_fv[1] - g_h;
+        out.d_paid_out.fixed_view_mut::<1, 23>(slot, 0).copy_from(&paid);
+        out.d_height.fixed_view_mut::<1, 23>(slot, 0).copy_from(&height);
+        out.d_paid_out[(slot, 23)] = d_compliance[0];
+        out.d_paid_out[(slot, 24)] = d_radius[0];
+        out.d_height[(slot, 23)] = d_compliance[1];
+        out.d_height[(slot, 24)] = d_radius[1];
+    }
+    out
+}
+
+/// Copy chained columns `[pose, tension, anchors, com, compliance, radius]` into
+/// the blocks `[pose, tension, anchor x4 (robot order), ...]` and the blocks
+/// with the given indices for compliance, radius and centre-of-mass shift.
+fn split_chain(
+    jacobian: &SMatrix<f64, 4, CHAIN_COLUMNS>,
+    slots: &SlotOrder,
+    blocks: &mut [DMatrix<f64>],
+    compliance_block: usize,
+    radius_block: usize,
+    com_block: usize,
+) {
+    blocks[0].copy_from(&jacobian.fixed_columns::<6>(0));
+    blocks[1].copy_from(&jacobian.fixed_columns::<2>(6));
+    let anchors: SMatrix<f64, 4, 12> = jacobian.fixed_columns::<12>(8).into_owned();
+    split_anchor_jacobian(&anchors, slots, &mut blocks[2..6]);
+    blocks[com_block].copy_from(&jacobian.fixed_columns::<3>(20));
+    blocks[compliance_block].copy_from(&jacobian.fixed_columns::<1>(23));
+    blocks[radius_block].copy_from(&jacobian.fixed_columns::<1>(24));
+}
+
+/// Extended length factor: `(1 + g_i) paid_out_i + l_i^0 - z_i^enc` with the
+/// paid-out length of the elastic catenary leaving a pulley
+/// (`generated::extended_cable` on `generated::cable_geometry`).
+pub struct ExtendedLengthFactor {
+    variables: Vec<VariableId>,
+    slots: Arc<SlotOrder>,
+    globals: CalibrationVariables,
+    pose: PoseVariables,
+    effects: EffectVariables,
+    encoder_lengths_m: Vector4<f64>,
+    sigmas: DVector<f64>,
+    kernel: RobustKernel,
+}
+
+impl ExtendedLengthFactor {
+    /// `encoder_lengths_m` in the robot's cable order.
+    pub fn new(
+        slots: Arc<SlotOrder>,
+        globals: CalibrationVariables,
+        effects: EffectVariables,
+        pose: PoseVariables,
+        encoder_lengths_m: &[f64; CABLE_COUNT],
+        sigma_m: f64,
+        kernel: RobustKernel,
+    ) -> Self {
+        let mut variables = variable_list(&pose, &globals, true, true);
+        variables.extend([
+            effects.axial_compliance,
+            effects.pulley_radius,
+            effects.encoder_gain_errors,
+            effects.com_shift,
+        ]);
+        Self {
+            variables,
+            encoder_lengths_m: slots.to_slots(encoder_lengths_m),
+            slots,
+            globals,
+            pose,
+            effects,
+            sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
+            kernel,
+        }
+    }
+}
+
+impl Factor for ExtendedLengthFactor {
+    fn variables(&self) -> &[VariableId] {
+        &self.variables
+    }
+    fn residual_dim(&self) -> usize {
+        CABLE_COUNT
+    }
+    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        let s = &self.slots;
+        let e = effect_arguments(values, s, &self.effects);
+        let offsets = gather_offsets(values, s, &self.globals);
+        let cables = extended_cables(values, s, &self.globals, &self.pose, &e, jacobians.is_some());
+        let scale = Vector4::from_fn(|slot, _| 1.0 + e.gain_errors[slot]);
+        let residual = cables.paid_out_m.component_mul(&scale) + offsets - self.encoder_lengths_m;
+        if let Some(blocks) = jacobians {
+            let mut chained = cables.d_paid_out;
+            for slot in 0..CABLE_COUNT {
+                chained.row_mut(slot).scale_mut(scale[slot]);
+            }
+            split_chain(&chained, s, blocks, 10, 11, 13);
+            blocks[6..10].iter_mut().for_each(|b| b.fill(0.0));
+            blocks[12].fill(0.0);
+            for (slot, &cable) in s.cables.iter().enumerate() {
+                blocks[6 + cable][(slot, 0)] = 1.0;
+                blocks[12][(slot, cable)] = cables.paid_out_m[slot];
+            }
+            rows_to_cables(s, blocks);
+        }
+        Some(slots_to_cables(s, &residual))
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn robust_kernel(&self) -> RobustKernel {
+        self.kernel
+    }
+    fn kind(&self) -> &'static str {
+        "catenary_length"
+    }
+}
+
+/// Extended attachment factor: eq. (15) with the elastic catenary leaving the
+/// pulley's exit point (`drop - h` of `generated::extended_cable`).
+pub struct ExtendedHeightFactor {
+    variables: Vec<VariableId>,
+    slots: Arc<SlotOrder>,
+    globals: CalibrationVariables,
+    pose: PoseVariables,
+    effects: EffectVariables,
+    sigmas: DVector<f64>,
+}
+
+impl ExtendedHeightFactor {
+    /// A height factor with standard deviation `sigma_m` (a model constraint: small).
+    pub fn new(
+        slots: Arc<SlotOrder>,
+        globals: CalibrationVariables,
+        effects: EffectVariables,
+        pose: PoseVariables,
+        sigma_m: f64,
+    ) -> Self {
+        let mut variables = variable_list(&pose, &globals, true, false);
+        variables.extend([effects.axial_compliance, effects.pulley_radius, effects.com_shift]);
+        Self {
+            variables,
+            slots,
+            globals,
+            pose,
+            effects,
+            sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
+        }
+    }
+}
+
+impl Factor for ExtendedHeightFactor {
+    fn variables(&self) -> &[VariableId] {
+        &self.variables
+    }
+    fn residual_dim(&self) -> usize {
+        CABLE_COUNT
+    }
+    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        let s = &self.slots;
+        let e = effect_arguments(values, s, &self.effects);
+        let cables = extended_cables(values, s, &self.globals, &self.pose, &e, jacobians.is_some());
+        if let Some(blocks) = jacobians {
+            split_chain(&cables.d_height, s, blocks, 6, 7, 8);
+            rows_to_cables(s, blocks);
+        }
+        Some(slots_to_cables(s, &cables.height_residual_m))
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn kind(&self) -> &'static str {
+        "attachment_height"
+    }
+}
+
+/// Force factor with a load-cell model: `bias + (1 + gain_error) |(f_h, f_v)| - f_m`.
+pub struct LoadCellFactor {
+    variables: [VariableId; 2],
+    measured_tension_n: f64,
+    sigmas: DVector<f64>,
+    kernel: RobustKernel,
+}
+
+impl LoadCellFactor {
+    /// A load-cell reading `measured_tension_n` with standard deviation `sigma_n`;
+    /// `load_cell` is the `[bias_n, gain_error]` variable.
+    pub fn new(
+        tension: VariableId,
+        load_cell: VariableId,
+        measured_tension_n: f64,
+        sigma_n: f64,
+        kernel: RobustKernel,
+    ) -> Self {
+        Self {
+            variables: [tension, load_cell],
+            measured_tension_n,
+            sigmas: DVector::from_element(1, sigma_n),
+            kernel,
+        }
+    }
+}
+
+impl Factor for LoadCellFactor {
+    fn variables(&self) -> &[VariableId] {
+        &self.variables
+    }
+    fn residual_dim(&self) -> usize {
+        1
+    }
+    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        let tension = tension_argument(values, self.variables[0]);
+        let cell = values.vector(self.variables[1]);
+        let mut j_tension = SMatrix::<f64, 1, 2>::zeros();
+        let mut j_bias = SMatrix::<f64, 1, 1>::zeros();
+        let mut j_gain = SMatrix::<f64, 1, 1>::zeros();
+        let want = jacobians.is_some();
+        let r = generated::load_cell_residual(
+            &tension,
+            cell[0],
+            cell[1],
+            self.measured_tension_n,
+            EPSILON,
+            want.then_some(&mut j_tension),
+            want.then_some(&mut j_bias),
+            want.then_some(&mut j_gain),
+        );
+        if let Some(blocks) = jacobians {
+            blocks[0].copy_from(&j_tension);
+            blocks[1][(0, 0)] = j_bias[(0, 0)];
+            blocks[1][(0, 1)] = j_gain[(0, 0)];
+        }
+        Some(DVector::from_element(1, r[0]))
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn robust_kernel(&self) -> RobustKernel {
+        self.kernel
+    }
+    fn kind(&self) -> &'static str {
+        "reference_tension"
+    }
+}
