@@ -33,6 +33,7 @@ pub mod experiment;
 #[allow(missing_docs, clippy::all)]
 pub mod generated;
 pub mod graph;
+pub mod hidden_effects;
 pub mod io;
 pub mod model;
 pub mod plot;

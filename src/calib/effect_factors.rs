@@ -34,7 +34,10 @@ pub struct EffectVariables {
     pub encoder_gain_errors: VariableId,
     /// `[bias_n, gain_error]` of the load cell (reading = `bias + (1 + gain_error) |T|`).
     pub load_cell: VariableId,
-    /// `[dx, dy, dz]`, the centre-of-mass shift from the nominal one, platform frame, metres.
+    /// `[dx, dy]`, the horizontal centre-of-mass shift from the nominal one,
+    /// platform frame, metres. A vertical shift is a known input only (added
+    /// to the nominal centre of mass): its moment arm `(R b_com) x z` vanishes
+    /// for a level platform, so nearly level poses cannot determine it.
     pub com_shift: VariableId,
 }
 
@@ -68,7 +71,7 @@ fn effect_arguments(values: &Values, slots: &SlotOrder, effects: &EffectVariable
         compliance_per_mn: values.vector(effects.axial_compliance)[0],
         pulley_radius_m: values.vector(effects.pulley_radius)[0],
         gain_errors: Vector4::from_fn(|slot, _| gains[slots.cables[slot]]),
-        com_offset_m: slots.com_offset_m + Vector3::new(shift[0], shift[1], shift[2]),
+        com_offset_m: slots.com_offset_m + Vector3::new(shift[0], shift[1], 0.0),
     }
 }
 
@@ -187,7 +190,7 @@ fn split_chain(
     blocks[1].copy_from(&jacobian.fixed_columns::<2>(6));
     let anchors: SMatrix<f64, 4, 12> = jacobian.fixed_columns::<12>(8).into_owned();
     split_anchor_jacobian(&anchors, slots, &mut blocks[2..6]);
-    blocks[com_block].copy_from(&jacobian.fixed_columns::<3>(20));
+    blocks[com_block].copy_from(&jacobian.fixed_columns::<2>(20));
     blocks[compliance_block].copy_from(&jacobian.fixed_columns::<1>(23));
     blocks[radius_block].copy_from(&jacobian.fixed_columns::<1>(24));
 }

@@ -376,7 +376,12 @@ pub fn build_graph(
     };
     let extended = model == CableModel::Catenary && (!robot.effects.is_none() || options.free_effect.is_some());
     let effect_variables = extended.then(|| insert_effect_variables(&mut graph.values, robot, options.free_effect));
-    let slots = Arc::new(SlotOrder::new(robot));
+    let mut slot_order = SlotOrder::new(robot);
+    if extended {
+        // The vertical centre-of-mass shift is a known input (see `EffectVariables::com_shift`).
+        slot_order.com_offset_m.z += robot.effects.com_shift_m[2];
+    }
+    let slots = Arc::new(slot_order);
     let noise = &options.noise;
     let mut pose_variables = Vec::with_capacity(measurements.len());
     for (k, m) in measurements.iter().enumerate() {
@@ -496,7 +501,7 @@ fn insert_effect_variables(values: &mut Values, robot: &Robot, free: Option<Effe
             "load cell bias and gain error",
             &[e.load_cell_bias_n, e.load_cell_gain - 1.0],
         ),
-        com_shift: vector("centre of mass shift", &e.com_shift_m),
+        com_shift: vector("centre of mass shift", &e.com_shift_m[..2]),
     };
     for kind in EffectKind::ALL {
         values.set_fixed(variables.of(kind), Some(kind) != free);
@@ -506,7 +511,7 @@ fn insert_effect_variables(values: &mut Values, robot: &Robot, free: Option<Effe
 
 /// The effects held in the graph's effect variables (the inverse of
 /// [`insert_effect_variables`]); a compliance `<= 0` reads as an inextensible cable.
-pub fn effects_from_graph(built: &CalibrationGraph) -> Option<Effects> {
+pub fn effects_from_graph(template: &Robot, built: &CalibrationGraph) -> Option<Effects> {
     let vars = built.effects?;
     let values = &built.graph.values;
     let compliance = values.vector(vars.axial_compliance)[0];
@@ -519,7 +524,7 @@ pub fn effects_from_graph(built: &CalibrationGraph) -> Option<Effects> {
         encoder_gain: std::array::from_fn(|i| 1.0 + gains[i]),
         load_cell_bias_n: cell[0],
         load_cell_gain: 1.0 + cell[1],
-        com_shift_m: [com[0], com[1], com[2]],
+        com_shift_m: [com[0], com[1], template.effects.com_shift_m[2]],
     })
 }
 
@@ -531,7 +536,7 @@ pub fn robot_from_graph(template: &Robot, built: &CalibrationGraph) -> Robot {
         robot.anchors_m[i] = Vector3::new(a[0], a[1], a[2]);
         robot.length_offsets_m[i] = built.graph.values.vector(built.globals.length_offsets[i])[0];
     }
-    if let Some(effects) = effects_from_graph(built) {
+    if let Some(effects) = effects_from_graph(template, built) {
         robot.effects = effects;
     }
     robot

@@ -158,6 +158,13 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
         ]);
     }
     out += &tests.to_string();
+    if d.variance_factor != 1.0 {
+        out += &format!(
+            "   the data are more precise than the stated noise: the information criteria use the a posteriori variance factor {:.4} (residual scale x{:.3})\n",
+            d.variance_factor,
+            d.variance_factor.sqrt()
+        );
+    }
     out += "\n2. residual structure (baseline): correlation with physical drivers, strongest first\n";
     let mut drivers = Table::new(["residual", "driver", "points", "correlation", "t", "structure"]);
     for t in d.drivers.iter().take(8) {

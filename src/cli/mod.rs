@@ -5,6 +5,7 @@ mod calibrate;
 mod demo;
 mod diagnose;
 mod experiment;
+mod hidden;
 mod output;
 mod simulate;
 mod verify;
@@ -42,6 +43,33 @@ enum Command {
 enum ExperimentCommand {
     /// The paper's Table II calibration protocol with the Cramer-Rao bound.
     Table2(Table2Args),
+    /// Hide effects in simulated data and score `sagcal diagnose` (issue 4's sweep).
+    HiddenEffects(HiddenEffectsArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct HiddenEffectsArgs {
+    /// Cases per effect (and with none) per robot.
+    #[arg(long, default_value_t = 20)]
+    seeds: usize,
+    /// Base random seed (each case's seed is derived from it and printed in the JSON).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Built-in robots, comma separated.
+    #[arg(long, default_value = "large,small")]
+    robots: String,
+    /// Static poses per case.
+    #[arg(long, default_value_t = 35)]
+    poses: usize,
+    /// Sensor noise of the data and the calibration.
+    #[arg(long, default_value = "authors", value_parser = sagcal::model::sensors::NoisePreset::parse)]
+    noise: sagcal::model::sensors::NoisePreset,
+    /// Segments per cable of the discretised simulator.
+    #[arg(long, default_value_t = 50)]
+    segments: usize,
+    /// Print JSON (with every case).
+    #[arg(long)]
+    json: bool,
 }
 
 fn parse_pose_counts(text: &str) -> Result<Vec<usize>, String> {
@@ -328,6 +356,7 @@ pub fn run() -> i32 {
         Some(Command::Verify(args)) => verify::run(&args),
         Some(Command::Diagnose(args)) => diagnose::run(&args),
         Some(Command::Experiment(ExperimentCommand::Table2(args))) => experiment::run(&args),
+        Some(Command::Experiment(ExperimentCommand::HiddenEffects(args))) => hidden::run(&args),
     };
     match result {
         Ok(()) => 0,

@@ -33,7 +33,7 @@ use serde::Serialize;
 
 use crate::calib::{
     build_graph, calibrate, refine_with_effect, CableModel, CalibrationError, CalibrationGraph, CalibrationOptions,
-    CalibrationResult, EffectEstimate,
+    CalibrationResult, EffectEstimate, ParameterUncertainty,
 };
 use crate::error::{Error, Result};
 use crate::graph::{whitened_squared_norm, FactorGraph, VariableValue};
@@ -151,6 +151,9 @@ pub struct CandidateFit {
 /// Why an estimate is physically impossible (a negative compliance or pulley
 /// radius, more than 3 sigma below zero), if it is.
 fn inadmissible(estimate: &EffectEstimate) -> Option<String> {
+    if estimate.sigmas.iter().any(|s| !s.is_finite()) {
+        return Some("not identifiable from these poses (singular information matrix)".into());
+    }
     let (value, sigma) = (estimate.values[0], estimate.sigmas[0]);
     let what = match estimate.effect {
         EffectKind::Elastic => "axial compliance",
@@ -210,6 +213,9 @@ pub struct Diagnosis {
     pub baseline_dof: usize,
     /// Whether the baseline's chi-square is within the 99.9 % quantile.
     pub baseline_consistent: bool,
+    /// The a posteriori variance factor dividing every chi-square in the BIC
+    /// (1 unless the data are more precise than the stated noise).
+    pub variance_factor: f64,
     /// Per factor type.
     pub factor_tests: Vec<FactorTest>,
     /// Residual-driver correlations of the baseline, strongest first.
@@ -226,6 +232,9 @@ pub struct Diagnosis {
     pub reason: String,
     /// What the verdict's extension gains.
     pub gain: Gain,
+    /// Given the truth: the baseline's anchor error over its stated 1-sigma
+    /// ([`error_over_sigma`]); above 1 the model error is visible in the anchors.
+    pub baseline_error_over_sigma: Option<f64>,
     /// The verdict's calibrated robot (anchors, offsets, effects); the baseline's for `none`.
     #[serde(skip)]
     pub robot_after: Robot,
@@ -252,6 +261,14 @@ struct PoseSample {
 }
 
 const CABLE_DRIVER_COUNT: usize = 7;
+
+/// The 0.1 % quantile of chi-square with `k` degrees of freedom (Wilson-Hilferty,
+/// as [`crate::calib::chi_square_quantile_999`]).
+pub fn chi_square_quantile_001(k: usize) -> f64 {
+    let k = k.max(1) as f64;
+    let c = 2.0 / (9.0 * k);
+    k * (1.0 - c - 3.0902 * c.sqrt()).max(0.0).powi(3)
+}
 
 /// The per-cable drivers, with units.
 pub const DRIVERS: [&str; CABLE_DRIVER_COUNT] = [
@@ -323,7 +340,18 @@ pub fn diagnose(
     let constraints = CABLE_COUNT * used.len();
     let base_chi = total_chi_square(&base_graph.graph);
     let dof = (n + constraints).saturating_sub(unknowns).max(1);
-    let bic = |chi: f64, added: usize| chi + (unknowns + added) as f64 * (n as f64).ln();
+    // A posteriori variance factor (geodesy's "variance of unit weight"): when
+    // the baseline's chi-square is below the 0.1 % quantile for its degrees of
+    // freedom the data are more precise than the stated noise (e.g. simulated
+    // data without noise), and the information criteria use the residual
+    // scale the data show, `chi^2 / s^2` with `s^2 = chi^2 / dof`. Never
+    // scaled up: a too-large chi-square is what the candidates must explain.
+    let variance_factor = if base_chi < chi_square_quantile_001(dof) {
+        base_chi / dof as f64
+    } else {
+        1.0
+    };
+    let bic = |chi: f64, added: usize| chi / variance_factor + (unknowns + added) as f64 * (n as f64).ln();
     let baseline_bic = bic(base_chi, 0);
     let factor_tests = factor_tests(&base_graph.graph, n, dof);
     let base_samples = samples(&baseline, &used, &base_graph)?;
@@ -475,6 +503,7 @@ pub fn diagnose(
         baseline_chi_square: base_chi,
         baseline_dof: dof,
         baseline_consistent: base_chi <= crate::calib::chi_square_quantile_999(dof),
+        variance_factor,
         factor_tests,
         drivers,
         baseline_bic,
@@ -483,9 +512,23 @@ pub fn diagnose(
         verdict,
         reason,
         gain,
+        baseline_error_over_sigma: truth.map(|t| error_over_sigma(&baseline.robot, t, &baseline.uncertainty)),
         robot_after: after.robot.clone(),
         series,
     })
+}
+
+/// Mean over anchors of `|error| / sqrt(trace Sigma)` (NaN without a full-rank covariance).
+pub fn error_over_sigma(estimate: &Robot, truth: &Robot, uncertainty: &ParameterUncertainty) -> f64 {
+    match crate::calib::anchor_rms_bound_m(uncertainty) {
+        Some(bounds) => {
+            (0..CABLE_COUNT)
+                .map(|i| (estimate.anchors_m[i] - truth.anchors_m[i]).norm() / bounds[i])
+                .sum::<f64>()
+                / CABLE_COUNT as f64
+        }
+        None => f64::NAN,
+    }
 }
 
 fn parameters(estimate: &EffectEstimate) -> Vec<ParameterValue> {

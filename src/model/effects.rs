@@ -262,7 +262,8 @@ pub enum EffectKind {
     EncoderScale,
     /// Bias and gain of the reference cable's load cell; two parameters.
     LoadCell,
-    /// Centre-of-mass shift from the nominal one; three parameters.
+    /// Horizontal centre-of-mass shift from the nominal one; two parameters
+    /// (a vertical shift is not identifiable from nearly level poses).
     Com,
 }
 
@@ -302,7 +303,7 @@ impl EffectKind {
             EffectKind::Pulley => &["radius_m"],
             EffectKind::EncoderScale => &["gain1", "gain2", "gain3", "gain4"],
             EffectKind::LoadCell => &["bias_n", "gain"],
-            EffectKind::Com => &["dx_m", "dy_m", "dz_m"],
+            EffectKind::Com => &["dx_m", "dy_m"],
         }
     }
 
@@ -319,7 +320,7 @@ impl EffectKind {
             EffectKind::Pulley => vec![effects.pulley_radius_m],
             EffectKind::EncoderScale => effects.encoder_gain.to_vec(),
             EffectKind::LoadCell => vec![effects.load_cell_bias_n, effects.load_cell_gain],
-            EffectKind::Com => effects.com_shift_m.to_vec(),
+            EffectKind::Com => effects.com_shift_m[..2].to_vec(),
         }
     }
 

@@ -1,0 +1,483 @@
+//! The hidden-effect experiment: simulate a robot with one effect of the
+//! catalogue (or none) through the discretised simulator, run
+//! [`crate::diagnose::diagnose`] without telling it, and score the verdict.
+//!
+//! # Magnitudes
+//!
+//! Each case draws its effect's magnitude from a physically plausible range
+//! for the robot ([`effect_ranges`]), derived from the robot's own data:
+//!
+//! * `elastic`: the cables are synthetic-fibre ropes of density 1.44 g/cm^3
+//!   (the large robot's 72.4 g/m is an 8 mm rope), so the fibre cross section
+//!   is `A = g_c / (rho g)` and `EA = A E`, `E` drawn log-uniformly. The large
+//!   robot's long spans call for an aramid rope, `E` = 30-100 GPa (rope
+//!   construction lowers the fibre's 70-130 GPa). The small robot's 3 mm rope
+//!   is taken as a nylon braid, `E` = 1-3 GPa: with its 6-22 N
+//!   tensions an aramid rope would stretch less than a millimetre, below the
+//!   encoders' noise, and could not change the anchors by their 1-sigma.
+//! * `pulley`: radius between 2.5 % and 7.5 % of the platform's weight-scaled
+//!   size: 0.1-0.3 m for the large robot, 0.02-0.05 m for the small one.
+//! * `encoder-scale`: each drum's gain `1 +- e`, `e` uniform in 0.1-0.3 %
+//!   (a rope wound on a drum has an effective radius uncertain by a fraction
+//!   of its diameter), random signs.
+//! * `loadcell`: bias of 5-12 % of the mean reference tension and gain error of
+//!   2-5 %, random signs: an uncalibrated field load cell sized for the peak
+//!   tension (full scale 2-3 x the mean) has zero and span errors of a few %
+//!   of full scale.
+//! * `com`: a horizontal shift of 8-20 cm in a random direction: a payload
+//!   mounted off the centre of the 0.42 m platform.
+//!
+//! The experiment reports, per effect, the smallest ratio of the baseline's
+//! anchor error to its stated 1-sigma: above 1, every magnitude drawn changes
+//! the calibrated anchors by more than their uncertainty.
+//!
+//! # Scoring
+//!
+//! A case is right when the verdict names the hidden effect (`none` for none).
+//! `pulley` is reported but left out of the detection score: a pulley radius
+//! is almost entirely absorbed by the anchors ([`pulley_identifiability`]),
+//! so it is supported as a known geometry input instead (the robot file's
+//! `[effects] pulley_radius_m`), and each pulley case also reports the anchor
+//! error of a calibration that is given the radius.
+
+use nalgebra::{DMatrix, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::calib::{build_graph, calibrate, CableModel, CalibrationError, CalibrationOptions};
+use crate::diagnose::{diagnose, DiagnoseOptions};
+use crate::error::{Error, Result};
+use crate::io::measurements::PoseMeasurement;
+use crate::model::effects::{EffectKind, Effects};
+use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::sensors::NoisePreset;
+use crate::model::statics::CableTension;
+use crate::sim::closed_form::{sample_equilibria, Workspace};
+use crate::sim::effects::{measure_with_effects, solve_with_effects};
+use crate::solver::{marginal_covariance, Covariance};
+
+/// Density of the synthetic-fibre (aramid) cables, kg/m^3.
+pub const CABLE_DENSITY_KG_M3: f64 = 1440.0;
+/// Standard gravity, m/s^2.
+const GRAVITY: f64 = 9.81;
+
+/// The range an effect's magnitude is drawn from, for one robot.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EffectRange {
+    /// The effect.
+    pub effect: String,
+    /// The range, in words with units.
+    pub range: String,
+    /// Why it is plausible.
+    pub justification: String,
+}
+
+/// Settings of the experiment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HiddenEffectOptions {
+    /// Static poses per case.
+    pub poses: usize,
+    /// Sensor noise of the simulated data and of the calibration.
+    pub noise: NoisePreset,
+    /// Segments per cable of the discretised simulator.
+    pub segments: usize,
+    /// Folds of the diagnosis' cross-validation.
+    pub folds: usize,
+}
+
+impl Default for HiddenEffectOptions {
+    /// 35 poses, the authors' noise, 50 segments, 5 folds.
+    fn default() -> Self {
+        Self {
+            poses: 35,
+            noise: NoisePreset::Authors,
+            segments: 50,
+            folds: 5,
+        }
+    }
+}
+
+/// One case: what was hidden and what the diagnosis said.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HiddenCase {
+    /// Robot name.
+    pub robot: String,
+    /// The case's seed.
+    pub seed: u64,
+    /// The hidden effect, or `none`.
+    pub hidden: String,
+    /// The hidden effect's parameters (`sagcal simulate --effect` specifications).
+    pub truth: String,
+    /// The diagnosis' verdict.
+    pub verdict: String,
+    /// Whether the verdict names the hidden effect.
+    pub correct: bool,
+    /// Mean absolute anchor-coordinate error of the baseline, metres.
+    pub anchor_mae_before_m: f64,
+    /// The same for the verdict's model.
+    pub anchor_mae_after_m: f64,
+    /// The same for the hidden effect's extended model, whatever the verdict.
+    pub anchor_mae_extended_m: Option<f64>,
+    /// Baseline anchor error over its 1-sigma (mean over anchors of `|error| / sqrt(trace Sigma)`).
+    pub baseline_error_over_sigma: f64,
+    /// Pulley cases: anchor error of a calibration given the true radius.
+    pub anchor_mae_known_geometry_m: Option<f64>,
+}
+
+/// The magnitude ranges of every effect for `robot` (module docs).
+pub fn effect_ranges(robot: &Robot) -> Vec<EffectRange> {
+    let (ea_low, ea_high) = axial_stiffness_range_n(robot);
+    let (r_low, r_high) = pulley_radius_range_m(robot);
+    vec![
+        EffectRange {
+            effect: "elastic".into(),
+            range: format!("EA {ea_low:.3e} .. {ea_high:.3e} N (log-uniform)"),
+            justification: format!(
+                "{}: A = g_c / (rho g) = {:.2} mm^2 from {:.1} g/m at {CABLE_DENSITY_KG_M3} kg/m^3, rope modulus {:.0}-{:.0} GPa",
+                if is_large(robot) { "aramid rope" } else { "nylon braid" },
+                cross_section_m2(robot) * 1e6,
+                robot.cable_weight_n_per_m / GRAVITY * 1e3,
+                rope_modulus_pa(robot).0 / 1e9,
+                rope_modulus_pa(robot).1 / 1e9
+            ),
+        },
+        EffectRange {
+            effect: "pulley".into(),
+            range: format!("radius {r_low:.3} .. {r_high:.3} m"),
+            justification: "pulley sizes of winches for this cable and robot scale".into(),
+        },
+        EffectRange {
+            effect: "encoder-scale".into(),
+            range: "gain 1 +- (0.001 .. 0.003) per cable".into(),
+            justification: "effective drum radius uncertain by a fraction of the rope diameter".into(),
+        },
+        EffectRange {
+            effect: "loadcell".into(),
+            range: "bias +-(5 .. 12) % of the mean reference tension, gain 1 +- (0.02 .. 0.05)".into(),
+            justification: "zero and span errors of an uncalibrated load cell of 2-3 x the mean tension full scale".into(),
+        },
+        EffectRange {
+            effect: "com".into(),
+            range: "horizontal shift 0.08 .. 0.20 m, random direction".into(),
+            justification: "payload mounted off the centre of the 0.42 m platform".into(),
+        },
+    ]
+}
+
+fn cross_section_m2(robot: &Robot) -> f64 {
+    robot.cable_weight_n_per_m / (CABLE_DENSITY_KG_M3 * GRAVITY)
+}
+
+/// The large robot (tens of kilograms, cables over 100 m) or a light one.
+fn is_large(robot: &Robot) -> bool {
+    robot.platform_weight_n > 100.0
+}
+
+/// Young's modulus range of the rope, pascals (module docs).
+fn rope_modulus_pa(robot: &Robot) -> (f64, f64) {
+    if is_large(robot) {
+        (30e9, 100e9)
+    } else {
+        (1e9, 3e9)
+    }
+}
+
+fn axial_stiffness_range_n(robot: &Robot) -> (f64, f64) {
+    let area = cross_section_m2(robot);
+    let (low, high) = rope_modulus_pa(robot);
+    (area * low, area * high)
+}
+
+fn pulley_radius_range_m(robot: &Robot) -> (f64, f64) {
+    if is_large(robot) {
+        (0.1, 0.3)
+    } else {
+        (0.02, 0.05)
+    }
+}
+
+fn signed(rng: &mut impl Rng, low: f64, high: f64) -> f64 {
+    let magnitude = rng.random_range(low..high);
+    if rng.random_bool(0.5) {
+        magnitude
+    } else {
+        -magnitude
+    }
+}
+
+/// Draw `effect`'s magnitude for `robot` (`None`: no effect).
+pub fn draw_effects(
+    robot: &Robot,
+    effect: Option<EffectKind>,
+    mean_reference_tension_n: f64,
+    rng: &mut impl Rng,
+) -> Effects {
+    let mut e = Effects::default();
+    match effect {
+        None => {}
+        Some(EffectKind::Elastic) => {
+            let (low, high) = axial_stiffness_range_n(robot);
+            e.axial_stiffness_n = Some((rng.random_range(low.ln()..high.ln())).exp());
+        }
+        Some(EffectKind::Pulley) => {
+            let (low, high) = pulley_radius_range_m(robot);
+            e.pulley_radius_m = rng.random_range(low..high);
+        }
+        Some(EffectKind::EncoderScale) => {
+            e.encoder_gain = std::array::from_fn(|_| 1.0 + signed(rng, 0.001, 0.003));
+        }
+        Some(EffectKind::LoadCell) => {
+            e.load_cell_bias_n = signed(rng, 0.05, 0.12) * mean_reference_tension_n;
+            e.load_cell_gain = 1.0 + signed(rng, 0.02, 0.05);
+        }
+        Some(EffectKind::Com) => {
+            let magnitude = rng.random_range(0.08..0.20);
+            let angle = rng.random_range(0.0..std::f64::consts::TAU);
+            e.com_shift_m = [magnitude * angle.cos(), magnitude * angle.sin(), 0.0];
+        }
+    }
+    e
+}
+
+/// The measurements and truth of one case (seeded).
+pub fn simulate_case(
+    truth: &Robot,
+    effect: Option<EffectKind>,
+    seed: u64,
+    options: &HiddenEffectOptions,
+) -> Result<(Vec<PoseMeasurement>, Effects, Robot)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let equilibria = sample_equilibria(truth, &Workspace::default_for(truth), options.poses, &mut rng)?;
+    let mean_tension = equilibria
+        .iter()
+        .map(|eq| eq.tensions[truth.reference_cable].magnitude_n())
+        .sum::<f64>()
+        / equilibria.len() as f64;
+    let effects = draw_effects(truth, effect, mean_tension, &mut rng);
+    let noise = options.noise.sigmas(truth.platform_weight_n);
+    let measurements = measure_with_effects(truth, &effects, &equilibria, &noise, options.segments, &mut rng)?;
+    // The initial guess: anchors and offsets off by up to 0.5 m per coordinate.
+    let mut guess = truth.clone();
+    for i in 0..CABLE_COUNT {
+        guess.anchors_m[i] += Vector3::from_fn(|_, _| rng.random_range(-0.5..0.5));
+        guess.length_offsets_m[i] += rng.random_range(-0.5..0.5);
+    }
+    Ok((measurements, effects, guess))
+}
+
+/// Run one case: simulate, diagnose blind, score.
+pub fn run_case(
+    truth: &Robot,
+    effect: Option<EffectKind>,
+    seed: u64,
+    options: &HiddenEffectOptions,
+) -> Result<HiddenCase> {
+    let (measurements, effects, guess) = simulate_case(truth, effect, seed, options)?;
+    let mut diagnose_options =
+        DiagnoseOptions::new(CalibrationOptions::new(options.noise.sigmas(truth.platform_weight_n)));
+    diagnose_options.folds = options.folds;
+    let mut truth_with_effects = truth.clone();
+    truth_with_effects.effects = effects;
+    let diagnosis = diagnose(
+        &guess,
+        &measurements,
+        Some(&truth_with_effects),
+        &diagnose_options,
+        &mut |_, _, _| {},
+    )?;
+    let hidden = effect.map_or("none", |k| k.name()).to_string();
+    let anchor_mae_extended_m = effect.and_then(|k| {
+        diagnosis
+            .candidates
+            .iter()
+            .find(|c| c.effect == k.name())
+            .and_then(|c| c.anchor_mae_m)
+    });
+    let anchor_mae_known_geometry_m = if effect == Some(EffectKind::Pulley) {
+        let mut known = guess.clone();
+        known.effects = effects;
+        let result = calibrate(&known, &measurements, &diagnose_options.calibration)?;
+        Some(CalibrationError::between(&result.robot, truth).anchor_coordinate_mae_m)
+    } else {
+        None
+    };
+    Ok(HiddenCase {
+        robot: truth.name.clone(),
+        seed,
+        truth: effects.to_string(),
+        correct: diagnosis.verdict == hidden,
+        verdict: diagnosis.verdict,
+        hidden,
+        anchor_mae_before_m: diagnosis.gain.anchor_mae_before_m.unwrap_or(f64::NAN),
+        anchor_mae_after_m: diagnosis.gain.anchor_mae_after_m.unwrap_or(f64::NAN),
+        anchor_mae_extended_m,
+        baseline_error_over_sigma: diagnosis.baseline_error_over_sigma.unwrap_or(f64::NAN),
+        anchor_mae_known_geometry_m,
+    })
+}
+
+/// The seed of case `index` of `effect` on robot number `robot_index`: distinct for every case.
+pub fn case_seed(base_seed: u64, robot_index: usize, effect: Option<EffectKind>, index: usize) -> u64 {
+    let effect_index = effect.map_or(0, |k| 1 + EffectKind::ALL.iter().position(|e| *e == k).unwrap_or(0));
+    base_seed
+        .wrapping_mul(1_000_003)
+        .wrapping_add((robot_index as u64) * 100_000 + (effect_index as u64) * 10_000 + index as u64)
+}
+
+/// Run `seeds` cases of every effect and of none on every robot, in parallel.
+/// `progress()` is called after each case. A case that fails is an error naming it.
+pub fn run_sweep(
+    robots: &[Robot],
+    seeds: usize,
+    base_seed: u64,
+    options: &HiddenEffectOptions,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<HiddenCase>> {
+    let effects: Vec<Option<EffectKind>> = std::iter::once(None).chain(EffectKind::ALL.map(Some)).collect();
+    let jobs: Vec<(usize, Option<EffectKind>, usize)> = (0..robots.len())
+        .flat_map(|r| effects.iter().flat_map(move |e| (0..seeds).map(move |i| (r, *e, i))))
+        .collect();
+    jobs.par_iter()
+        .map(|&(r, effect, index)| {
+            let seed = case_seed(base_seed, r, effect, index);
+            let case = run_case(&robots[r], effect, seed, options).map_err(|e| {
+                Error::InvalidInput(format!(
+                    "hidden-effect case robot `{}`, effect {}, seed {seed}: {e}",
+                    robots[r].name,
+                    effect.map_or("none", |k| k.name())
+                ))
+            });
+            progress();
+            case
+        })
+        .collect()
+}
+
+/// Evidence that an effect's parameter is (not) identifiable apart from the anchors.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Identifiability {
+    /// Robot name.
+    pub robot: String,
+    /// The effect examined.
+    pub effect: String,
+    /// Its true value.
+    pub value: f64,
+    /// Poses.
+    pub poses: usize,
+    /// 1-sigma of the parameter from the Fisher information with anchors and offsets free.
+    pub sigma: f64,
+    /// 1-sigma with anchors and offsets known (the parameter alone).
+    pub sigma_alone: f64,
+    /// Multiple correlation of the parameter with the anchors and offsets,
+    /// `sqrt(1 - sigma_alone^2 / sigma^2)`: 1 = fully absorbed.
+    pub correlation_with_anchors: f64,
+    /// The anchor shift that mimics the effect, `Sigma_ap / Sigma_pp * value`, per anchor, metres.
+    pub mimicking_anchor_shift_m: Vec<[f64; 3]>,
+    /// Baseline calibration of noise-free data with the effect: chi-square left (stated noise).
+    pub baseline_chi_square: f64,
+    /// Its degrees of freedom.
+    pub baseline_dof: usize,
+    /// The baseline's mean Euclidean anchor error (the bias the effect causes), metres.
+    pub baseline_anchor_bias_m: f64,
+    /// The mimicking shift's mean Euclidean size, metres.
+    pub mimicking_shift_mean_m: f64,
+}
+
+/// The identifiability of a pulley radius (or any effect) on `truth`: Fisher
+/// information at the true equilibria of the discretised robot, and the bias
+/// of a baseline calibration of noise-free data.
+pub fn identifiability(
+    truth: &Robot,
+    effect: EffectKind,
+    effects: &Effects,
+    poses: usize,
+    seed: u64,
+    options: &HiddenEffectOptions,
+) -> Result<Identifiability> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let equilibria = sample_equilibria(truth, &Workspace::default_for(truth), poses, &mut rng)?;
+    let solved = solve_with_effects(truth, effects, &equilibria, options.segments)?;
+    let noise = options.noise.sigmas(truth.platform_weight_n);
+    let free = NoisePreset::None.sigmas(truth.platform_weight_n);
+    let measurements = measure_with_effects(truth, effects, &equilibria, &free, options.segments, &mut rng)?;
+    let mut known = truth.clone();
+    known.effects = *effects;
+    let calibration = CalibrationOptions {
+        free_effect: Some(effect),
+        ..CalibrationOptions::new(noise)
+    };
+    let true_poses: Vec<_> = solved.iter().map(|s| s.pose).collect();
+    let true_tensions: Vec<CableTension> = solved
+        .iter()
+        .map(|s| {
+            let f = s.cables[truth.reference_cable].platform_force_n;
+            CableTension {
+                horizontal_n: f.x.hypot(f.y),
+                vertical_n: f.z,
+            }
+        })
+        .collect();
+    let built = build_graph(
+        &known,
+        &measurements,
+        &true_poses,
+        &true_tensions,
+        CableModel::Catenary,
+        &calibration,
+    );
+    let vars = built.effects.expect("extended graph");
+    let parameter = vars.of(effect);
+    let mut selected: Vec<_> = built.globals.anchors.to_vec();
+    selected.extend(built.globals.length_offsets);
+    selected.push(parameter);
+    let joint = match marginal_covariance(&built.graph, &selected).map_err(Error::InvalidInput)? {
+        Covariance::Full(c) => c,
+        Covariance::RankDeficient(_) => {
+            return Err(Error::InvalidInput(
+                "identifiability: the information matrix is singular".into(),
+            ))
+        }
+    };
+    let p = joint.nrows() - 1;
+    let sigma = joint[(p, p)].sqrt();
+    let information: DMatrix<f64> = joint
+        .clone()
+        .try_inverse()
+        .ok_or_else(|| Error::InvalidInput("identifiability: singular covariance".into()))?;
+    let sigma_alone = (1.0 / information[(p, p)]).sqrt();
+    let value = EffectKind::parameters(effect, effects)[0];
+    let shifts: Vec<[f64; 3]> = (0..CABLE_COUNT)
+        .map(|i| std::array::from_fn(|c| joint[(3 * i + c, p)] / joint[(p, p)] * value))
+        .collect();
+    let mimicking_shift_mean_m = shifts.iter().map(|s| Vector3::from(*s).norm()).sum::<f64>() / CABLE_COUNT as f64;
+    // The bias: a baseline calibration (effect ignored) of the noise-free data.
+    let baseline = calibrate(truth, &measurements, &CalibrationOptions::new(noise))?;
+    let statistics = &baseline.factor_statistics;
+    let chi: f64 = statistics
+        .iter()
+        .filter(|s| s.kind != "tension_guard")
+        .map(|s| s.chi_square)
+        .sum();
+    let components: usize = statistics
+        .iter()
+        .filter(|s| ["catenary_length", "reference_tension", "pose_prior"].contains(&s.kind.as_str()))
+        .map(|s| s.components)
+        .sum();
+    let dof = (components + 4 * poses).saturating_sub(8 * poses + 16);
+    Ok(Identifiability {
+        robot: truth.name.clone(),
+        effect: effect.name().into(),
+        value,
+        poses,
+        sigma,
+        sigma_alone,
+        correlation_with_anchors: (1.0 - (sigma_alone / sigma).powi(2)).max(0.0).sqrt(),
+        mimicking_anchor_shift_m: shifts,
+        baseline_chi_square: chi,
+        baseline_dof: dof,
+        baseline_anchor_bias_m: CalibrationError::between(&baseline.robot, truth).anchor_mean_euclidean_m,
+        mimicking_shift_mean_m,
+    })
+}
