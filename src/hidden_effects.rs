@@ -24,8 +24,9 @@
 //!   2-5 %, random signs: an uncalibrated field load cell sized for the peak
 //!   tension (full scale 2-3 x the mean) has zero and span errors of a few %
 //!   of full scale.
-//! * `com`: a horizontal shift of 8-20 cm in a random direction: a payload
-//!   mounted off the centre of the 0.42 m platform.
+//! * `com`: a horizontal shift in a random direction: a payload mounted off
+//!   the centre of the 0.42 m platform, 14-25 cm on the large robot (smaller
+//!   shifts move its anchors by less than their 1-sigma), 8-20 cm on the small one.
 //!
 //! The experiment reports, per effect, the smallest ratio of the baseline's
 //! anchor error to its stated 1-sigma: above 1, every magnitude drawn changes
@@ -160,7 +161,11 @@ pub fn effect_ranges(robot: &Robot) -> Vec<EffectRange> {
         },
         EffectRange {
             effect: "com".into(),
-            range: "horizontal shift 0.08 .. 0.20 m, random direction".into(),
+            range: format!(
+                "horizontal shift {:.2} .. {:.2} m, random direction",
+                com_shift_range_m(robot).0,
+                com_shift_range_m(robot).1
+            ),
             justification: "payload mounted off the centre of the 0.42 m platform".into(),
         },
     ]
@@ -188,6 +193,47 @@ fn axial_stiffness_range_n(robot: &Robot) -> (f64, f64) {
     let area = cross_section_m2(robot);
     let (low, high) = rope_modulus_pa(robot);
     (area * low, area * high)
+}
+
+fn com_shift_range_m(robot: &Robot) -> (f64, f64) {
+    if is_large(robot) {
+        (0.14, 0.25)
+    } else {
+        (0.08, 0.20)
+    }
+}
+
+/// The mean reference-cable tension over `poses` sampled equilibria, newtons.
+pub fn mean_reference_tension_n(robot: &Robot, poses: usize, seed: u64) -> Result<f64> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let equilibria = sample_equilibria(robot, &Workspace::default_for(robot), poses, &mut rng)?;
+    Ok(equilibria
+        .iter()
+        .map(|eq| eq.tensions[robot.reference_cable].magnitude_n())
+        .sum::<f64>()
+        / equilibria.len().max(1) as f64)
+}
+
+/// Mid-range magnitudes of the effects that are candidates for exclusion from
+/// the detection score: the pulley radius and the load-cell bias.
+pub fn mid_range_effects(robot: &Robot, mean_reference_tension_n: f64) -> Vec<(EffectKind, Effects)> {
+    let (low, high) = pulley_radius_range_m(robot);
+    vec![
+        (
+            EffectKind::Pulley,
+            Effects {
+                pulley_radius_m: 0.5 * (low + high),
+                ..Effects::default()
+            },
+        ),
+        (
+            EffectKind::LoadCell,
+            Effects {
+                load_cell_bias_n: 0.085 * mean_reference_tension_n,
+                ..Effects::default()
+            },
+        ),
+    ]
 }
 
 fn pulley_radius_range_m(robot: &Robot) -> (f64, f64) {
@@ -233,7 +279,8 @@ pub fn draw_effects(
             e.load_cell_gain = 1.0 + signed(rng, 0.02, 0.05);
         }
         Some(EffectKind::Com) => {
-            let magnitude = rng.random_range(0.08..0.20);
+            let (low, high) = com_shift_range_m(robot);
+            let magnitude = rng.random_range(low..high);
             let angle = rng.random_range(0.0..std::f64::consts::TAU);
             e.com_shift_m = [magnitude * angle.cos(), magnitude * angle.sin(), 0.0];
         }
@@ -440,7 +487,8 @@ pub fn identifiability(
             ))
         }
     };
-    let p = joint.nrows() - 1;
+    // The parameter's first component follows the 12 anchor coordinates and 4 offsets.
+    let p = 3 * CABLE_COUNT + CABLE_COUNT;
     let sigma = joint[(p, p)].sqrt();
     let information: DMatrix<f64> = joint
         .clone()

@@ -234,5 +234,23 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
         );
     }
     out += "\n";
+    if !d.drivers_after.is_empty() {
+        out += &format!("\n   residual structure left with {} (strongest first):\n", d.verdict);
+        let mut left = Table::new(["residual", "driver", "correlation", "t", "structure"]);
+        for t in d.drivers_after.iter().take(5) {
+            left.row([
+                t.residual.clone(),
+                t.driver.clone(),
+                format!("{:+.3}", t.correlation),
+                format!("{:+.1}", t.t_statistic),
+                if t.significant {
+                    "yes (p < 0.001)".into()
+                } else {
+                    "no".to_string()
+                },
+            ]);
+        }
+        out += &left.to_string();
+    }
     out
 }

@@ -220,6 +220,8 @@ pub struct Diagnosis {
     pub factor_tests: Vec<FactorTest>,
     /// Residual-driver correlations of the baseline, strongest first.
     pub drivers: Vec<DriverTest>,
+    /// The same with the verdict's model (empty for `none`): the structure left.
+    pub drivers_after: Vec<DriverTest>,
     /// Baseline BIC.
     pub baseline_bic: f64,
     /// Baseline held-out residual RMS.
@@ -464,6 +466,7 @@ pub fn diagnose(
         offset_mae_before_m: before_error.map(|e| e.offset_mae_m),
         offset_mae_after_m: after_error.map(|e| e.offset_mae_m),
     };
+    let mut drivers_after = Vec::new();
     let series = match winner_fit {
         Some((kind, result)) => {
             let candidate_options = CalibrationOptions {
@@ -471,6 +474,7 @@ pub fn diagnose(
                 ..resolved
             };
             let after_samples = samples(result, &used, &rebuild(result, &used, &candidate_options))?;
+            drivers_after = driver_tests(&after_samples);
             let (residual, driver) = winning_driver(*kind);
             let driver = if *kind == EffectKind::Com {
                 strongest_driver(&drivers, "encoder")
@@ -506,6 +510,7 @@ pub fn diagnose(
         variance_factor,
         factor_tests,
         drivers,
+        drivers_after,
         baseline_bic,
         baseline_cv_rms: baseline_cv,
         candidates,
