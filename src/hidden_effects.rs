@@ -214,6 +214,44 @@ pub fn mean_reference_tension_n(robot: &Robot, poses: usize, seed: u64) -> Resul
         / equilibria.len().max(1) as f64)
 }
 
+/// The smallest magnitude of every scored effect's range (encoder gains with
+/// alternating signs), to check that it moves the anchors by more than their 1-sigma.
+pub fn smallest_effects(robot: &Robot, mean_reference_tension_n: f64) -> Vec<(EffectKind, Effects)> {
+    let (_, ea_high) = axial_stiffness_range_n(robot);
+    let (com_low, _) = com_shift_range_m(robot);
+    vec![
+        (
+            EffectKind::Elastic,
+            Effects {
+                axial_stiffness_n: Some(ea_high),
+                ..Effects::default()
+            },
+        ),
+        (
+            EffectKind::EncoderScale,
+            Effects {
+                encoder_gain: [1.001, 0.999, 1.001, 0.999],
+                ..Effects::default()
+            },
+        ),
+        (
+            EffectKind::LoadCell,
+            Effects {
+                load_cell_bias_n: 0.05 * mean_reference_tension_n,
+                load_cell_gain: 1.02,
+                ..Effects::default()
+            },
+        ),
+        (
+            EffectKind::Com,
+            Effects {
+                com_shift_m: [com_low / 2f64.sqrt(), com_low / 2f64.sqrt(), 0.0],
+                ..Effects::default()
+            },
+        ),
+    ]
+}
+
 /// Mid-range magnitudes of the effects that are candidates for exclusion from
 /// the detection score: the pulley radius and the load-cell bias.
 pub fn mid_range_effects(robot: &Robot, mean_reference_tension_n: f64) -> Vec<(EffectKind, Effects)> {
@@ -428,6 +466,8 @@ pub struct Identifiability {
     pub baseline_dof: usize,
     /// The baseline's mean Euclidean anchor error (the bias the effect causes), metres.
     pub baseline_anchor_bias_m: f64,
+    /// That bias over the anchors' stated 1-sigma ([`crate::diagnose::error_over_sigma`]).
+    pub baseline_bias_over_sigma: f64,
     /// The mimicking shift's mean Euclidean size, metres.
     pub mimicking_shift_mean_m: f64,
 }
@@ -526,6 +566,7 @@ pub fn identifiability(
         baseline_chi_square: chi,
         baseline_dof: dof,
         baseline_anchor_bias_m: CalibrationError::between(&baseline.robot, truth).anchor_mean_euclidean_m,
+        baseline_bias_over_sigma: crate::diagnose::error_over_sigma(&baseline.robot, truth, &baseline.uncertainty),
         mimicking_shift_mean_m,
     })
 }

@@ -119,6 +119,26 @@ fn opt(value: Option<f64>, digits: usize) -> String {
     value.map_or_else(|| "-".into(), |v| format!("{v:.digits$}"))
 }
 
+/// The `count` strongest residual-driver correlations as a table.
+fn driver_table(tests: &[sagcal::diagnose::DriverTest], count: usize) -> String {
+    let mut table = Table::new(["residual", "driver", "points", "correlation", "t", "structure"]);
+    for t in tests.iter().take(count) {
+        table.row([
+            t.residual.clone(),
+            t.driver.clone(),
+            t.points.to_string(),
+            format!("{:+.3}", t.correlation),
+            format!("{:+.1}", t.t_statistic),
+            if t.significant {
+                "yes (p < 0.001)".into()
+            } else {
+                "no".to_string()
+            },
+        ]);
+    }
+    table.to_string()
+}
+
 /// The human-readable diagnosis.
 pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
     let mut out = format!(
@@ -166,22 +186,7 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
         );
     }
     out += "\n2. residual structure (baseline): correlation with physical drivers, strongest first\n";
-    let mut drivers = Table::new(["residual", "driver", "points", "correlation", "t", "structure"]);
-    for t in d.drivers.iter().take(8) {
-        drivers.row([
-            t.residual.clone(),
-            t.driver.clone(),
-            t.points.to_string(),
-            format!("{:+.3}", t.correlation),
-            format!("{:+.1}", t.t_statistic),
-            if t.significant {
-                "yes (p < 0.001)".into()
-            } else {
-                "no".to_string()
-            },
-        ]);
-    }
-    out += &drivers.to_string();
+    out += &driver_table(&d.drivers, 8);
     out += &format!(
         "\n3. candidate extensions (baseline: BIC {:.1}, held-out residual RMS {:.3})\n",
         d.baseline_bic, d.baseline_cv_rms
@@ -236,21 +241,7 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
     out += "\n";
     if !d.drivers_after.is_empty() {
         out += &format!("\n   residual structure left with {} (strongest first):\n", d.verdict);
-        let mut left = Table::new(["residual", "driver", "correlation", "t", "structure"]);
-        for t in d.drivers_after.iter().take(5) {
-            left.row([
-                t.residual.clone(),
-                t.driver.clone(),
-                format!("{:+.3}", t.correlation),
-                format!("{:+.1}", t.t_statistic),
-                if t.significant {
-                    "yes (p < 0.001)".into()
-                } else {
-                    "no".to_string()
-                },
-            ]);
-        }
-        out += &left.to_string();
+        out += &driver_table(&d.drivers_after, 5);
     }
     out
 }

@@ -4,8 +4,8 @@ use std::collections::BTreeMap;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sagcal::hidden_effects::{
-    effect_ranges, identifiability, mean_reference_tension_n, mid_range_effects, run_sweep, EffectRange, HiddenCase,
-    HiddenEffectOptions, Identifiability,
+    effect_ranges, identifiability, mean_reference_tension_n, mid_range_effects, run_sweep, smallest_effects,
+    EffectRange, HiddenCase, HiddenEffectOptions, Identifiability,
 };
 use sagcal::model::effects::EffectKind;
 use sagcal::model::Robot;
@@ -43,6 +43,7 @@ struct Report {
     none_false_rejection_rate: f64,
     anchor_ratio_extended_over_baseline: f64,
     identifiability: Vec<Identifiability>,
+    smallest: Vec<Identifiability>,
     cases: Vec<HiddenCase>,
 }
 
@@ -99,6 +100,13 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
             pulley.push(id);
         }
     }
+    let mut smallest = Vec::new();
+    for robot in &robots {
+        let mean_tension = mean_reference_tension_n(robot, args.poses, args.seed)?;
+        for (kind, effects) in smallest_effects(robot, mean_tension) {
+            smallest.push(identifiability(robot, kind, &effects, args.poses, args.seed, &options)?);
+        }
+    }
     let mut scores = Vec::new();
     for robot in &robots {
         for hidden in std::iter::once("none").chain(EffectKind::ALL.map(|k| k.name())) {
@@ -152,6 +160,7 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         none_false_rejection_rate,
         anchor_ratio_extended_over_baseline,
         identifiability: pulley,
+        smallest,
         cases,
     };
     if args.json {
@@ -231,6 +240,24 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
             format!("{:.3}", p.mimicking_shift_mean_m),
             format!("{:.3}", p.baseline_anchor_bias_m),
             format!("{:.2} / {}", p.baseline_chi_square, p.baseline_dof),
+        ]);
+    }
+    println!("{t}");
+    println!("the smallest magnitude of each scored range, noise-free data: the baseline's anchor bias over its 1-sigma (must exceed 1):");
+    let mut t = Table::new([
+        "robot",
+        "effect",
+        "magnitude",
+        "baseline anchor bias m",
+        "bias / 1-sigma",
+    ]);
+    for p in &report.smallest {
+        t.row([
+            p.robot.clone(),
+            p.effect.clone(),
+            format!("{:.4e}", p.value),
+            format!("{:.4}", p.baseline_anchor_bias_m),
+            format!("{:.2}", p.baseline_bias_over_sigma),
         ]);
     }
     println!("{t}");
