@@ -1,99 +1,435 @@
-//! Generated analytic Jacobians against central finite differences, per factor.
+//! The generated analytic Jacobians (`generated/`) against central finite differences.
 //!
-//! `make bench` (or `cargo bench --bench jacobians`). Each group times the
-//! residual + Jacobian evaluation both ways and prints the largest relative
-//! difference between the two Jacobians beside the timings.
+//! One criterion group per generated function, named after it, at one operating point of the
+//! large robot (`robots/large.toml`), with two benchmarks:
+//!
+//! * `analytic/large`: the generated function with every Jacobian output requested;
+//! * `numerical/large`: the same Jacobians by central differences `(f(x + h) - f(x - h)) / 2h` of
+//!   the value-only call (every Jacobian output `None`) over every column of every Jacobian
+//!   block: the pose through the retraction `(R * Exp(dtheta), p + dp)`, every other argument
+//!   additively, with `h = 1e-6 * max(1, |x|)` (`x` the coordinate, 0 for `dtheta`).
+//!
+//! `extended_cable` is evaluated for the four cables of the point (spans and tensions from
+//! `cable_geometry` there, compliance 0.5 1/MN, pulley radius 0.2 m), `load_cell_residual` with a
+//! bias of 3 N and a gain error of 0.01. Before each group the largest relative difference
+//! between the two Jacobians, `max |a - n| / max(1, max |n|)` per block and the maximum over the
+//! blocks, is printed beside the function's name.
+//!
+//! Run with `cargo bench --bench jacobians` (`make bench` runs every bench); add a filter such
+//! as `-- catenary_length_residual` for one group.
+
+use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use nalgebra::{SMatrix, Vector2, Vector3, Vector4, Vector6};
+use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, SVector, Vector2, Vector3, Vector4, Vector6};
 use sagcal::calib::factors::{SlotOrder, EPSILON};
-use sagcal::generated::catenary_length_residual;
+use sagcal::generated;
 use sagcal::model::{PlatformPose, Robot};
 
-/// A large-robot operating point.
+type M<const R: usize, const C: usize> = SMatrix<f64, R, C>;
+
+/// All arguments of the generated functions.
+#[derive(Clone)]
 struct Point {
     pose: PlatformPose,
-    tension: Vector2<f64>,
-    anchors: SMatrix<f64, 3, 4>,
-    slots: SlotOrder,
-    offsets: Vector4<f64>,
-    encoders: Vector4<f64>,
+    reference_tension_n: Vector2<f64>,
+    anchors_m: Matrix3x4<f64>,
+    attachments_m: Matrix3x4<f64>,
+    com_offset_m: Vector3<f64>,
+    platform_weight_n: f64,
+    cable_weight_n_per_m: f64,
+    length_offsets_m: Vector4<f64>,
+    encoder_lengths_m: Vector4<f64>,
+    prior: PlatformPose,
+    measured_tension_n: f64,
+    /// Per slot `extended_cable`'s span (m), `f_h` and `f_v` (N), from `cable_geometry`.
+    spans_m: Vector4<f64>,
+    horizontal_tensions_n: Vector4<f64>,
+    vertical_tensions_n: Vector4<f64>,
+    axial_compliance_per_mn: f64,
+    pulley_radius_m: f64,
+    load_cell_bias_n: f64,
+    load_cell_gain_error: f64,
 }
 
+/// A large-robot operating point where all four cables pull.
 fn point() -> Point {
     let robot = Robot::builtin("large").expect("built-in robot");
     let slots = SlotOrder::new(&robot);
-    let mut anchors = SMatrix::<f64, 3, 4>::zeros();
-    for (slot, &cable) in slots.cables.iter().enumerate() {
-        anchors.set_column(slot, &robot.anchors_m[cable]);
-    }
-    Point {
-        pose: PlatformPose::from_roll_pitch_yaw_deg(Vector3::new(5.0, -3.0, 10.0), 0.5, -1.0, 0.3),
-        tension: Vector2::new(600.0, 90.0),
-        anchors,
-        slots,
-        offsets: Vector4::new(0.1, -0.2, 0.3, 0.0),
-        encoders: Vector4::new(170.0, 180.0, 160.0, 175.0),
-    }
+    let pose = PlatformPose::from_roll_pitch_yaw_deg(Vector3::new(5.0, -3.0, 10.0), 0.5, -1.0, 0.3);
+    let reference_tension_n = Vector2::new(600.0, 90.0);
+    let mut p = Point {
+        pose,
+        reference_tension_n,
+        anchors_m: Matrix3x4::from_columns(&slots.cables.map(|c| robot.anchors_m[c])),
+        attachments_m: slots.attachments_m,
+        com_offset_m: slots.com_offset_m,
+        platform_weight_n: slots.platform_weight_n,
+        cable_weight_n_per_m: slots.cable_weight_n_per_m,
+        length_offsets_m: Vector4::new(0.1, -0.2, 0.3, 0.0),
+        encoder_lengths_m: Vector4::new(170.0, 180.0, 160.0, 175.0),
+        prior: pose.retract(&Vector6::new(0.01, -0.02, 0.015, 0.05, -0.03, 0.02)),
+        measured_tension_n: reference_tension_n.norm() + 2.0,
+        spans_m: Vector4::zeros(),
+        horizontal_tensions_n: Vector4::zeros(),
+        vertical_tensions_n: Vector4::zeros(),
+        axial_compliance_per_mn: 0.5,
+        pulley_radius_m: 0.2,
+        load_cell_bias_n: 3.0,
+        load_cell_gain_error: 0.01,
+    };
+    let g = geometry(&p, None);
+    p.spans_m = Vector4::from_fn(|j, _| g[4 * j]);
+    p.horizontal_tensions_n = Vector4::from_fn(|j, _| g[4 * j + 1]);
+    p.vertical_tensions_n = Vector4::from_fn(|j, _| g[4 * j + 2]);
+    assert!(
+        p.horizontal_tensions_n.min() > 0.0 && p.vertical_tensions_n.min() > 0.0,
+        "a slack or pushing cable: {g}"
+    );
+    p
 }
 
-fn length_residual(p: &Point, pose: &PlatformPose, jacobian: Option<&mut SMatrix<f64, 4, 6>>) -> Vector4<f64> {
-    catenary_length_residual(
-        &pose.position_m,
-        &pose.rotation_xyzw(),
-        &p.tension,
-        &p.anchors,
-        &p.slots.attachments_m,
-        &p.slots.com_offset_m,
-        p.slots.platform_weight_n,
-        p.slots.cable_weight_n_per_m,
-        &p.offsets,
-        &p.encoders,
+// Each generated function at a point, with all its Jacobians (`Some`) or none.
+
+fn tensions(p: &Point, j: Option<&mut (M<8, 6>, M<8, 2>, M<8, 12>)>) -> SVector<f64, 8> {
+    let (pose, reference, anchors) = match j {
+        Some((a, b, c)) => (Some(a), Some(b), Some(c)),
+        None => (None, None, None),
+    };
+    generated::cable_tensions_from_reference(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.reference_tension_n,
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.com_offset_m,
+        p.platform_weight_n,
         EPSILON,
-        jacobian,
-        None,
-        None,
-        None,
+        pose,
+        reference,
+        anchors,
     )
 }
 
-/// Pose Jacobian by central differences through the solver's retraction.
-fn numerical_pose_jacobian(p: &Point) -> SMatrix<f64, 4, 6> {
-    let mut j = SMatrix::<f64, 4, 6>::zeros();
-    for c in 0..6 {
-        let h = if c < 3 { 1e-6 } else { 1e-5 };
-        let mut step = Vector6::zeros();
-        step[c] = h;
-        let plus = length_residual(p, &p.pose.retract(&step), None);
-        let minus = length_residual(p, &p.pose.retract(&-step), None);
-        j.set_column(c, &((plus - minus) / (2.0 * h)));
-    }
-    j
+fn catenary_length(p: &Point, j: Option<&mut (M<4, 6>, M<4, 2>, M<4, 12>, M<4, 4>)>) -> SVector<f64, 4> {
+    let (pose, reference, anchors, offsets) = match j {
+        Some((a, b, c, d)) => (Some(a), Some(b), Some(c), Some(d)),
+        None => (None, None, None, None),
+    };
+    generated::catenary_length_residual(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.reference_tension_n,
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.com_offset_m,
+        p.platform_weight_n,
+        p.cable_weight_n_per_m,
+        &p.length_offsets_m,
+        &p.encoder_lengths_m,
+        EPSILON,
+        pose,
+        reference,
+        anchors,
+        offsets,
+    )
 }
 
-fn catenary_length(c: &mut Criterion) {
-    let p = point();
-    let mut analytic = SMatrix::<f64, 4, 6>::zeros();
-    length_residual(&p, &p.pose, Some(&mut analytic));
-    let numerical = numerical_pose_jacobian(&p);
-    let scale = numerical.abs().max().max(1.0);
-    println!(
-        "catenary_length_residual: max |analytic - numerical| / max |J| = {:.2e}",
-        (analytic - numerical).abs().max() / scale
-    );
-    let mut group = c.benchmark_group("catenary_length_residual_pose_jacobian");
+fn attachment_height(p: &Point, j: Option<&mut (M<4, 6>, M<4, 2>, M<4, 12>)>) -> SVector<f64, 4> {
+    let (pose, reference, anchors) = match j {
+        Some((a, b, c)) => (Some(a), Some(b), Some(c)),
+        None => (None, None, None),
+    };
+    generated::attachment_height_residual(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.reference_tension_n,
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.com_offset_m,
+        p.platform_weight_n,
+        p.cable_weight_n_per_m,
+        EPSILON,
+        pose,
+        reference,
+        anchors,
+    )
+}
+
+fn reference_tension(p: &Point, j: Option<&mut M<1, 2>>) -> SVector<f64, 1> {
+    generated::reference_tension_residual(&p.reference_tension_n, p.measured_tension_n, EPSILON, j)
+}
+
+fn pose_prior(p: &Point, j: Option<&mut M<6, 6>>) -> SVector<f64, 6> {
+    generated::pose_prior_residual(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.prior.position_m,
+        &p.prior.rotation_xyzw(),
+        EPSILON,
+        j,
+    )
+}
+
+fn rigid_length(p: &Point, j: Option<&mut (M<4, 6>, M<4, 12>, M<4, 4>)>) -> SVector<f64, 4> {
+    let (pose, anchors, offsets) = match j {
+        Some((a, b, c)) => (Some(a), Some(b), Some(c)),
+        None => (None, None, None),
+    };
+    generated::rigid_length_residual(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.length_offsets_m,
+        &p.encoder_lengths_m,
+        EPSILON,
+        pose,
+        anchors,
+        offsets,
+    )
+}
+
+fn geometry(p: &Point, j: Option<&mut (M<16, 6>, M<16, 2>, M<16, 12>, M<16, 3>)>) -> SVector<f64, 16> {
+    let (pose, reference, anchors, com) = match j {
+        Some((a, b, c, d)) => (Some(a), Some(b), Some(c), Some(d)),
+        None => (None, None, None, None),
+    };
+    generated::cable_geometry(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.reference_tension_n,
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.com_offset_m,
+        p.platform_weight_n,
+        EPSILON,
+        pose,
+        reference,
+        anchors,
+        com,
+    )
+}
+
+/// Per slot the 2x1 Jacobians of `extended_cable`: span, `f_h`, `f_v`, compliance, radius.
+type ExtendedJacobians = [(M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>); 4];
+
+/// `extended_cable` of the four slots stacked: `[paid_out_0, drop_0, paid_out_1, ...]`.
+fn extended(p: &Point, mut j: Option<&mut ExtendedJacobians>) -> SVector<f64, 8> {
+    let mut value = SVector::<f64, 8>::zeros();
+    for s in 0..4 {
+        let (span, horizontal, vertical, compliance, radius) = match j.as_deref_mut() {
+            Some(j) => {
+                let (a, b, c, d, e) = &mut j[s];
+                (Some(a), Some(b), Some(c), Some(d), Some(e))
+            }
+            None => (None, None, None, None, None),
+        };
+        let cable = generated::extended_cable(
+            p.spans_m[s],
+            p.horizontal_tensions_n[s],
+            p.vertical_tensions_n[s],
+            p.cable_weight_n_per_m,
+            p.axial_compliance_per_mn,
+            p.pulley_radius_m,
+            EPSILON,
+            span,
+            horizontal,
+            vertical,
+            compliance,
+            radius,
+        );
+        value.fixed_rows_mut::<2>(2 * s).copy_from(&cable);
+    }
+    value
+}
+
+/// The per-slot Jacobians of [`extended`] as blocks of the stacked value: span, `f_h` and `f_v`
+/// (8x4, block diagonal), compliance and radius (8x1).
+fn extended_blocks(j: &ExtendedJacobians) -> Vec<DMatrix<f64>> {
+    let mut blocks = vec![DMatrix::zeros(8, 4), DMatrix::zeros(8, 4), DMatrix::zeros(8, 4)];
+    blocks.extend([DMatrix::zeros(8, 1), DMatrix::zeros(8, 1)]);
+    for (s, (span, horizontal, vertical, compliance, radius)) in j.iter().enumerate() {
+        for (b, d) in [span, horizontal, vertical].into_iter().enumerate() {
+            blocks[b].view_mut((2 * s, s), (2, 1)).copy_from(d);
+        }
+        blocks[3].view_mut((2 * s, 0), (2, 1)).copy_from(compliance);
+        blocks[4].view_mut((2 * s, 0), (2, 1)).copy_from(radius);
+    }
+    blocks
+}
+
+fn load_cell(p: &Point, j: Option<&mut (M<1, 2>, M<1, 1>, M<1, 1>)>) -> SVector<f64, 1> {
+    let (reference, bias, gain) = match j {
+        Some((a, b, c)) => (Some(a), Some(b), Some(c)),
+        None => (None, None, None),
+    };
+    generated::load_cell_residual(
+        &p.reference_tension_n,
+        p.load_cell_bias_n,
+        p.load_cell_gain_error,
+        p.measured_tension_n,
+        EPSILON,
+        reference,
+        bias,
+        gain,
+    )
+}
+
+fn dynamic<const R: usize, const C: usize>(m: &M<R, C>) -> DMatrix<f64> {
+    DMatrix::from_column_slice(R, C, m.as_slice())
+}
+
+/// A differentiated argument block, in the column order of the generated Jacobians.
+#[derive(Clone, Copy)]
+enum Block {
+    /// The pose, tangent `[dtheta, dp]` of the retraction `(R * Exp(dtheta), p + dp)`.
+    Pose,
+    /// Coordinates perturbed additively (matrices column by column).
+    Additive(fn(&mut Point) -> &mut [f64]),
+}
+
+/// Central differences of `f` at `p`, one matrix per block, one column per block coordinate.
+fn central_differences(p: &Point, blocks: &[Block], f: impl Fn(&Point) -> DVector<f64>) -> Vec<DMatrix<f64>> {
+    let mut q = p.clone();
+    let mut jacobians = Vec::with_capacity(blocks.len());
+    for &block in blocks {
+        let n = match block {
+            Block::Pose => 6,
+            Block::Additive(x) => x(&mut q).len(),
+        };
+        let mut columns = Vec::with_capacity(n);
+        for k in 0..n {
+            let (x0, magnitude) = match block {
+                Block::Pose if k < 3 => (0.0, 0.0),
+                Block::Pose => (0.0, p.pose.position_m[k - 3].abs()),
+                Block::Additive(x) => {
+                    let x0 = x(&mut q)[k];
+                    (x0, x0.abs())
+                }
+            };
+            let h = 1e-6 * magnitude.max(1.0);
+            // `f` at `p` moved by `t` along coordinate `k`.
+            let mut at = |t: f64| {
+                match block {
+                    Block::Pose => q.pose = p.pose.retract(&Vector6::ith(k, t)),
+                    Block::Additive(x) => x(&mut q)[k] = x0 + t,
+                }
+                f(&q)
+            };
+            columns.push((at(h) - at(-h)) / (2.0 * h));
+            match block {
+                Block::Pose => q.pose = p.pose,
+                Block::Additive(x) => x(&mut q)[k] = x0,
+            }
+        }
+        jacobians.push(DMatrix::from_columns(&columns));
+    }
+    jacobians
+}
+
+/// The group `name` of the generated function `f`, whose Jacobians `J` are the blocks `blocks`
+/// (`split` turns them into matrices): prints the largest relative difference between the
+/// analytic and the numerical Jacobians, then times both.
+fn group<J: Default, const R: usize>(
+    c: &mut Criterion,
+    name: &str,
+    p: &Point,
+    blocks: &[Block],
+    f: impl Fn(&Point, Option<&mut J>) -> SVector<f64, R>,
+    split: impl Fn(&J) -> Vec<DMatrix<f64>>,
+) {
+    let value = |q: &Point| DVector::from_column_slice(f(q, None).as_slice());
+    let mut analytic = J::default();
+    f(p, Some(&mut analytic));
+    let numerical = central_differences(p, blocks, value);
+    let difference = split(&analytic)
+        .iter()
+        .zip(&numerical)
+        .map(|(a, n)| (a - n).amax() / n.amax().max(1.0))
+        .fold(0.0, f64::max);
+    println!("{name}: max relative Jacobian difference {difference:.1e}");
+
+    let mut group = c.benchmark_group(name);
     group.bench_function(BenchmarkId::new("analytic", "large"), |b| {
         b.iter(|| {
-            let mut j = SMatrix::<f64, 4, 6>::zeros();
-            std::hint::black_box(length_residual(&p, &p.pose, Some(&mut j)));
-            j
+            let mut j = J::default();
+            let v = f(black_box(p), Some(&mut j));
+            black_box((v, j))
         })
     });
     group.bench_function(BenchmarkId::new("numerical", "large"), |b| {
-        b.iter(|| numerical_pose_jacobian(&p))
+        b.iter(|| black_box(central_differences(black_box(p), blocks, value)))
     });
     group.finish();
 }
 
-criterion_group!(benches, catenary_length);
+fn jacobians(c: &mut Criterion) {
+    use Block::{Additive, Pose};
+    let p = point();
+    let reference = Additive(|q| q.reference_tension_n.as_mut_slice());
+    let anchors = Additive(|q| q.anchors_m.as_mut_slice());
+    let offsets = Additive(|q| q.length_offsets_m.as_mut_slice());
+    let com = Additive(|q| q.com_offset_m.as_mut_slice());
+    // The blocks of eq. (11)'s functions: pose, reference tension, anchors.
+    let statics = [Pose, reference, anchors];
+
+    group(c, "cable_tensions_from_reference", &p, &statics, tensions, |j| {
+        vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)]
+    });
+    group(
+        c,
+        "catenary_length_residual",
+        &p,
+        &[Pose, reference, anchors, offsets],
+        catenary_length,
+        |j| vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2), dynamic(&j.3)],
+    );
+    group(c, "attachment_height_residual", &p, &statics, attachment_height, |j| {
+        vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)]
+    });
+    group(
+        c,
+        "reference_tension_residual",
+        &p,
+        &[reference],
+        reference_tension,
+        |j| vec![dynamic(j)],
+    );
+    group(c, "pose_prior_residual", &p, &[Pose], pose_prior, |j| vec![dynamic(j)]);
+    group(
+        c,
+        "rigid_length_residual",
+        &p,
+        &[Pose, anchors, offsets],
+        rigid_length,
+        |j| vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)],
+    );
+    group(
+        c,
+        "cable_geometry",
+        &p,
+        &[Pose, reference, anchors, com],
+        geometry,
+        |j| vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2), dynamic(&j.3)],
+    );
+    let per_cable: [Block; 5] = [
+        Additive(|q| q.spans_m.as_mut_slice()),
+        Additive(|q| q.horizontal_tensions_n.as_mut_slice()),
+        Additive(|q| q.vertical_tensions_n.as_mut_slice()),
+        Additive(|q| std::slice::from_mut(&mut q.axial_compliance_per_mn)),
+        Additive(|q| std::slice::from_mut(&mut q.pulley_radius_m)),
+    ];
+    group(c, "extended_cable", &p, &per_cable, extended, extended_blocks);
+    let load_cell_blocks: [Block; 3] = [
+        reference,
+        Additive(|q| std::slice::from_mut(&mut q.load_cell_bias_n)),
+        Additive(|q| std::slice::from_mut(&mut q.load_cell_gain_error)),
+    ];
+    group(c, "load_cell_residual", &p, &load_cell_blocks, load_cell, |j| {
+        vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)]
+    });
+}
+
+criterion_group!(benches, jacobians);
 criterion_main!(benches);
