@@ -550,7 +550,7 @@ pub fn identifiability(
         .sum();
     let components: usize = statistics
         .iter()
-        .filter(|s| ["catenary_length", "reference_tension", "pose_prior"].contains(&s.kind.as_str()))
+        .filter(|s| crate::diagnose::MEASUREMENT_KINDS.contains(&s.kind.as_str()))
         .map(|s| s.components)
         .sum();
     let dof = (components + 4 * poses).saturating_sub(8 * poses + 16);

@@ -315,7 +315,7 @@ fn fmt_sig(x: f64, sig: i32) -> String {
 }
 
 /// A pixel coordinate for an attribute (always a finite number).
-fn n2(x: f64) -> String {
+pub(crate) fn n2(x: f64) -> String {
     if x.is_finite() {
         format!("{:.2}", x + 0.0)
     } else {
@@ -324,7 +324,7 @@ fn n2(x: f64) -> String {
 }
 
 /// Escape text for XML content and attribute values; control characters become spaces.
-fn esc(s: &str) -> String {
+pub(crate) fn esc(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {
@@ -342,7 +342,7 @@ fn esc(s: &str) -> String {
 }
 
 /// `s` cut to at most `max` characters (with an ellipsis).
-fn shorten(s: &str, max: usize) -> String {
+pub(crate) fn shorten(s: &str, max: usize) -> String {
     if s.chars().count() <= max {
         s.to_owned()
     } else {
@@ -353,7 +353,7 @@ fn shorten(s: &str, max: usize) -> String {
 }
 
 /// Rough width of `s` in pixels at `font` px (sans-serif average).
-fn text_w(s: &str, font: f64) -> f64 {
+pub(crate) fn text_w(s: &str, font: f64) -> f64 {
     s.chars().count() as f64 * font * 0.6
 }
 
@@ -434,7 +434,7 @@ fn arrow(s: &mut String, x0: f64, y0: f64, x1: f64, y1: f64, color: &str) {
 }
 
 /// Text with a white halo so it stays readable over grid and ellipses.
-fn halo_text(s: &mut String, x: f64, y: f64, anchor: &str, fill: &str, text: &str) {
+pub(crate) fn halo_text(s: &mut String, x: f64, y: f64, anchor: &str, fill: &str, text: &str) {
     let _ = writeln!(
         s,
         r#"<text x="{}" y="{}" text-anchor="{anchor}" fill="{fill}" stroke="white" stroke-width="3" stroke-linejoin="round" paint-order="stroke">{}</text>"#,

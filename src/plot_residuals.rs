@@ -49,6 +49,7 @@
 //! assert_eq!(svg.matches(r#"class="after""#).count(), 50);
 //! ```
 
+use crate::plot::{esc, halo_text, n2, shorten, text_w};
 use std::fmt::Write as _;
 
 /// One series of points: `(driver value, residual)` pairs and a name.
@@ -679,60 +680,6 @@ fn fmt_sig(x: f64, sig: i32) -> String {
         (f64::from(sig - 1) - ax.log10().floor()).clamp(0.0, 9.0) as usize
     };
     format!("{:.dec$}", x + 0.0)
-}
-
-/// A pixel coordinate for an attribute (always a finite number).
-fn n2(x: f64) -> String {
-    if x.is_finite() {
-        format!("{:.2}", x + 0.0)
-    } else {
-        "0".to_owned()
-    }
-}
-
-/// Escape text for XML content and attribute values; control characters become spaces.
-fn esc(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c if (c as u32) < 0x20 || c == '\u{7f}' => out.push(' '),
-            '\u{FFFE}' | '\u{FFFF}' => out.push('\u{FFFD}'),
-            c => out.push(c),
-        }
-    }
-    out
-}
-
-/// `s` cut to at most `max` characters (with an ellipsis).
-fn shorten(s: &str, max: usize) -> String {
-    if s.chars().count() <= max {
-        s.to_owned()
-    } else {
-        let mut t: String = s.chars().take(max.saturating_sub(1)).collect();
-        t.push('\u{2026}');
-        t
-    }
-}
-
-/// Rough width of `s` in pixels at `font` px (sans-serif average).
-fn text_w(s: &str, font: f64) -> f64 {
-    s.chars().count() as f64 * font * 0.6
-}
-
-/// Text with a white halo so it stays readable over the points.
-fn halo_text(s: &mut String, x: f64, y: f64, anchor: &str, fill: &str, text: &str) {
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="{}" text-anchor="{anchor}" fill="{fill}" stroke="white" stroke-width="3" stroke-linejoin="round" paint-order="stroke">{}</text>"#,
-        n2(x),
-        n2(y),
-        esc(text)
-    );
 }
 
 #[cfg(test)]

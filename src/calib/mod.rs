@@ -258,6 +258,27 @@ pub struct CalibrationResult {
     pub effect_estimate: Option<EffectEstimate>,
 }
 
+impl EffectEstimate {
+    /// Report values (gains as `1 + error`) from the effect variable's contents.
+    pub fn values_from_variable(kind: EffectKind, raw: &[f64]) -> Vec<f64> {
+        match kind {
+            EffectKind::EncoderScale => raw.iter().map(|g| 1.0 + g).collect(),
+            EffectKind::LoadCell => vec![raw[0], 1.0 + raw[1]],
+            _ => raw.to_vec(),
+        }
+    }
+
+    /// The effect variable's contents (gain errors) for these estimates: the
+    /// inverse of [`EffectEstimate::values_from_variable`].
+    pub fn variable_values(&self) -> Vec<f64> {
+        match self.effect {
+            EffectKind::EncoderScale => self.values.iter().map(|g| g - 1.0).collect(),
+            EffectKind::LoadCell => vec![self.values[0], self.values[1] - 1.0],
+            _ => self.values.clone(),
+        }
+    }
+}
+
 /// An effect's estimated parameters with their 1-sigma uncertainty.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EffectEstimate {
@@ -284,6 +305,17 @@ impl CalibrationResult {
     /// Whether the last stage stopped at a minimum.
     pub fn converged(&self) -> bool {
         self.final_stage().termination.converged()
+    }
+
+    /// The estimated reference tensions as [`CableTension`]s (one per pose used).
+    pub fn reference_tensions(&self) -> Vec<CableTension> {
+        self.reference_tensions_n
+            .iter()
+            .map(|t| CableTension {
+                horizontal_n: t[0],
+                vertical_n: t[1],
+            })
+            .collect()
     }
 }
 
@@ -702,9 +734,15 @@ fn orientation_check(result: &CalibrationResult, measurements: &[PoseMeasurement
 /// 1 % for k >= 3; Johnson, Kotz & Balakrishnan, *Continuous Univariate
 /// Distributions*, vol. 1, 1994, eq. 18.24).
 pub fn chi_square_quantile_999(k: usize) -> f64 {
+    chi_square_quantile(k, 3.0902)
+}
+
+/// The quantile of chi-square with `k` degrees of freedom at the standard
+/// normal quantile `z` (Wilson-Hilferty, see [`chi_square_quantile_999`]).
+pub fn chi_square_quantile(k: usize, z: f64) -> f64 {
     let k = k.max(1) as f64;
     let c = 2.0 / (9.0 * k);
-    k * (1.0 - c + 3.0902 * c.sqrt()).powi(3)
+    k * (1.0 - c + z * c.sqrt()).max(0.0).powi(3)
 }
 
 impl CalibrationOptions {
@@ -961,19 +999,11 @@ pub fn refine_with_effect(
             baseline.poses.len()
         )));
     }
-    let tensions: Vec<CableTension> = baseline
-        .reference_tensions_n
-        .iter()
-        .map(|t| CableTension {
-            horizontal_n: t[0],
-            vertical_n: t[1],
-        })
-        .collect();
     let mut built = build_graph(
         &baseline.robot,
         &used,
         &baseline.poses,
-        &tensions,
+        &baseline.reference_tensions(),
         CableModel::Catenary,
         options,
     );
@@ -993,11 +1023,7 @@ fn effect_estimate(built: &CalibrationGraph, kind: EffectKind) -> Result<EffectE
         .ok_or_else(|| Error::InvalidInput("the graph has no effect parameters".into()))?;
     let id = vars.of(kind);
     let raw = built.graph.values.vector(id).clone();
-    let values: Vec<f64> = match kind {
-        EffectKind::EncoderScale => raw.iter().map(|g| 1.0 + g).collect(),
-        EffectKind::LoadCell => vec![raw[0], 1.0 + raw[1]],
-        _ => raw.iter().copied().collect(),
-    };
+    let values = EffectEstimate::values_from_variable(kind, raw.as_slice());
     let sigmas = match marginal_covariance(&built.graph, &[id]).map_err(Error::InvalidInput)? {
         Covariance::Full(c) => (0..raw.len()).map(|k| c[(k, k)].max(0.0).sqrt()).collect(),
         Covariance::RankDeficient(_) => vec![f64::NAN; raw.len()],

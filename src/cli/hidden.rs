@@ -88,7 +88,7 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
     // Identifiability at mid-range magnitudes: an effect whose parameter the
     // Fisher information cannot separate from the other unknowns at 3 sigma is
     // left out of the detection score on that robot (with this evidence).
-    let mut pulley = Vec::new();
+    let mut identifiability_rows = Vec::new();
     let mut unscored: Vec<(String, String)> = Vec::new();
     for robot in &robots {
         let mean_tension = mean_reference_tension_n(robot, args.poses, args.seed)?;
@@ -97,7 +97,7 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
             if kind == EffectKind::Pulley || id.sigma > id.value.abs() / 3.0 {
                 unscored.push((robot.name.clone(), kind.name().to_string()));
             }
-            pulley.push(id);
+            identifiability_rows.push(id);
         }
     }
     let mut smallest = Vec::new();
@@ -159,7 +159,7 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         detection_rate,
         none_false_rejection_rate,
         anchor_ratio_extended_over_baseline,
-        identifiability: pulley,
+        identifiability: identifiability_rows,
         smallest,
         cases,
     };

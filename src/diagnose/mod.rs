@@ -44,7 +44,7 @@ use crate::model::statics::{self, CableTension};
 use crate::solver::optimize;
 
 /// The factor types that are measurements (the others are model constraints).
-const MEASUREMENT_KINDS: [&str; 3] = ["catenary_length", "reference_tension", "pose_prior"];
+pub const MEASUREMENT_KINDS: [&str; 3] = ["catenary_length", "reference_tension", "pose_prior"];
 
 /// Two-sided p < 0.001 for a correlation's t statistic (normal approximation).
 pub const DRIVER_T_LIMIT: f64 = 3.29;
@@ -267,9 +267,7 @@ const CABLE_DRIVER_COUNT: usize = 7;
 /// The 0.1 % quantile of chi-square with `k` degrees of freedom (Wilson-Hilferty,
 /// as [`crate::calib::chi_square_quantile_999`]).
 pub fn chi_square_quantile_001(k: usize) -> f64 {
-    let k = k.max(1) as f64;
-    let c = 2.0 / (9.0 * k);
-    k * (1.0 - c - 3.0902 * c.sqrt()).max(0.0).powi(3)
+    crate::calib::chi_square_quantile(k, -3.0902)
 }
 
 /// The per-cable drivers, with units.
@@ -554,31 +552,18 @@ fn parameters(estimate: &EffectEstimate) -> Vec<ParameterValue> {
 /// variable set from its estimate (the robot file's effects cannot hold a
 /// negative compliance).
 fn rebuild(result: &CalibrationResult, used: &[PoseMeasurement], options: &CalibrationOptions) -> CalibrationGraph {
-    let tensions: Vec<CableTension> = result
-        .reference_tensions_n
-        .iter()
-        .map(|t| CableTension {
-            horizontal_n: t[0],
-            vertical_n: t[1],
-        })
-        .collect();
     let mut built = build_graph(
         &result.robot,
         used,
         &result.poses,
-        &tensions,
+        &result.reference_tensions(),
         CableModel::Catenary,
         options,
     );
     if let (Some(vars), Some(estimate)) = (built.effects, &result.effect_estimate) {
-        let raw: Vec<f64> = match estimate.effect {
-            EffectKind::EncoderScale => estimate.values.iter().map(|g| g - 1.0).collect(),
-            EffectKind::LoadCell => vec![estimate.values[0], estimate.values[1] - 1.0],
-            _ => estimate.values.clone(),
-        };
         built.graph.values.set(
             vars.of(estimate.effect),
-            VariableValue::Vector(nalgebra::DVector::from_vec(raw)),
+            VariableValue::Vector(nalgebra::DVector::from_vec(estimate.variable_values())),
         );
     }
     built
@@ -652,15 +637,11 @@ fn samples(result: &CalibrationResult, used: &[PoseMeasurement], built: &Calibra
     let cells = normalised("reference_tension");
     let priors = normalised("pose_prior");
     let robot = &result.robot;
+    let references = result.reference_tensions();
     (0..used.len())
         .map(|k| {
             let pose = &result.poses[k];
-            let t = result.reference_tensions_n[k];
-            let reference = CableTension {
-                horizontal_n: t[0],
-                vertical_n: t[1],
-            };
-            let tensions = statics::cable_tensions(robot, pose, reference)?;
+            let tensions = statics::cable_tensions(robot, pose, references[k])?;
             let cables = statics::catenaries(robot, pose, &tensions);
             let geometry = statics::cable_geometry(robot, pose);
             let cable_drivers = std::array::from_fn(|i| {
@@ -849,13 +830,8 @@ fn subgraph(
 ) -> CalibrationGraph {
     let measurements: Vec<PoseMeasurement> = indices.iter().map(|&k| used[k]).collect();
     let poses: Vec<_> = indices.iter().map(|&k| fit.poses[k]).collect();
-    let tensions: Vec<CableTension> = indices
-        .iter()
-        .map(|&k| CableTension {
-            horizontal_n: fit.reference_tensions_n[k][0],
-            vertical_n: fit.reference_tensions_n[k][1],
-        })
-        .collect();
+    let all_tensions = fit.reference_tensions();
+    let tensions: Vec<CableTension> = indices.iter().map(|&k| all_tensions[k]).collect();
     let mut built = build_graph(
         &fit.robot,
         &measurements,
