@@ -25,6 +25,7 @@
 
 #![warn(missing_docs)]
 
+pub mod benchmark;
 pub mod calib;
 pub mod diagnose;
 pub mod error;

@@ -150,9 +150,11 @@ pub(super) fn slots_to_cables(slots: &SlotOrder, residual: &Vector4<f64>) -> DVe
 /// Reorder the rows of Jacobian blocks from slot order to cable order.
 pub(super) fn rows_to_cables(slots: &SlotOrder, blocks: &mut [DMatrix<f64>]) {
     for block in blocks {
-        let copy = block.clone();
-        for (slot, &cable) in slots.cables.iter().enumerate() {
-            block.row_mut(cable).copy_from(&copy.row(slot));
+        for mut column in block.column_iter_mut() {
+            let by_slot: [f64; CABLE_COUNT] = std::array::from_fn(|slot| column[slot]);
+            for (slot, &cable) in slots.cables.iter().enumerate() {
+                column[cable] = by_slot[slot];
+            }
         }
     }
 }

@@ -586,6 +586,19 @@ fn paper_initial_tension(robot: &Robot, pose: &PlatformPose) -> CableTension {
     }
 }
 
+/// Step (2) of the initialisation for a given robot: every pose's static
+/// equilibrium at its measured position and load-cell tension (the poses and
+/// reference tensions `(f_h, f_v)` to start the catenary graph from). Poses
+/// without an equilibrium start from the measured pose and eq. (17)-(18);
+/// their indices are the third element.
+pub fn warm_start(
+    robot: &Robot,
+    measurements: &[PoseMeasurement],
+) -> (Vec<PlatformPose>, Vec<CableTension>, Vec<usize>) {
+    let warm = warm_up(robot, measurements);
+    (warm.poses, warm.tensions, warm.failures)
+}
+
 /// The per-pose warm-up: a start for every pose.
 struct WarmUp {
     poses: Vec<PlatformPose>,

@@ -99,13 +99,70 @@ pub struct WhitenedLinearization {
 /// undefined there, or a residual or Jacobian entry is not finite).
 pub fn linearize_factor(factor: &dyn Factor, values: &Values) -> Result<WhitenedLinearization, &'static str> {
     let rows = factor.residual_dim();
-    let mut jacobians: Vec<DMatrix<f64>> = factor
-        .variables()
-        .iter()
-        .map(|&v| DMatrix::zeros(rows, values.tangent_dim(v)))
-        .collect();
+    let mut linearized = WhitenedLinearization {
+        residual: Vec::with_capacity(rows),
+        jacobians: factor
+            .variables()
+            .iter()
+            .map(|&v| DMatrix::zeros(rows, values.tangent_dim(v)))
+            .collect(),
+        cost: 0.0,
+    };
+    linearize_into(factor, values, &mut linearized)?;
+    Ok(linearized)
+}
+
+/// Reusable buffers for linearising many factors one after the other: one
+/// set of Jacobian blocks per factor shape, so that a solver iteration over
+/// thousands of factors allocates nothing for them.
+#[derive(Default)]
+pub struct LinearizationBuffers {
+    by_shape: Vec<WhitenedLinearization>,
+}
+
+impl LinearizationBuffers {
+    /// Linearise `factor` at `values` into the buffers of its shape (see [`linearize_factor`]).
+    pub fn linearize(&mut self, factor: &dyn Factor, values: &Values) -> Result<&WhitenedLinearization, &'static str> {
+        let rows = factor.residual_dim();
+        let variables = factor.variables();
+        let same_shape = |l: &WhitenedLinearization| {
+            l.jacobians.len() == variables.len()
+                && l.jacobians
+                    .iter()
+                    .zip(variables)
+                    .all(|(j, &v)| j.nrows() == rows && j.ncols() == values.tangent_dim(v))
+        };
+        let index = match self.by_shape.iter().position(same_shape) {
+            Some(index) => {
+                for jacobian in &mut self.by_shape[index].jacobians {
+                    jacobian.fill(0.0);
+                }
+                index
+            }
+            None => {
+                self.by_shape.push(WhitenedLinearization {
+                    residual: Vec::with_capacity(rows),
+                    jacobians: variables
+                        .iter()
+                        .map(|&v| DMatrix::zeros(rows, values.tangent_dim(v)))
+                        .collect(),
+                    cost: 0.0,
+                });
+                self.by_shape.len() - 1
+            }
+        };
+        let linearized = &mut self.by_shape[index];
+        linearize_into(factor, values, linearized)?;
+        Ok(linearized)
+    }
+}
+
+/// Evaluate, whiten and reweight one factor into `out`, whose Jacobian
+/// blocks are zeroed and sized for the factor.
+fn linearize_into(factor: &dyn Factor, values: &Values, out: &mut WhitenedLinearization) -> Result<(), &'static str> {
+    let rows = factor.residual_dim();
     let residual = factor
-        .evaluate(values, Some(&mut jacobians))
+        .evaluate(values, Some(&mut out.jacobians))
         .ok_or("model undefined (slack cable)")?;
     let sigmas = factor.sigmas();
     let s = whitened_squared_norm(&residual, sigmas);
@@ -114,21 +171,20 @@ pub fn linearize_factor(factor: &dyn Factor, values: &Values) -> Result<Whitened
     }
     let kernel = factor.robust_kernel();
     let scale = kernel.weight(s).sqrt();
-    let whitened: Vec<f64> = (0..rows).map(|r| residual[r] / sigmas[r] * scale).collect();
-    for jac in &mut jacobians {
-        for r in 0..rows {
-            let w = scale / sigmas[r];
-            for c in 0..jac.ncols() {
-                jac[(r, c)] *= w;
+    out.residual.clear();
+    out.residual.extend((0..rows).map(|r| residual[r] / sigmas[r] * scale));
+    for jac in &mut out.jacobians {
+        let columns = jac.ncols();
+        let data = jac.as_mut_slice();
+        for c in 0..columns {
+            for r in 0..rows {
+                data[c * rows + r] *= scale / sigmas[r];
             }
         }
     }
-    if jacobians.iter().any(|j| j.iter().any(|v| !v.is_finite())) {
+    if out.jacobians.iter().any(|j| j.iter().any(|v| !v.is_finite())) {
         return Err("non-finite Jacobian");
     }
-    Ok(WhitenedLinearization {
-        residual: whitened,
-        jacobians,
-        cost: 0.5 * kernel.rho(s),
-    })
+    out.cost = 0.5 * kernel.rho(s);
+    Ok(())
 }

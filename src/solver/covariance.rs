@@ -44,7 +44,7 @@ pub enum Covariance {
 ///    (rounding noise made `H` look positive definite), reported with its
 ///    components in the selected variables.
 pub fn marginal_covariance(graph: &FactorGraph, selected: &[VariableId]) -> Result<Covariance, String> {
-    let system = LinearSystem::new(&graph.values, &graph.factors)?;
+    let mut system = LinearSystem::new(&graph.values, &graph.factors, &graph.local_groups)?;
     let hessian = linearize(graph, &graph.values, &system)
         .map_err(|e| format!("covariance at the solution: {e}"))?
         .hessian;
@@ -58,11 +58,14 @@ pub fn marginal_covariance(graph: &FactorGraph, selected: &[VariableId]) -> Resu
         }
     }
     let zero_damping = vec![0.0; system.dim];
+    if !system.factorize(&hessian, &zero_damping) {
+        return Ok(Covariance::RankDeficient(null_space(graph, &system, &hessian)));
+    }
     let mut covariance = DMatrix::zeros(columns.len(), columns.len());
     for (k, &col) in columns.iter().enumerate() {
         let mut unit = vec![0.0; system.dim];
         unit[col] = 1.0;
-        let Some(x) = system.solve(&hessian, &zero_damping, &unit) else {
+        let Some(x) = system.solve_factored(&unit) else {
             return Ok(Covariance::RankDeficient(null_space(graph, &system, &hessian)));
         };
         for (m, &row) in columns.iter().enumerate() {

@@ -3,17 +3,27 @@
 //! The sparsity pattern of `H = J^T W J` (lower triangle) follows from which
 //! variables share a factor. It is built once per problem at the block level
 //! (one dense block per pair of connected free variables), its symbolic
-//! Cholesky (AMD ordering) is computed once, and every damping trial only
-//! refactors numerically (faer's `Llt::try_new_with_symbolic`).
+//! Cholesky (AMD ordering, supernodal) is computed once, and every damping
+//! trial only refactors numerically into buffers allocated once
+//! (`SymbolicCholesky::factorize_numeric_llt`, single-threaded).
+//!
+//! `H` is accumulated block by block (each factor's `J^T J` blocks are
+//! contiguous, see [`LinearSystem::accumulate`]) and scattered into the
+//! compressed-column values of the pattern before each factorisation.
 
 use std::collections::HashMap;
 
-use faer::linalg::solvers::SolveCore;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
-use faer::{Conj, Mat, Side};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::llt::factor::{LltParams, LltRegularization};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
+};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, MatMut, Par, Side, Spec};
 use nalgebra::DMatrix;
 
+use super::schur::SchurLayout;
 use crate::graph::{Factor, Values, VariableId};
 
 /// Where the free variables sit in the tangent vector, and the pattern of `H`.
@@ -28,9 +38,63 @@ pub struct LinearSystem {
     diagonal_slots: Vec<usize>,
     /// Number of stored entries (lower triangle, block-wise).
     entry_count: usize,
+    /// The lower triangle of `H`, compressed columns.
     pattern: SymbolicSparseColMat<usize>,
-    argsort: faer::sparse::Argsort<usize>,
-    symbolic: SymbolicLlt<usize>,
+    /// Per stored entry (block-wise order), its index in the compressed-column values.
+    csc_position: Vec<usize>,
+    factorization: Factorization,
+}
+
+/// Largest tangent dimension of the global variables for block elimination
+/// (its reduced system is a dense Cholesky of this size).
+const MAX_SCHUR_GLOBALS: usize = 400;
+
+/// How `H + damping` is factored.
+enum Factorization {
+    /// Block elimination of the local groups ([`SchurLayout`]).
+    Schur(SchurLayout),
+    /// faer's supernodal sparse Cholesky of the whole pattern.
+    Sparse(Box<SparseCholesky>),
+}
+
+/// faer's sparse Cholesky: the symbolic analysis (AMD ordering, supernodal)
+/// done once, and numerical buffers reused by every factorisation.
+struct SparseCholesky {
+    symbolic: SymbolicCholesky<usize>,
+    /// `H + damping` in compressed-column order.
+    matrix_values: Vec<f64>,
+    /// Values of the Cholesky factor.
+    factor_values: Vec<f64>,
+    /// Scratch memory of faer's factorisation and triangular solves.
+    scratch: MemBuffer,
+    /// Whether `factor_values` holds a valid factorisation.
+    factored: bool,
+}
+
+impl SparseCholesky {
+    fn new(pattern: &SymbolicSparseColMat<usize>, entry_count: usize) -> Result<Self, String> {
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
+        let scratch = StackReq::any_of(&[
+            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Spec::<LltParams, f64>::default()),
+            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ]);
+        Ok(Self {
+            matrix_values: vec![0.0; entry_count],
+            factor_values: vec![0.0; symbolic.len_val()],
+            scratch: MemBuffer::try_new(scratch).map_err(|_| "out of memory for the Cholesky workspace".to_string())?,
+            factored: false,
+            symbolic,
+        })
+    }
 }
 
 /// A block of `H` between variables `row_var` (larger offset) and `col_var`.
@@ -40,13 +104,37 @@ struct BlockLayout {
 
 impl LinearSystem {
     /// Analyse the pattern of `H` for these factors and free variables.
-    pub fn new(values: &Values, factors: &[Box<dyn Factor>]) -> Result<Self, String> {
+    ///
+    /// `local_groups` (see [`crate::graph::FactorGraph::local_groups`]): when
+    /// every factor touches at most one group, the groups are eliminated
+    /// block by block ([`schur`](super::schur)); otherwise, or without groups,
+    /// `H` is factored by faer's supernodal sparse Cholesky.
+    pub fn new(values: &Values, factors: &[Box<dyn Factor>], local_groups: &[Vec<VariableId>]) -> Result<Self, String> {
         let mut offsets = vec![None; values.len()];
+        let mut in_group = vec![false; values.len()];
+        for id in local_groups.iter().flatten() {
+            in_group[id.0] = true;
+        }
+        // Globals first, then each group's free variables together.
         let mut dim = 0;
         for (id, variable) in values.iter() {
-            if !variable.fixed {
+            if !variable.fixed && !in_group[id.0] {
                 offsets[id.0] = Some(dim);
                 dim += variable.value.tangent_dim();
+            }
+        }
+        let globals = dim;
+        let mut group_ranges = Vec::with_capacity(local_groups.len());
+        for group in local_groups {
+            let start = dim;
+            for &id in group {
+                if !values.variable(id).fixed && offsets[id.0].is_none() {
+                    offsets[id.0] = Some(dim);
+                    dim += values.tangent_dim(id);
+                }
+            }
+            if dim > start {
+                group_ranges.push((start, dim - start));
             }
         }
         if dim == 0 {
@@ -96,13 +184,7 @@ impl LinearSystem {
             factor_blocks.push(list);
         }
         // Scalar (row, col) of every stored entry, in storage order.
-        let mut indices = vec![
-            Pair {
-                row: 0usize,
-                col: 0usize
-            };
-            entry_count
-        ];
+        let mut indices = vec![(0usize, 0usize); entry_count];
         let mut diagonal_slots = vec![0; dim];
         for &(a, b) in &block_order {
             let start = blocks[&(a.0, b.0)].start;
@@ -114,10 +196,7 @@ impl LinearSystem {
                     if a == b && i < j {
                         continue;
                     }
-                    indices[k] = Pair {
-                        row: oa + i,
-                        col: ob + j,
-                    };
+                    indices[k] = (oa + i, ob + j);
                     if a == b && i == j {
                         diagonal_slots[oa + i] = k;
                     }
@@ -125,10 +204,29 @@ impl LinearSystem {
                 }
             }
         }
-        let (pattern, argsort) = SymbolicSparseColMat::try_new_from_indices(dim, dim, &indices)
-            .map_err(|e| format!("cannot build the sparsity pattern: {e:?}"))?;
-        let symbolic = SymbolicLlt::try_new(pattern.as_ref(), Side::Lower)
-            .map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
+        // Compressed columns: sort the entries by (column, row).
+        let order = column_major_order(&indices, dim);
+        let mut col_ptr = vec![0usize; dim + 1];
+        let mut row_idx = Vec::with_capacity(entry_count);
+        let mut csc_position = vec![0usize; entry_count];
+        for (position, &k) in order.iter().enumerate() {
+            let (row, col) = indices[k];
+            col_ptr[col + 1] += 1;
+            row_idx.push(row);
+            csc_position[k] = position;
+        }
+        for col in 0..dim {
+            col_ptr[col + 1] += col_ptr[col];
+        }
+        let pattern = SymbolicSparseColMat::new_checked(dim, dim, col_ptr, None, row_idx);
+        // The reduced system of the elimination is dense: worth it while it is small.
+        let schur = (!group_ranges.is_empty() && globals <= MAX_SCHUR_GLOBALS)
+            .then(|| SchurLayout::new(&indices, globals, group_ranges))
+            .flatten();
+        let factorization = match schur {
+            Some(layout) => Factorization::Schur(layout),
+            None => Factorization::Sparse(Box::new(SparseCholesky::new(&pattern, entry_count)?)),
+        };
         Ok(Self {
             offsets,
             dim,
@@ -136,8 +234,8 @@ impl LinearSystem {
             diagonal_slots,
             entry_count,
             pattern,
-            argsort,
-            symbolic,
+            csc_position,
+            factorization,
         })
     }
 
@@ -157,32 +255,44 @@ impl LinearSystem {
         hessian: &mut [f64],
         gradient: &mut [f64],
     ) {
+        match residual.len() {
+            1 => self.accumulate_rows::<1>(index, variables, jacobians, residual, hessian, gradient),
+            4 => self.accumulate_rows::<4>(index, variables, jacobians, residual, hessian, gradient),
+            6 => self.accumulate_rows::<6>(index, variables, jacobians, residual, hessian, gradient),
+            _ => self.accumulate_rows::<0>(index, variables, jacobians, residual, hessian, gradient),
+        }
+    }
+
+    /// [`LinearSystem::accumulate`] for `R`-row factors (`R = 0`: any row count).
+    #[inline(always)]
+    fn accumulate_rows<const R: usize>(
+        &self,
+        index: usize,
+        variables: &[VariableId],
+        jacobians: &[DMatrix<f64>],
+        residual: &[f64],
+        hessian: &mut [f64],
+        gradient: &mut [f64],
+    ) {
+        let rows = if R == 0 { residual.len() } else { R };
         for (slot, &var) in variables.iter().enumerate() {
             if let Some(offset) = self.offsets[var.0] {
-                let jac = &jacobians[slot];
-                for c in 0..jac.ncols() {
-                    let mut sum = 0.0;
-                    for r in 0..jac.nrows() {
-                        sum += jac[(r, c)] * residual[r];
-                    }
-                    gradient[offset + c] += sum;
+                // Column-major: column c of the block is data[c * rows..(c + 1) * rows].
+                let data = jacobians[slot].as_slice();
+                for c in 0..data.len() / rows {
+                    gradient[offset + c] += dot::<R>(&data[c * rows..(c + 1) * rows], residual);
                 }
             }
         }
         for &(slot_a, slot_b, start) in &self.factor_blocks[index] {
-            let (ja, jb) = (&jacobians[slot_a], &jacobians[slot_b]);
+            let (ja, jb) = (jacobians[slot_a].as_slice(), jacobians[slot_b].as_slice());
             let same = variables[slot_a] == variables[slot_b];
+            let (columns_a, columns_b) = (ja.len() / rows, jb.len() / rows);
             let mut k = start;
-            for j in 0..jb.ncols() {
-                for i in 0..ja.ncols() {
-                    if same && i < j {
-                        continue;
-                    }
-                    let mut sum = 0.0;
-                    for r in 0..ja.nrows() {
-                        sum += ja[(r, i)] * jb[(r, j)];
-                    }
-                    hessian[k] += sum;
+            for j in 0..columns_b {
+                let column_b = &jb[j * rows..(j + 1) * rows];
+                for i in (if same { j } else { 0 })..columns_a {
+                    hessian[k] += dot::<R>(&ja[i * rows..(i + 1) * rows], column_b);
                     k += 1;
                 }
             }
@@ -194,34 +304,125 @@ impl LinearSystem {
         self.diagonal_slots.iter().map(|&k| hessian[k]).collect()
     }
 
-    /// Solve `(H + diag(damping)) x = rhs`; `None` if the matrix is not positive definite.
-    pub fn solve(&self, hessian: &[f64], damping: &[f64], rhs: &[f64]) -> Option<Vec<f64>> {
-        let mut values = hessian.to_vec();
-        for (i, &k) in self.diagonal_slots.iter().enumerate() {
-            values[k] += damping[i];
+    /// Factor `H + diag(damping)` (Cholesky); `false` if it is not
+    /// numerically positive definite. Solves with [`LinearSystem::solve_factored`].
+    pub fn factorize(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
+        let sparse = match &mut self.factorization {
+            Factorization::Schur(layout) => return layout.factorize(hessian, damping),
+            Factorization::Sparse(sparse) => sparse,
+        };
+        sparse.factored = false;
+        for (k, &position) in self.csc_position.iter().enumerate() {
+            sparse.matrix_values[position] = hessian[k];
         }
-        let matrix = SparseColMat::new_from_argsort(self.pattern.clone(), &self.argsort, &values).ok()?;
-        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), matrix.as_ref(), Side::Lower).ok()?;
-        let mut x = Mat::<f64>::from_fn(self.dim, 1, |i, _| rhs[i]);
-        llt.solve_in_place_with_conj(Conj::No, x.as_mut());
-        let solution: Vec<f64> = (0..self.dim).map(|i| x[(i, 0)]).collect();
+        for (i, &k) in self.diagonal_slots.iter().enumerate() {
+            sparse.matrix_values[self.csc_position[k]] += damping[i];
+        }
+        if sparse.matrix_values.iter().any(|v| !v.is_finite()) {
+            return false;
+        }
+        let matrix = SparseColMatRef::new(self.pattern.as_ref(), &sparse.matrix_values);
+        let factored = sparse.symbolic.factorize_numeric_llt(
+            &mut sparse.factor_values,
+            matrix,
+            Side::Lower,
+            LltRegularization::default(),
+            Par::Seq,
+            MemStack::new(&mut sparse.scratch),
+            Spec::default(),
+        );
+        sparse.factored = factored.is_ok();
+        sparse.factored
+    }
+
+    /// Solve with the last successful [`LinearSystem::factorize`]; `None` if
+    /// there is none or the solution is not finite.
+    pub fn solve_factored(&mut self, rhs: &[f64]) -> Option<Vec<f64>> {
+        let sparse = match &mut self.factorization {
+            Factorization::Schur(layout) => return layout.solve(rhs),
+            Factorization::Sparse(sparse) => sparse,
+        };
+        if !sparse.factored {
+            return None;
+        }
+        let mut solution = rhs.to_vec();
+        let llt = LltRef::new(&sparse.symbolic, &sparse.factor_values);
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut solution, self.dim, 1),
+            Par::Seq,
+            MemStack::new(&mut sparse.scratch),
+        );
         solution.iter().all(|v| v.is_finite()).then_some(solution)
+    }
+
+    /// Whether the local groups are eliminated block by block (else faer's sparse Cholesky).
+    pub fn uses_block_elimination(&self) -> bool {
+        matches!(self.factorization, Factorization::Schur(_))
+    }
+
+    /// Solve `(H + diag(damping)) x = rhs`; `None` if the matrix is not positive definite.
+    pub fn solve(&mut self, hessian: &[f64], damping: &[f64], rhs: &[f64]) -> Option<Vec<f64>> {
+        if !self.factorize(hessian, damping) {
+            return None;
+        }
+        self.solve_factored(rhs)
     }
 
     /// `H` as a dense symmetric matrix (for the rank analysis of small problems).
     pub fn dense(&self, hessian: &[f64]) -> DMatrix<f64> {
-        let matrix = SparseColMat::new_from_argsort(self.pattern.clone(), &self.argsort, hessian);
         let mut dense = DMatrix::zeros(self.dim, self.dim);
-        if let Ok(matrix) = matrix {
-            for col in 0..self.dim {
-                let rows = matrix.symbolic().row_idx_of_col_raw(col);
-                let vals = matrix.val_of_col(col);
-                for (&row, &v) in rows.iter().zip(vals) {
-                    dense[(row, col)] = v;
-                    dense[(col, row)] = v;
-                }
+        let col_ptr = self.pattern.col_ptr();
+        let row_idx = self.pattern.row_idx();
+        let mut values = vec![0.0; self.entry_count];
+        for (k, &position) in self.csc_position.iter().enumerate() {
+            values[position] = hessian[k];
+        }
+        for col in 0..self.dim {
+            for position in col_ptr[col]..col_ptr[col + 1] {
+                let row = row_idx[position];
+                dense[(row, col)] = values[position];
+                dense[(col, row)] = values[position];
             }
         }
         dense
     }
+}
+
+/// `a . b` for two columns of `R` entries (`R = 0`: of equal length).
+#[inline(always)]
+fn dot<const R: usize>(a: &[f64], b: &[f64]) -> f64 {
+    if R == 0 {
+        return a.iter().zip(b).map(|(x, y)| x * y).sum();
+    }
+    let (a, b) = (&a[..R], &b[..R]);
+    let mut sum = 0.0;
+    for r in 0..R {
+        sum += a[r] * b[r];
+    }
+    sum
+}
+
+/// The permutation that sorts `(row, col)` entries by column, then row: two
+/// stable counting sorts (by row, then by column), linear in the entries.
+fn column_major_order(indices: &[(usize, usize)], dim: usize) -> Vec<usize> {
+    let counting_sort = |order: &[usize], key: &dyn Fn(usize) -> usize| -> Vec<usize> {
+        let mut start = vec![0usize; dim + 1];
+        for &k in order {
+            start[key(k) + 1] += 1;
+        }
+        for i in 0..dim {
+            start[i + 1] += start[i];
+        }
+        let mut sorted = vec![0usize; order.len()];
+        for &k in order {
+            let slot = &mut start[key(k)];
+            sorted[*slot] = k;
+            *slot += 1;
+        }
+        sorted
+    };
+    let identity: Vec<usize> = (0..indices.len()).collect();
+    let by_row = counting_sort(&identity, &|k| indices[k].0);
+    counting_sort(&by_row, &|k| indices[k].1)
 }

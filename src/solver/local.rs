@@ -14,9 +14,8 @@
 //! nonlinear elimination (Lanzkron, Rose & Wilkes, 1996). At a minimum of the
 //! full problem the refinement changes nothing.
 
-use nalgebra::{DMatrix, DVector};
-
-use crate::graph::{linearize_factor, FactorGraph, Values, VariableId};
+use super::schur::{backward_substitute, cholesky_in_place, forward_substitute};
+use crate::graph::{FactorGraph, LinearizationBuffers, Values, VariableId};
 
 /// Gauss-Newton iterations per group and refinement.
 const MAX_ITERATIONS: usize = 8;
@@ -74,6 +73,11 @@ impl LocalGroups {
         Self { groups }
     }
 
+    /// No groups: nothing to refine.
+    pub(crate) fn none() -> Self {
+        Self { groups: Vec::new() }
+    }
+
     /// Whether there is anything to refine.
     pub(crate) fn is_empty(&self) -> bool {
         self.groups.is_empty()
@@ -82,10 +86,21 @@ impl LocalGroups {
     /// Re-minimise every group in place. A group whose model is undefined
     /// keeps its values.
     pub(crate) fn refine(&self, graph: &FactorGraph, values: &mut Values) {
+        let mut workspace = Workspace::default();
         for group in &self.groups {
-            refine_group(graph, group, values);
+            refine_group(graph, group, values, &mut workspace);
         }
     }
+}
+
+/// Buffers reused across groups: factor linearisations, `H`, `g`, the step.
+#[derive(Default)]
+struct Workspace {
+    buffers: LinearizationBuffers,
+    hessian: Vec<f64>,
+    gradient: Vec<f64>,
+    damped: Vec<f64>,
+    step: Vec<f64>,
 }
 
 fn group_cost(graph: &FactorGraph, group: &Group, values: &Values) -> Option<f64> {
@@ -96,39 +111,67 @@ fn group_cost(graph: &FactorGraph, group: &Group, values: &Values) -> Option<f64
         .sum()
 }
 
-/// `H`, `g` of the group's factors with respect to the group's variables.
-fn linearize_group(graph: &FactorGraph, group: &Group, values: &Values) -> Option<(DMatrix<f64>, DVector<f64>)> {
-    let dim = *group.offsets.last()?;
-    let mut hessian = DMatrix::<f64>::zeros(dim, dim);
-    let mut gradient = DVector::<f64>::zeros(dim);
+/// `H` (column-major `dim x dim`, lower triangle and diagonal filled) and `g`
+/// of the group's factors with respect to the group's variables; `false` if
+/// a factor is undefined or not finite.
+fn linearize_group(graph: &FactorGraph, group: &Group, values: &Values, work: &mut Workspace) -> bool {
+    let dim = group.offsets[group.offsets.len() - 1];
+    work.hessian.clear();
+    work.hessian.resize(dim * dim, 0.0);
+    work.gradient.clear();
+    work.gradient.resize(dim, 0.0);
     for &f in &group.factors {
         let factor = graph.factors[f].as_ref();
-        let linearized = linearize_factor(factor, values).ok()?;
+        let Ok(linearized) = work.buffers.linearize(factor, values) else {
+            return false;
+        };
         let rows = linearized.residual.len();
-        let mut jacobian = DMatrix::zeros(rows, dim);
-        for (slot, &v) in factor.variables().iter().enumerate() {
-            if let Some(k) = group.variables.iter().position(|&g| g == v) {
-                let start = group.offsets[k];
-                let block = &linearized.jacobians[slot];
-                jacobian.columns_mut(start, block.ncols()).copy_from(block);
+        // The factor's blocks on group variables, with their offset in the group.
+        let variables = factor.variables();
+        for (slot_a, &a) in variables.iter().enumerate() {
+            let Some(ka) = group.variables.iter().position(|&v| v == a) else {
+                continue;
+            };
+            let (offset_a, ja) = (group.offsets[ka], linearized.jacobians[slot_a].as_slice());
+            for (c, column) in ja.chunks_exact(rows).enumerate() {
+                work.gradient[offset_a + c] += dot(column, &linearized.residual);
+            }
+            for (slot_b, &b) in variables.iter().enumerate() {
+                let Some(kb) = group.variables.iter().position(|&v| v == b) else {
+                    continue;
+                };
+                let (offset_b, jb) = (group.offsets[kb], linearized.jacobians[slot_b].as_slice());
+                if offset_a < offset_b {
+                    continue;
+                }
+                for (i, column_a) in ja.chunks_exact(rows).enumerate() {
+                    for (j, column_b) in jb.chunks_exact(rows).enumerate() {
+                        let (row, col) = (offset_a + i, offset_b + j);
+                        if row >= col {
+                            work.hessian[row + col * dim] += dot(column_a, column_b);
+                        }
+                    }
+                }
             }
         }
-        let whitened = DVector::from_column_slice(&linearized.residual);
-        hessian += jacobian.transpose() * &jacobian;
-        gradient += jacobian.transpose() * whitened;
     }
-    (hessian.iter().all(|v| v.is_finite()) && gradient.iter().all(|v| v.is_finite())).then_some((hessian, gradient))
+    work.hessian.iter().chain(&work.gradient).all(|v| v.is_finite())
 }
 
-fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values) {
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &mut Workspace) {
     let Some(mut cost) = group_cost(graph, group, values) else {
         return;
     };
+    let dim = group.offsets[group.offsets.len() - 1];
     let mut damping = 1e-8;
     for _ in 0..MAX_ITERATIONS {
-        let Some((hessian, gradient)) = linearize_group(graph, group, values) else {
+        if !linearize_group(graph, group, values, work) {
             return;
-        };
+        }
         let originals: Vec<_> = group
             .variables
             .iter()
@@ -136,16 +179,20 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values) {
             .collect();
         let mut improved = false;
         while damping < 1e8 {
-            let mut damped = hessian.clone();
-            for i in 0..damped.nrows() {
-                damped[(i, i)] += damping * hessian[(i, i)].max(1e-12);
+            work.damped.clone_from(&work.hessian);
+            for i in 0..dim {
+                work.damped[i + i * dim] += damping * work.hessian[i + i * dim].max(1e-12);
             }
-            let Some(step) = damped.cholesky().map(|c| c.solve(&(-&gradient))) else {
+            if !cholesky_in_place(&mut work.damped, dim) {
                 damping *= 10.0;
                 continue;
-            };
+            }
+            work.step.clear();
+            work.step.extend(work.gradient.iter().map(|g| -g));
+            forward_substitute(&work.damped, dim, &mut work.step);
+            backward_substitute(&work.damped, dim, &mut work.step);
             for (k, &v) in group.variables.iter().enumerate() {
-                let slice = &step.as_slice()[group.offsets[k]..group.offsets[k + 1]];
+                let slice = &work.step[group.offsets[k]..group.offsets[k + 1]];
                 values.set(v, originals[k].retract(slice));
             }
             match group_cost(graph, group, values) {

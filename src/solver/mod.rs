@@ -2,7 +2,9 @@
 //!
 //! Each iteration linearises every factor once (whitened by its sigmas,
 //! reweighted by its robust kernel), assembles `H = J^T J` and `g = J^T r`
-//! into the pattern analysed once by [`LinearSystem`], and tries damped steps
+//! into the pattern analysed once by [`LinearSystem`] (which eliminates the
+//! graph's local groups block by block when the structure allows, see the
+//! `schur` module, else uses faer's sparse Cholesky), and tries damped steps
 //! `(H + lambda D) dx = -g` with `D = clamp(diag H)` (Marquardt scaling).
 //! A trial is accepted when the gain ratio
 //! `rho = (actual cost decrease) / (decrease predicted by the linear model)`
@@ -21,6 +23,7 @@
 mod covariance;
 mod linear_system;
 mod local;
+mod schur;
 
 use local::LocalGroups;
 
@@ -29,7 +32,7 @@ pub use linear_system::LinearSystem;
 
 use serde::Serialize;
 
-use crate::graph::{linearize_factor, FactorGraph, Values};
+use crate::graph::{FactorGraph, LinearizationBuffers, Values};
 
 /// Stopping rules and damping limits.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,18 +49,24 @@ pub struct LmParams {
     pub initial_damping: f64,
     /// Give up when `lambda` exceeds this without an acceptable step.
     pub max_damping: f64,
+    /// Re-minimise the graph's local groups after every trial step (the
+    /// nonlinear elimination of the module docs); `false`: plain
+    /// Levenberg-Marquardt (the groups are still eliminated in the linear solve).
+    pub local_refinement: bool,
 }
 
 impl Default for LmParams {
-    /// 500 iterations, cost tolerance 1e-12, gradient 1e-10, step 1e-12, lambda 1e-4 .. 1e16.
+    /// 500 iterations, cost tolerance 1e-12, gradient 1e-10, step 1e-12,
+    /// lambda 1e-4 .. 1e16, local refinement on.
     fn default() -> Self {
         Self {
             max_iterations: 500,
             relative_cost_tolerance: 1e-12,
             gradient_tolerance: 1e-10,
             relative_step_tolerance: 1e-12,
-            initial_damping: 1e-4,
+            initial_damping: 1e-10,
             max_damping: 1e16,
+            local_refinement: true,
         }
     }
 }
@@ -154,9 +163,10 @@ pub(crate) fn linearize(graph: &FactorGraph, values: &Values, system: &LinearSys
     let mut hessian = system.zero_hessian();
     let mut gradient = vec![0.0; system.dim];
     let mut cost = 0.0;
+    let mut buffers = LinearizationBuffers::default();
     for (index, factor) in graph.factors.iter().enumerate() {
         let variables = factor.variables();
-        let linearized = linearize_factor(factor.as_ref(), values).map_err(|what| {
+        let linearized = buffers.linearize(factor.as_ref(), values).map_err(|what| {
             let names: Vec<&str> = variables.iter().map(|&v| values.variable(v).name.as_str()).collect();
             format!("{} factor on [{}]: {what}", factor.kind(), names.join(", "))
         })?;
@@ -191,8 +201,12 @@ pub(crate) fn retract_all(values: &Values, system: &LinearSystem, step: &[f64]) 
 
 /// Minimise the graph's cost from its current values; the values are updated in place.
 pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSummary, String> {
-    let system = LinearSystem::new(&graph.values, &graph.factors)?;
-    let groups = LocalGroups::new(graph);
+    let mut system = LinearSystem::new(&graph.values, &graph.factors, &graph.local_groups)?;
+    let groups = if params.local_refinement {
+        LocalGroups::new(graph)
+    } else {
+        LocalGroups::none()
+    };
     let mut values = graph.values.clone();
     if !groups.is_empty() {
         groups.refine(graph, &mut values);
