@@ -4,7 +4,7 @@ VENV := codegen/.venv
 PYTHON := $(VENV)/bin/python
 PYTHON3 ?= python3
 
-.PHONY: all codegen codegen-check test lint bench demo verify clean-venv
+.PHONY: all codegen codegen-check test lint bench bench-peers demo verify clean-venv
 
 all: test
 
@@ -31,8 +31,14 @@ lint:
 	cargo fmt --all -- --check
 	cargo clippy --all-targets -- -D warnings
 
+## Criterion benches: generated Jacobians (analytic vs numerical) and solver scaling.
 bench:
 	cargo bench
+
+## sagcal against apex-solver and factrs on the same problem (peers/, its own lock file;
+## not part of `make test`). Writes target/bench-peers/peers.json and peers.svg.
+bench-peers:
+	cargo run --release --manifest-path peers/Cargo.toml -- --out target/bench-peers
 
 demo:
 	cargo run --release

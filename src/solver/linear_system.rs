@@ -12,6 +12,7 @@
 //! compressed-column values of the pattern before each factorisation.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::{LltParams, LltRegularization};
@@ -38,10 +39,8 @@ pub struct LinearSystem {
     diagonal_slots: Vec<usize>,
     /// Number of stored entries (lower triangle, block-wise).
     entry_count: usize,
-    /// The lower triangle of `H`, compressed columns.
-    pattern: SymbolicSparseColMat<usize>,
-    /// Per stored entry (block-wise order), its index in the compressed-column values.
-    csc_position: Vec<usize>,
+    /// `(row, col)` tangent indices of every stored entry (block-wise order).
+    indices: Vec<(usize, usize)>,
     factorization: Factorization,
 }
 
@@ -60,6 +59,10 @@ enum Factorization {
 /// faer's sparse Cholesky: the symbolic analysis (AMD ordering, supernodal)
 /// done once, and numerical buffers reused by every factorisation.
 struct SparseCholesky {
+    /// The lower triangle of `H`, compressed columns.
+    pattern: SymbolicSparseColMat<usize>,
+    /// Per stored entry (block-wise order), its index in the compressed-column values.
+    csc_position: Vec<usize>,
     symbolic: SymbolicCholesky<usize>,
     /// `H + damping` in compressed-column order.
     matrix_values: Vec<f64>,
@@ -72,7 +75,23 @@ struct SparseCholesky {
 }
 
 impl SparseCholesky {
-    fn new(pattern: &SymbolicSparseColMat<usize>, entry_count: usize) -> Result<Self, String> {
+    fn new(indices: &[(usize, usize)], dim: usize) -> Result<Self, String> {
+        let entry_count = indices.len();
+        // Compressed columns: sort the entries by (column, row).
+        let order = column_major_order(indices, dim);
+        let mut col_ptr = vec![0usize; dim + 1];
+        let mut row_idx = Vec::with_capacity(entry_count);
+        let mut csc_position = vec![0usize; entry_count];
+        for (position, &k) in order.iter().enumerate() {
+            let (row, col) = indices[k];
+            col_ptr[col + 1] += 1;
+            row_idx.push(row);
+            csc_position[k] = position;
+        }
+        for col in 0..dim {
+            col_ptr[col + 1] += col_ptr[col];
+        }
+        let pattern = SymbolicSparseColMat::new_checked(dim, dim, col_ptr, None, row_idx);
         let symbolic = factorize_symbolic_cholesky(
             pattern.as_ref(),
             Side::Lower,
@@ -93,7 +112,35 @@ impl SparseCholesky {
             scratch: MemBuffer::try_new(scratch).map_err(|_| "out of memory for the Cholesky workspace".to_string())?,
             factored: false,
             symbolic,
+            pattern,
+            csc_position,
         })
+    }
+}
+
+/// Blocks by `(row variable, column variable)` index.
+type BlockMap = HashMap<(usize, usize), BlockLayout, BuildHasherDefault<IndexHasher>>;
+
+/// A multiplicative hasher for small integer keys (variable indices): the
+/// pattern analysis looks up one block per pair of variables of every
+/// factor, and the default SipHash dominated it.
+#[derive(Default)]
+struct IndexHasher(u64);
+
+impl Hasher for IndexHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_usize(&mut self, i: usize) {
+        self.write_u64(i as u64);
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
     }
 }
 
@@ -141,25 +188,24 @@ impl LinearSystem {
             return Err("every variable is fixed: nothing to solve".into());
         }
         let tangent = |id: VariableId| values.tangent_dim(id);
-        let mut blocks: HashMap<(usize, usize), BlockLayout> = HashMap::new();
+        let mut blocks: BlockMap = BlockMap::default();
         let mut block_order: Vec<(VariableId, VariableId)> = Vec::new();
         let mut entry_count = 0;
         let mut factor_blocks = Vec::with_capacity(factors.len());
-        let mut block_for =
-            |a: VariableId, b: VariableId, blocks: &mut HashMap<(usize, usize), BlockLayout>| -> usize {
-                let layout = blocks.entry((a.0, b.0)).or_insert_with(|| {
-                    let size = if a == b {
-                        tangent(a) * (tangent(a) + 1) / 2
-                    } else {
-                        tangent(a) * tangent(b)
-                    };
-                    let start = entry_count;
-                    entry_count += size;
-                    block_order.push((a, b));
-                    BlockLayout { start }
-                });
-                layout.start
-            };
+        let mut block_for = |a: VariableId, b: VariableId, blocks: &mut BlockMap| -> usize {
+            let layout = blocks.entry((a.0, b.0)).or_insert_with(|| {
+                let size = if a == b {
+                    tangent(a) * (tangent(a) + 1) / 2
+                } else {
+                    tangent(a) * tangent(b)
+                };
+                let start = entry_count;
+                entry_count += size;
+                block_order.push((a, b));
+                BlockLayout { start }
+            });
+            layout.start
+        };
         // Every free variable gets its diagonal block, even if no factor touches it
         // (then H is singular and the solver reports it instead of crashing).
         for (id, _) in values.iter() {
@@ -204,28 +250,13 @@ impl LinearSystem {
                 }
             }
         }
-        // Compressed columns: sort the entries by (column, row).
-        let order = column_major_order(&indices, dim);
-        let mut col_ptr = vec![0usize; dim + 1];
-        let mut row_idx = Vec::with_capacity(entry_count);
-        let mut csc_position = vec![0usize; entry_count];
-        for (position, &k) in order.iter().enumerate() {
-            let (row, col) = indices[k];
-            col_ptr[col + 1] += 1;
-            row_idx.push(row);
-            csc_position[k] = position;
-        }
-        for col in 0..dim {
-            col_ptr[col + 1] += col_ptr[col];
-        }
-        let pattern = SymbolicSparseColMat::new_checked(dim, dim, col_ptr, None, row_idx);
         // The reduced system of the elimination is dense: worth it while it is small.
         let schur = (!group_ranges.is_empty() && globals <= MAX_SCHUR_GLOBALS)
             .then(|| SchurLayout::new(&indices, globals, group_ranges))
             .flatten();
         let factorization = match schur {
             Some(layout) => Factorization::Schur(layout),
-            None => Factorization::Sparse(Box::new(SparseCholesky::new(&pattern, entry_count)?)),
+            None => Factorization::Sparse(Box::new(SparseCholesky::new(&indices, dim)?)),
         };
         Ok(Self {
             offsets,
@@ -233,8 +264,7 @@ impl LinearSystem {
             factor_blocks,
             diagonal_slots,
             entry_count,
-            pattern,
-            csc_position,
+            indices,
             factorization,
         })
     }
@@ -312,16 +342,16 @@ impl LinearSystem {
             Factorization::Sparse(sparse) => sparse,
         };
         sparse.factored = false;
-        for (k, &position) in self.csc_position.iter().enumerate() {
+        for (k, &position) in sparse.csc_position.iter().enumerate() {
             sparse.matrix_values[position] = hessian[k];
         }
         for (i, &k) in self.diagonal_slots.iter().enumerate() {
-            sparse.matrix_values[self.csc_position[k]] += damping[i];
+            sparse.matrix_values[sparse.csc_position[k]] += damping[i];
         }
         if sparse.matrix_values.iter().any(|v| !v.is_finite()) {
             return false;
         }
-        let matrix = SparseColMatRef::new(self.pattern.as_ref(), &sparse.matrix_values);
+        let matrix = SparseColMatRef::new(sparse.pattern.as_ref(), &sparse.matrix_values);
         let factored = sparse.symbolic.factorize_numeric_llt(
             &mut sparse.factor_values,
             matrix,
@@ -372,18 +402,9 @@ impl LinearSystem {
     /// `H` as a dense symmetric matrix (for the rank analysis of small problems).
     pub fn dense(&self, hessian: &[f64]) -> DMatrix<f64> {
         let mut dense = DMatrix::zeros(self.dim, self.dim);
-        let col_ptr = self.pattern.col_ptr();
-        let row_idx = self.pattern.row_idx();
-        let mut values = vec![0.0; self.entry_count];
-        for (k, &position) in self.csc_position.iter().enumerate() {
-            values[position] = hessian[k];
-        }
-        for col in 0..self.dim {
-            for position in col_ptr[col]..col_ptr[col + 1] {
-                let row = row_idx[position];
-                dense[(row, col)] = values[position];
-                dense[(col, row)] = values[position];
-            }
+        for (&(row, col), &value) in self.indices.iter().zip(hessian) {
+            dense[(row, col)] = value;
+            dense[(col, row)] = value;
         }
         dense
     }

@@ -30,6 +30,9 @@ struct Group {
     offsets: Vec<usize>,
     /// Indices of the factors touching the group.
     factors: Vec<usize>,
+    /// Per factor of `factors`: its variable slots that belong to the group,
+    /// with the variable's tangent offset within the group.
+    factor_slots: Vec<Vec<(usize, usize)>>,
 }
 
 /// The graph's local groups, resolved against its factors.
@@ -60,6 +63,7 @@ impl LocalGroups {
                 variables,
                 offsets,
                 factors: Vec::new(),
+                factor_slots: Vec::new(),
             });
         }
         for (index, factor) in graph.factors.iter().enumerate() {
@@ -67,7 +71,18 @@ impl LocalGroups {
             touched.sort_unstable();
             touched.dedup();
             for g in touched {
-                groups[g].factors.push(index);
+                let group = &mut groups[g];
+                let slots = factor
+                    .variables()
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(slot, v)| {
+                        let k = group.variables.iter().position(|g| g == v)?;
+                        Some((slot, group.offsets[k]))
+                    })
+                    .collect();
+                group.factors.push(index);
+                group.factor_slots.push(slots);
             }
         }
         Self { groups }
@@ -112,38 +127,31 @@ fn group_cost(graph: &FactorGraph, group: &Group, values: &Values) -> Option<f64
 }
 
 /// `H` (column-major `dim x dim`, lower triangle and diagonal filled) and `g`
-/// of the group's factors with respect to the group's variables; `false` if
-/// a factor is undefined or not finite.
-fn linearize_group(graph: &FactorGraph, group: &Group, values: &Values, work: &mut Workspace) -> bool {
+/// of the group's factors with respect to the group's variables, and the
+/// group's cost; `None` if a factor is undefined or not finite.
+fn linearize_group(graph: &FactorGraph, group: &Group, values: &Values, work: &mut Workspace) -> Option<f64> {
     let dim = group.offsets[group.offsets.len() - 1];
     work.hessian.clear();
     work.hessian.resize(dim * dim, 0.0);
     work.gradient.clear();
     work.gradient.resize(dim, 0.0);
-    for &f in &group.factors {
-        let factor = graph.factors[f].as_ref();
-        let Ok(linearized) = work.buffers.linearize(factor, values) else {
-            return false;
+    let mut cost = 0.0;
+    for (&f, slots) in group.factors.iter().zip(&group.factor_slots) {
+        let Ok(linearized) = work.buffers.linearize(graph.factors[f].as_ref(), values) else {
+            return None;
         };
+        cost += linearized.cost;
         let rows = linearized.residual.len();
-        // The factor's blocks on group variables, with their offset in the group.
-        let variables = factor.variables();
-        for (slot_a, &a) in variables.iter().enumerate() {
-            let Some(ka) = group.variables.iter().position(|&v| v == a) else {
-                continue;
-            };
-            let (offset_a, ja) = (group.offsets[ka], linearized.jacobians[slot_a].as_slice());
+        for &(slot_a, offset_a) in slots {
+            let ja = linearized.jacobians[slot_a].as_slice();
             for (c, column) in ja.chunks_exact(rows).enumerate() {
                 work.gradient[offset_a + c] += dot(column, &linearized.residual);
             }
-            for (slot_b, &b) in variables.iter().enumerate() {
-                let Some(kb) = group.variables.iter().position(|&v| v == b) else {
-                    continue;
-                };
-                let (offset_b, jb) = (group.offsets[kb], linearized.jacobians[slot_b].as_slice());
+            for &(slot_b, offset_b) in slots {
                 if offset_a < offset_b {
                     continue;
                 }
+                let jb = linearized.jacobians[slot_b].as_slice();
                 for (i, column_a) in ja.chunks_exact(rows).enumerate() {
                     for (j, column_b) in jb.chunks_exact(rows).enumerate() {
                         let (row, col) = (offset_a + i, offset_b + j);
@@ -155,7 +163,11 @@ fn linearize_group(graph: &FactorGraph, group: &Group, values: &Values, work: &m
             }
         }
     }
-    work.hessian.iter().chain(&work.gradient).all(|v| v.is_finite())
+    work.hessian
+        .iter()
+        .chain(&work.gradient)
+        .all(|v| v.is_finite())
+        .then_some(cost)
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -163,14 +175,17 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &mut Workspace) {
-    let Some(mut cost) = group_cost(graph, group, values) else {
-        return;
-    };
     let dim = group.offsets[group.offsets.len() - 1];
     let mut damping = 1e-8;
-    for _ in 0..MAX_ITERATIONS {
-        if !linearize_group(graph, group, values, work) {
+    // The cost at the current values: the linearisation's at the start, then
+    // that of the last accepted trial.
+    let mut cost = f64::NAN;
+    for iteration in 0..MAX_ITERATIONS {
+        let Some(linearized_cost) = linearize_group(graph, group, values, work) else {
             return;
+        };
+        if iteration == 0 {
+            cost = linearized_cost;
         }
         let originals: Vec<_> = group
             .variables
@@ -191,6 +206,19 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &
             work.step.extend(work.gradient.iter().map(|g| -g));
             forward_substitute(&work.damped, dim, &mut work.step);
             backward_substitute(&work.damped, dim, &mut work.step);
+            // Predicted decrease of the damped Gauss-Newton step,
+            // 1/2 dx.(lambda D dx - g): below the tolerance the group is at
+            // its minimum and the trial evaluation is saved.
+            let predicted: f64 = 0.5
+                * (0..dim)
+                    .map(|i| {
+                        let dx = work.step[i];
+                        dx * (damping * work.hessian[i + i * dim].max(1e-12) * dx - work.gradient[i])
+                    })
+                    .sum::<f64>();
+            if predicted < RELATIVE_TOLERANCE * cost {
+                return;
+            }
             for (k, &v) in group.variables.iter().enumerate() {
                 let slice = &work.step[group.offsets[k]..group.offsets[k + 1]];
                 values.set(v, originals[k].retract(slice));
