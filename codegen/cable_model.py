@@ -20,6 +20,11 @@ Conventions (identical to the hand-written Rust in ``src/model``):
   an explicit ``epsilon`` (a small positive number at run time, e.g.
   ``10 * f64::EPSILON``, SymForce's default).
 
+Intermediate quantities are marked with ``forward_mode.checkpoint`` (and
+``rotation_matrix``, ``linear_solution``): the marks change nothing in the
+values, they tell ``generate.py`` where to apply the chain rule (see
+``forward_mode.py``), which halves the operations of the generated Jacobians.
+
 The cable's material enters only through :class:`CableProperties`, which the
 catenary functions take as an argument: an elastic cable (Irvine's elastic
 catenary, axial stiffness ``EA``) or a pulley radius become new fields there
@@ -40,6 +45,8 @@ except symforce.AlreadyUsedEpsilon:
     pass
 
 import symforce.symbolic as sf  # noqa: E402  (must follow set_epsilon_to_symbol)
+
+from forward_mode import checkpoint, linear_solution, rotation_matrix  # noqa: E402
 
 # Number of cables of the suspended robot, and the slot of the reference cable.
 CABLE_COUNT = 4
@@ -304,8 +311,8 @@ def horizontal_span(anchor: sf.V3, attachment_world: sf.V3, epsilon: sf.Scalar) 
         from the anchor towards the attachment.
     """
     delta = attachment_world - anchor
-    span = sf.sqrt(delta[0] ** 2 + delta[1] ** 2 + epsilon)
-    direction = sf.V3(delta[0] / span, delta[1] / span, 0)
+    span = checkpoint(sf.sqrt(delta[0] ** 2 + delta[1] ** 2 + epsilon))
+    direction = checkpoint(sf.V3(delta[0] / span, delta[1] / span, 0))
     return span, direction
 
 
@@ -388,7 +395,8 @@ def attachments_world(position_m: sf.V3, rotation: sf.Rot3, attachments_m: sf.Ma
     Returns:
         The four world-frame attachment points.
     """
-    return [position_m + rotation * attachments_m[:, j] for j in range(CABLE_COUNT)]
+    matrix = rotation_matrix(rotation)
+    return [checkpoint(position_m + matrix * attachments_m[:, j]) for j in range(CABLE_COUNT)]
 
 
 def platform_wrench(rotation: sf.Rot3, com_offset_m: sf.V3, platform_weight_n: sf.Scalar) -> sf.Matrix:
@@ -404,7 +412,7 @@ def platform_wrench(rotation: sf.Rot3, com_offset_m: sf.V3, platform_weight_n: s
     Returns:
         The 6-vector ``[force; moment]``.
     """
-    moment_arm = rotation * com_offset_m
+    moment_arm = checkpoint(rotation_matrix(rotation) * com_offset_m)
     return sf.Matrix.block_matrix([[UP], [moment_arm.cross(UP)]]) * platform_weight_n
 
 
@@ -412,7 +420,9 @@ def solve3(matrix: sf.Matrix33, rhs: sf.V3, epsilon: sf.Scalar) -> sf.V3:
     """Solve a 3x3 linear system by Cramer's rule with a safe determinant.
 
     ``x = adj(A) b / det(A)``, with ``det`` pushed away from zero by
-    :func:`safe_divisor`. Only used for the small blocks of eq. (11).
+    :func:`safe_divisor`. Only used for the small blocks of eq. (11). Its
+    Jacobians are implicit (``dx = A^-1 (db - dA x)``,
+    ``forward_mode.linear_solution``), not the quotient rule of Cramer's formulas.
 
     Args:
         matrix: ``A``.
@@ -423,12 +433,11 @@ def solve3(matrix: sf.Matrix33, rhs: sf.V3, epsilon: sf.Scalar) -> sf.V3:
         ``x`` with ``A x = b``.
     """
     c0, c1, c2 = matrix[:, 0], matrix[:, 1], matrix[:, 2]
-    det = safe_divisor(c0.dot(c1.cross(c2)), epsilon)
-    # Cramer: x_k = det(A with column k replaced by b) / det(A).
-    x0 = rhs.dot(c1.cross(c2))
-    x1 = c0.dot(rhs.cross(c2))
-    x2 = c0.dot(c1.cross(rhs))
-    return sf.V3(x0, x1, x2) / det
+    det = checkpoint(safe_divisor(c0.dot(c1.cross(c2)), epsilon))
+    # Cramer: x_k = det(A with column k replaced by b) / det(A) = (row k of adj(A)) . b / det(A),
+    # the rows of the adjugate being c1 x c2, c2 x c0 and c0 x c1.
+    inverse = sf.Matrix33.block_matrix([[c1.cross(c2).T], [c2.cross(c0).T], [c0.cross(c1).T]]) / det
+    return linear_solution(inverse, matrix, rhs)
 
 
 def cable_tensions_from_reference(
@@ -482,7 +491,8 @@ def cable_tensions_from_reference(
     Returns:
         ``[(f_h0, f_v0), ..., (f_h3, f_v3)]`` in slot order; slot 0 is the input.
     """
-    arms = [rotation * attachments_m[:, j] for j in range(CABLE_COUNT)]
+    matrix = rotation_matrix(rotation)
+    arms = [checkpoint(matrix * attachments_m[:, j]) for j in range(CABLE_COUNT)]
     directions = []
     for j in range(CABLE_COUNT):
         _, direction = horizontal_span(anchors_m[:, j], position_m + arms[j], epsilon)

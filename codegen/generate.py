@@ -56,6 +56,7 @@ REPO_DIR = CODEGEN_DIR.parent
 sys.path.insert(0, str(CODEGEN_DIR))
 
 import factors  # noqa: E402
+import forward_mode  # noqa: E402
 
 README_PATH = CODEGEN_DIR / "README.md"
 # generate.py owns only the part of README.md between these markers; the rest is written by hand.
@@ -371,14 +372,49 @@ def rust_docstring(spec: FunctionSpec, inputs: Values, outputs: Values) -> str:
     return "\n".join(lines)
 
 
+def block_seeds(tape: forward_mode.Tape, inputs: Values, block: str) -> tuple[dict[sf.Symbol, list[sf.Expr]], int]:
+    """The seeds of one Jacobian block for :meth:`forward_mode.Tape.jacobian`, and its tangent dimension.
+
+    The pose: ``Tape.pose_seeds`` (the ``Rot3`` tangent, as in :func:`jacobian`);
+    any other block: the identity over its storage (matrices column by column,
+    the column order of :func:`jacobian`).
+    """
+    if block == "pose":
+        return tape.pose_seeds(inputs["rotation_xyzw"], inputs["position_m"]), 6
+    argument = inputs[block]
+    symbols = [argument] if isinstance(argument, sf.Symbol) else list(argument.to_storage())
+    return {symbol: [sf.S(int(k == i)) for k in range(len(symbols))] for i, symbol in enumerate(symbols)}, len(symbols)
+
+
+def value_and_jacobians(spec: FunctionSpec, inputs: Values) -> Values:
+    """The function's value and its Jacobian blocks, keyed by output name.
+
+    When the model marks intermediate quantities (``forward_mode.checkpoint``,
+    the statics and spans of eq. 2-11), the Jacobians are the chain rule through
+    them (:meth:`forward_mode.Tape.jacobian`): about half the operations of
+    differentiating the expanded expressions. Functions without such quantities
+    (the pose prior, the per-cable effects) are differentiated whole, which is
+    cheaper for them.
+    """
+    outputs = Values()
+    with forward_mode.recording() as tape:
+        value = spec.symbolic(*inputs.values())  # type: ignore[operator]
+    if not tape.definitions:
+        outputs[spec.output_name] = value
+        for block in spec.jacobians:
+            outputs[JACOBIAN_BLOCKS[block][0]] = jacobian(value, inputs, block)
+        return outputs
+    outputs[spec.output_name] = tape.expand(value)
+    for block in spec.jacobians:
+        seeds, columns = block_seeds(tape, inputs, block)
+        outputs[JACOBIAN_BLOCKS[block][0]] = tape.expand(tape.jacobian(list(value.to_storage()), seeds, columns))
+    return outputs
+
+
 def build_codegen(spec: FunctionSpec) -> Codegen:
     """The SymForce Codegen object of one function."""
     inputs = symbolic_inputs(spec)
-    value = spec.symbolic(*inputs.values())  # type: ignore[operator]
-    outputs = Values()
-    outputs[spec.output_name] = value
-    for block in spec.jacobians:
-        outputs[JACOBIAN_BLOCKS[block][0]] = jacobian(value, inputs, block)
+    outputs = value_and_jacobians(spec, inputs)
     return Codegen(
         inputs=inputs,
         outputs=outputs,

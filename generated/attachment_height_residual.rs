@@ -37,1670 +37,703 @@ pub fn attachment_height_residual(
     jacobian_reference_tension: Option<&mut nalgebra::SMatrix<f64, 4, 2>>,
     jacobian_anchors: Option<&mut nalgebra::SMatrix<f64, 4, 12>>,
 ) -> nalgebra::SVector<f64, 4> {
-    // Total ops: 3942
+    // Total ops: 1944
 
-    // Intermediate terms (1106)
+    // Intermediate terms (528)
     let tmp0: f64 = 2.0_f64 * rotation_xyzw[3];
     let tmp1: f64 = tmp0 * rotation_xyzw[1];
     let tmp2: f64 = 2.0_f64 * rotation_xyzw[0];
     let tmp3: f64 = tmp2 * rotation_xyzw[2];
     let tmp4: f64 = tmp1 + tmp3;
-    let tmp5: f64 = tmp4 * attachments_m[(2, 0)];
-    let tmp6: f64 = tmp0 * rotation_xyzw[2];
-    let tmp7: f64 = -tmp6;
-    let tmp8: f64 = tmp2 * rotation_xyzw[1];
-    let tmp9: f64 = tmp7 + tmp8;
-    let tmp10: f64 = tmp9 * attachments_m[(1, 0)];
-    let tmp11: f64 = rotation_xyzw[1] * rotation_xyzw[1];
-    let tmp12: f64 = -2.0_f64 * tmp11;
-    let tmp13: f64 = rotation_xyzw[2] * rotation_xyzw[2];
-    let tmp14: f64 = 1.0_f64 - 2.0_f64 * tmp13;
-    let tmp15: f64 = tmp12 + tmp14;
-    let tmp16: f64 = tmp15 * attachments_m[(0, 0)];
-    let tmp17: f64 = tmp10 + tmp16 + tmp5;
-    let tmp18: f64 = tmp17 - anchors_m[(0, 0)] + position_m[0];
-    let tmp19: f64 = tmp18 * tmp18;
-    let tmp20: f64 = tmp2 * rotation_xyzw[3];
-    let tmp21: f64 = -tmp20;
-    let tmp22: f64 = 2.0_f64 * rotation_xyzw[1] * rotation_xyzw[2];
-    let tmp23: f64 = tmp21 + tmp22;
-    let tmp24: f64 = tmp23 * attachments_m[(2, 0)];
-    let tmp25: f64 = tmp6 + tmp8;
-    let tmp26: f64 = tmp25 * attachments_m[(0, 0)];
-    let tmp27: f64 = rotation_xyzw[0] * rotation_xyzw[0];
-    let tmp28: f64 = -2.0_f64 * tmp27;
-    let tmp29: f64 = tmp14 + tmp28;
-    let tmp30: f64 = tmp29 * attachments_m[(1, 0)];
-    let tmp31: f64 = tmp24 + tmp26 + tmp30;
-    let tmp32: f64 = tmp31 - anchors_m[(1, 0)] + position_m[1];
-    let tmp33: f64 = tmp32 * tmp32;
-    let tmp34: f64 = tmp19 + tmp33 + epsilon;
-    let tmp35: f64 = tmp34.sqrt();
-    let tmp36: f64 = 1.0_f64 / reference_tension_n[0];
-    let tmp37: f64 = 0.5_f64 * cable_weight_n_per_m;
-    let tmp38: f64 = tmp35 * tmp37;
-    let tmp39: f64 = tmp36 * tmp38;
-    let tmp40: f64 = tmp39 + epsilon * tmp39.signum();
-    let tmp41: f64 = tmp40.sinh();
-    let tmp42: f64 = 1.0_f64 / tmp40;
-    let tmp43: f64 = tmp39 + (tmp36 * reference_tension_n[1]).asinh();
-    let tmp44: f64 = tmp43.sinh();
-    let tmp45: f64 = tmp42 * tmp44;
-    let tmp46: f64 = tmp41 * tmp45;
-    let tmp47: f64 = tmp20 + tmp22;
-    let tmp48: f64 = -tmp1;
-    let tmp49: f64 = tmp3 + tmp48;
-    let tmp50: f64 = tmp12 + tmp28 + 1.0_f64;
-    let tmp51: f64 = tmp47 * attachments_m[(1, 0)] + tmp49 * attachments_m[(0, 0)] + tmp50 * attachments_m[(2, 0)];
-    let tmp52: f64 = tmp15 * attachments_m[(0, 1)] + tmp4 * attachments_m[(2, 1)] + tmp9 * attachments_m[(1, 1)];
-    let tmp53: f64 = tmp52 - anchors_m[(0, 1)] + position_m[0];
-    let tmp54: f64 = tmp23 * attachments_m[(2, 2)] + tmp25 * attachments_m[(0, 2)] + tmp29 * attachments_m[(1, 2)];
-    let tmp55: f64 = tmp54 - anchors_m[(1, 2)] + position_m[1];
-    let tmp56: f64 = tmp15 * attachments_m[(0, 2)] + tmp4 * attachments_m[(2, 2)] + tmp9 * attachments_m[(1, 2)];
-    let tmp57: f64 = tmp56 - anchors_m[(0, 2)] + position_m[0];
-    let tmp58: f64 = tmp57 * tmp57;
-    let tmp59: f64 = tmp55 * tmp55;
-    let tmp60: f64 = tmp58 + tmp59 + epsilon;
-    let tmp61: f64 = tmp60.sqrt();
-    let tmp62: f64 = 1.0_f64 / tmp61;
-    let tmp63: f64 = tmp23 * attachments_m[(2, 3)] + tmp25 * attachments_m[(0, 3)] + tmp29 * attachments_m[(1, 3)];
-    let tmp64: f64 = tmp63 - anchors_m[(1, 3)] + position_m[1];
-    let tmp65: f64 = tmp15 * attachments_m[(0, 3)] + tmp4 * attachments_m[(2, 3)] + tmp9 * attachments_m[(1, 3)];
-    let tmp66: f64 = tmp65 - anchors_m[(0, 3)] + position_m[0];
+    let tmp5: f64 = tmp0 * rotation_xyzw[2];
+    let tmp6: f64 = tmp2 * rotation_xyzw[1];
+    let tmp7: f64 = -tmp5 + tmp6;
+    let tmp8: f64 = -2.0_f64 * (rotation_xyzw[2] * rotation_xyzw[2]);
+    let tmp9: f64 = 1.0_f64 - 2.0_f64 * (rotation_xyzw[1] * rotation_xyzw[1]);
+    let tmp10: f64 = tmp8 + tmp9;
+    let tmp11: f64 = tmp10 * attachments_m[(0, 0)] + tmp4 * attachments_m[(2, 0)] + tmp7 * attachments_m[(1, 0)];
+    let tmp12: f64 = tmp11 - anchors_m[(0, 0)] + position_m[0];
+    let tmp13: f64 = tmp12 * tmp12;
+    let tmp14: f64 = tmp2 * rotation_xyzw[3];
+    let tmp15: f64 = 2.0_f64 * rotation_xyzw[1] * rotation_xyzw[2];
+    let tmp16: f64 = -tmp14 + tmp15;
+    let tmp17: f64 = tmp5 + tmp6;
+    let tmp18: f64 = -2.0_f64 * (rotation_xyzw[0] * rotation_xyzw[0]);
+    let tmp19: f64 = tmp18 + tmp8 + 1.0_f64;
+    let tmp20: f64 = tmp16 * attachments_m[(2, 0)] + tmp17 * attachments_m[(0, 0)] + tmp19 * attachments_m[(1, 0)];
+    let tmp21: f64 = tmp20 - anchors_m[(1, 0)] + position_m[1];
+    let tmp22: f64 = tmp21 * tmp21;
+    let tmp23: f64 = tmp13 + tmp22 + epsilon;
+    let tmp24: f64 = tmp23.sqrt();
+    let tmp25: f64 = 1.0_f64 / reference_tension_n[0];
+    let tmp26: f64 = 0.5_f64 * cable_weight_n_per_m;
+    let tmp27: f64 = tmp24 * tmp26;
+    let tmp28: f64 = tmp25 * tmp27;
+    let tmp29: f64 = tmp28 + (tmp25 * reference_tension_n[1]).asinh();
+    let tmp30: f64 = tmp29.sinh();
+    let tmp31: f64 = tmp28 + epsilon * tmp28.signum();
+    let tmp32: f64 = 1.0_f64 / tmp31;
+    let tmp33: f64 = tmp31.sinh();
+    let tmp34: f64 = tmp32 * tmp33;
+    let tmp35: f64 = tmp30 * tmp34;
+    let tmp36: f64 = tmp14 + tmp15;
+    let tmp37: f64 = -tmp1 + tmp3;
+    let tmp38: f64 = tmp18 + tmp9;
+    let tmp39: f64 = tmp36 * attachments_m[(1, 0)] + tmp37 * attachments_m[(0, 0)] + tmp38 * attachments_m[(2, 0)];
+    let tmp40: f64 = tmp10 * attachments_m[(0, 1)] + tmp4 * attachments_m[(2, 1)] + tmp7 * attachments_m[(1, 1)];
+    let tmp41: f64 = tmp40 - anchors_m[(0, 1)] + position_m[0];
+    let tmp42: f64 = tmp41 * tmp41;
+    let tmp43: f64 = tmp16 * attachments_m[(2, 1)] + tmp17 * attachments_m[(0, 1)] + tmp19 * attachments_m[(1, 1)];
+    let tmp44: f64 = tmp43 - anchors_m[(1, 1)] + position_m[1];
+    let tmp45: f64 = tmp44 * tmp44;
+    let tmp46: f64 = tmp42 + tmp45 + epsilon;
+    let tmp47: f64 = tmp46.sqrt();
+    let tmp48: f64 = 1.0_f64 / tmp24;
+    let tmp49: f64 = tmp21 * tmp48;
+    let tmp50: f64 = tmp12 * tmp48;
+    let tmp51: f64 = tmp11 * tmp49 - tmp20 * tmp50;
+    let tmp52: f64 = tmp10 * attachments_m[(0, 2)] + tmp4 * attachments_m[(2, 2)] + tmp7 * attachments_m[(1, 2)];
+    let tmp53: f64 = tmp52 - anchors_m[(0, 2)] + position_m[0];
+    let tmp54: f64 = tmp53 * tmp53;
+    let tmp55: f64 = tmp16 * attachments_m[(2, 2)] + tmp17 * attachments_m[(0, 2)] + tmp19 * attachments_m[(1, 2)];
+    let tmp56: f64 = tmp55 - anchors_m[(1, 2)] + position_m[1];
+    let tmp57: f64 = tmp56 * tmp56;
+    let tmp58: f64 = tmp54 + tmp57 + epsilon;
+    let tmp59: f64 = tmp58.sqrt();
+    let tmp60: f64 = 1.0_f64 / tmp59;
+    let tmp61: f64 = tmp56 * tmp60;
+    let tmp62: f64 = tmp10 * attachments_m[(0, 3)] + tmp4 * attachments_m[(2, 3)] + tmp7 * attachments_m[(1, 3)];
+    let tmp63: f64 = tmp62 - anchors_m[(0, 3)] + position_m[0];
+    let tmp64: f64 = tmp63 * tmp63;
+    let tmp65: f64 = tmp16 * attachments_m[(2, 3)] + tmp17 * attachments_m[(0, 3)] + tmp19 * attachments_m[(1, 3)];
+    let tmp66: f64 = tmp65 - anchors_m[(1, 3)] + position_m[1];
     let tmp67: f64 = tmp66 * tmp66;
-    let tmp68: f64 = tmp64 * tmp64;
-    let tmp69: f64 = tmp67 + tmp68 + epsilon;
-    let tmp70: f64 = tmp69.sqrt();
-    let tmp71: f64 = 1.0_f64 / tmp70;
-    let tmp72: f64 = tmp65 * tmp71;
-    let tmp73: f64 = tmp63 * tmp71;
-    let tmp74: f64 = tmp64 * tmp72 - tmp66 * tmp73;
-    let tmp75: f64 = tmp62 * tmp74;
-    let tmp76: f64 = tmp56 * tmp62;
-    let tmp77: f64 = tmp54 * tmp62;
-    let tmp78: f64 = tmp55 * tmp76 - tmp57 * tmp77;
-    let tmp79: f64 = tmp71 * tmp78;
-    let tmp80: f64 = tmp55 * tmp75 - tmp64 * tmp79;
-    let tmp81: f64 = tmp53 * tmp53;
-    let tmp82: f64 = tmp23 * attachments_m[(2, 1)] + tmp25 * attachments_m[(0, 1)] + tmp29 * attachments_m[(1, 1)];
-    let tmp83: f64 = tmp82 - anchors_m[(1, 1)] + position_m[1];
-    let tmp84: f64 = tmp83 * tmp83;
-    let tmp85: f64 = tmp81 + tmp84 + epsilon;
-    let tmp86: f64 = tmp85.sqrt();
-    let tmp87: f64 = 1.0_f64 / tmp86;
-    let tmp88: f64 = tmp80 * tmp87;
-    let tmp89: f64 = -tmp57 * tmp75 + tmp66 * tmp79;
-    let tmp90: f64 = tmp87 * tmp89;
-    let tmp91: f64 = tmp52 * tmp87;
-    let tmp92: f64 = tmp82 * tmp87;
-    let tmp93: f64 = -tmp53 * tmp92 + tmp83 * tmp91;
-    let tmp94: f64 = tmp66 * tmp71;
-    let tmp95: f64 = tmp55 * tmp62;
-    let tmp96: f64 = tmp64 * tmp71;
-    let tmp97: f64 = tmp62 * tmp96;
-    let tmp98: f64 = tmp57 * tmp97 - tmp94 * tmp95;
-    let tmp99: f64 = -tmp53 * tmp88 - tmp83 * tmp90 - tmp93 * tmp98;
-    let tmp100: f64 = tmp99 + epsilon * tmp99.signum();
-    let tmp101: f64 = 1.0_f64 / tmp35;
-    let tmp102: f64 = tmp101 * tmp32;
-    let tmp103: f64 = tmp102 * tmp89;
-    let tmp104: f64 = tmp101 * tmp18;
-    let tmp105: f64 = tmp104 * tmp80;
-    let tmp106: f64 = tmp101 * tmp17;
-    let tmp107: f64 = tmp101 * tmp31;
-    let tmp108: f64 = tmp106 * tmp32 - tmp107 * tmp18;
-    let tmp109: f64 = tmp108 * tmp98;
-    let tmp110: f64 =
-        tmp103 * reference_tension_n[0] + tmp105 * reference_tension_n[0] + tmp109 * reference_tension_n[0];
-    let tmp111: f64 = 1.0_f64 / tmp110;
-    let tmp112: f64 = tmp111 * tmp86;
-    let tmp113: f64 = tmp112 * tmp37;
-    let tmp114: f64 = tmp100 * tmp113;
-    let tmp115: f64 = tmp114 + epsilon * tmp114.signum();
-    let tmp116: f64 = 1.0_f64 / tmp115;
-    let tmp117: f64 = -tmp54 + tmp63;
-    let tmp118: f64 = -tmp56 + tmp65;
-    let tmp119: f64 = -tmp54 * tmp65 + tmp56 * tmp63;
-    let tmp120: f64 = -tmp117 * tmp52 + tmp118 * tmp82 + tmp119;
-    let tmp121: f64 = tmp120 + epsilon * tmp120.signum();
-    let tmp122: f64 = 1.0_f64 / tmp121;
-    let tmp123: f64 = tmp100 * tmp122;
-    let tmp124: f64 = tmp102 * tmp51;
-    let tmp125: f64 = tmp47 * attachments_m[(1, 2)] + tmp49 * attachments_m[(0, 2)] + tmp50 * attachments_m[(2, 2)];
-    let tmp126: f64 = 1.0_f64 / tmp100;
-    let tmp127: f64 = tmp108 * reference_tension_n[0];
-    let tmp128: f64 = tmp102 * tmp74;
-    let tmp129: f64 = tmp127 * tmp96 - tmp128 * reference_tension_n[0];
-    let tmp130: f64 = tmp129 * tmp87;
-    let tmp131: f64 = tmp104 * tmp74;
-    let tmp132: f64 = -tmp127 * tmp94 + tmp131 * reference_tension_n[0];
-    let tmp133: f64 = tmp132 * tmp87;
-    let tmp134: f64 = tmp102 * reference_tension_n[0];
-    let tmp135: f64 = tmp104 * reference_tension_n[0];
-    let tmp136: f64 = tmp134 * tmp94 - tmp135 * tmp96;
-    let tmp137: f64 = -tmp130 * tmp53 - tmp133 * tmp83 - tmp136 * tmp93;
-    let tmp138: f64 = tmp126 * tmp137;
-    let tmp139: f64 = tmp125 * tmp138;
-    let tmp140: f64 = tmp47 * attachments_m[(1, 3)] + tmp49 * attachments_m[(0, 3)] + tmp50 * attachments_m[(2, 3)];
-    let tmp141: f64 = tmp102 * tmp78;
-    let tmp142: f64 = -tmp127 * tmp95 + tmp141 * reference_tension_n[0];
-    let tmp143: f64 = tmp142 * tmp87;
-    let tmp144: f64 = tmp57 * tmp62;
-    let tmp145: f64 = tmp104 * tmp78;
-    let tmp146: f64 = tmp127 * tmp144 - tmp145 * reference_tension_n[0];
-    let tmp147: f64 = tmp146 * tmp87;
-    let tmp148: f64 = -tmp134 * tmp144 + tmp135 * tmp95;
-    let tmp149: f64 = -tmp143 * tmp53 - tmp147 * tmp83 - tmp148 * tmp93;
-    let tmp150: f64 = tmp126 * tmp149;
-    let tmp151: f64 = tmp140 * tmp150;
-    let tmp152: f64 = tmp83 * tmp87;
-    let tmp153: f64 = tmp47 * attachments_m[(1, 1)] + tmp49 * attachments_m[(0, 1)] + tmp50 * attachments_m[(2, 1)];
-    let tmp154: f64 = tmp126 * tmp153;
-    let tmp155: f64 = tmp110 * tmp154;
-    let tmp156: f64 = -tmp124 * reference_tension_n[0]
-        - tmp139 * tmp95
-        - tmp151 * tmp96
-        - tmp152 * tmp155
-        - tmp31 * reference_tension_n[1]
-        + platform_weight_n * (tmp23 * com_offset_m[2] + tmp25 * com_offset_m[0] + tmp29 * com_offset_m[1]);
-    let tmp157: f64 = tmp104 * tmp51;
-    let tmp158: f64 = tmp53 * tmp87;
-    let tmp159: f64 = tmp139 * tmp144
-        + tmp151 * tmp94
-        + tmp155 * tmp158
-        + tmp157 * reference_tension_n[0]
-        + tmp17 * reference_tension_n[1]
-        - platform_weight_n * (tmp15 * com_offset_m[0] + tmp4 * com_offset_m[2] + tmp9 * com_offset_m[1]);
-    let tmp160: f64 = platform_weight_n - reference_tension_n[1];
-    let tmp161: f64 = tmp117 * tmp159 + tmp118 * tmp156 + tmp119 * tmp160;
-    let tmp162: f64 = tmp111 * tmp161;
-    let tmp163: f64 = tmp114 + (tmp123 * tmp162).asinh();
-    let tmp164: f64 = tmp163.sinh();
-    let tmp165: f64 = tmp116 * tmp164;
-    let tmp166: f64 = tmp115.sinh();
-    let tmp167: f64 = tmp166 * tmp86;
-    let tmp168: f64 = 1.0_f64 / tmp137;
-    let tmp169: f64 = tmp168 * tmp61;
-    let tmp170: f64 = tmp169 * tmp37;
-    let tmp171: f64 = tmp100 * tmp170;
-    let tmp172: f64 = tmp171 + epsilon * tmp171.signum();
-    let tmp173: f64 = 1.0_f64 / tmp172;
-    let tmp174: f64 = tmp172.sinh();
-    let tmp175: f64 = tmp159 + tmp160 * tmp65;
-    let tmp176: f64 = -tmp156 + tmp160 * tmp63;
-    let tmp177: f64 = -tmp156 * tmp65 - tmp159 * tmp63 + tmp175 * tmp82 - tmp176 * tmp52;
-    let tmp178: f64 = tmp123 * tmp168;
-    let tmp179: f64 = tmp171 + (tmp177 * tmp178).asinh();
-    let tmp180: f64 = tmp179.sinh();
-    let tmp181: f64 = tmp174 * tmp180;
-    let tmp182: f64 = tmp181 * tmp61;
-    let tmp183: f64 = 1.0_f64 / tmp149;
-    let tmp184: f64 = tmp183 * tmp70;
-    let tmp185: f64 = tmp184 * tmp37;
-    let tmp186: f64 = tmp100 * tmp185;
-    let tmp187: f64 = tmp186 + epsilon * tmp186.signum();
-    let tmp188: f64 = tmp187.sinh();
-    let tmp189: f64 = tmp156 - tmp160 * tmp54;
-    let tmp190: f64 = -tmp159 - tmp160 * tmp56;
-    let tmp191: f64 = tmp156 * tmp56 + tmp159 * tmp54 - tmp189 * tmp52 + tmp190 * tmp82;
-    let tmp192: f64 = tmp183 * tmp191;
-    let tmp193: f64 = tmp186 + (tmp123 * tmp192).asinh();
-    let tmp194: f64 = tmp193.sinh();
-    let tmp195: f64 = tmp188 * tmp194;
-    let tmp196: f64 = 1.0_f64 / tmp187;
-    let tmp197: f64 = tmp196 * tmp70;
-    let tmp198: f64 = tmp45 * tmp40.cosh();
-    let tmp199: f64 = -tmp8;
-    let tmp200: f64 = tmp199 + tmp6;
-    let tmp201: f64 = tmp200 * attachments_m[(2, 0)] + tmp4 * attachments_m[(1, 0)];
-    let tmp202: f64 = 2.0_f64 * tmp18;
-    let tmp203: f64 = rotation_xyzw[3] * rotation_xyzw[3];
-    let tmp204: f64 = -tmp203;
-    let tmp205: f64 = tmp13 + tmp204;
-    let tmp206: f64 = -tmp11;
-    let tmp207: f64 = tmp206 + tmp27;
-    let tmp208: f64 = tmp205 + tmp207;
-    let tmp209: f64 = tmp208 * attachments_m[(2, 0)] + tmp23 * attachments_m[(1, 0)];
-    let tmp210: f64 = 2.0_f64 * tmp32;
-    let tmp211: f64 = tmp201 * tmp202 + tmp209 * tmp210;
-    let tmp212: f64 = 0.25_f64 * cable_weight_n_per_m;
-    let tmp213: f64 = tmp212 * tmp36;
-    let tmp214: f64 = tmp211 * tmp213;
-    let tmp215: f64 = tmp41 * tmp42 * tmp43.cosh();
-    let tmp216: f64 = tmp213 * tmp215;
-    let tmp217: f64 = tmp41 * tmp44 / (tmp40 * tmp40);
-    let tmp218: f64 = 0.5_f64 * tmp211;
-    let tmp219: f64 = tmp101 * tmp46;
-    let tmp220: f64 = -tmp22;
-    let tmp221: f64 = tmp21 + tmp220;
-    let tmp222: f64 = -tmp27;
-    let tmp223: f64 = tmp13 + tmp203 + tmp206 + tmp222;
-    let tmp224: f64 = tmp221 * attachments_m[(2, 0)] + tmp223 * attachments_m[(1, 0)];
-    let tmp225: f64 = tmp4 * attachments_m[(1, 2)];
-    let tmp226: f64 = tmp200 * attachments_m[(2, 2)];
-    let tmp227: f64 = tmp225 + tmp226;
-    let tmp228: f64 = 2.0_f64 * tmp57;
-    let tmp229: f64 = tmp23 * attachments_m[(1, 2)];
-    let tmp230: f64 = tmp208 * attachments_m[(2, 2)];
-    let tmp231: f64 = tmp229 + tmp230;
-    let tmp232: f64 = 2.0_f64 * tmp55;
-    let tmp233: f64 = tmp227 * tmp228 + tmp231 * tmp232;
-    let tmp234: f64 = 1.0_f64 / (tmp60 * tmp60.sqrt());
-    let tmp235: f64 = 0.5_f64 * tmp234 * tmp55;
-    let tmp236: f64 = tmp235 * tmp94;
-    let tmp237: f64 = tmp208 * attachments_m[(2, 3)] + tmp23 * attachments_m[(1, 3)];
-    let tmp238: f64 = tmp144 * tmp71;
-    let tmp239: f64 = 1.0_f64 / (tmp69 * tmp69.sqrt());
-    let tmp240: f64 = tmp144 * tmp239;
-    let tmp241: f64 = tmp200 * attachments_m[(2, 3)] + tmp4 * attachments_m[(1, 3)];
-    let tmp242: f64 = 2.0_f64 * tmp66;
-    let tmp243: f64 = 2.0_f64 * tmp64;
-    let tmp244: f64 = tmp237 * tmp243 + tmp241 * tmp242;
-    let tmp245: f64 = 0.5_f64 * tmp244;
-    let tmp246: f64 = tmp245 * tmp64;
-    let tmp247: f64 = tmp66 * tmp95;
-    let tmp248: f64 = tmp239 * tmp247;
-    let tmp249: f64 = tmp234 * tmp57;
-    let tmp250: f64 = 0.5_f64 * tmp249;
-    let tmp251: f64 = tmp250 * tmp96;
-    let tmp252: f64 = tmp71 * tmp95;
-    let tmp253: f64 = tmp62 * tmp94;
-    let tmp254: f64 = tmp227 * tmp97 - tmp231 * tmp253 + tmp233 * tmp236 - tmp233 * tmp251 + tmp237 * tmp238
-        - tmp240 * tmp246
-        - tmp241 * tmp252
-        + tmp245 * tmp248;
-    let tmp255: f64 = tmp101 * reference_tension_n[0];
-    let tmp256: f64 = tmp255 * tmp89;
-    let tmp257: f64 = tmp255 * tmp80;
-    let tmp258: f64 = tmp233 * tmp74;
-    let tmp259: f64 = tmp239 * tmp63;
-    let tmp260: f64 = tmp259 * tmp66;
-    let tmp261: f64 = tmp239 * tmp65;
-    let tmp262: f64 = tmp261 * tmp64;
-    let tmp263: f64 =
-        tmp237 * tmp72 - tmp237 * tmp94 - tmp241 * tmp73 + tmp241 * tmp96 + tmp245 * tmp260 - tmp245 * tmp262;
-    let tmp264: f64 = tmp239 * tmp78;
-    let tmp265: f64 = tmp245 * tmp264;
-    let tmp266: f64 = tmp250 * tmp54;
-    let tmp267: f64 = tmp235 * tmp56;
-    let tmp268: f64 =
-        -tmp144 * tmp231 - tmp227 * tmp77 + tmp227 * tmp95 + tmp231 * tmp76 + tmp233 * tmp266 - tmp233 * tmp267;
-    let tmp269: f64 =
-        tmp231 * tmp75 - tmp235 * tmp258 - tmp237 * tmp79 + tmp263 * tmp95 + tmp265 * tmp64 - tmp268 * tmp96;
-    let tmp270: f64 =
-        -tmp144 * tmp263 - tmp227 * tmp75 + tmp241 * tmp79 + tmp250 * tmp258 - tmp265 * tmp66 + tmp268 * tmp94;
-    let tmp271: f64 = 1.0_f64 / (tmp34 * tmp34.sqrt());
-    let tmp272: f64 = tmp271 * reference_tension_n[0];
-    let tmp273: f64 = tmp272 * tmp32;
-    let tmp274: f64 = tmp218 * tmp273;
-    let tmp275: f64 = tmp17 * tmp271;
-    let tmp276: f64 = tmp275 * tmp32;
-    let tmp277: f64 = tmp271 * tmp31;
-    let tmp278: f64 = tmp18 * tmp277;
-    let tmp279: f64 =
-        tmp102 * tmp201 - tmp104 * tmp209 + tmp106 * tmp209 - tmp107 * tmp201 - tmp218 * tmp276 + tmp218 * tmp278;
-    let tmp280: f64 = tmp98 * reference_tension_n[0];
-    let tmp281: f64 = tmp18 * tmp272;
-    let tmp282: f64 = tmp218 * tmp281;
-    let tmp283: f64 = tmp127 * tmp254 + tmp134 * tmp270 + tmp135 * tmp269 + tmp201 * tmp257 + tmp209 * tmp256
-        - tmp274 * tmp89
-        + tmp279 * tmp280
-        - tmp282 * tmp80;
-    let tmp284: f64 = 1.0_f64 / (tmp110 * tmp110);
-    let tmp285: f64 = tmp100 * tmp37;
-    let tmp286: f64 = tmp285 * tmp86;
-    let tmp287: f64 = tmp284 * tmp286;
-    let tmp288: f64 = tmp200 * attachments_m[(2, 1)] + tmp4 * attachments_m[(1, 1)];
-    let tmp289: f64 = 2.0_f64 * tmp53;
-    let tmp290: f64 = tmp208 * attachments_m[(2, 1)] + tmp23 * attachments_m[(1, 1)];
-    let tmp291: f64 = 2.0_f64 * tmp83;
-    let tmp292: f64 = tmp288 * tmp289 + tmp290 * tmp291;
-    let tmp293: f64 = tmp100 * tmp212;
-    let tmp294: f64 = tmp111 * tmp293 * tmp87;
-    let tmp295: f64 = 0.5_f64 * tmp292;
-    let tmp296: f64 = 1.0_f64 / (tmp85 * tmp85.sqrt());
-    let tmp297: f64 = tmp296 * tmp83;
-    let tmp298: f64 = tmp297 * tmp89;
-    let tmp299: f64 = tmp296 * tmp53;
-    let tmp300: f64 = tmp295 * tmp299;
-    let tmp301: f64 = tmp297 * tmp52;
-    let tmp302: f64 =
-        tmp152 * tmp288 - tmp158 * tmp290 - tmp288 * tmp92 + tmp290 * tmp91 - tmp295 * tmp301 + tmp300 * tmp82;
-    let tmp303: f64 = -tmp152 * tmp270 - tmp158 * tmp269 - tmp254 * tmp93 - tmp288 * tmp88 - tmp290 * tmp90
-        + tmp295 * tmp298
-        + tmp300 * tmp80
-        - tmp302 * tmp98;
-    let tmp304: f64 = tmp113 * tmp303 - tmp283 * tmp287 + tmp292 * tmp294;
-    let tmp305: f64 = tmp164 / (tmp115 * tmp115);
-    let tmp306: f64 = tmp167 * tmp305;
-    let tmp307: f64 = tmp165 * tmp115.cosh();
-    let tmp308: f64 = tmp307 * tmp86;
-    let tmp309: f64 = -tmp225 - tmp226 + tmp241;
-    let tmp310: f64 = -tmp229 - tmp230 + tmp237;
-    let tmp311: f64 = tmp227 * tmp63 - tmp231 * tmp65 + tmp237 * tmp56 - tmp241 * tmp54;
-    let tmp312: f64 = -tmp117 * tmp288 + tmp118 * tmp290 + tmp309 * tmp82 - tmp310 * tmp52 + tmp311;
-    let tmp313: f64 = 1.0_f64 / (tmp121 * tmp121);
-    let tmp314: f64 = tmp100 * tmp313;
-    let tmp315: f64 = tmp162 * tmp314;
-    let tmp316: f64 = tmp122 * tmp303;
-    let tmp317: f64 = tmp100 * tmp100;
-    let tmp318: f64 = 1.0_f64 / tmp317;
-    let tmp319: f64 = tmp303 * tmp318;
-    let tmp320: f64 = tmp110 * tmp153;
-    let tmp321: f64 = tmp158 * tmp320;
-    let tmp322: f64 = tmp319 * tmp321;
-    let tmp323: f64 = tmp282 * tmp51;
-    let tmp324: f64 = tmp155 * tmp300;
-    let tmp325: f64 = tmp151 * tmp239;
-    let tmp326: f64 = tmp245 * tmp66;
-    let tmp327: f64 = tmp325 * tmp326;
-    let tmp328: f64 = tmp255 * tmp51;
-    let tmp329: f64 = tmp201 * tmp328;
-    let tmp330: f64 = tmp140 * tmp149;
-    let tmp331: f64 = tmp330 * tmp94;
-    let tmp332: f64 = tmp319 * tmp331;
-    let tmp333: f64 = tmp132 * tmp297;
-    let tmp334: f64 = tmp255 * tmp74;
-    let tmp335: f64 = tmp127 * tmp71;
-    let tmp336: f64 = tmp94 * reference_tension_n[0];
-    let tmp337: f64 = tmp127 * tmp239;
-    let tmp338: f64 = tmp337 * tmp66;
-    let tmp339: f64 = tmp135 * tmp239;
-    let tmp340: f64 = tmp135 * tmp71;
-    let tmp341: f64 = tmp255 * tmp96;
-    let tmp342: f64 = tmp134 * tmp71;
-    let tmp343: f64 = tmp255 * tmp94;
-    let tmp344: f64 = tmp96 * reference_tension_n[0];
-    let tmp345: f64 = tmp18 * tmp271;
-    let tmp346: f64 = tmp344 * tmp345;
-    let tmp347: f64 = tmp134 * tmp239;
-    let tmp348: f64 = tmp271 * tmp32;
-    let tmp349: f64 = tmp336 * tmp348;
-    let tmp350: f64 = tmp129 * tmp300
-        - tmp130 * tmp288
-        - tmp133 * tmp290
-        - tmp136 * tmp302
-        - tmp152
-            * (tmp135 * tmp263 + tmp201 * tmp334 - tmp241 * tmp335 + tmp245 * tmp338
-                - tmp279 * tmp336
-                - tmp282 * tmp74)
-        - tmp158
-            * (-tmp134 * tmp263 - tmp209 * tmp334 + tmp237 * tmp335 - tmp246 * tmp337
-                + tmp274 * tmp74
-                + tmp279 * tmp344)
-        + tmp295 * tmp333
-        - tmp93
-            * (-tmp201 * tmp341 + tmp209 * tmp343 + tmp218 * tmp346 - tmp218 * tmp349 - tmp237 * tmp340
-                + tmp241 * tmp342
-                + tmp246 * tmp339
-                - tmp326 * tmp347);
-    let tmp351: f64 = tmp125 * tmp126;
-    let tmp352: f64 = tmp144 * tmp351;
-    let tmp353: f64 = tmp350 * tmp352;
-    let tmp354: f64 = tmp151 * tmp71;
-    let tmp355: f64 = tmp241 * tmp354;
-    let tmp356: f64 = tmp125 * tmp137;
-    let tmp357: f64 = tmp144 * tmp356;
-    let tmp358: f64 = tmp319 * tmp357;
-    let tmp359: f64 = tmp139 * tmp250;
-    let tmp360: f64 = tmp233 * tmp359;
-    let tmp361: f64 = tmp139 * tmp62;
-    let tmp362: f64 = tmp227 * tmp361;
-    let tmp363: f64 = tmp155 * tmp87;
-    let tmp364: f64 = tmp288 * tmp363;
-    let tmp365: f64 = platform_weight_n * (tmp200 * com_offset_m[2] + tmp4 * com_offset_m[1]);
-    let tmp366: f64 = tmp146 * tmp297;
-    let tmp367: f64 = tmp127 * tmp250;
-    let tmp368: f64 = tmp127 * tmp62;
-    let tmp369: f64 = tmp144 * reference_tension_n[0];
-    let tmp370: f64 = tmp255 * tmp78;
-    let tmp371: f64 = tmp281 * tmp78;
-    let tmp372: f64 = tmp127 * tmp235;
-    let tmp373: f64 = tmp95 * reference_tension_n[0];
-    let tmp374: f64 = tmp233 * tmp235;
-    let tmp375: f64 = tmp255 * tmp95;
-    let tmp376: f64 = tmp348 * tmp369;
-    let tmp377: f64 = tmp134 * tmp62;
-    let tmp378: f64 = tmp135 * tmp62;
-    let tmp379: f64 = tmp345 * tmp373;
-    let tmp380: f64 = tmp144 * tmp255;
-    let tmp381: f64 = tmp134 * tmp250;
-    let tmp382: f64 = tmp142 * tmp300
-        - tmp143 * tmp288
-        - tmp147 * tmp290
-        - tmp148 * tmp302
-        - tmp152
-            * (-tmp135 * tmp268 - tmp201 * tmp370 + tmp218 * tmp371 + tmp227 * tmp368 - tmp233 * tmp367
-                + tmp279 * tmp369)
-        - tmp158
-            * (tmp134 * tmp268 + tmp209 * tmp370 - tmp231 * tmp368 + tmp233 * tmp372
-                - tmp274 * tmp78
-                - tmp279 * tmp373)
-        + tmp295 * tmp366
-        - tmp93
-            * (-tmp135 * tmp374 + tmp201 * tmp375 - tmp209 * tmp380 + tmp218 * tmp376
-                - tmp218 * tmp379
-                - tmp227 * tmp377
-                + tmp231 * tmp378
-                + tmp233 * tmp381);
-    let tmp383: f64 = tmp126 * tmp140;
-    let tmp384: f64 = tmp383 * tmp94;
-    let tmp385: f64 = tmp382 * tmp384;
-    let tmp386: f64 = tmp221 * attachments_m[(2, 2)] + tmp223 * attachments_m[(1, 2)];
-    let tmp387: f64 = tmp138 * tmp144;
-    let tmp388: f64 = tmp386 * tmp387;
-    let tmp389: f64 = tmp135 * tmp224;
-    let tmp390: f64 = tmp154 * tmp158;
-    let tmp391: f64 = tmp283 * tmp390;
-    let tmp392: f64 = tmp201 * reference_tension_n[1];
-    let tmp393: f64 = tmp221 * attachments_m[(2, 3)] + tmp223 * attachments_m[(1, 3)];
-    let tmp394: f64 = tmp150 * tmp94;
-    let tmp395: f64 = tmp393 * tmp394;
-    let tmp396: f64 = tmp221 * attachments_m[(2, 1)] + tmp223 * attachments_m[(1, 1)];
-    let tmp397: f64 = tmp110 * tmp126;
-    let tmp398: f64 = tmp396 * tmp397;
-    let tmp399: f64 = tmp158 * tmp398;
-    let tmp400: f64 =
-        -tmp322 - tmp323 - tmp324 - tmp327 + tmp329 - tmp332 + tmp353 + tmp355 - tmp358 - tmp360 + tmp362 + tmp364
-            - tmp365
-            + tmp385
-            + tmp388
-            + tmp389
-            + tmp391
-            + tmp392
-            + tmp395
-            + tmp399;
-    let tmp401: f64 = tmp356 * tmp95;
-    let tmp402: f64 = tmp319 * tmp401;
-    let tmp403: f64 = tmp246 * tmp325;
-    let tmp404: f64 = tmp138 * tmp95;
-    let tmp405: f64 = tmp386 * tmp404;
-    let tmp406: f64 = platform_weight_n * (tmp208 * com_offset_m[2] + tmp23 * com_offset_m[1]);
-    let tmp407: f64 = tmp209 * tmp328;
-    let tmp408: f64 = tmp152 * tmp320;
-    let tmp409: f64 = tmp319 * tmp408;
-    let tmp410: f64 = tmp274 * tmp51;
-    let tmp411: f64 = tmp155 * tmp297;
-    let tmp412: f64 = tmp295 * tmp411;
-    let tmp413: f64 = tmp152 * tmp154;
-    let tmp414: f64 = tmp283 * tmp413;
-    let tmp415: f64 = tmp383 * tmp96;
-    let tmp416: f64 = tmp382 * tmp415;
-    let tmp417: f64 = tmp237 * tmp354;
-    let tmp418: f64 = tmp152 * tmp398;
-    let tmp419: f64 = tmp351 * tmp95;
-    let tmp420: f64 = tmp350 * tmp419;
-    let tmp421: f64 = tmp330 * tmp96;
-    let tmp422: f64 = tmp319 * tmp421;
-    let tmp423: f64 = tmp134 * tmp224;
-    let tmp424: f64 = tmp209 * reference_tension_n[1];
-    let tmp425: f64 = tmp150 * tmp96;
-    let tmp426: f64 = tmp393 * tmp425;
-    let tmp427: f64 = tmp290 * tmp363;
-    let tmp428: f64 = tmp231 * tmp361;
-    let tmp429: f64 = tmp139 * tmp374;
-    let tmp430: f64 = tmp402 + tmp403 - tmp405 + tmp406 - tmp407 + tmp409 + tmp410 + tmp412
-        - tmp414
-        - tmp416
-        - tmp417
-        - tmp418
-        - tmp420
-        + tmp422
-        - tmp423
-        - tmp424
-        - tmp426
-        - tmp427
-        - tmp428
-        + tmp429;
-    let tmp431: f64 = tmp111 * tmp123;
-    let tmp432: f64 = tmp123 * tmp161;
-    let tmp433: f64 = tmp284 * tmp432;
-    let tmp434: f64 = tmp313 * tmp317;
-    let tmp435: f64 = 1.0_f64 / (((tmp161 * tmp161) * tmp284 * tmp434 + 1.0_f64).sqrt());
-    let tmp436: f64 = tmp116 * tmp167 * tmp163.cosh();
-    let tmp437: f64 = tmp165 * tmp166;
-    let tmp438: f64 = tmp437 * tmp87;
-    let tmp439: f64 = tmp233 * tmp62;
-    let tmp440: f64 = tmp173 * tmp181;
-    let tmp441: f64 = 0.5_f64 * tmp440;
-    let tmp442: f64 = tmp168 * tmp293;
-    let tmp443: f64 = 1.0_f64 / (tmp137 * tmp137);
-    let tmp444: f64 = tmp350 * tmp443;
-    let tmp445: f64 = tmp285 * tmp61;
-    let tmp446: f64 = tmp170 * tmp303 + tmp439 * tmp442 - tmp444 * tmp445;
-    let tmp447: f64 = tmp173 * tmp61;
-    let tmp448: f64 = tmp180 * tmp172.cosh();
-    let tmp449: f64 = tmp447 * tmp448;
-    let tmp450: f64 = 1.0_f64 / (tmp172 * tmp172);
-    let tmp451: f64 = tmp182 * tmp450;
-    let tmp452: f64 = tmp123 * tmp177;
-    let tmp453: f64 = tmp168 * tmp177;
-    let tmp454: f64 = tmp314 * tmp453;
-    let tmp455: f64 = 1.0_f64 / (((tmp177 * tmp177) * tmp434 * tmp443 + 1.0_f64).sqrt());
-    let tmp456: f64 = tmp174 * tmp447 * tmp179.cosh();
-    let tmp457: f64 = 1.0_f64 / (tmp149 * tmp149);
-    let tmp458: f64 = tmp285 * tmp70;
-    let tmp459: f64 = tmp457 * tmp458;
-    let tmp460: f64 = tmp100 * tmp183;
-    let tmp461: f64 = tmp212 * tmp460 * tmp71;
-    let tmp462: f64 = tmp185 * tmp303 + tmp244 * tmp461 - tmp382 * tmp459;
-    let tmp463: f64 = tmp194 * tmp187.cosh();
-    let tmp464: f64 = tmp197 * tmp463;
-    let tmp465: f64 = tmp195 / (tmp187 * tmp187);
-    let tmp466: f64 = tmp465 * tmp70;
-    let tmp467: f64 = 1.0_f64 / (((tmp191 * tmp191) * tmp434 * tmp457 + 1.0_f64).sqrt());
-    let tmp468: f64 = tmp123 * tmp191;
-    let tmp469: f64 = tmp457 * tmp468;
-    let tmp470: f64 = tmp123 * tmp183;
-    let tmp471: f64 = tmp192 * tmp314;
-    let tmp472: f64 = tmp188 * tmp197 * tmp193.cosh();
-    let tmp473: f64 = tmp195 * tmp196;
-    let tmp474: f64 = tmp473 * tmp71;
-    let tmp475: f64 = tmp20 + tmp220;
-    let tmp476: f64 = tmp25 * attachments_m[(2, 0)] + tmp475 * attachments_m[(0, 0)];
-    let tmp477: f64 = -tmp3;
-    let tmp478: f64 = tmp477 + tmp48;
-    let tmp479: f64 = -tmp13;
-    let tmp480: f64 = tmp203 + tmp479;
-    let tmp481: f64 = tmp207 + tmp480;
-    let tmp482: f64 = tmp478 * attachments_m[(0, 0)] + tmp481 * attachments_m[(2, 0)];
-    let tmp483: f64 = tmp202 * tmp482 + tmp210 * tmp476;
-    let tmp484: f64 = tmp213 * tmp483;
-    let tmp485: f64 = 0.5_f64 * tmp483;
-    let tmp486: f64 = tmp11 + tmp204 + tmp27 + tmp479;
-    let tmp487: f64 = tmp486 * attachments_m[(0, 0)] + tmp49 * attachments_m[(2, 0)];
-    let tmp488: f64 = tmp25 * attachments_m[(2, 1)] + tmp475 * attachments_m[(0, 1)];
-    let tmp489: f64 = tmp478 * attachments_m[(0, 1)] + tmp481 * attachments_m[(2, 1)];
-    let tmp490: f64 = tmp289 * tmp489 + tmp291 * tmp488;
-    let tmp491: f64 = 0.5_f64 * tmp490;
-    let tmp492: f64 = tmp475 * attachments_m[(0, 2)];
-    let tmp493: f64 = tmp25 * attachments_m[(2, 2)];
-    let tmp494: f64 = tmp492 + tmp493;
-    let tmp495: f64 = tmp478 * attachments_m[(0, 2)];
-    let tmp496: f64 = tmp481 * attachments_m[(2, 2)];
-    let tmp497: f64 = tmp495 + tmp496;
-    let tmp498: f64 = tmp228 * tmp497 + tmp232 * tmp494;
-    let tmp499: f64 = tmp498 * tmp74;
-    let tmp500: f64 = tmp478 * attachments_m[(0, 3)] + tmp481 * attachments_m[(2, 3)];
-    let tmp501: f64 = tmp25 * attachments_m[(2, 3)] + tmp475 * attachments_m[(0, 3)];
-    let tmp502: f64 = tmp242 * tmp500 + tmp243 * tmp501;
-    let tmp503: f64 = 0.5_f64 * tmp502;
-    let tmp504: f64 =
-        tmp260 * tmp503 - tmp262 * tmp503 - tmp500 * tmp73 + tmp500 * tmp96 + tmp501 * tmp72 - tmp501 * tmp94;
-    let tmp505: f64 = tmp264 * tmp64;
-    let tmp506: f64 =
-        -tmp144 * tmp494 + tmp266 * tmp498 - tmp267 * tmp498 + tmp494 * tmp76 - tmp497 * tmp77 + tmp497 * tmp95;
-    let tmp507: f64 =
-        -tmp235 * tmp499 + tmp494 * tmp75 - tmp501 * tmp79 + tmp503 * tmp505 + tmp504 * tmp95 - tmp506 * tmp96;
-    let tmp508: f64 = tmp239 * tmp503;
-    let tmp509: f64 = tmp508 * tmp64;
-    let tmp510: f64 = -tmp144 * tmp509 + tmp236 * tmp498 + tmp238 * tmp501 + tmp247 * tmp508
-        - tmp251 * tmp498
-        - tmp252 * tmp500
-        - tmp253 * tmp494
-        + tmp497 * tmp97;
-    let tmp511: f64 = tmp299 * tmp491;
-    let tmp512: f64 =
-        tmp152 * tmp489 - tmp158 * tmp488 - tmp301 * tmp491 + tmp488 * tmp91 - tmp489 * tmp92 + tmp511 * tmp82;
-    let tmp513: f64 = tmp264 * tmp66;
-    let tmp514: f64 =
-        -tmp144 * tmp504 + tmp250 * tmp499 - tmp497 * tmp75 + tmp500 * tmp79 - tmp503 * tmp513 + tmp506 * tmp94;
-    let tmp515: f64 =
-        -tmp152 * tmp514 - tmp158 * tmp507 + tmp298 * tmp491 - tmp488 * tmp90 - tmp489 * tmp88 - tmp510 * tmp93
-            + tmp511 * tmp80
-            - tmp512 * tmp98;
-    let tmp516: f64 = tmp122 * tmp162;
-    let tmp517: f64 = -tmp492 - tmp493 + tmp501;
-    let tmp518: f64 = tmp361 * tmp497;
-    let tmp519: f64 = tmp328 * tmp482;
-    let tmp520: f64 =
-        tmp102 * tmp482 - tmp104 * tmp476 + tmp106 * tmp476 - tmp107 * tmp482 - tmp276 * tmp485 + tmp278 * tmp485;
-    let tmp521: f64 = tmp281 * tmp485;
-    let tmp522: f64 = tmp273 * tmp485;
-    let tmp523: f64 =
-        tmp127 * tmp510 + tmp134 * tmp514 + tmp135 * tmp507 + tmp256 * tmp476 + tmp257 * tmp482 + tmp280 * tmp520
-            - tmp521 * tmp80
-            - tmp522 * tmp89;
-    let tmp524: f64 = tmp390 * tmp523;
-    let tmp525: f64 = tmp318 * tmp515;
-    let tmp526: f64 = tmp331 * tmp525;
-    let tmp527: f64 = tmp235 * tmp498;
-    let tmp528: f64 = tmp142 * tmp511
-        - tmp143 * tmp489
-        - tmp147 * tmp488
-        - tmp148 * tmp512
-        - tmp152
-            * (-tmp135 * tmp506 - tmp367 * tmp498 + tmp368 * tmp497 + tmp369 * tmp520 - tmp370 * tmp482
-                + tmp521 * tmp78)
-        - tmp158
-            * (tmp134 * tmp506 - tmp368 * tmp494 + tmp370 * tmp476 + tmp372 * tmp498
-                - tmp373 * tmp520
-                - tmp522 * tmp78)
-        + tmp366 * tmp491
-        - tmp93
-            * (-tmp135 * tmp527 + tmp375 * tmp482 + tmp376 * tmp485 - tmp377 * tmp497 + tmp378 * tmp494
-                - tmp379 * tmp485
-                - tmp380 * tmp476
-                + tmp381 * tmp498);
-    let tmp529: f64 = tmp384 * tmp528;
-    let tmp530: f64 = tmp359 * tmp498;
-    let tmp531: f64 = tmp482 * reference_tension_n[1];
-    let tmp532: f64 = tmp486 * attachments_m[(0, 2)] + tmp49 * attachments_m[(2, 2)];
-    let tmp533: f64 = tmp387 * tmp532;
-    let tmp534: f64 = tmp354 * tmp500;
-    let tmp535: f64 = tmp486 * attachments_m[(0, 1)] + tmp49 * attachments_m[(2, 1)];
-    let tmp536: f64 = tmp397 * tmp535;
-    let tmp537: f64 = tmp158 * tmp536;
-    let tmp538: f64 = tmp155 * tmp511;
-    let tmp539: f64 = platform_weight_n * (tmp478 * com_offset_m[0] + tmp481 * com_offset_m[2]);
-    let tmp540: f64 = tmp127 * tmp508;
-    let tmp541: f64 = tmp508 * tmp66;
-    let tmp542: f64 = tmp129 * tmp511
-        - tmp130 * tmp489
-        - tmp133 * tmp488
-        - tmp136 * tmp512
-        - tmp152
-            * (tmp135 * tmp504 + tmp334 * tmp482 - tmp335 * tmp500 - tmp336 * tmp520 - tmp521 * tmp74 + tmp540 * tmp66)
-        - tmp158
-            * (-tmp134 * tmp504 - tmp334 * tmp476 + tmp335 * tmp501 + tmp344 * tmp520 + tmp522 * tmp74
-                - tmp540 * tmp64)
-        + tmp333 * tmp491
-        - tmp93
-            * (-tmp134 * tmp541 + tmp135 * tmp509 - tmp340 * tmp501 - tmp341 * tmp482
-                + tmp342 * tmp500
-                + tmp343 * tmp476
-                + tmp346 * tmp485
-                - tmp349 * tmp485);
-    let tmp543: f64 = tmp352 * tmp542;
-    let tmp544: f64 = tmp363 * tmp489;
-    let tmp545: f64 = tmp486 * attachments_m[(0, 3)] + tmp49 * attachments_m[(2, 3)];
-    let tmp546: f64 = tmp394 * tmp545;
-    let tmp547: f64 = tmp321 * tmp525;
-    let tmp548: f64 = tmp151 * tmp541;
-    let tmp549: f64 = tmp51 * tmp521;
-    let tmp550: f64 = tmp357 * tmp525;
-    let tmp551: f64 = tmp135 * tmp487;
-    let tmp552: f64 =
-        tmp518 + tmp519 + tmp524 - tmp526 + tmp529 - tmp530 + tmp531 + tmp533 + tmp534 + tmp537 - tmp538 - tmp539
-            + tmp543
-            + tmp544
-            + tmp546
-            - tmp547
-            - tmp548
-            - tmp549
-            - tmp550
-            + tmp551;
-    let tmp553: f64 = -tmp494 * tmp65 + tmp497 * tmp63 - tmp500 * tmp54 + tmp501 * tmp56;
-    let tmp554: f64 = -tmp495 - tmp496 + tmp500;
-    let tmp555: f64 = tmp318 * tmp401;
-    let tmp556: f64 = tmp515 * tmp555;
-    let tmp557: f64 = tmp354 * tmp501;
-    let tmp558: f64 = tmp363 * tmp488;
-    let tmp559: f64 = platform_weight_n * (tmp25 * com_offset_m[2] + tmp475 * com_offset_m[0]);
-    let tmp560: f64 = tmp476 * reference_tension_n[1];
-    let tmp561: f64 = tmp413 * tmp523;
-    let tmp562: f64 = tmp51 * tmp522;
-    let tmp563: f64 = tmp328 * tmp476;
-    let tmp564: f64 = tmp421 * tmp525;
-    let tmp565: f64 = tmp408 * tmp525;
-    let tmp566: f64 = tmp415 * tmp528;
-    let tmp567: f64 = tmp411 * tmp491;
-    let tmp568: f64 = tmp419 * tmp542;
-    let tmp569: f64 = tmp139 * tmp527;
-    let tmp570: f64 = tmp404 * tmp532;
-    let tmp571: f64 = tmp134 * tmp487;
-    let tmp572: f64 = tmp361 * tmp494;
-    let tmp573: f64 = tmp151 * tmp509;
-    let tmp574: f64 = tmp425 * tmp545;
-    let tmp575: f64 = tmp152 * tmp536;
-    let tmp576: f64 = tmp556 - tmp557 - tmp558 + tmp559 - tmp560 - tmp561 + tmp562 - tmp563 + tmp564 + tmp565 - tmp566
-        + tmp567
-        - tmp568
-        + tmp569
-        - tmp570
-        - tmp571
-        - tmp572
-        + tmp573
-        - tmp574
-        - tmp575;
-    let tmp577: f64 = -tmp117 * tmp489 + tmp118 * tmp488 - tmp517 * tmp52 + tmp553 + tmp554 * tmp82;
-    let tmp578: f64 = tmp113 * tmp515 - tmp287 * tmp523 + tmp294 * tmp490;
-    let tmp579: f64 = tmp443 * tmp452;
-    let tmp580: f64 = tmp122 * tmp453;
-    let tmp581: f64 = tmp498 * tmp62;
-    let tmp582: f64 = tmp443 * tmp445;
-    let tmp583: f64 = tmp170 * tmp515 + tmp442 * tmp581 - tmp542 * tmp582;
-    let tmp584: f64 = tmp185 * tmp515 - tmp459 * tmp528 + tmp461 * tmp502;
-    let tmp585: f64 = tmp122 * tmp192;
-    let tmp586: f64 = tmp199 + tmp7;
-    let tmp587: f64 = tmp11 + tmp222;
-    let tmp588: f64 = tmp480 + tmp587;
-    let tmp589: f64 = tmp586 * attachments_m[(1, 0)] + tmp588 * attachments_m[(0, 0)];
-    let tmp590: f64 = tmp205 + tmp587;
-    let tmp591: f64 = tmp590 * attachments_m[(1, 0)] + tmp9 * attachments_m[(0, 0)];
-    let tmp592: f64 = tmp202 * tmp591 + tmp210 * tmp589;
-    let tmp593: f64 = 0.5_f64 * tmp592;
-    let tmp594: f64 = tmp213 * tmp592;
-    let tmp595: f64 = tmp1 + tmp477;
-    let tmp596: f64 = tmp47 * attachments_m[(0, 0)] + tmp595 * attachments_m[(1, 0)];
-    let tmp597: f64 = tmp586 * attachments_m[(1, 1)] + tmp588 * attachments_m[(0, 1)];
-    let tmp598: f64 = tmp590 * attachments_m[(1, 1)] + tmp9 * attachments_m[(0, 1)];
-    let tmp599: f64 = tmp289 * tmp598 + tmp291 * tmp597;
-    let tmp600: f64 = 0.5_f64 * tmp599;
-    let tmp601: f64 = tmp586 * attachments_m[(1, 2)];
-    let tmp602: f64 = tmp588 * attachments_m[(0, 2)];
-    let tmp603: f64 = tmp601 + tmp602;
-    let tmp604: f64 = tmp9 * attachments_m[(0, 2)];
-    let tmp605: f64 = tmp590 * attachments_m[(1, 2)];
-    let tmp606: f64 = tmp604 + tmp605;
-    let tmp607: f64 = tmp228 * tmp606 + tmp232 * tmp603;
-    let tmp608: f64 =
-        -tmp144 * tmp603 + tmp266 * tmp607 - tmp267 * tmp607 + tmp603 * tmp76 - tmp606 * tmp77 + tmp606 * tmp95;
-    let tmp609: f64 = tmp586 * attachments_m[(1, 3)] + tmp588 * attachments_m[(0, 3)];
-    let tmp610: f64 = tmp590 * attachments_m[(1, 3)] + tmp9 * attachments_m[(0, 3)];
-    let tmp611: f64 = tmp242 * tmp610 + tmp243 * tmp609;
-    let tmp612: f64 = 0.5_f64 * tmp611;
-    let tmp613: f64 =
-        tmp260 * tmp612 - tmp262 * tmp612 + tmp609 * tmp72 - tmp609 * tmp94 - tmp610 * tmp73 + tmp610 * tmp96;
-    let tmp614: f64 = tmp607 * tmp74;
-    let tmp615: f64 =
-        -tmp235 * tmp614 + tmp505 * tmp612 + tmp603 * tmp75 - tmp608 * tmp96 - tmp609 * tmp79 + tmp613 * tmp95;
-    let tmp616: f64 =
-        tmp102 * tmp591 - tmp104 * tmp589 + tmp106 * tmp589 - tmp107 * tmp591 - tmp276 * tmp593 + tmp278 * tmp593;
-    let tmp617: f64 =
-        -tmp144 * tmp613 + tmp250 * tmp614 - tmp513 * tmp612 - tmp606 * tmp75 + tmp608 * tmp94 + tmp610 * tmp79;
-    let tmp618: f64 = tmp273 * tmp593;
-    let tmp619: f64 = tmp612 * tmp64;
-    let tmp620: f64 = tmp236 * tmp607 + tmp238 * tmp609 - tmp240 * tmp619 + tmp248 * tmp612
-        - tmp251 * tmp607
-        - tmp252 * tmp610
-        - tmp253 * tmp603
-        + tmp606 * tmp97;
-    let tmp621: f64 = tmp281 * tmp593;
-    let tmp622: f64 =
-        tmp127 * tmp620 + tmp134 * tmp617 + tmp135 * tmp615 + tmp256 * tmp589 + tmp257 * tmp591 + tmp280 * tmp616
-            - tmp618 * tmp89
-            - tmp621 * tmp80;
-    let tmp623: f64 = tmp299 * tmp600;
-    let tmp624: f64 =
-        tmp152 * tmp598 - tmp158 * tmp597 - tmp301 * tmp600 + tmp597 * tmp91 - tmp598 * tmp92 + tmp623 * tmp82;
-    let tmp625: f64 = tmp297 * tmp600;
-    let tmp626: f64 = -tmp152 * tmp617 - tmp158 * tmp615 - tmp597 * tmp90 - tmp598 * tmp88 - tmp620 * tmp93
-        + tmp623 * tmp80
-        - tmp624 * tmp98
-        + tmp625 * tmp89;
-    let tmp627: f64 = tmp113 * tmp626 - tmp287 * tmp622 + tmp294 * tmp599;
-    let tmp628: f64 = -tmp601 - tmp602 + tmp609;
-    let tmp629: f64 = tmp363 * tmp598;
-    let tmp630: f64 = tmp359 * tmp607;
-    let tmp631: f64 = tmp361 * tmp606;
-    let tmp632: f64 = tmp318 * tmp626;
-    let tmp633: f64 = tmp321 * tmp632;
-    let tmp634: f64 = tmp47 * attachments_m[(0, 1)] + tmp595 * attachments_m[(1, 1)];
-    let tmp635: f64 = tmp397 * tmp634;
-    let tmp636: f64 = tmp158 * tmp635;
-    let tmp637: f64 = tmp612 * tmp66;
-    let tmp638: f64 = tmp325 * tmp637;
-    let tmp639: f64 = tmp47 * attachments_m[(0, 3)] + tmp595 * attachments_m[(1, 3)];
-    let tmp640: f64 = tmp394 * tmp639;
-    let tmp641: f64 = tmp357 * tmp632;
-    let tmp642: f64 = tmp129 * tmp623 - tmp130 * tmp598 + tmp132 * tmp625
-        - tmp133 * tmp597
-        - tmp136 * tmp624
-        - tmp152
-            * (tmp135 * tmp613 + tmp334 * tmp591 - tmp335 * tmp610 - tmp336 * tmp616 + tmp338 * tmp612
-                - tmp621 * tmp74)
-        - tmp158
-            * (-tmp134 * tmp613 - tmp334 * tmp589 + tmp335 * tmp609 - tmp337 * tmp619
-                + tmp344 * tmp616
-                + tmp618 * tmp74)
-        - tmp93
-            * (tmp339 * tmp619 - tmp340 * tmp609 - tmp341 * tmp591
-                + tmp342 * tmp610
-                + tmp343 * tmp589
-                + tmp346 * tmp593
-                - tmp347 * tmp637
-                - tmp349 * tmp593);
-    let tmp643: f64 = tmp352 * tmp642;
-    let tmp644: f64 = tmp235 * tmp607;
-    let tmp645: f64 = tmp142 * tmp623 - tmp143 * tmp598 + tmp146 * tmp625
-        - tmp147 * tmp597
-        - tmp148 * tmp624
-        - tmp152
-            * (-tmp135 * tmp608 - tmp367 * tmp607 + tmp368 * tmp606 + tmp369 * tmp616 - tmp370 * tmp591
-                + tmp371 * tmp593)
-        - tmp158
-            * (tmp134 * tmp608 - tmp368 * tmp603 + tmp370 * tmp589 + tmp372 * tmp607
-                - tmp373 * tmp616
-                - tmp618 * tmp78)
-        - tmp93
-            * (-tmp135 * tmp644 + tmp375 * tmp591 + tmp376 * tmp593 - tmp377 * tmp606 + tmp378 * tmp603
-                - tmp379 * tmp593
-                - tmp380 * tmp589
-                + tmp381 * tmp607);
-    let tmp646: f64 = tmp384 * tmp645;
-    let tmp647: f64 = tmp331 * tmp632;
-    let tmp648: f64 = tmp328 * tmp591;
-    let tmp649: f64 = tmp591 * reference_tension_n[1];
-    let tmp650: f64 = tmp51 * tmp621;
-    let tmp651: f64 = tmp354 * tmp610;
-    let tmp652: f64 = platform_weight_n * (tmp590 * com_offset_m[1] + tmp9 * com_offset_m[0]);
-    let tmp653: f64 = tmp135 * tmp596;
-    let tmp654: f64 = tmp390 * tmp622;
-    let tmp655: f64 = tmp155 * tmp623;
-    let tmp656: f64 = tmp47 * attachments_m[(0, 2)] + tmp595 * attachments_m[(1, 2)];
-    let tmp657: f64 = tmp387 * tmp656;
-    let tmp658: f64 = tmp629 - tmp630 + tmp631 - tmp633 + tmp636 - tmp638 + tmp640 - tmp641 + tmp643 + tmp646 - tmp647
-        + tmp648
-        + tmp649
-        - tmp650
-        + tmp651
-        - tmp652
-        + tmp653
-        + tmp654
-        - tmp655
-        + tmp657;
-    let tmp659: f64 = -tmp54 * tmp610 + tmp56 * tmp609 - tmp603 * tmp65 + tmp606 * tmp63;
-    let tmp660: f64 = -tmp604 - tmp605 + tmp610;
-    let tmp661: f64 = tmp139 * tmp644;
-    let tmp662: f64 = tmp354 * tmp609;
-    let tmp663: f64 = tmp408 * tmp632;
-    let tmp664: f64 = tmp419 * tmp642;
-    let tmp665: f64 = tmp152 * tmp635;
-    let tmp666: f64 = tmp415 * tmp645;
-    let tmp667: f64 = tmp325 * tmp619;
-    let tmp668: f64 = tmp155 * tmp625;
-    let tmp669: f64 = tmp134 * tmp596;
-    let tmp670: f64 = tmp361 * tmp603;
-    let tmp671: f64 = tmp421 * tmp632;
-    let tmp672: f64 = platform_weight_n * (tmp586 * com_offset_m[1] + tmp588 * com_offset_m[0]);
-    let tmp673: f64 = tmp328 * tmp589;
-    let tmp674: f64 = tmp51 * tmp618;
-    let tmp675: f64 = tmp363 * tmp597;
-    let tmp676: f64 = tmp425 * tmp639;
-    let tmp677: f64 = tmp555 * tmp626;
-    let tmp678: f64 = tmp413 * tmp622;
-    let tmp679: f64 = tmp404 * tmp656;
-    let tmp680: f64 = tmp589 * reference_tension_n[1];
-    let tmp681: f64 =
-        tmp661 - tmp662 + tmp663 - tmp664 - tmp665 - tmp666 + tmp667 + tmp668 - tmp669 - tmp670 + tmp671 + tmp672
-            - tmp673
-            + tmp674
-            - tmp675
-            - tmp676
-            + tmp677
-            - tmp678
-            - tmp679
-            - tmp680;
-    let tmp682: f64 = -tmp117 * tmp598 + tmp118 * tmp597 - tmp52 * tmp628 + tmp659 + tmp660 * tmp82;
-    let tmp683: f64 = tmp607 * tmp62;
-    let tmp684: f64 = tmp170 * tmp626 + tmp442 * tmp683 - tmp582 * tmp642;
-    let tmp685: f64 = tmp185 * tmp626 - tmp459 * tmp645 + tmp461 * tmp611;
-    let tmp686: f64 = tmp36 * tmp37;
-    let tmp687: f64 = tmp18 * tmp686;
-    let tmp688: f64 = tmp217 * tmp687;
-    let tmp689: f64 = tmp215 * tmp687;
-    let tmp690: f64 = tmp198 * tmp687;
-    let tmp691: f64 = tmp104 * tmp46;
-    let tmp692: f64 = tmp296 * tmp81;
-    let tmp693: f64 = tmp692 * tmp80;
-    let tmp694: f64 = tmp299 * tmp83;
-    let tmp695: f64 = tmp694 * tmp89;
-    let tmp696: f64 = tmp239 * tmp67;
-    let tmp697: f64 = tmp696 * tmp95;
-    let tmp698: f64 = tmp249 * tmp55;
-    let tmp699: f64 = tmp698 * tmp94;
-    let tmp700: f64 = tmp64 * tmp66;
-    let tmp701: f64 = tmp239 * tmp700;
-    let tmp702: f64 = tmp144 * tmp701;
-    let tmp703: f64 = tmp234 * tmp58;
-    let tmp704: f64 = tmp703 * tmp96;
-    let tmp705: f64 = -tmp252 + tmp697 + tmp699 - tmp702 - tmp704 + tmp97;
-    let tmp706: f64 = tmp56 * tmp698;
-    let tmp707: f64 = tmp54 * tmp703;
-    let tmp708: f64 = -tmp706 + tmp707 - tmp77;
-    let tmp709: f64 = tmp259 * tmp67;
-    let tmp710: f64 = tmp261 * tmp700;
-    let tmp711: f64 = tmp709 - tmp710 - tmp73;
-    let tmp712: f64 = tmp264 * tmp700;
-    let tmp713: f64 = tmp698 * tmp74;
-    let tmp714: f64 = -tmp713;
-    let tmp715: f64 = -tmp708 * tmp96 + tmp711 * tmp95 + tmp712 + tmp714;
-    let tmp716: f64 = tmp52 * tmp694;
-    let tmp717: f64 = tmp692 * tmp82;
-    let tmp718: f64 = -tmp716 + tmp717 - tmp92;
-    let tmp719: f64 = tmp703 * tmp74;
-    let tmp720: f64 = -tmp75;
-    let tmp721: f64 = tmp264 * tmp67;
-    let tmp722: f64 = -tmp144 * tmp711 + tmp708 * tmp94 + tmp719 + tmp720 - tmp721 + tmp79;
-    let tmp723: f64 = -tmp152 * tmp722 - tmp158 * tmp715 + tmp693 + tmp695 - tmp705 * tmp93 - tmp718 * tmp98 - tmp88;
-    let tmp724: f64 = tmp122 * tmp723;
-    let tmp725: f64 = tmp318 * tmp723;
-    let tmp726: f64 = tmp357 * tmp725;
-    let tmp727: f64 = tmp132 * tmp694;
-    let tmp728: f64 = tmp129 * tmp692;
-    let tmp729: f64 = tmp18 * tmp32;
-    let tmp730: f64 = tmp271 * tmp729;
-    let tmp731: f64 = tmp336 * tmp730;
-    let tmp732: f64 = tmp134 * tmp696;
-    let tmp733: f64 = tmp19 * tmp271;
-    let tmp734: f64 = tmp344 * tmp733;
-    let tmp735: f64 = tmp135 * tmp701;
-    let tmp736: f64 = -tmp335;
-    let tmp737: f64 = tmp733 * reference_tension_n[0];
-    let tmp738: f64 = tmp737 * tmp74;
-    let tmp739: f64 = tmp127 * tmp696;
-    let tmp740: f64 = tmp19 * tmp277;
-    let tmp741: f64 = tmp275 * tmp729;
-    let tmp742: f64 = -tmp107 + tmp740 - tmp741;
-    let tmp743: f64 = tmp127 * tmp701;
-    let tmp744: f64 = -tmp743;
-    let tmp745: f64 = tmp272 * tmp729;
-    let tmp746: f64 = tmp74 * tmp745;
-    let tmp747: f64 = -tmp130
-        - tmp136 * tmp718
-        - tmp152 * (tmp135 * tmp711 + tmp334 - tmp336 * tmp742 + tmp736 - tmp738 + tmp739)
-        - tmp158 * (-tmp134 * tmp711 + tmp344 * tmp742 + tmp744 + tmp746)
-        + tmp727
-        + tmp728
-        - tmp93 * (-tmp341 + tmp342 - tmp731 - tmp732 + tmp734 + tmp735);
-    let tmp748: f64 = tmp352 * tmp747;
-    let tmp749: f64 = tmp142 * tmp692;
-    let tmp750: f64 = tmp146 * tmp694;
-    let tmp751: f64 = tmp134 * tmp703;
-    let tmp752: f64 = tmp369 * tmp730;
-    let tmp753: f64 = tmp135 * tmp698;
-    let tmp754: f64 = tmp373 * tmp733;
-    let tmp755: f64 = tmp127 * tmp698;
-    let tmp756: f64 = tmp745 * tmp78;
-    let tmp757: f64 = -tmp756;
-    let tmp758: f64 = -tmp370;
-    let tmp759: f64 = tmp127 * tmp703;
-    let tmp760: f64 = tmp737 * tmp78;
-    let tmp761: f64 = -tmp143
-        - tmp148 * tmp718
-        - tmp152 * (-tmp135 * tmp708 + tmp368 + tmp369 * tmp742 + tmp758 - tmp759 + tmp760)
-        - tmp158 * (tmp134 * tmp708 - tmp373 * tmp742 + tmp755 + tmp757)
-        + tmp749
-        + tmp750
-        - tmp93 * (tmp375 - tmp377 + tmp751 + tmp752 - tmp753 - tmp754);
-    let tmp762: f64 = tmp384 * tmp761;
-    let tmp763: f64 = tmp737 * tmp80;
-    let tmp764: f64 = tmp745 * tmp89;
-    let tmp765: f64 = tmp127 * tmp705 + tmp134 * tmp722 + tmp135 * tmp715 + tmp257 + tmp280 * tmp742 - tmp763 - tmp764;
-    let tmp766: f64 = tmp390 * tmp765;
-    let tmp767: f64 = tmp321 * tmp725;
-    let tmp768: f64 = tmp331 * tmp725;
-    let tmp769: f64 = tmp51 * tmp737;
-    let tmp770: f64 = tmp328 - tmp769;
-    let tmp771: f64 = tmp155 * tmp692;
-    let tmp772: f64 = tmp363 - tmp771;
-    let tmp773: f64 = tmp151 * tmp696;
-    let tmp774: f64 = tmp354 - tmp773;
-    let tmp775: f64 = tmp139 * tmp703;
-    let tmp776: f64 = tmp361 - tmp775;
-    let tmp777: f64 = -tmp726 + tmp748 + tmp762 + tmp766 - tmp767 - tmp768 + tmp770 + tmp772 + tmp774 + tmp776;
-    let tmp778: f64 = tmp555 * tmp723;
-    let tmp779: f64 = tmp419 * tmp747;
-    let tmp780: f64 = tmp415 * tmp761;
-    let tmp781: f64 = tmp408 * tmp725;
-    let tmp782: f64 = tmp421 * tmp725;
-    let tmp783: f64 = tmp413 * tmp765;
-    let tmp784: f64 = tmp51 * tmp745;
-    let tmp785: f64 = tmp139 * tmp698;
-    let tmp786: f64 = tmp155 * tmp694;
-    let tmp787: f64 = tmp151 * tmp701;
-    let tmp788: f64 = tmp784 + tmp785 + tmp786 + tmp787;
-    let tmp789: f64 = tmp778 - tmp779 - tmp780 + tmp781 + tmp782 - tmp783 + tmp788;
-    let tmp790: f64 = tmp111 * tmp285;
-    let tmp791: f64 = tmp158 * tmp790;
-    let tmp792: f64 = tmp37 * tmp723;
-    let tmp793: f64 = tmp112 * tmp792 - tmp287 * tmp765 + tmp791;
-    let tmp794: f64 = tmp158 * tmp437;
-    let tmp795: f64 = tmp144 * tmp440;
-    let tmp796: f64 = -tmp784;
-    let tmp797: f64 = -tmp785;
-    let tmp798: f64 = -tmp786;
-    let tmp799: f64 = -tmp787;
-    let tmp800: f64 = tmp796 + tmp797 + tmp798 + tmp799;
-    let tmp801: f64 = tmp168 * tmp285;
-    let tmp802: f64 = tmp144 * tmp801;
-    let tmp803: f64 = tmp169 * tmp792 - tmp582 * tmp747 + tmp802;
-    let tmp804: f64 = tmp37 * tmp460;
-    let tmp805: f64 = tmp804 * tmp94;
-    let tmp806: f64 = tmp184 * tmp792 - tmp459 * tmp761 + tmp805;
-    let tmp807: f64 = -tmp328;
-    let tmp808: f64 = tmp769 + tmp807;
-    let tmp809: f64 = -tmp363;
-    let tmp810: f64 = tmp771 + tmp809;
-    let tmp811: f64 = -tmp354;
-    let tmp812: f64 = tmp773 + tmp811;
-    let tmp813: f64 = -tmp361;
-    let tmp814: f64 = tmp775 + tmp813;
-    let tmp815: f64 = tmp473 * tmp94;
-    let tmp816: f64 = tmp32 * tmp686;
-    let tmp817: f64 = tmp198 * tmp816;
-    let tmp818: f64 = tmp215 * tmp816;
-    let tmp819: f64 = tmp217 * tmp816;
-    let tmp820: f64 = tmp102 * tmp46;
-    let tmp821: f64 = tmp745 * tmp80;
-    let tmp822: f64 = tmp261 * tmp68;
-    let tmp823: f64 = tmp259 * tmp700;
-    let tmp824: f64 = tmp72 - tmp822 + tmp823;
-    let tmp825: f64 = tmp54 * tmp698;
-    let tmp826: f64 = tmp234 * tmp59;
-    let tmp827: f64 = tmp56 * tmp826;
-    let tmp828: f64 = tmp76 + tmp825 - tmp827;
-    let tmp829: f64 = -tmp712;
-    let tmp830: f64 = -tmp144 * tmp824 + tmp713 + tmp828 * tmp94 + tmp829;
-    let tmp831: f64 = tmp271 * tmp33;
-    let tmp832: f64 = tmp831 * reference_tension_n[0];
-    let tmp833: f64 = tmp832 * tmp89;
-    let tmp834: f64 = tmp698 * tmp96;
-    let tmp835: f64 = tmp701 * tmp95;
-    let tmp836: f64 = tmp826 * tmp94;
-    let tmp837: f64 = tmp239 * tmp68;
-    let tmp838: f64 = tmp144 * tmp837;
-    let tmp839: f64 = tmp238 - tmp253 - tmp834 + tmp835 + tmp836 - tmp838;
-    let tmp840: f64 = -tmp79;
-    let tmp841: f64 = tmp74 * tmp826;
-    let tmp842: f64 = tmp264 * tmp68;
-    let tmp843: f64 = tmp75 + tmp824 * tmp95 - tmp828 * tmp96 + tmp840 - tmp841 + tmp842;
-    let tmp844: f64 = tmp17 * tmp831;
-    let tmp845: f64 = tmp277 * tmp729;
-    let tmp846: f64 = tmp106 - tmp844 + tmp845;
-    let tmp847: f64 = tmp127 * tmp839 + tmp134 * tmp830 + tmp135 * tmp843 + tmp256 + tmp280 * tmp846 - tmp821 - tmp833;
-    let tmp848: f64 = tmp694 * tmp82;
-    let tmp849: f64 = tmp296 * tmp84;
-    let tmp850: f64 = tmp52 * tmp849;
-    let tmp851: f64 = tmp848 - tmp850 + tmp91;
-    let tmp852: f64 = tmp694 * tmp80;
-    let tmp853: f64 = tmp849 * tmp89;
-    let tmp854: f64 = -tmp152 * tmp830 - tmp158 * tmp843 - tmp839 * tmp93 - tmp851 * tmp98 + tmp852 + tmp853 - tmp90;
-    let tmp855: f64 = tmp152 * tmp790;
-    let tmp856: f64 = tmp113 * tmp854 - tmp287 * tmp847 + tmp855;
-    let tmp857: f64 = tmp318 * tmp854;
-    let tmp858: f64 = tmp357 * tmp857;
-    let tmp859: f64 = tmp331 * tmp857;
-    let tmp860: f64 = tmp321 * tmp857;
-    let tmp861: f64 = tmp132 * tmp849;
-    let tmp862: f64 = tmp129 * tmp694;
-    let tmp863: f64 = tmp127 * tmp837;
-    let tmp864: f64 = -tmp334;
-    let tmp865: f64 = tmp74 * tmp832;
-    let tmp866: f64 = -tmp746;
-    let tmp867: f64 = tmp832 * tmp94;
-    let tmp868: f64 = tmp344 * tmp730;
-    let tmp869: f64 = tmp135 * tmp837;
-    let tmp870: f64 = tmp134 * tmp701;
-    let tmp871: f64 = -tmp133
-        - tmp136 * tmp851
-        - tmp152 * (tmp135 * tmp824 - tmp336 * tmp846 + tmp743 + tmp866)
-        - tmp158 * (-tmp134 * tmp824 + tmp335 + tmp344 * tmp846 - tmp863 + tmp864 + tmp865)
-        + tmp861
-        + tmp862
-        - tmp93 * (-tmp340 + tmp343 - tmp867 + tmp868 + tmp869 - tmp870);
-    let tmp872: f64 = tmp352 * tmp871;
-    let tmp873: f64 = tmp390 * tmp847;
-    let tmp874: f64 = tmp142 * tmp694;
-    let tmp875: f64 = tmp146 * tmp849;
-    let tmp876: f64 = -tmp368;
-    let tmp877: f64 = tmp127 * tmp826;
-    let tmp878: f64 = tmp78 * tmp832;
-    let tmp879: f64 = tmp134 * tmp698;
-    let tmp880: f64 = tmp369 * tmp831;
-    let tmp881: f64 = tmp373 * tmp730;
-    let tmp882: f64 = tmp135 * tmp826;
-    let tmp883: f64 = -tmp755;
-    let tmp884: f64 = -tmp147
-        - tmp148 * tmp851
-        - tmp152 * (-tmp135 * tmp828 + tmp369 * tmp846 + tmp756 + tmp883)
-        - tmp158 * (tmp134 * tmp828 + tmp370 - tmp373 * tmp846 + tmp876 + tmp877 - tmp878)
-        + tmp874
-        + tmp875
-        - tmp93 * (tmp378 - tmp380 + tmp879 + tmp880 - tmp881 - tmp882);
-    let tmp885: f64 = tmp384 * tmp884;
-    let tmp886: f64 = tmp800 - tmp858 - tmp859 - tmp860 + tmp872 + tmp873 + tmp885;
-    let tmp887: f64 = tmp408 * tmp857;
-    let tmp888: f64 = tmp415 * tmp884;
-    let tmp889: f64 = tmp419 * tmp871;
-    let tmp890: f64 = tmp555 * tmp854;
-    let tmp891: f64 = tmp421 * tmp857;
-    let tmp892: f64 = tmp413 * tmp847;
-    let tmp893: f64 = tmp51 * tmp832;
-    let tmp894: f64 = tmp807 + tmp893;
-    let tmp895: f64 = tmp139 * tmp826;
-    let tmp896: f64 = tmp813 + tmp895;
-    let tmp897: f64 = tmp155 * tmp849;
-    let tmp898: f64 = tmp809 + tmp897;
-    let tmp899: f64 = tmp151 * tmp837;
-    let tmp900: f64 = tmp811 + tmp899;
-    let tmp901: f64 = tmp887 - tmp888 - tmp889 + tmp890 + tmp891 - tmp892 + tmp894 + tmp896 + tmp898 + tmp900;
-    let tmp902: f64 = tmp152 * tmp437;
-    let tmp903: f64 = tmp328 - tmp893;
-    let tmp904: f64 = tmp361 - tmp895;
-    let tmp905: f64 = tmp363 - tmp897;
-    let tmp906: f64 = tmp354 - tmp899;
-    let tmp907: f64 = tmp801 * tmp95;
-    let tmp908: f64 = tmp170 * tmp854 - tmp582 * tmp871 + tmp907;
-    let tmp909: f64 = tmp440 * tmp95;
-    let tmp910: f64 = tmp473 * tmp96;
-    let tmp911: f64 = tmp457 * tmp884;
-    let tmp912: f64 = tmp804 * tmp96;
-    let tmp913: f64 = tmp185 * tmp854 - tmp458 * tmp911 + tmp912;
-    let tmp914: f64 = 1.0_f64 / (reference_tension_n[0] * reference_tension_n[0]);
-    let tmp915: f64 = tmp34 * tmp37 * tmp914;
-    let tmp916: f64 = 1.0_f64 / ((tmp914 * (reference_tension_n[1] * reference_tension_n[1]) + 1.0_f64).sqrt());
-    let tmp917: f64 = tmp215 * tmp35;
-    let tmp918: f64 = tmp103 + tmp105 + tmp109;
-    let tmp919: f64 = -tmp152 * (tmp108 * tmp144 - tmp145)
-        - tmp158 * (-tmp108 * tmp95 + tmp141)
-        - tmp93 * (-tmp102 * tmp144 + tmp104 * tmp95);
-    let tmp920: f64 = tmp384 * tmp919;
-    let tmp921: f64 = -tmp152 * (-tmp108 * tmp94 + tmp131)
-        - tmp158 * (tmp108 * tmp96 - tmp128)
-        - tmp93 * (tmp102 * tmp94 - tmp104 * tmp96);
-    let tmp922: f64 = tmp352 * tmp921;
-    let tmp923: f64 = tmp390 * tmp918;
-    let tmp924: f64 = tmp157 + tmp920 + tmp922 + tmp923;
-    let tmp925: f64 = tmp415 * tmp919;
-    let tmp926: f64 = tmp419 * tmp921;
-    let tmp927: f64 = tmp413 * tmp918;
-    let tmp928: f64 = -tmp124 - tmp925 - tmp926 - tmp927;
-    let tmp929: f64 = tmp284 * tmp285 * tmp85;
-    let tmp930: f64 = tmp166 * tmp305;
-    let tmp931: f64 = tmp929 * tmp930;
-    let tmp932: f64 = tmp307 * tmp929;
-    let tmp933: f64 = tmp285 * tmp443 * tmp60;
-    let tmp934: f64 = tmp921 * tmp933;
-    let tmp935: f64 = tmp173 * tmp448;
-    let tmp936: f64 = tmp181 * tmp450;
-    let tmp937: f64 = tmp285 * tmp457 * tmp69;
-    let tmp938: f64 = tmp465 * tmp937;
-    let tmp939: f64 = tmp196 * tmp463 * tmp937;
-    let tmp940: f64 = -tmp24 - tmp26 - tmp30;
-    let tmp941: f64 = tmp107 - tmp740 + tmp741;
-    let tmp942: f64 = -tmp257 + tmp280 * tmp941 + tmp763 + tmp764;
-    let tmp943: f64 = tmp929 * tmp942;
-    let tmp944: f64 = -tmp152 * (-tmp336 * tmp941 + tmp738 + tmp864)
-        - tmp158 * (tmp344 * tmp941 + tmp866)
-        - tmp93 * (tmp341 + tmp731 - tmp734);
-    let tmp945: f64 = tmp419 * tmp944;
-    let tmp946: f64 = tmp413 * tmp942;
-    let tmp947: f64 = -tmp152 * (tmp369 * tmp941 + tmp370 - tmp760)
-        - tmp158 * (-tmp373 * tmp941 + tmp756)
-        - tmp93 * (-tmp375 - tmp752 + tmp754);
-    let tmp948: f64 = tmp415 * tmp947;
-    let tmp949: f64 = tmp796 - tmp945 - tmp946 - tmp948;
-    let tmp950: f64 = tmp384 * tmp947;
-    let tmp951: f64 = tmp390 * tmp942;
-    let tmp952: f64 = tmp352 * tmp944;
-    let tmp953: f64 = tmp808 + tmp950 + tmp951 + tmp952;
-    let tmp954: f64 = tmp933 * tmp944;
-    let tmp955: f64 = -tmp106 + tmp844 - tmp845;
-    let tmp956: f64 = -tmp256 + tmp280 * tmp955 + tmp821 + tmp833;
-    let tmp957: f64 = tmp390 * tmp956;
-    let tmp958: f64 = -tmp152 * (tmp369 * tmp955 + tmp757)
-        - tmp158 * (-tmp373 * tmp955 + tmp758 + tmp878)
-        - tmp93 * (tmp380 - tmp880 + tmp881);
-    let tmp959: f64 = tmp384 * tmp958;
-    let tmp960: f64 = -tmp152 * (-tmp336 * tmp955 + tmp746)
-        - tmp158 * (tmp334 + tmp344 * tmp955 - tmp865)
-        - tmp93 * (-tmp343 + tmp867 - tmp868);
-    let tmp961: f64 = tmp352 * tmp960;
-    let tmp962: f64 = tmp784 + tmp957 + tmp959 + tmp961;
-    let tmp963: f64 = tmp413 * tmp956;
-    let tmp964: f64 = tmp415 * tmp958;
-    let tmp965: f64 = tmp419 * tmp960;
-    let tmp966: f64 = tmp903 - tmp963 - tmp964 - tmp965;
-    let tmp967: f64 = tmp933 * tmp960;
-    let tmp968: f64 = tmp716 - tmp717 + tmp92;
-    let tmp969: f64 = -tmp693 - tmp695 + tmp88 - tmp968 * tmp98;
-    let tmp970: f64 = tmp555 * tmp969;
-    let tmp971: f64 = tmp130 - tmp136 * tmp968 - tmp727 - tmp728;
-    let tmp972: f64 = tmp419 * tmp971;
-    let tmp973: f64 = tmp318 * tmp969;
-    let tmp974: f64 = tmp408 * tmp973;
-    let tmp975: f64 = tmp421 * tmp973;
-    let tmp976: f64 = tmp143 - tmp148 * tmp968 - tmp749 - tmp750;
-    let tmp977: f64 = tmp415 * tmp976;
-    let tmp978: f64 = tmp798 + tmp970 - tmp972 + tmp974 + tmp975 - tmp977;
-    let tmp979: f64 = tmp331 * tmp973;
-    let tmp980: f64 = tmp384 * tmp976;
-    let tmp981: f64 = tmp321 * tmp973;
-    let tmp982: f64 = tmp352 * tmp971;
-    let tmp983: f64 = tmp357 * tmp973;
-    let tmp984: f64 = tmp810 - tmp979 + tmp980 - tmp981 + tmp982 - tmp983;
-    let tmp985: f64 = tmp37 * tmp969;
-    let tmp986: f64 = tmp112 * tmp985 - tmp791;
-    let tmp987: f64 = tmp169 * tmp985 - tmp582 * tmp971;
-    let tmp988: f64 = tmp184 * tmp985 - tmp459 * tmp976;
-    let tmp989: f64 = -tmp848 + tmp850 - tmp91;
-    let tmp990: f64 = -tmp852 - tmp853 + tmp90 - tmp98 * tmp989;
-    let tmp991: f64 = tmp318 * tmp990;
-    let tmp992: f64 = tmp331 * tmp991;
-    let tmp993: f64 = tmp318 * tmp357;
-    let tmp994: f64 = tmp990 * tmp993;
-    let tmp995: f64 = tmp321 * tmp991;
-    let tmp996: f64 = tmp133 - tmp136 * tmp989 - tmp861 - tmp862;
-    let tmp997: f64 = tmp352 * tmp996;
-    let tmp998: f64 = tmp147 - tmp148 * tmp989 - tmp874 - tmp875;
-    let tmp999: f64 = tmp384 * tmp998;
-    let tmp1000: f64 = tmp786 - tmp992 - tmp994 - tmp995 + tmp997 + tmp999;
-    let tmp1001: f64 = tmp415 * tmp998;
-    let tmp1002: f64 = tmp419 * tmp996;
-    let tmp1003: f64 = tmp408 * tmp991;
-    let tmp1004: f64 = tmp421 * tmp991;
-    let tmp1005: f64 = tmp555 * tmp990;
-    let tmp1006: f64 = -tmp1001 - tmp1002 + tmp1003 + tmp1004 + tmp1005 + tmp905;
-    let tmp1007: f64 = tmp37 * tmp990;
-    let tmp1008: f64 = tmp1007 * tmp112 - tmp855;
-    let tmp1009: f64 = tmp1007 * tmp169 - tmp582 * tmp996;
-    let tmp1010: f64 = tmp1007 * tmp184 - tmp459 * tmp998;
-    let tmp1011: f64 = -tmp699 + tmp704 - tmp97;
-    let tmp1012: f64 = tmp706 - tmp707 + tmp77;
-    let tmp1013: f64 = tmp1012 * tmp94 - tmp719 + tmp75;
-    let tmp1014: f64 = -tmp1012 * tmp96 + tmp713;
-    let tmp1015: f64 = -tmp1011 * tmp93 - tmp1013 * tmp152 - tmp1014 * tmp158;
-    let tmp1016: f64 = tmp1011 * tmp127 + tmp1013 * tmp134 + tmp1014 * tmp135;
-    let tmp1017: f64 = tmp1015 * tmp318;
-    let tmp1018: f64 = tmp1017 * tmp331;
-    let tmp1019: f64 = tmp1017 * tmp357;
-    let tmp1020: f64 = tmp1017 * tmp321;
-    let tmp1021: f64 = tmp1016 * tmp390;
-    let tmp1022: f64 = -tmp152 * (-tmp1012 * tmp135 + tmp759 + tmp876)
-        - tmp158 * (tmp1012 * tmp134 + tmp883)
-        - tmp93 * (tmp377 - tmp751 + tmp753);
-    let tmp1023: f64 = tmp1022 * tmp384;
-    let tmp1024: f64 = -tmp1018 - tmp1019 - tmp1020 + tmp1021 + tmp1023 + tmp814;
-    let tmp1025: f64 = tmp1017 * tmp408;
-    let tmp1026: f64 = tmp1016 * tmp413;
-    let tmp1027: f64 = tmp1017 * tmp401;
-    let tmp1028: f64 = tmp1017 * tmp421;
-    let tmp1029: f64 = tmp1022 * tmp415;
-    let tmp1030: f64 = tmp1025 - tmp1026 + tmp1027 + tmp1028 - tmp1029 + tmp797;
-    let tmp1031: f64 = tmp1015 * tmp37;
-    let tmp1032: f64 = -tmp1016 * tmp287 + tmp1031 * tmp112;
-    let tmp1033: f64 = tmp1031 * tmp169 - tmp802;
-    let tmp1034: f64 = -tmp1022 * tmp459 + tmp1031 * tmp184;
-    let tmp1035: f64 = -tmp76 - tmp825 + tmp827;
-    let tmp1036: f64 = -tmp1035 * tmp96 + tmp720 + tmp841;
-    let tmp1037: f64 = tmp1035 * tmp94 + tmp714;
-    let tmp1038: f64 = tmp253 + tmp834 - tmp836;
-    let tmp1039: f64 = tmp1036 * tmp135 + tmp1037 * tmp134 + tmp1038 * tmp127;
-    let tmp1040: f64 = -tmp152 * (-tmp1035 * tmp135 + tmp755)
-        - tmp158 * (tmp1035 * tmp134 + tmp368 - tmp877)
-        - tmp93 * (-tmp378 - tmp879 + tmp882);
-    let tmp1041: f64 = tmp1040 * tmp415;
-    let tmp1042: f64 = -tmp1036 * tmp158 - tmp1037 * tmp152 - tmp1038 * tmp93;
-    let tmp1043: f64 = tmp1042 * tmp318;
-    let tmp1044: f64 = tmp1043 * tmp408;
-    let tmp1045: f64 = tmp1043 * tmp421;
-    let tmp1046: f64 = tmp1042 * tmp555;
-    let tmp1047: f64 = tmp1039 * tmp413;
-    let tmp1048: f64 = -tmp1041 + tmp1044 + tmp1045 + tmp1046 - tmp1047 + tmp904;
-    let tmp1049: f64 = tmp1040 * tmp384;
-    let tmp1050: f64 = tmp1042 * tmp993;
-    let tmp1051: f64 = tmp1043 * tmp331;
-    let tmp1052: f64 = tmp1043 * tmp321;
-    let tmp1053: f64 = tmp1039 * tmp390;
-    let tmp1054: f64 = tmp1049 - tmp1050 - tmp1051 - tmp1052 + tmp1053 + tmp785;
-    let tmp1055: f64 = -tmp1039 * tmp287 + tmp1042 * tmp113;
-    let tmp1056: f64 = tmp1042 * tmp170 - tmp907;
-    let tmp1057: f64 = -tmp1040 * tmp459 + tmp1042 * tmp185;
-    let tmp1058: f64 = -tmp709 + tmp710 + tmp73;
-    let tmp1059: f64 = tmp1058 * tmp95 + tmp829;
-    let tmp1060: f64 = tmp252 - tmp697 + tmp702;
-    let tmp1061: f64 = -tmp1058 * tmp144 + tmp721 + tmp840;
-    let tmp1062: f64 = tmp1059 * tmp135 + tmp1060 * tmp127 + tmp1061 * tmp134;
-    let tmp1063: f64 = tmp1062 * tmp284;
-    let tmp1064: f64 = -tmp1059 * tmp158 - tmp1060 * tmp93 - tmp1061 * tmp152;
-    let tmp1065: f64 = -tmp1063 * tmp286 + tmp1064 * tmp113;
-    let tmp1066: f64 = tmp1064 * tmp318;
-    let tmp1067: f64 = tmp1066 * tmp408;
-    let tmp1068: f64 = tmp1062 * tmp413;
-    let tmp1069: f64 = -tmp152 * (tmp1058 * tmp135 + tmp335 - tmp739)
-        - tmp158 * (-tmp1058 * tmp134 + tmp743)
-        - tmp93 * (-tmp342 + tmp732 - tmp735);
-    let tmp1070: f64 = tmp1069 * tmp419;
-    let tmp1071: f64 = tmp1066 * tmp421;
-    let tmp1072: f64 = tmp1064 * tmp555;
-    let tmp1073: f64 = tmp1067 - tmp1068 - tmp1070 + tmp1071 + tmp1072 + tmp799;
-    let tmp1074: f64 = tmp1066 * tmp321;
-    let tmp1075: f64 = tmp1069 * tmp352;
-    let tmp1076: f64 = tmp1066 * tmp331;
-    let tmp1077: f64 = tmp1062 * tmp390;
-    let tmp1078: f64 = tmp1066 * tmp357;
-    let tmp1079: f64 = -tmp1074 + tmp1075 - tmp1076 + tmp1077 - tmp1078 + tmp812;
-    let tmp1080: f64 = tmp1064 * tmp170 - tmp1069 * tmp582;
-    let tmp1081: f64 = tmp1064 * tmp185 - tmp805;
-    let tmp1082: f64 = -tmp72 + tmp822 - tmp823;
-    let tmp1083: f64 = -tmp1082 * tmp144 + tmp712;
-    let tmp1084: f64 = -tmp238 - tmp835 + tmp838;
-    let tmp1085: f64 = tmp1082 * tmp95 + tmp79 - tmp842;
-    let tmp1086: f64 = -tmp1083 * tmp152 - tmp1084 * tmp93 - tmp1085 * tmp158;
-    let tmp1087: f64 = tmp1083 * tmp134 + tmp1084 * tmp127 + tmp1085 * tmp135;
-    let tmp1088: f64 = tmp1086 * tmp113 - tmp1087 * tmp287;
-    let tmp1089: f64 = tmp1086 * tmp122;
-    let tmp1090: f64 = tmp1086 * tmp318;
-    let tmp1091: f64 = tmp1090 * tmp408;
-    let tmp1092: f64 = tmp1090 * tmp421;
-    let tmp1093: f64 = tmp1087 * tmp413;
-    let tmp1094: f64 = -tmp152 * (tmp1082 * tmp135 + tmp744)
-        - tmp158 * (-tmp1082 * tmp134 + tmp736 + tmp863)
-        - tmp93 * (tmp340 - tmp869 + tmp870);
-    let tmp1095: f64 = tmp1094 * tmp419;
-    let tmp1096: f64 = tmp1086 * tmp555;
-    let tmp1097: f64 = tmp1091 + tmp1092 - tmp1093 - tmp1095 + tmp1096 + tmp906;
-    let tmp1098: f64 = tmp1087 * tmp390;
-    let tmp1099: f64 = tmp1090 * tmp321;
-    let tmp1100: f64 = tmp1090 * tmp331;
-    let tmp1101: f64 = tmp1090 * tmp357;
-    let tmp1102: f64 = tmp1094 * tmp352;
-    let tmp1103: f64 = tmp1098 - tmp1099 - tmp1100 - tmp1101 + tmp1102 + tmp787;
-    let tmp1104: f64 = tmp1086 * tmp170 - tmp1094 * tmp582;
-    let tmp1105: f64 = tmp1086 * tmp185 - tmp912;
+    let tmp68: f64 = tmp64 + tmp67 + epsilon;
+    let tmp69: f64 = tmp68.sqrt();
+    let tmp70: f64 = 1.0_f64 / tmp69;
+    let tmp71: f64 = tmp63 * tmp70;
+    let tmp72: f64 = tmp66 * tmp70;
+    let tmp73: f64 = tmp53 * tmp60;
+    let tmp74: f64 = -tmp61 * tmp71 + tmp72 * tmp73;
+    let tmp75: f64 = tmp62 * tmp72 - tmp65 * tmp71;
+    let tmp76: f64 = tmp52 * tmp61 - tmp55 * tmp73;
+    let tmp77: f64 = tmp61 * tmp75 - tmp72 * tmp76;
+    let tmp78: f64 = 1.0_f64 / tmp47;
+    let tmp79: f64 = tmp41 * tmp78;
+    let tmp80: f64 = tmp71 * tmp76 - tmp73 * tmp75;
+    let tmp81: f64 = tmp44 * tmp78;
+    let tmp82: f64 = tmp40 * tmp81 - tmp43 * tmp79;
+    let tmp83: f64 = -tmp74 * tmp82 - tmp77 * tmp79 - tmp80 * tmp81;
+    let tmp84: f64 = 1.0_f64 / (tmp83 + epsilon * tmp83.signum());
+    let tmp85: f64 = tmp74 * tmp84;
+    let tmp86: f64 = tmp51 * tmp85;
+    let tmp87: f64 = tmp80 * tmp84;
+    let tmp88: f64 = tmp49 * reference_tension_n[0];
+    let tmp89: f64 = tmp77 * tmp84;
+    let tmp90: f64 = tmp50 * tmp89;
+    let tmp91: f64 = tmp86 * reference_tension_n[0] + tmp87 * tmp88 + tmp90 * reference_tension_n[0];
+    let tmp92: f64 = 1.0_f64 / tmp91;
+    let tmp93: f64 = platform_weight_n - reference_tension_n[1];
+    let tmp94: f64 = tmp52 * tmp65 - tmp55 * tmp62;
+    let tmp95: f64 = -tmp55 + tmp65;
+    let tmp96: f64 = -tmp52 + tmp62;
+    let tmp97: f64 = -tmp40 * tmp95 + tmp43 * tmp96 + tmp94;
+    let tmp98: f64 = 1.0_f64 / (tmp97 + epsilon * tmp97.signum());
+    let tmp99: f64 = tmp94 * tmp98;
+    let tmp100: f64 = tmp39 * tmp50;
+    let tmp101: f64 = tmp84 * (tmp73 * tmp82 - tmp76 * tmp79);
+    let tmp102: f64 = -tmp61 * tmp82 + tmp76 * tmp81;
+    let tmp103: f64 = tmp102 * tmp84;
+    let tmp104: f64 = tmp50 * reference_tension_n[0];
+    let tmp105: f64 = tmp61 * tmp79 - tmp73 * tmp81;
+    let tmp106: f64 = tmp105 * tmp84;
+    let tmp107: f64 = tmp106 * tmp51;
+    let tmp108: f64 = tmp101 * tmp88 + tmp103 * tmp104 + tmp107 * reference_tension_n[0];
+    let tmp109: f64 = tmp36 * attachments_m[(1, 3)] + tmp37 * attachments_m[(0, 3)] + tmp38 * attachments_m[(2, 3)];
+    let tmp110: f64 = tmp108 * tmp109;
+    let tmp111: f64 = tmp36 * attachments_m[(1, 1)] + tmp37 * attachments_m[(0, 1)] + tmp38 * attachments_m[(2, 1)];
+    let tmp112: f64 = tmp111 * tmp91;
+    let tmp113: f64 = tmp71 * tmp81 - tmp72 * tmp79;
+    let tmp114: f64 = tmp113 * tmp84;
+    let tmp115: f64 = tmp114 * tmp51;
+    let tmp116: f64 = -tmp71 * tmp82 + tmp75 * tmp79;
+    let tmp117: f64 = tmp116 * tmp84;
+    let tmp118: f64 = tmp72 * tmp82 - tmp75 * tmp81;
+    let tmp119: f64 = tmp118 * tmp84;
+    let tmp120: f64 = tmp119 * tmp50;
+    let tmp121: f64 = tmp115 * reference_tension_n[0] + tmp117 * tmp88 + tmp120 * reference_tension_n[0];
+    let tmp122: f64 = tmp36 * attachments_m[(1, 2)] + tmp37 * attachments_m[(0, 2)] + tmp38 * attachments_m[(2, 2)];
+    let tmp123: f64 = tmp121 * tmp122;
+    let tmp124: f64 = tmp100 * reference_tension_n[0]
+        + tmp11 * reference_tension_n[1]
+        + tmp110 * tmp71
+        + tmp112 * tmp79
+        + tmp123 * tmp73
+        - platform_weight_n * (tmp10 * com_offset_m[0] + tmp4 * com_offset_m[2] + tmp7 * com_offset_m[1]);
+    let tmp125: f64 = tmp95 * tmp98;
+    let tmp126: f64 = tmp39 * tmp49;
+    let tmp127: f64 = -tmp110 * tmp72
+        - tmp112 * tmp81
+        - tmp123 * tmp61
+        - tmp126 * reference_tension_n[0]
+        - tmp20 * reference_tension_n[1]
+        + platform_weight_n * (tmp16 * com_offset_m[2] + tmp17 * com_offset_m[0] + tmp19 * com_offset_m[1]);
+    let tmp128: f64 = tmp96 * tmp98;
+    let tmp129: f64 = tmp124 * tmp125 + tmp127 * tmp128 + tmp93 * tmp99;
+    let tmp130: f64 = tmp47 * tmp92;
+    let tmp131: f64 = tmp130 * tmp26;
+    let tmp132: f64 = tmp131 + (tmp129 * tmp92).asinh();
+    let tmp133: f64 = tmp132.sinh();
+    let tmp134: f64 = tmp131 + epsilon * tmp131.signum();
+    let tmp135: f64 = 1.0_f64 / tmp134;
+    let tmp136: f64 = tmp134.sinh();
+    let tmp137: f64 = tmp135 * tmp136;
+    let tmp138: f64 = tmp133 * tmp137;
+    let tmp139: f64 = tmp98 * (-tmp40 * tmp65 + tmp43 * tmp62);
+    let tmp140: f64 = tmp98 * (tmp43 - tmp65);
+    let tmp141: f64 = tmp98 * (tmp40 - tmp62);
+    let tmp142: f64 = tmp124 * tmp140 + tmp127 * tmp141 + tmp139 * tmp93;
+    let tmp143: f64 = 1.0_f64 / tmp121;
+    let tmp144: f64 = tmp26 * tmp59;
+    let tmp145: f64 = tmp143 * tmp144;
+    let tmp146: f64 = tmp145 + (tmp142 * tmp143).asinh();
+    let tmp147: f64 = tmp146.sinh();
+    let tmp148: f64 = tmp145 + epsilon * tmp145.signum();
+    let tmp149: f64 = 1.0_f64 / tmp148;
+    let tmp150: f64 = tmp148.sinh();
+    let tmp151: f64 = tmp149 * tmp150;
+    let tmp152: f64 = tmp147 * tmp151;
+    let tmp153: f64 = 1.0_f64 / tmp108;
+    let tmp154: f64 = -tmp43 + tmp55;
+    let tmp155: f64 = tmp154 * tmp98;
+    let tmp156: f64 = tmp98 * (tmp40 * tmp55 - tmp43 * tmp52);
+    let tmp157: f64 = tmp98 * (-tmp40 + tmp52);
+    let tmp158: f64 = tmp124 * tmp155 + tmp127 * tmp157 + tmp156 * tmp93;
+    let tmp159: f64 = tmp26 * tmp69;
+    let tmp160: f64 = tmp153 * tmp159;
+    let tmp161: f64 = tmp160 + (tmp153 * tmp158).asinh();
+    let tmp162: f64 = tmp161.sinh();
+    let tmp163: f64 = tmp160 + epsilon * tmp160.signum();
+    let tmp164: f64 = 1.0_f64 / tmp163;
+    let tmp165: f64 = tmp163.sinh();
+    let tmp166: f64 = tmp164 * tmp165;
+    let tmp167: f64 = tmp162 * tmp166;
+    let tmp168: f64 = tmp30 * tmp32 * tmp31.cosh();
+    let tmp169: f64 = tmp30 * tmp33 / (tmp31 * tmp31);
+    let tmp170: f64 = tmp34 * tmp29.cosh();
+    let tmp171: f64 = tmp168 * tmp28 - tmp169 * tmp28 + tmp170 * tmp28 + tmp35;
+    let tmp172: f64 = tmp4 * attachments_m[(1, 0)] - tmp7 * attachments_m[(2, 0)];
+    let tmp173: f64 = tmp172 * tmp48;
+    let tmp174: f64 = tmp16 * attachments_m[(1, 0)] - tmp19 * attachments_m[(2, 0)];
+    let tmp175: f64 = tmp174 * tmp48;
+    let tmp176: f64 = tmp12 * tmp173 + tmp175 * tmp21;
+    let tmp177: f64 = -tmp36 * attachments_m[(2, 0)] + tmp38 * attachments_m[(1, 0)];
+    let tmp178: f64 = tmp4 * attachments_m[(1, 3)] - tmp7 * attachments_m[(2, 3)];
+    let tmp179: f64 = tmp178 * tmp70;
+    let tmp180: f64 = tmp16 * attachments_m[(1, 3)] - tmp19 * attachments_m[(2, 3)];
+    let tmp181: f64 = tmp180 * tmp70;
+    let tmp182: f64 = tmp179 * tmp63 + tmp181 * tmp66;
+    let tmp183: f64 = 1.0_f64 / tmp68;
+    let tmp184: f64 = tmp183 * tmp63;
+    let tmp185: f64 = tmp179 - tmp182 * tmp184;
+    let tmp186: f64 = tmp108 * tmp185;
+    let tmp187: f64 = tmp4 * attachments_m[(1, 2)] - tmp7 * attachments_m[(2, 2)];
+    let tmp188: f64 = tmp4 * attachments_m[(1, 1)] - tmp7 * attachments_m[(2, 1)];
+    let tmp189: f64 = tmp187 * tmp60;
+    let tmp190: f64 = tmp16 * attachments_m[(1, 2)] - tmp19 * attachments_m[(2, 2)];
+    let tmp191: f64 = tmp190 * tmp60;
+    let tmp192: f64 = tmp189 * tmp53 + tmp191 * tmp56;
+    let tmp193: f64 = 1.0_f64 / tmp58;
+    let tmp194: f64 = tmp192 * tmp193;
+    let tmp195: f64 = tmp189 - tmp194 * tmp53;
+    let tmp196: f64 = tmp121 * tmp195;
+    let tmp197: f64 = tmp188 * tmp78;
+    let tmp198: f64 = tmp16 * attachments_m[(1, 1)] - tmp19 * attachments_m[(2, 1)];
+    let tmp199: f64 = tmp198 * tmp78;
+    let tmp200: f64 = tmp197 * tmp41 + tmp199 * tmp44;
+    let tmp201: f64 = 1.0_f64 / tmp46;
+    let tmp202: f64 = tmp201 * tmp41;
+    let tmp203: f64 = tmp197 - tmp200 * tmp202;
+    let tmp204: f64 = tmp203 * tmp91;
+    let tmp205: f64 = 1.0_f64 / tmp23;
+    let tmp206: f64 = tmp12 * tmp205;
+    let tmp207: f64 = reference_tension_n[0] * (tmp173 - tmp176 * tmp206);
+    let tmp208: f64 = tmp205 * tmp21;
+    let tmp209: f64 = reference_tension_n[0] * (tmp175 - tmp176 * tmp208);
+    let tmp210: f64 = tmp21 * reference_tension_n[0];
+    let tmp211: f64 = tmp201 * tmp44;
+    let tmp212: f64 = tmp199 - tmp200 * tmp211;
+    let tmp213: f64 = tmp191 - tmp194 * tmp56;
+    let tmp214: f64 = tmp183 * tmp66;
+    let tmp215: f64 = tmp181 - tmp182 * tmp214;
+    let tmp216: f64 = tmp12 * reference_tension_n[0];
+    let tmp217: f64 = tmp84
+        * (-tmp108 * (-tmp179 * tmp66 + tmp181 * tmp63 + tmp185 * tmp65 - tmp215 * tmp62) + tmp11 * tmp209
+            - tmp121 * (-tmp189 * tmp56 + tmp191 * tmp53 + tmp195 * tmp55 - tmp213 * tmp52)
+            + tmp173 * tmp210
+            - tmp175 * tmp216
+            - tmp20 * tmp207
+            - tmp91 * (-tmp197 * tmp44 + tmp199 * tmp41 + tmp203 * tmp43 - tmp212 * tmp40));
+    let tmp218: f64 = tmp186 + tmp196 + tmp204 + tmp207;
+    let tmp219: f64 = tmp218 * tmp84;
+    let tmp220: f64 = tmp121 * tmp213;
+    let tmp221: f64 = tmp212 * tmp91;
+    let tmp222: f64 = tmp108 * tmp215;
+    let tmp223: f64 = tmp209 + tmp220 + tmp221 + tmp222;
+    let tmp224: f64 = tmp223 * tmp84;
+    let tmp225: f64 = tmp217 * tmp74 + tmp219 * tmp77 + tmp224 * tmp80;
+    let tmp226: f64 = tmp111 * tmp79;
+    let tmp227: f64 = -tmp36 * attachments_m[(2, 2)] + tmp38 * attachments_m[(1, 2)];
+    let tmp228: f64 = tmp121 * tmp73;
+    let tmp229: f64 = tmp101 * tmp223 + tmp102 * tmp219 + tmp105 * tmp217;
+    let tmp230: f64 = tmp109 * tmp71;
+    let tmp231: f64 = tmp113 * tmp217 + tmp116 * tmp224 + tmp119 * tmp218;
+    let tmp232: f64 = tmp122 * tmp73;
+    let tmp233: f64 = -tmp36 * attachments_m[(2, 1)] + tmp38 * attachments_m[(1, 1)];
+    let tmp234: f64 = tmp79 * tmp91;
+    let tmp235: f64 = -tmp36 * attachments_m[(2, 3)] + tmp38 * attachments_m[(1, 3)];
+    let tmp236: f64 = tmp108 * tmp71;
+    let tmp237: f64 = tmp104 * tmp177
+        + tmp109 * tmp186
+        + tmp111 * tmp204
+        + tmp122 * tmp196
+        + tmp129 * tmp188
+        + tmp142 * tmp187
+        + tmp158 * tmp178
+        + tmp172 * reference_tension_n[1]
+        + tmp207 * tmp39
+        + tmp225 * tmp226
+        + tmp227 * tmp228
+        + tmp229 * tmp230
+        + tmp231 * tmp232
+        + tmp233 * tmp234
+        + tmp235 * tmp236
+        - platform_weight_n * (tmp4 * com_offset_m[1] - tmp7 * com_offset_m[2]);
+    let tmp238: f64 = tmp122 * tmp61;
+    let tmp239: f64 = tmp108 * tmp72;
+    let tmp240: f64 = tmp109 * tmp72;
+    let tmp241: f64 = tmp81 * tmp91;
+    let tmp242: f64 = tmp111 * tmp81;
+    let tmp243: f64 = tmp121 * tmp61;
+    let tmp244: f64 = -tmp109 * tmp222
+        - tmp111 * tmp221
+        - tmp122 * tmp220
+        - tmp129 * tmp198
+        - tmp142 * tmp190
+        - tmp158 * tmp180
+        - tmp174 * reference_tension_n[1]
+        - tmp177 * tmp88
+        - tmp209 * tmp39
+        - tmp225 * tmp242
+        - tmp227 * tmp243
+        - tmp229 * tmp240
+        - tmp231 * tmp238
+        - tmp233 * tmp241
+        - tmp235 * tmp239
+        + platform_weight_n * (tmp16 * com_offset_m[1] - tmp19 * com_offset_m[2]);
+    let tmp245: f64 = 1.0_f64 / (tmp91 * tmp91);
+    let tmp246: f64 = 1.0_f64 / (((tmp129 * tmp129) * tmp245 + 1.0_f64).sqrt());
+    let tmp247: f64 = tmp137 * tmp132.cosh();
+    let tmp248: f64 = tmp130 * tmp246 * tmp247;
+    let tmp249: f64 = tmp131 * tmp133;
+    let tmp250: f64 = tmp135 * tmp134.cosh();
+    let tmp251: f64 = tmp136 / (tmp134 * tmp134);
+    let tmp252: f64 = tmp131 * tmp247 + tmp138 + tmp249 * tmp250 - tmp249 * tmp251;
+    let tmp253: f64 = tmp245 * tmp26;
+    let tmp254: f64 = tmp133 * tmp253 * tmp46;
+    let tmp255: f64 = tmp247 * tmp47 * (-tmp129 * tmp245 * tmp246 - tmp253 * tmp47) - tmp250 * tmp254 + tmp251 * tmp254;
+    let tmp256: f64 = 1.0_f64 / (tmp121 * tmp121);
+    let tmp257: f64 = 1.0_f64 / (((tmp142 * tmp142) * tmp256 + 1.0_f64).sqrt());
+    let tmp258: f64 = tmp151 * tmp146.cosh();
+    let tmp259: f64 = tmp258 * tmp59;
+    let tmp260: f64 = tmp143 * tmp257 * tmp259;
+    let tmp261: f64 = tmp145 * tmp147;
+    let tmp262: f64 = tmp150 / (tmp148 * tmp148);
+    let tmp263: f64 = tmp149 * tmp148.cosh();
+    let tmp264: f64 = tmp145 * tmp258 + tmp152 - tmp261 * tmp262 + tmp261 * tmp263;
+    let tmp265: f64 = tmp147 * tmp256 * tmp26 * tmp58;
+    let tmp266: f64 = tmp259 * (-tmp142 * tmp256 * tmp257 - tmp144 * tmp256) + tmp262 * tmp265 - tmp263 * tmp265;
+    let tmp267: f64 = 1.0_f64 / (tmp108 * tmp108);
+    let tmp268: f64 = 1.0_f64 / (((tmp158 * tmp158) * tmp267 + 1.0_f64).sqrt());
+    let tmp269: f64 = tmp166 * tmp161.cosh();
+    let tmp270: f64 = tmp269 * tmp69;
+    let tmp271: f64 = tmp153 * tmp268 * tmp270;
+    let tmp272: f64 = tmp162 * tmp164 * tmp163.cosh();
+    let tmp273: f64 = tmp26 * tmp267 * tmp68;
+    let tmp274: f64 = tmp162 * tmp165 / (tmp163 * tmp163);
+    let tmp275: f64 = tmp270 * (-tmp158 * tmp267 * tmp268 - tmp159 * tmp267) - tmp272 * tmp273 + tmp273 * tmp274;
+    let tmp276: f64 = tmp160 * tmp269 + tmp160 * tmp272 - tmp160 * tmp274 + tmp167;
+    let tmp277: f64 = tmp10 * attachments_m[(2, 0)] - tmp4 * attachments_m[(0, 0)];
+    let tmp278: f64 = tmp277 * tmp48;
+    let tmp279: f64 = -tmp16 * attachments_m[(0, 0)] + tmp17 * attachments_m[(2, 0)];
+    let tmp280: f64 = tmp279 * tmp48;
+    let tmp281: f64 = tmp12 * tmp278 + tmp21 * tmp280;
+    let tmp282: f64 = tmp37 * attachments_m[(2, 0)] - tmp38 * attachments_m[(0, 0)];
+    let tmp283: f64 = tmp10 * attachments_m[(2, 1)] - tmp4 * attachments_m[(0, 1)];
+    let tmp284: f64 = tmp283 * tmp78;
+    let tmp285: f64 = -tmp16 * attachments_m[(0, 1)] + tmp17 * attachments_m[(2, 1)];
+    let tmp286: f64 = tmp285 * tmp78;
+    let tmp287: f64 = tmp284 * tmp41 + tmp286 * tmp44;
+    let tmp288: f64 = -tmp211 * tmp287 + tmp286;
+    let tmp289: f64 = tmp288 * tmp91;
+    let tmp290: f64 = tmp10 * attachments_m[(2, 3)] - tmp4 * attachments_m[(0, 3)];
+    let tmp291: f64 = tmp290 * tmp70;
+    let tmp292: f64 = -tmp16 * attachments_m[(0, 3)] + tmp17 * attachments_m[(2, 3)];
+    let tmp293: f64 = tmp292 * tmp70;
+    let tmp294: f64 = tmp291 * tmp63 + tmp293 * tmp66;
+    let tmp295: f64 = -tmp214 * tmp294 + tmp293;
+    let tmp296: f64 = tmp108 * tmp295;
+    let tmp297: f64 = tmp10 * attachments_m[(2, 2)] - tmp4 * attachments_m[(0, 2)];
+    let tmp298: f64 = tmp297 * tmp60;
+    let tmp299: f64 = -tmp16 * attachments_m[(0, 2)] + tmp17 * attachments_m[(2, 2)];
+    let tmp300: f64 = tmp299 * tmp60;
+    let tmp301: f64 = tmp298 * tmp53 + tmp300 * tmp56;
+    let tmp302: f64 = tmp193 * tmp301;
+    let tmp303: f64 = tmp300 - tmp302 * tmp56;
+    let tmp304: f64 = tmp121 * tmp303;
+    let tmp305: f64 = reference_tension_n[0] * (-tmp208 * tmp281 + tmp280);
+    let tmp306: f64 = tmp289 + tmp296 + tmp304 + tmp305;
+    let tmp307: f64 = -tmp184 * tmp294 + tmp291;
+    let tmp308: f64 = tmp108 * tmp307;
+    let tmp309: f64 = -tmp202 * tmp287 + tmp284;
+    let tmp310: f64 = tmp309 * tmp91;
+    let tmp311: f64 = tmp298 - tmp302 * tmp53;
+    let tmp312: f64 = tmp121 * tmp311;
+    let tmp313: f64 = reference_tension_n[0] * (-tmp206 * tmp281 + tmp278);
+    let tmp314: f64 = tmp308 + tmp310 + tmp312 + tmp313;
+    let tmp315: f64 = tmp314 * tmp84;
+    let tmp316: f64 = -tmp108 * (-tmp291 * tmp66 + tmp293 * tmp63 - tmp295 * tmp62 + tmp307 * tmp65) + tmp11 * tmp305
+        - tmp121 * (-tmp298 * tmp56 + tmp300 * tmp53 - tmp303 * tmp52 + tmp311 * tmp55)
+        - tmp20 * tmp313
+        + tmp210 * tmp278
+        - tmp216 * tmp280
+        - tmp91 * (-tmp284 * tmp44 + tmp286 * tmp41 - tmp288 * tmp40 + tmp309 * tmp43);
+    let tmp317: f64 = tmp306 * tmp87 + tmp315 * tmp77 + tmp316 * tmp85;
+    let tmp318: f64 = tmp37 * attachments_m[(2, 3)] - tmp38 * attachments_m[(0, 3)];
+    let tmp319: f64 = tmp37 * attachments_m[(2, 2)] - tmp38 * attachments_m[(0, 2)];
+    let tmp320: f64 = tmp101 * tmp306 + tmp102 * tmp315 + tmp106 * tmp316;
+    let tmp321: f64 = tmp114 * tmp316 + tmp117 * tmp306 + tmp119 * tmp314;
+    let tmp322: f64 = tmp37 * attachments_m[(2, 1)] - tmp38 * attachments_m[(0, 1)];
+    let tmp323: f64 = tmp104 * tmp282
+        + tmp109 * tmp308
+        + tmp111 * tmp310
+        + tmp122 * tmp312
+        + tmp129 * tmp283
+        + tmp142 * tmp297
+        + tmp158 * tmp290
+        + tmp226 * tmp317
+        + tmp228 * tmp319
+        + tmp230 * tmp320
+        + tmp232 * tmp321
+        + tmp234 * tmp322
+        + tmp236 * tmp318
+        + tmp277 * reference_tension_n[1]
+        + tmp313 * tmp39
+        - platform_weight_n * (tmp10 * com_offset_m[2] - tmp4 * com_offset_m[0]);
+    let tmp324: f64 = -tmp109 * tmp296
+        - tmp111 * tmp289
+        - tmp122 * tmp304
+        - tmp129 * tmp285
+        - tmp142 * tmp299
+        - tmp158 * tmp292
+        - tmp238 * tmp321
+        - tmp239 * tmp318
+        - tmp240 * tmp320
+        - tmp241 * tmp322
+        - tmp242 * tmp317
+        - tmp243 * tmp319
+        - tmp279 * reference_tension_n[1]
+        - tmp282 * tmp88
+        - tmp305 * tmp39
+        + platform_weight_n * (-tmp16 * com_offset_m[0] + tmp17 * com_offset_m[2]);
+    let tmp325: f64 = -tmp10 * attachments_m[(1, 0)] + tmp7 * attachments_m[(0, 0)];
+    let tmp326: f64 = tmp325 * tmp48;
+    let tmp327: f64 = -tmp17 * attachments_m[(1, 0)] + tmp19 * attachments_m[(0, 0)];
+    let tmp328: f64 = tmp327 * tmp48;
+    let tmp329: f64 = tmp12 * tmp326 + tmp21 * tmp328;
+    let tmp330: f64 = tmp36 * attachments_m[(0, 0)] - tmp37 * attachments_m[(1, 0)];
+    let tmp331: f64 = tmp36 * attachments_m[(0, 1)] - tmp37 * attachments_m[(1, 1)];
+    let tmp332: f64 = -tmp17 * attachments_m[(1, 3)] + tmp19 * attachments_m[(0, 3)];
+    let tmp333: f64 = tmp332 * tmp70;
+    let tmp334: f64 = -tmp10 * attachments_m[(1, 3)] + tmp7 * attachments_m[(0, 3)];
+    let tmp335: f64 = tmp334 * tmp70;
+    let tmp336: f64 = tmp333 * tmp66 + tmp335 * tmp63;
+    let tmp337: f64 = tmp183 * tmp336;
+    let tmp338: f64 = tmp333 - tmp337 * tmp66;
+    let tmp339: f64 = tmp108 * tmp338;
+    let tmp340: f64 = reference_tension_n[0] * (-tmp208 * tmp329 + tmp328);
+    let tmp341: f64 = -tmp17 * attachments_m[(1, 1)] + tmp19 * attachments_m[(0, 1)];
+    let tmp342: f64 = tmp341 * tmp78;
+    let tmp343: f64 = -tmp10 * attachments_m[(1, 1)] + tmp7 * attachments_m[(0, 1)];
+    let tmp344: f64 = tmp343 * tmp78;
+    let tmp345: f64 = tmp342 * tmp44 + tmp344 * tmp41;
+    let tmp346: f64 = -tmp202 * tmp345 + tmp344;
+    let tmp347: f64 = -tmp211 * tmp345 + tmp342;
+    let tmp348: f64 = -tmp17 * attachments_m[(1, 2)] + tmp19 * attachments_m[(0, 2)];
+    let tmp349: f64 = tmp348 * tmp60;
+    let tmp350: f64 = -tmp10 * attachments_m[(1, 2)] + tmp7 * attachments_m[(0, 2)];
+    let tmp351: f64 = tmp350 * tmp60;
+    let tmp352: f64 = tmp349 * tmp56 + tmp351 * tmp53;
+    let tmp353: f64 = tmp193 * tmp352;
+    let tmp354: f64 = tmp349 - tmp353 * tmp56;
+    let tmp355: f64 = tmp351 - tmp353 * tmp53;
+    let tmp356: f64 = tmp335 - tmp337 * tmp63;
+    let tmp357: f64 = reference_tension_n[0] * (-tmp206 * tmp329 + tmp326);
+    let tmp358: f64 = -tmp108 * (tmp333 * tmp63 - tmp335 * tmp66 - tmp338 * tmp62 + tmp356 * tmp65) + tmp11 * tmp340
+        - tmp121 * (tmp349 * tmp53 - tmp351 * tmp56 - tmp354 * tmp52 + tmp355 * tmp55)
+        - tmp20 * tmp357
+        + tmp210 * tmp326
+        - tmp216 * tmp328
+        - tmp91 * (tmp342 * tmp41 - tmp344 * tmp44 + tmp346 * tmp43 - tmp347 * tmp40);
+    let tmp359: f64 = tmp121 * tmp355;
+    let tmp360: f64 = tmp346 * tmp91;
+    let tmp361: f64 = tmp108 * tmp356;
+    let tmp362: f64 = tmp357 + tmp359 + tmp360 + tmp361;
+    let tmp363: f64 = tmp362 * tmp84;
+    let tmp364: f64 = tmp347 * tmp91;
+    let tmp365: f64 = tmp121 * tmp354;
+    let tmp366: f64 = tmp339 + tmp340 + tmp364 + tmp365;
+    let tmp367: f64 = tmp101 * tmp366 + tmp102 * tmp363 + tmp106 * tmp358;
+    let tmp368: f64 = tmp36 * attachments_m[(0, 3)] - tmp37 * attachments_m[(1, 3)];
+    let tmp369: f64 = tmp36 * attachments_m[(0, 2)] - tmp37 * attachments_m[(1, 2)];
+    let tmp370: f64 = tmp114 * tmp358 + tmp117 * tmp366 + tmp119 * tmp362;
+    let tmp371: f64 = tmp358 * tmp85 + tmp363 * tmp77 + tmp366 * tmp87;
+    let tmp372: f64 = -tmp109 * tmp339
+        - tmp111 * tmp364
+        - tmp122 * tmp365
+        - tmp129 * tmp341
+        - tmp142 * tmp348
+        - tmp158 * tmp332
+        - tmp238 * tmp370
+        - tmp239 * tmp368
+        - tmp240 * tmp367
+        - tmp241 * tmp331
+        - tmp242 * tmp371
+        - tmp243 * tmp369
+        - tmp327 * reference_tension_n[1]
+        - tmp330 * tmp88
+        - tmp340 * tmp39
+        + platform_weight_n * (-tmp17 * com_offset_m[1] + tmp19 * com_offset_m[0]);
+    let tmp373: f64 = tmp104 * tmp330
+        + tmp109 * tmp361
+        + tmp111 * tmp360
+        + tmp122 * tmp359
+        + tmp129 * tmp343
+        + tmp142 * tmp350
+        + tmp158 * tmp334
+        + tmp226 * tmp371
+        + tmp228 * tmp369
+        + tmp230 * tmp367
+        + tmp232 * tmp370
+        + tmp234 * tmp331
+        + tmp236 * tmp368
+        + tmp325 * reference_tension_n[1]
+        + tmp357 * tmp39
+        - platform_weight_n * (-tmp10 * com_offset_m[1] + tmp7 * com_offset_m[0]);
+    let tmp374: f64 = tmp171 * tmp50;
+    let tmp375: f64 = tmp252 * tmp79;
+    let tmp376: f64 = 1.0_f64 / (tmp68 * tmp68.sqrt());
+    let tmp377: f64 = tmp376 * tmp64;
+    let tmp378: f64 = -tmp377 + tmp70;
+    let tmp379: f64 = tmp376 * tmp63 * tmp66;
+    let tmp380: f64 = tmp379 * tmp62;
+    let tmp381: f64 = 1.0_f64 / (tmp46 * tmp46.sqrt());
+    let tmp382: f64 = tmp381 * tmp42;
+    let tmp383: f64 = -tmp382 + tmp78;
+    let tmp384: f64 = tmp381 * tmp41 * tmp44;
+    let tmp385: f64 = tmp384 * tmp40;
+    let tmp386: f64 = 1.0_f64 / (tmp58 * tmp58.sqrt());
+    let tmp387: f64 = tmp386 * tmp53 * tmp56;
+    let tmp388: f64 = tmp387 * tmp52;
+    let tmp389: f64 = tmp386 * tmp54;
+    let tmp390: f64 = -tmp389 + tmp60;
+    let tmp391: f64 = 1.0_f64 / (tmp23 * tmp23.sqrt());
+    let tmp392: f64 = tmp12 * tmp210 * tmp391;
+    let tmp393: f64 = tmp11 * tmp392;
+    let tmp394: f64 = tmp13 * tmp391;
+    let tmp395: f64 = reference_tension_n[0] * (-tmp394 + tmp48);
+    let tmp396: f64 = -tmp108 * (tmp378 * tmp65 + tmp380)
+        - tmp121 * (tmp388 + tmp390 * tmp55)
+        - tmp20 * tmp395
+        - tmp393
+        - tmp91 * (tmp383 * tmp43 + tmp385);
+    let tmp397: f64 = tmp108 * tmp378;
+    let tmp398: f64 = tmp121 * tmp390;
+    let tmp399: f64 = tmp383 * tmp91;
+    let tmp400: f64 = tmp395 + tmp397 + tmp398 + tmp399;
+    let tmp401: f64 = tmp400 * tmp84;
+    let tmp402: f64 = tmp121 * tmp387;
+    let tmp403: f64 = tmp384 * tmp91;
+    let tmp404: f64 = tmp108 * tmp379;
+    let tmp405: f64 = -tmp392 - tmp402 - tmp403 - tmp404;
+    let tmp406: f64 = tmp405 * tmp84;
+    let tmp407: f64 = tmp396 * tmp85 + tmp401 * tmp77 + tmp406 * tmp80;
+    let tmp408: f64 = tmp114 * tmp396 + tmp116 * tmp406 + tmp119 * tmp400;
+    let tmp409: f64 = tmp101 * tmp405 + tmp102 * tmp401 + tmp106 * tmp396;
+    let tmp410: f64 = tmp109 * tmp397
+        + tmp111 * tmp399
+        + tmp122 * tmp398
+        + tmp226 * tmp407
+        + tmp230 * tmp409
+        + tmp232 * tmp408
+        + tmp39 * tmp395;
+    let tmp411: f64 = tmp123 * tmp387;
+    let tmp412: f64 = tmp39 * tmp392;
+    let tmp413: f64 = tmp110 * tmp379;
+    let tmp414: f64 = tmp112 * tmp384;
+    let tmp415: f64 = -tmp238 * tmp408 - tmp240 * tmp409 - tmp242 * tmp407 + tmp411 + tmp412 + tmp413 + tmp414;
+    let tmp416: f64 = tmp264 * tmp60;
+    let tmp417: f64 = tmp416 * tmp53;
+    let tmp418: f64 = tmp276 * tmp71;
+    let tmp419: f64 = tmp171 * tmp49;
+    let tmp420: f64 = tmp252 * tmp81;
+    let tmp421: f64 = -tmp411;
+    let tmp422: f64 = -tmp412;
+    let tmp423: f64 = -tmp413;
+    let tmp424: f64 = tmp22 * tmp391;
+    let tmp425: f64 = reference_tension_n[0] * (-tmp424 + tmp48);
+    let tmp426: f64 = tmp386 * tmp57;
+    let tmp427: f64 = -tmp426 + tmp60;
+    let tmp428: f64 = tmp121 * tmp427;
+    let tmp429: f64 = tmp376 * tmp67;
+    let tmp430: f64 = -tmp429 + tmp70;
+    let tmp431: f64 = tmp108 * tmp430;
+    let tmp432: f64 = tmp381 * tmp45;
+    let tmp433: f64 = -tmp432 + tmp78;
+    let tmp434: f64 = tmp433 * tmp91;
+    let tmp435: f64 = tmp425 + tmp428 + tmp431 + tmp434;
+    let tmp436: f64 = tmp379 * tmp65;
+    let tmp437: f64 = tmp384 * tmp43;
+    let tmp438: f64 = tmp387 * tmp55;
+    let tmp439: f64 = tmp20 * tmp392;
+    let tmp440: f64 = -tmp108 * (-tmp430 * tmp62 - tmp436) + tmp11 * tmp425 - tmp121 * (-tmp427 * tmp52 - tmp438)
+        + tmp439
+        - tmp91 * (-tmp40 * tmp433 - tmp437);
+    let tmp441: f64 = tmp114 * tmp440 + tmp117 * tmp435 + tmp118 * tmp406;
+    let tmp442: f64 = tmp406 * tmp77 + tmp435 * tmp87 + tmp440 * tmp85;
+    let tmp443: f64 = tmp101 * tmp435 + tmp102 * tmp406 + tmp106 * tmp440;
+    let tmp444: f64 = -tmp414;
+    let tmp445: f64 = tmp226 * tmp442 + tmp230 * tmp443 + tmp232 * tmp441 + tmp421 + tmp422 + tmp423 + tmp444;
+    let tmp446: f64 = -tmp109 * tmp431
+        - tmp111 * tmp434
+        - tmp122 * tmp428
+        - tmp238 * tmp441
+        - tmp240 * tmp443
+        - tmp242 * tmp442
+        - tmp39 * tmp425;
+    let tmp447: f64 = tmp416 * tmp56;
+    let tmp448: f64 = tmp276 * tmp72;
+    let tmp449: f64 = 1.0_f64 / (reference_tension_n[0] * reference_tension_n[0]);
+    let tmp450: f64 = tmp23 * tmp26 * tmp449;
+    let tmp451: f64 = 1.0_f64 / ((tmp449 * (reference_tension_n[1] * reference_tension_n[1]) + 1.0_f64).sqrt());
+    let tmp452: f64 = tmp170 * tmp24;
+    let tmp453: f64 = tmp101 * tmp49 + tmp103 * tmp50 + tmp107;
+    let tmp454: f64 = tmp49 * tmp87 + tmp86 + tmp90;
+    let tmp455: f64 = tmp115 + tmp117 * tmp49 + tmp120;
+    let tmp456: f64 = tmp100 + tmp226 * tmp454 + tmp230 * tmp453 + tmp232 * tmp455;
+    let tmp457: f64 = -tmp126 - tmp238 * tmp455 - tmp240 * tmp453 - tmp242 * tmp454;
+    let tmp458: f64 = -tmp48;
+    let tmp459: f64 = reference_tension_n[0] * (tmp394 + tmp458);
+    let tmp460: f64 = -tmp20 * tmp459 + tmp393;
+    let tmp461: f64 = tmp392 * tmp87 + tmp459 * tmp89 + tmp460 * tmp85;
+    let tmp462: f64 = tmp101 * tmp392 + tmp103 * tmp459 + tmp106 * tmp460;
+    let tmp463: f64 = tmp114 * tmp460 + tmp117 * tmp392 + tmp119 * tmp459;
+    let tmp464: f64 = -tmp238 * tmp463 - tmp240 * tmp462 - tmp242 * tmp461 + tmp422;
+    let tmp465: f64 = tmp226 * tmp461 + tmp230 * tmp462 + tmp232 * tmp463 + tmp39 * tmp459;
+    let tmp466: f64 = reference_tension_n[0] * (tmp424 + tmp458);
+    let tmp467: f64 = tmp11 * tmp466 - tmp439;
+    let tmp468: f64 = tmp101 * tmp466 + tmp103 * tmp392 + tmp106 * tmp467;
+    let tmp469: f64 = tmp114 * tmp467 + tmp117 * tmp466 + tmp119 * tmp392;
+    let tmp470: f64 = tmp392 * tmp89 + tmp466 * tmp87 + tmp467 * tmp85;
+    let tmp471: f64 = -tmp238 * tmp469 - tmp240 * tmp468 - tmp242 * tmp470 - tmp39 * tmp466;
+    let tmp472: f64 = tmp226 * tmp470 + tmp230 * tmp468 + tmp232 * tmp469 + tmp412;
+    let tmp473: f64 = -tmp78;
+    let tmp474: f64 = tmp382 + tmp473;
+    let tmp475: f64 = -tmp385 + tmp43 * tmp474;
+    let tmp476: f64 = tmp85 * tmp91;
+    let tmp477: f64 = tmp474 * tmp91;
+    let tmp478: f64 = tmp403 * tmp87 - tmp475 * tmp476 + tmp477 * tmp89;
+    let tmp479: f64 = tmp106 * tmp91;
+    let tmp480: f64 = tmp101 * tmp403 + tmp103 * tmp477 - tmp475 * tmp479;
+    let tmp481: f64 = tmp114 * tmp91;
+    let tmp482: f64 = tmp117 * tmp403 + tmp119 * tmp477 - tmp475 * tmp481;
+    let tmp483: f64 = -tmp238 * tmp482 - tmp240 * tmp480 - tmp242 * tmp478 + tmp444;
+    let tmp484: f64 = tmp112 * tmp474 + tmp226 * tmp478 + tmp230 * tmp480 + tmp232 * tmp482;
+    let tmp485: f64 = tmp484 * tmp98;
+    let tmp486: f64 = tmp432 + tmp473;
+    let tmp487: f64 = tmp486 * tmp91;
+    let tmp488: f64 = -tmp40 * tmp486 + tmp437;
+    let tmp489: f64 = tmp403 * tmp89 - tmp476 * tmp488 + tmp487 * tmp87;
+    let tmp490: f64 = tmp117 * tmp487 + tmp119 * tmp403 - tmp481 * tmp488;
+    let tmp491: f64 = tmp101 * tmp487 + tmp103 * tmp403 - tmp479 * tmp488;
+    let tmp492: f64 = tmp226 * tmp489 + tmp230 * tmp491 + tmp232 * tmp490 + tmp414;
+    let tmp493: f64 = -tmp112 * tmp486 - tmp238 * tmp490 - tmp240 * tmp491 - tmp242 * tmp489;
+    let tmp494: f64 = -tmp60;
+    let tmp495: f64 = tmp389 + tmp494;
+    let tmp496: f64 = tmp121 * (-tmp388 + tmp495 * tmp55);
+    let tmp497: f64 = tmp121 * tmp495;
+    let tmp498: f64 = tmp402 * tmp87 - tmp496 * tmp85 + tmp497 * tmp89;
+    let tmp499: f64 = -tmp114 * tmp496 + tmp117 * tmp402 + tmp119 * tmp497;
+    let tmp500: f64 = tmp101 * tmp402 + tmp103 * tmp497 - tmp106 * tmp496;
+    let tmp501: f64 = tmp123 * tmp495 + tmp226 * tmp498 + tmp230 * tmp500 + tmp232 * tmp499;
+    let tmp502: f64 = -tmp238 * tmp499 - tmp240 * tmp500 - tmp242 * tmp498 + tmp421;
+    let tmp503: f64 = tmp426 + tmp494;
+    let tmp504: f64 = tmp121 * (tmp438 - tmp503 * tmp52);
+    let tmp505: f64 = tmp121 * tmp503;
+    let tmp506: f64 = -tmp114 * tmp504 + tmp117 * tmp505 + tmp119 * tmp402;
+    let tmp507: f64 = tmp402 * tmp89 - tmp504 * tmp85 + tmp505 * tmp87;
+    let tmp508: f64 = tmp101 * tmp505 + tmp103 * tmp402 - tmp106 * tmp504;
+    let tmp509: f64 = -tmp123 * tmp503 - tmp238 * tmp506 - tmp240 * tmp508 - tmp242 * tmp507;
+    let tmp510: f64 = tmp226 * tmp507 + tmp230 * tmp508 + tmp232 * tmp506 + tmp411;
+    let tmp511: f64 = -tmp70;
+    let tmp512: f64 = tmp377 + tmp511;
+    let tmp513: f64 = tmp108 * tmp512;
+    let tmp514: f64 = tmp108 * (-tmp380 + tmp512 * tmp65);
+    let tmp515: f64 = tmp404 * tmp87 + tmp513 * tmp89 - tmp514 * tmp85;
+    let tmp516: f64 = tmp101 * tmp404 + tmp103 * tmp513 - tmp106 * tmp514;
+    let tmp517: f64 = -tmp114 * tmp514 + tmp117 * tmp404 + tmp119 * tmp513;
+    let tmp518: f64 = tmp110 * tmp512 + tmp226 * tmp515 + tmp230 * tmp516 + tmp232 * tmp517;
+    let tmp519: f64 = -tmp238 * tmp517 - tmp240 * tmp516 - tmp242 * tmp515 + tmp423;
+    let tmp520: f64 = tmp429 + tmp511;
+    let tmp521: f64 = tmp108 * (tmp436 - tmp520 * tmp62);
+    let tmp522: f64 = tmp108 * tmp520;
+    let tmp523: f64 = tmp101 * tmp522 + tmp103 * tmp404 - tmp106 * tmp521;
+    let tmp524: f64 = -tmp114 * tmp521 + tmp117 * tmp522 + tmp119 * tmp404;
+    let tmp525: f64 = tmp404 * tmp89 - tmp521 * tmp85 + tmp522 * tmp87;
+    let tmp526: f64 = -tmp110 * tmp520 - tmp238 * tmp524 - tmp240 * tmp523 - tmp242 * tmp525;
+    let tmp527: f64 = tmp226 * tmp525 + tmp230 * tmp523 + tmp232 * tmp524 + tmp413;
 
     // Output terms (4)
     if let Some(jacobian_pose) = jacobian_pose {
-        jacobian_pose[(0, 0)] = tmp198 * tmp214 + tmp211 * tmp216 - tmp214 * tmp217 + tmp218 * tmp219 + tmp224;
-        jacobian_pose[(1, 0)] = tmp295 * tmp438 - tmp304 * tmp306
-            + tmp304 * tmp308
-            + tmp396
-            + tmp436
-                * (tmp304
-                    + tmp435
-                        * (tmp162 * tmp316 - tmp283 * tmp433 - tmp312 * tmp315
-                            + tmp431
-                                * (tmp117 * tmp400
-                                    + tmp118 * tmp430
-                                    + tmp156 * tmp309
-                                    + tmp159 * tmp310
-                                    + tmp160 * tmp311)));
-        jacobian_pose[(2, 0)] = tmp386 + tmp439 * tmp441 + tmp446 * tmp449 - tmp446 * tmp451
-            + tmp456
-                * (tmp446
-                    + tmp455
-                        * (tmp178
-                            * (-tmp156 * tmp241 - tmp159 * tmp237 + tmp175 * tmp290
-                                - tmp176 * tmp288
-                                - tmp400 * tmp63
-                                - tmp430 * tmp65
-                                - tmp52
-                                    * (tmp160 * tmp237 - tmp402 - tmp403 + tmp405 - tmp406 + tmp407
-                                        - tmp409
-                                        - tmp410
-                                        - tmp412
-                                        + tmp414
-                                        + tmp416
-                                        + tmp417
-                                        + tmp418
-                                        + tmp420
-                                        - tmp422
-                                        + tmp423
-                                        + tmp424
-                                        + tmp426
-                                        + tmp427
-                                        + tmp428
-                                        - tmp429)
-                                + tmp82 * (tmp160 * tmp241 + tmp400))
-                            - tmp312 * tmp454
-                            + tmp316 * tmp453
-                            - tmp444 * tmp452));
-        jacobian_pose[(3, 0)] = tmp245 * tmp474 + tmp393 + tmp462 * tmp464 - tmp462 * tmp466
-            + tmp472
-                * (tmp462
-                    + tmp467
-                        * (tmp192 * tmp316 - tmp312 * tmp471 - tmp382 * tmp469
-                            + tmp470
-                                * (tmp156 * tmp227 + tmp159 * tmp231 - tmp189 * tmp288
-                                    + tmp190 * tmp290
-                                    + tmp400 * tmp54
-                                    + tmp430 * tmp56
-                                    - tmp52 * (-tmp160 * tmp231 + tmp430)
-                                    + tmp82
-                                        * (-tmp160 * tmp227 + tmp322 + tmp323 + tmp324 + tmp327 - tmp329 + tmp332
-                                            - tmp353
-                                            - tmp355
-                                            + tmp358
-                                            + tmp360
-                                            - tmp362
-                                            - tmp364
-                                            + tmp365
-                                            - tmp385
-                                            - tmp388
-                                            - tmp389
-                                            - tmp391
-                                            - tmp392
-                                            - tmp395
-                                            - tmp399))));
-        jacobian_pose[(0, 1)] = tmp198 * tmp484 + tmp216 * tmp483 - tmp217 * tmp484 + tmp219 * tmp485 + tmp487;
-        jacobian_pose[(1, 1)] = -tmp306 * tmp578
-            + tmp308 * tmp578
-            + tmp436
-                * (tmp435
-                    * (-tmp315 * tmp577
-                        + tmp431
-                            * (tmp117 * tmp552
-                                + tmp118 * tmp576
-                                + tmp156 * tmp554
-                                + tmp159 * tmp517
-                                + tmp160 * tmp553)
-                        - tmp433 * tmp523
-                        + tmp515 * tmp516)
-                    + tmp578)
-            + tmp438 * tmp491
-            + tmp535;
-        jacobian_pose[(2, 1)] = tmp441 * tmp581 + tmp449 * tmp583 - tmp451 * tmp583
-            + tmp456
-                * (tmp455
-                    * (tmp178
-                        * (-tmp156 * tmp500 - tmp159 * tmp501 + tmp175 * tmp488
-                            - tmp176 * tmp489
-                            - tmp52
-                                * (tmp160 * tmp501 - tmp556 + tmp557 + tmp558 - tmp559 + tmp560 + tmp561 - tmp562
-                                    + tmp563
-                                    - tmp564
-                                    - tmp565
-                                    + tmp566
-                                    - tmp567
-                                    + tmp568
-                                    - tmp569
-                                    + tmp570
-                                    + tmp571
-                                    + tmp572
-                                    - tmp573
-                                    + tmp574
-                                    + tmp575)
-                            - tmp552 * tmp63
-                            - tmp576 * tmp65
-                            + tmp82 * (tmp160 * tmp500 + tmp552))
-                        - tmp454 * tmp577
-                        + tmp515 * tmp580
-                        - tmp542 * tmp579)
-                    + tmp583)
-            + tmp532;
-        jacobian_pose[(3, 1)] = tmp464 * tmp584 - tmp466 * tmp584
-            + tmp472
-                * (tmp467
-                    * (-tmp469 * tmp528
-                        + tmp470
-                            * (tmp156 * tmp497 + tmp159 * tmp494 - tmp189 * tmp489 + tmp190 * tmp488
-                                - tmp52 * (-tmp160 * tmp494 + tmp576)
-                                + tmp54 * tmp552
-                                + tmp56 * tmp576
-                                + tmp82
-                                    * (-tmp160 * tmp497 - tmp518 - tmp519 - tmp524 + tmp526 - tmp529 + tmp530
-                                        - tmp531
-                                        - tmp533
-                                        - tmp534
-                                        - tmp537
-                                        + tmp538
-                                        + tmp539
-                                        - tmp543
-                                        - tmp544
-                                        - tmp546
-                                        + tmp547
-                                        + tmp548
-                                        + tmp549
-                                        + tmp550
-                                        - tmp551))
-                        - tmp471 * tmp577
-                        + tmp515 * tmp585)
-                    + tmp584)
-            + tmp474 * tmp503
-            + tmp545;
-        jacobian_pose[(0, 2)] = tmp198 * tmp594 + tmp216 * tmp592 - tmp217 * tmp594 + tmp219 * tmp593 + tmp596;
-        jacobian_pose[(1, 2)] = -tmp306 * tmp627
-            + tmp308 * tmp627
-            + tmp436
-                * (tmp435
-                    * (-tmp315 * tmp682
-                        + tmp431
-                            * (tmp117 * tmp658
-                                + tmp118 * tmp681
-                                + tmp156 * tmp660
-                                + tmp159 * tmp628
-                                + tmp160 * tmp659)
-                        - tmp433 * tmp622
-                        + tmp516 * tmp626)
-                    + tmp627)
-            + tmp438 * tmp600
-            + tmp634;
-        jacobian_pose[(2, 2)] = tmp441 * tmp683 + tmp449 * tmp684 - tmp451 * tmp684
-            + tmp456
-                * (tmp455
-                    * (tmp178
-                        * (-tmp156 * tmp610 - tmp159 * tmp609 + tmp175 * tmp597
-                            - tmp176 * tmp598
-                            - tmp52
-                                * (tmp160 * tmp609 - tmp661 + tmp662 - tmp663 + tmp664 + tmp665 + tmp666
-                                    - tmp667
-                                    - tmp668
-                                    + tmp669
-                                    + tmp670
-                                    - tmp671
-                                    - tmp672
-                                    + tmp673
-                                    - tmp674
-                                    + tmp675
-                                    + tmp676
-                                    - tmp677
-                                    + tmp678
-                                    + tmp679
-                                    + tmp680)
-                            - tmp63 * tmp658
-                            - tmp65 * tmp681
-                            + tmp82 * (tmp160 * tmp610 + tmp658))
-                        - tmp454 * tmp682
-                        - tmp579 * tmp642
-                        + tmp580 * tmp626)
-                    + tmp684)
-            + tmp656;
-        jacobian_pose[(3, 2)] = tmp464 * tmp685 - tmp466 * tmp685
-            + tmp472
-                * (tmp467
-                    * (-tmp469 * tmp645
-                        + tmp470
-                            * (tmp156 * tmp606 + tmp159 * tmp603 - tmp189 * tmp598 + tmp190 * tmp597
-                                - tmp52 * (-tmp160 * tmp603 + tmp681)
-                                + tmp54 * tmp658
-                                + tmp56 * tmp681
-                                + tmp82
-                                    * (-tmp160 * tmp606 - tmp629 + tmp630 - tmp631 + tmp633 - tmp636 + tmp638
-                                        - tmp640
-                                        + tmp641
-                                        - tmp643
-                                        - tmp646
-                                        + tmp647
-                                        - tmp648
-                                        - tmp649
-                                        + tmp650
-                                        - tmp651
-                                        + tmp652
-                                        - tmp653
-                                        - tmp654
-                                        + tmp655
-                                        - tmp657))
-                        - tmp471 * tmp682
-                        + tmp585 * tmp626)
-                    + tmp685)
-            + tmp474 * tmp612
-            + tmp639;
-        jacobian_pose[(0, 3)] = -tmp688 + tmp689 + tmp690 + tmp691;
-        jacobian_pose[(1, 3)] = -tmp306 * tmp793
-            + tmp308 * tmp793
-            + tmp436
-                * (tmp435 * (tmp162 * tmp724 + tmp431 * (tmp117 * tmp777 + tmp118 * tmp789) - tmp433 * tmp765)
-                    + tmp793)
-            + tmp794;
-        jacobian_pose[(2, 3)] = tmp449 * tmp803 - tmp451 * tmp803
-            + tmp456
-                * (tmp455
-                    * (tmp178
-                        * (-tmp52 * (-tmp778 + tmp779 + tmp780 - tmp781 - tmp782 + tmp783 + tmp800)
-                            - tmp63 * tmp777
-                            - tmp65 * tmp789
-                            + tmp777 * tmp82)
-                        + tmp453 * tmp724
-                        - tmp579 * tmp747)
-                    + tmp803)
-            + tmp795;
-        jacobian_pose[(3, 3)] = tmp464 * tmp806 - tmp466 * tmp806
-            + tmp472
-                * (tmp467
-                    * (tmp192 * tmp724 - tmp469 * tmp761
-                        + tmp470
-                            * (-tmp52 * tmp789
-                                + tmp54 * tmp777
-                                + tmp56 * tmp789
-                                + tmp82
-                                    * (tmp726 - tmp748 - tmp762 - tmp766
-                                        + tmp767
-                                        + tmp768
-                                        + tmp808
-                                        + tmp810
-                                        + tmp812
-                                        + tmp814)))
-                    + tmp806)
-            + tmp815;
-        jacobian_pose[(0, 4)] = tmp817 + tmp818 - tmp819 + tmp820;
-        jacobian_pose[(1, 4)] = -tmp306 * tmp856
-            + tmp308 * tmp856
-            + tmp436
-                * (tmp435 * (tmp431 * (tmp117 * tmp886 + tmp118 * tmp901) - tmp433 * tmp847 + tmp516 * tmp854)
-                    + tmp856)
-            + tmp902;
-        jacobian_pose[(2, 4)] = tmp449 * tmp908 - tmp451 * tmp908
-            + tmp456
-                * (tmp455
-                    * (tmp178
-                        * (-tmp52
-                            * (-tmp887 + tmp888 + tmp889 - tmp890 - tmp891
-                                + tmp892
-                                + tmp903
-                                + tmp904
-                                + tmp905
-                                + tmp906)
-                            - tmp63 * tmp886
-                            - tmp65 * tmp901
-                            + tmp82 * tmp886)
-                        - tmp579 * tmp871
-                        + tmp580 * tmp854)
-                    + tmp908)
-            + tmp909;
-        jacobian_pose[(3, 4)] = tmp464 * tmp913 - tmp466 * tmp913
-            + tmp472
-                * (tmp467
-                    * (-tmp468 * tmp911
-                        + tmp470
-                            * (-tmp52 * tmp901
-                                + tmp54 * tmp886
-                                + tmp56 * tmp901
-                                + tmp82 * (tmp788 + tmp858 + tmp859 + tmp860 - tmp872 - tmp873 - tmp885))
-                        + tmp585 * tmp854)
-                    + tmp913)
-            + tmp910;
+        jacobian_pose[(0, 0)] = tmp171 * tmp176 + tmp177;
+        jacobian_pose[(1, 0)] =
+            tmp200 * tmp252 + tmp225 * tmp255 + tmp233 + tmp248 * (tmp125 * tmp237 + tmp128 * tmp244);
+        jacobian_pose[(2, 0)] =
+            tmp192 * tmp264 + tmp227 + tmp231 * tmp266 + tmp260 * (tmp140 * tmp237 + tmp141 * tmp244);
+        jacobian_pose[(3, 0)] =
+            tmp182 * tmp276 + tmp229 * tmp275 + tmp235 + tmp271 * (tmp155 * tmp237 + tmp157 * tmp244);
+        jacobian_pose[(0, 1)] = tmp171 * tmp281 + tmp282;
+        jacobian_pose[(1, 1)] =
+            tmp248 * (tmp125 * tmp323 + tmp128 * tmp324) + tmp252 * tmp287 + tmp255 * tmp317 + tmp322;
+        jacobian_pose[(2, 1)] =
+            tmp260 * (tmp140 * tmp323 + tmp141 * tmp324) + tmp264 * tmp301 + tmp266 * tmp321 + tmp319;
+        jacobian_pose[(3, 1)] =
+            tmp271 * (tmp155 * tmp323 + tmp157 * tmp324) + tmp275 * tmp320 + tmp276 * tmp294 + tmp318;
+        jacobian_pose[(0, 2)] = tmp171 * tmp329 + tmp330;
+        jacobian_pose[(1, 2)] =
+            tmp248 * (tmp125 * tmp373 + tmp128 * tmp372) + tmp252 * tmp345 + tmp255 * tmp371 + tmp331;
+        jacobian_pose[(2, 2)] =
+            tmp260 * (tmp140 * tmp373 + tmp141 * tmp372) + tmp264 * tmp352 + tmp266 * tmp370 + tmp369;
+        jacobian_pose[(3, 2)] =
+            tmp271 * (tmp155 * tmp373 + tmp157 * tmp372) + tmp275 * tmp367 + tmp276 * tmp336 + tmp368;
+        jacobian_pose[(0, 3)] = tmp374;
+        jacobian_pose[(1, 3)] = tmp248 * (tmp125 * tmp410 + tmp128 * tmp415) + tmp255 * tmp407 + tmp375;
+        jacobian_pose[(2, 3)] = tmp260 * (tmp140 * tmp410 + tmp141 * tmp415) + tmp266 * tmp408 + tmp417;
+        jacobian_pose[(3, 3)] = tmp271 * (tmp155 * tmp410 + tmp157 * tmp415) + tmp275 * tmp409 + tmp418;
+        jacobian_pose[(0, 4)] = tmp419;
+        jacobian_pose[(1, 4)] = tmp248 * (tmp125 * tmp445 + tmp128 * tmp446) + tmp255 * tmp442 + tmp420;
+        jacobian_pose[(2, 4)] = tmp260 * (tmp140 * tmp445 + tmp141 * tmp446) + tmp266 * tmp441 + tmp447;
+        jacobian_pose[(3, 4)] = tmp271 * (tmp155 * tmp445 + tmp157 * tmp446) + tmp275 * tmp443 + tmp448;
         jacobian_pose[(0, 5)] = 1.0_f64;
         jacobian_pose[(1, 5)] = 1.0_f64;
         jacobian_pose[(2, 5)] = 1.0_f64;
@@ -1708,266 +741,69 @@ pub fn attachment_height_residual(
     }
     if let Some(jacobian_reference_tension) = jacobian_reference_tension {
         jacobian_reference_tension[(0, 0)] =
-            -tmp198 * tmp915 + tmp217 * tmp915 + tmp917 * (-tmp38 * tmp914 - tmp914 * tmp916 * reference_tension_n[1]);
-        jacobian_reference_tension[(1, 0)] = tmp436
-            * (-tmp287 * tmp918 + tmp435 * (tmp431 * (tmp117 * tmp924 + tmp118 * tmp928) - tmp433 * tmp918))
-            + tmp918 * tmp931
-            - tmp918 * tmp932;
-        jacobian_reference_tension[(2, 0)] = tmp456
-            * (tmp455
-                * (tmp178
-                    * (-tmp52 * (tmp124 + tmp925 + tmp926 + tmp927) - tmp63 * tmp924 - tmp65 * tmp928
-                        + tmp82 * tmp924)
-                    - tmp579 * tmp921)
-                - tmp582 * tmp921)
-            - tmp934 * tmp935
-            + tmp934 * tmp936;
-        jacobian_reference_tension[(3, 0)] = tmp472
-            * (-tmp459 * tmp919
-                + tmp467
-                    * (-tmp469 * tmp919
-                        + tmp470
-                            * (-tmp52 * tmp928
-                                + tmp54 * tmp924
-                                + tmp56 * tmp928
-                                + tmp82 * (-tmp157 - tmp920 - tmp922 - tmp923))))
-            + tmp919 * tmp938
-            - tmp919 * tmp939;
-        jacobian_reference_tension[(0, 1)] = tmp36 * tmp916 * tmp917;
-        jacobian_reference_tension[(1, 1)] = tmp431 * tmp435 * tmp436 * (tmp117 * tmp17 + tmp118 * tmp940 - tmp119);
-        jacobian_reference_tension[(2, 1)] = tmp178
-            * tmp455
-            * tmp456
-            * (-tmp17 * tmp63 - tmp52 * (tmp31 - tmp63) - tmp65 * tmp940 + tmp82 * (tmp17 - tmp65));
-        jacobian_reference_tension[(3, 1)] = tmp467
-            * tmp470
-            * tmp472
-            * (tmp17 * tmp54 - tmp52 * (tmp54 + tmp940) + tmp56 * tmp940 + tmp82 * (-tmp10 - tmp16 - tmp5 + tmp56));
+            -tmp168 * tmp450 + tmp169 * tmp450 + tmp452 * (-tmp27 * tmp449 - tmp449 * tmp451 * reference_tension_n[1]);
+        jacobian_reference_tension[(1, 0)] = tmp248 * (tmp125 * tmp456 + tmp128 * tmp457) + tmp255 * tmp454;
+        jacobian_reference_tension[(2, 0)] = tmp260 * (tmp140 * tmp456 + tmp141 * tmp457) + tmp266 * tmp455;
+        jacobian_reference_tension[(3, 0)] = tmp271 * (tmp155 * tmp456 + tmp157 * tmp457) + tmp275 * tmp453;
+        jacobian_reference_tension[(0, 1)] = tmp25 * tmp451 * tmp452;
+        jacobian_reference_tension[(1, 1)] = tmp248 * (tmp11 * tmp125 - tmp128 * tmp20 - tmp99);
+        jacobian_reference_tension[(2, 1)] = tmp260 * (tmp11 * tmp140 - tmp139 - tmp141 * tmp20);
+        jacobian_reference_tension[(3, 1)] = tmp271 * (tmp11 * tmp155 - tmp156 - tmp157 * tmp20);
     }
     if let Some(jacobian_anchors) = jacobian_anchors {
-        jacobian_anchors[(0, 0)] = tmp688 - tmp689 - tmp690 - tmp691;
-        jacobian_anchors[(1, 0)] = -tmp307 * tmp943
-            + tmp436 * (-tmp287 * tmp942 + tmp435 * (tmp431 * (tmp117 * tmp953 + tmp118 * tmp949) - tmp433 * tmp942))
-            + tmp930 * tmp943;
-        jacobian_anchors[(2, 0)] = tmp456
-            * (tmp455
-                * (tmp178
-                    * (-tmp52 * (tmp784 + tmp945 + tmp946 + tmp948) - tmp63 * tmp953 - tmp65 * tmp949
-                        + tmp82 * tmp953)
-                    - tmp579 * tmp944)
-                - tmp582 * tmp944)
-            - tmp935 * tmp954
-            + tmp936 * tmp954;
-        jacobian_anchors[(3, 0)] = tmp472
-            * (-tmp459 * tmp947
-                + tmp467
-                    * (-tmp469 * tmp947
-                        + tmp470
-                            * (-tmp52 * tmp949
-                                + tmp54 * tmp953
-                                + tmp56 * tmp949
-                                + tmp82 * (tmp770 - tmp950 - tmp951 - tmp952))))
-            + tmp938 * tmp947
-            - tmp939 * tmp947;
-        jacobian_anchors[(0, 1)] = -tmp817 - tmp818 + tmp819 - tmp820;
-        jacobian_anchors[(1, 1)] = tmp436
-            * (-tmp287 * tmp956 + tmp435 * (tmp431 * (tmp117 * tmp962 + tmp118 * tmp966) - tmp433 * tmp956))
-            + tmp931 * tmp956
-            - tmp932 * tmp956;
-        jacobian_anchors[(2, 1)] = tmp456
-            * (tmp455
-                * (tmp178
-                    * (-tmp52 * (tmp894 + tmp963 + tmp964 + tmp965) - tmp63 * tmp962 - tmp65 * tmp966
-                        + tmp82 * tmp962)
-                    - tmp579 * tmp960)
-                - tmp582 * tmp960)
-            - tmp935 * tmp967
-            + tmp936 * tmp967;
-        jacobian_anchors[(3, 1)] = tmp472
-            * (-tmp459 * tmp958
-                + tmp467
-                    * (-tmp469 * tmp958
-                        + tmp470
-                            * (-tmp52 * tmp966
-                                + tmp54 * tmp962
-                                + tmp56 * tmp966
-                                + tmp82 * (tmp796 - tmp957 - tmp959 - tmp961))))
-            + tmp938 * tmp958
-            - tmp939 * tmp958;
+        jacobian_anchors[(0, 0)] = -tmp374;
+        jacobian_anchors[(1, 0)] = tmp248 * (tmp125 * tmp465 + tmp128 * tmp464) + tmp255 * tmp461;
+        jacobian_anchors[(2, 0)] = tmp260 * (tmp140 * tmp465 + tmp141 * tmp464) + tmp266 * tmp463;
+        jacobian_anchors[(3, 0)] = tmp271 * (tmp155 * tmp465 + tmp157 * tmp464) + tmp275 * tmp462;
+        jacobian_anchors[(0, 1)] = -tmp419;
+        jacobian_anchors[(1, 1)] = tmp248 * (tmp125 * tmp472 + tmp128 * tmp471) + tmp255 * tmp470;
+        jacobian_anchors[(2, 1)] = tmp260 * (tmp140 * tmp472 + tmp141 * tmp471) + tmp266 * tmp469;
+        jacobian_anchors[(3, 1)] = tmp271 * (tmp155 * tmp472 + tmp157 * tmp471) + tmp275 * tmp468;
         jacobian_anchors[(0, 2)] = -1.0_f64;
         jacobian_anchors[(1, 2)] = 0.0;
         jacobian_anchors[(2, 2)] = 0.0;
         jacobian_anchors[(3, 2)] = 0.0;
         jacobian_anchors[(0, 3)] = 0.0;
-        jacobian_anchors[(1, 3)] = -tmp306 * tmp986
-            + tmp308 * tmp986
-            + tmp436 * (tmp435 * (tmp431 * (tmp117 * tmp984 + tmp118 * tmp978) + tmp516 * tmp969) + tmp986)
-            - tmp794;
-        jacobian_anchors[(2, 3)] = tmp449 * tmp987 - tmp451 * tmp987
-            + tmp456
-                * (tmp455
-                    * (tmp178
-                        * (-tmp52 * (tmp786 - tmp970 + tmp972 - tmp974 - tmp975 + tmp977)
-                            - tmp63 * tmp984
-                            - tmp65 * tmp978
-                            + tmp82 * tmp984)
-                        - tmp579 * tmp971
-                        + tmp580 * tmp969)
-                    + tmp987);
-        jacobian_anchors[(3, 3)] = tmp464 * tmp988 - tmp466 * tmp988
-            + tmp472
-                * (tmp467
-                    * (-tmp469 * tmp976
-                        + tmp470
-                            * (-tmp52 * tmp978
-                                + tmp54 * tmp984
-                                + tmp56 * tmp978
-                                + tmp82 * (tmp772 + tmp979 - tmp980 + tmp981 - tmp982 + tmp983))
-                        + tmp585 * tmp969)
-                    + tmp988);
+        jacobian_anchors[(1, 3)] = tmp248 * (tmp128 * tmp483 + tmp485 * tmp95) + tmp255 * tmp478 - tmp375;
+        jacobian_anchors[(2, 3)] = tmp260 * (tmp140 * tmp484 + tmp141 * tmp483) + tmp266 * tmp482;
+        jacobian_anchors[(3, 3)] = tmp271 * (tmp154 * tmp485 + tmp157 * tmp483) + tmp275 * tmp480;
         jacobian_anchors[(0, 4)] = 0.0;
-        jacobian_anchors[(1, 4)] = -tmp1008 * tmp306
-            + tmp1008 * tmp308
-            + tmp436 * (tmp1008 + tmp435 * (tmp431 * (tmp1000 * tmp117 + tmp1006 * tmp118) + tmp516 * tmp990))
-            - tmp902;
-        jacobian_anchors[(2, 4)] = tmp1009 * tmp449 - tmp1009 * tmp451
-            + tmp456
-                * (tmp1009
-                    + tmp455
-                        * (tmp178
-                            * (-tmp1000 * tmp63 + tmp1000 * tmp82
-                                - tmp1006 * tmp65
-                                - tmp52 * (tmp1001 + tmp1002 - tmp1003 - tmp1004 - tmp1005 + tmp898))
-                            - tmp579 * tmp996
-                            + tmp580 * tmp990));
-        jacobian_anchors[(3, 4)] = tmp1010 * tmp464 - tmp1010 * tmp466
-            + tmp472
-                * (tmp1010
-                    + tmp467
-                        * (-tmp469 * tmp998
-                            + tmp470
-                                * (tmp1000 * tmp54 - tmp1006 * tmp52
-                                    + tmp1006 * tmp56
-                                    + tmp82 * (tmp798 + tmp992 + tmp994 + tmp995 - tmp997 - tmp999))
-                            + tmp585 * tmp990));
+        jacobian_anchors[(1, 4)] = tmp248 * (tmp125 * tmp492 + tmp128 * tmp493) + tmp255 * tmp489 - tmp420;
+        jacobian_anchors[(2, 4)] = tmp260 * (tmp140 * tmp492 + tmp141 * tmp493) + tmp266 * tmp490;
+        jacobian_anchors[(3, 4)] = tmp271 * (tmp155 * tmp492 + tmp157 * tmp493) + tmp275 * tmp491;
         jacobian_anchors[(0, 5)] = 0.0;
         jacobian_anchors[(1, 5)] = -1.0_f64;
         jacobian_anchors[(2, 5)] = 0.0;
         jacobian_anchors[(3, 5)] = 0.0;
         jacobian_anchors[(0, 6)] = 0.0;
-        jacobian_anchors[(1, 6)] = -tmp1032 * tmp306
-            + tmp1032 * tmp308
-            + tmp436
-                * (tmp1032
-                    + tmp435 * (tmp1015 * tmp516 - tmp1016 * tmp433 + tmp431 * (tmp1024 * tmp117 + tmp1030 * tmp118)));
-        jacobian_anchors[(2, 6)] = tmp1033 * tmp449 - tmp1033 * tmp451
-            + tmp456
-                * (tmp1033
-                    + tmp455
-                        * (tmp1015 * tmp580
-                            + tmp178
-                                * (-tmp1024 * tmp63 + tmp1024 * tmp82
-                                    - tmp1030 * tmp65
-                                    - tmp52 * (-tmp1025 + tmp1026 - tmp1027 - tmp1028 + tmp1029 + tmp785))))
-            - tmp795;
-        jacobian_anchors[(3, 6)] = tmp1034 * tmp464 - tmp1034 * tmp466
-            + tmp472
-                * (tmp1034
-                    + tmp467
-                        * (tmp1015 * tmp585 - tmp1022 * tmp469
-                            + tmp470
-                                * (tmp1024 * tmp54 - tmp1030 * tmp52
-                                    + tmp1030 * tmp56
-                                    + tmp82 * (tmp1018 + tmp1019 + tmp1020 - tmp1021 - tmp1023 + tmp776))));
+        jacobian_anchors[(1, 6)] = tmp248 * (tmp125 * tmp501 + tmp128 * tmp502) + tmp255 * tmp498;
+        jacobian_anchors[(2, 6)] = tmp260 * (tmp140 * tmp501 + tmp141 * tmp502) + tmp266 * tmp499 - tmp417;
+        jacobian_anchors[(3, 6)] = tmp271 * (tmp155 * tmp501 + tmp157 * tmp502) + tmp275 * tmp500;
         jacobian_anchors[(0, 7)] = 0.0;
-        jacobian_anchors[(1, 7)] = -tmp1055 * tmp306
-            + tmp1055 * tmp308
-            + tmp436
-                * (tmp1055
-                    + tmp435 * (-tmp1039 * tmp433 + tmp1042 * tmp516 + tmp431 * (tmp1048 * tmp118 + tmp1054 * tmp117)));
-        jacobian_anchors[(2, 7)] = tmp1056 * tmp449 - tmp1056 * tmp451
-            + tmp456
-                * (tmp1056
-                    + tmp455
-                        * (tmp1042 * tmp580
-                            + tmp178
-                                * (-tmp1048 * tmp65 - tmp1054 * tmp63 + tmp1054 * tmp82
-                                    - tmp52 * (tmp1041 - tmp1044 - tmp1045 - tmp1046 + tmp1047 + tmp896))))
-            - tmp909;
-        jacobian_anchors[(3, 7)] = tmp1057 * tmp464 - tmp1057 * tmp466
-            + tmp472
-                * (tmp1057
-                    + tmp467
-                        * (-tmp1040 * tmp469
-                            + tmp1042 * tmp585
-                            + tmp470
-                                * (-tmp1048 * tmp52
-                                    + tmp1048 * tmp56
-                                    + tmp1054 * tmp54
-                                    + tmp82 * (-tmp1049 + tmp1050 + tmp1051 + tmp1052 - tmp1053 + tmp797))));
+        jacobian_anchors[(1, 7)] = tmp248 * (tmp125 * tmp510 + tmp128 * tmp509) + tmp255 * tmp507;
+        jacobian_anchors[(2, 7)] = tmp260 * (tmp140 * tmp510 + tmp141 * tmp509) + tmp266 * tmp506 - tmp447;
+        jacobian_anchors[(3, 7)] = tmp271 * (tmp155 * tmp510 + tmp157 * tmp509) + tmp275 * tmp508;
         jacobian_anchors[(0, 8)] = 0.0;
         jacobian_anchors[(1, 8)] = 0.0;
         jacobian_anchors[(2, 8)] = -1.0_f64;
         jacobian_anchors[(3, 8)] = 0.0;
         jacobian_anchors[(0, 9)] = 0.0;
-        jacobian_anchors[(1, 9)] = -tmp1065 * tmp306
-            + tmp1065 * tmp308
-            + tmp436
-                * (tmp1065
-                    + tmp435 * (-tmp1063 * tmp432 + tmp1064 * tmp516 + tmp431 * (tmp1073 * tmp118 + tmp1079 * tmp117)));
-        jacobian_anchors[(2, 9)] = tmp1080 * tmp449 - tmp1080 * tmp451
-            + tmp456
-                * (tmp1080
-                    + tmp455
-                        * (tmp1064 * tmp580 - tmp1069 * tmp579
-                            + tmp178
-                                * (-tmp1073 * tmp65 - tmp1079 * tmp63 + tmp1079 * tmp82
-                                    - tmp52 * (-tmp1067 + tmp1068 + tmp1070 - tmp1071 - tmp1072 + tmp787))));
-        jacobian_anchors[(3, 9)] = tmp1081 * tmp464 - tmp1081 * tmp466
-            + tmp472
-                * (tmp1081
-                    + tmp467
-                        * (tmp1064 * tmp585
-                            + tmp470
-                                * (-tmp1073 * tmp52
-                                    + tmp1073 * tmp56
-                                    + tmp1079 * tmp54
-                                    + tmp82 * (tmp1074 - tmp1075 + tmp1076 - tmp1077 + tmp1078 + tmp774))))
-            - tmp815;
+        jacobian_anchors[(1, 9)] = tmp248 * (tmp125 * tmp518 + tmp128 * tmp519) + tmp255 * tmp515;
+        jacobian_anchors[(2, 9)] = tmp260 * (tmp140 * tmp518 + tmp141 * tmp519) + tmp266 * tmp517;
+        jacobian_anchors[(3, 9)] = tmp271 * (tmp155 * tmp518 + tmp157 * tmp519) + tmp275 * tmp516 - tmp418;
         jacobian_anchors[(0, 10)] = 0.0;
-        jacobian_anchors[(1, 10)] = -tmp1088 * tmp306
-            + tmp1088 * tmp308
-            + tmp436
-                * (tmp1088
-                    + tmp435 * (-tmp1087 * tmp433 + tmp1089 * tmp162 + tmp431 * (tmp1097 * tmp118 + tmp1103 * tmp117)));
-        jacobian_anchors[(2, 10)] = tmp1104 * tmp449 - tmp1104 * tmp451
-            + tmp456
-                * (tmp1104
-                    + tmp455
-                        * (tmp1089 * tmp453 - tmp1094 * tmp579
-                            + tmp178
-                                * (-tmp1097 * tmp65 - tmp1103 * tmp63 + tmp1103 * tmp82
-                                    - tmp52 * (-tmp1091 - tmp1092 + tmp1093 + tmp1095 - tmp1096 + tmp900))));
-        jacobian_anchors[(3, 10)] = tmp1105 * tmp464 - tmp1105 * tmp466
-            + tmp472
-                * (tmp1105
-                    + tmp467
-                        * (tmp1089 * tmp192
-                            + tmp470
-                                * (-tmp1097 * tmp52
-                                    + tmp1097 * tmp56
-                                    + tmp1103 * tmp54
-                                    + tmp82 * (-tmp1098 + tmp1099 + tmp1100 + tmp1101 - tmp1102 + tmp799))))
-            - tmp910;
+        jacobian_anchors[(1, 10)] = tmp248 * (tmp125 * tmp527 + tmp128 * tmp526) + tmp255 * tmp525;
+        jacobian_anchors[(2, 10)] = tmp260 * (tmp140 * tmp527 + tmp141 * tmp526) + tmp266 * tmp524;
+        jacobian_anchors[(3, 10)] = tmp271 * (tmp155 * tmp527 + tmp157 * tmp526) + tmp275 * tmp523 - tmp448;
         jacobian_anchors[(0, 11)] = 0.0;
         jacobian_anchors[(1, 11)] = 0.0;
         jacobian_anchors[(2, 11)] = 0.0;
         jacobian_anchors[(3, 11)] = -1.0_f64;
     }
     nalgebra::SVector::<f64, 4>::from([
-        tmp35 * tmp46 + tmp51 - anchors_m[(2, 0)] + position_m[2],
-        tmp153 + tmp165 * tmp167 - anchors_m[(2, 1)] + position_m[2],
-        tmp125 + tmp173 * tmp182 - anchors_m[(2, 2)] + position_m[2],
-        tmp140 + tmp195 * tmp197 - anchors_m[(2, 3)] + position_m[2],
+        tmp24 * tmp35 + tmp39 - anchors_m[(2, 0)] + position_m[2],
+        tmp111 + tmp138 * tmp47 - anchors_m[(2, 1)] + position_m[2],
+        tmp122 + tmp152 * tmp59 - anchors_m[(2, 2)] + position_m[2],
+        tmp109 + tmp167 * tmp69 - anchors_m[(2, 3)] + position_m[2],
     ])
 }

@@ -38,1425 +38,655 @@ pub fn cable_geometry(
     jacobian_anchors: Option<&mut nalgebra::SMatrix<f64, 16, 12>>,
     jacobian_com_offset: Option<&mut nalgebra::SMatrix<f64, 16, 3>>,
 ) -> nalgebra::SVector<f64, 16> {
-    // Total ops: 3250
+    // Total ops: 1609
 
-    // Intermediate terms (948)
+    // Intermediate terms (431)
     let tmp0: f64 = 2.0_f64 * rotation_xyzw[3];
     let tmp1: f64 = tmp0 * rotation_xyzw[1];
-    let tmp2: f64 = 2.0_f64 * rotation_xyzw[0];
-    let tmp3: f64 = tmp2 * rotation_xyzw[2];
+    let tmp2: f64 = 2.0_f64 * rotation_xyzw[2];
+    let tmp3: f64 = tmp2 * rotation_xyzw[0];
     let tmp4: f64 = tmp1 + tmp3;
-    let tmp5: f64 = tmp4 * attachments_m[(2, 0)];
-    let tmp6: f64 = tmp0 * rotation_xyzw[2];
-    let tmp7: f64 = -tmp6;
-    let tmp8: f64 = tmp2 * rotation_xyzw[1];
-    let tmp9: f64 = tmp7 + tmp8;
-    let tmp10: f64 = tmp9 * attachments_m[(1, 0)];
-    let tmp11: f64 = rotation_xyzw[1] * rotation_xyzw[1];
-    let tmp12: f64 = -2.0_f64 * tmp11;
-    let tmp13: f64 = rotation_xyzw[2] * rotation_xyzw[2];
-    let tmp14: f64 = 1.0_f64 - 2.0_f64 * tmp13;
-    let tmp15: f64 = tmp12 + tmp14;
-    let tmp16: f64 = tmp15 * attachments_m[(0, 0)];
-    let tmp17: f64 = tmp10 + tmp16 + tmp5;
-    let tmp18: f64 = tmp17 - anchors_m[(0, 0)] + position_m[0];
-    let tmp19: f64 = tmp18 * tmp18;
-    let tmp20: f64 = tmp2 * rotation_xyzw[3];
-    let tmp21: f64 = -tmp20;
-    let tmp22: f64 = 2.0_f64 * rotation_xyzw[1] * rotation_xyzw[2];
-    let tmp23: f64 = tmp21 + tmp22;
-    let tmp24: f64 = tmp23 * attachments_m[(2, 0)];
-    let tmp25: f64 = tmp6 + tmp8;
-    let tmp26: f64 = tmp25 * attachments_m[(0, 0)];
-    let tmp27: f64 = rotation_xyzw[0] * rotation_xyzw[0];
-    let tmp28: f64 = -2.0_f64 * tmp27;
-    let tmp29: f64 = tmp14 + tmp28;
-    let tmp30: f64 = tmp29 * attachments_m[(1, 0)];
-    let tmp31: f64 = tmp24 + tmp26 + tmp30;
-    let tmp32: f64 = tmp31 - anchors_m[(1, 0)] + position_m[1];
-    let tmp33: f64 = tmp32 * tmp32;
-    let tmp34: f64 = tmp19 + tmp33 + epsilon;
-    let tmp35: f64 = tmp34.sqrt();
-    let tmp36: f64 = tmp20 + tmp22;
-    let tmp37: f64 = -tmp1;
-    let tmp38: f64 = tmp3 + tmp37;
-    let tmp39: f64 = tmp12 + tmp28 + 1.0_f64;
-    let tmp40: f64 = tmp36 * attachments_m[(1, 0)] + tmp38 * attachments_m[(0, 0)] + tmp39 * attachments_m[(2, 0)];
-    let tmp41: f64 = tmp15 * attachments_m[(0, 1)] + tmp4 * attachments_m[(2, 1)] + tmp9 * attachments_m[(1, 1)];
-    let tmp42: f64 = tmp41 - anchors_m[(0, 1)] + position_m[0];
-    let tmp43: f64 = tmp42 * tmp42;
-    let tmp44: f64 = tmp23 * attachments_m[(2, 1)] + tmp25 * attachments_m[(0, 1)] + tmp29 * attachments_m[(1, 1)];
-    let tmp45: f64 = tmp44 - anchors_m[(1, 1)] + position_m[1];
-    let tmp46: f64 = tmp45 * tmp45;
-    let tmp47: f64 = tmp43 + tmp46 + epsilon;
+    let tmp5: f64 = tmp2 * rotation_xyzw[3];
+    let tmp6: f64 = 2.0_f64 * rotation_xyzw[0] * rotation_xyzw[1];
+    let tmp7: f64 = -tmp5 + tmp6;
+    let tmp8: f64 = -2.0_f64 * (rotation_xyzw[2] * rotation_xyzw[2]);
+    let tmp9: f64 = 1.0_f64 - 2.0_f64 * (rotation_xyzw[1] * rotation_xyzw[1]);
+    let tmp10: f64 = tmp8 + tmp9;
+    let tmp11: f64 = tmp10 * attachments_m[(0, 0)] + tmp4 * attachments_m[(2, 0)] + tmp7 * attachments_m[(1, 0)];
+    let tmp12: f64 = tmp11 - anchors_m[(0, 0)] + position_m[0];
+    let tmp13: f64 = tmp12 * tmp12;
+    let tmp14: f64 = tmp0 * rotation_xyzw[0];
+    let tmp15: f64 = tmp2 * rotation_xyzw[1];
+    let tmp16: f64 = -tmp14 + tmp15;
+    let tmp17: f64 = tmp5 + tmp6;
+    let tmp18: f64 = -2.0_f64 * (rotation_xyzw[0] * rotation_xyzw[0]);
+    let tmp19: f64 = tmp18 + tmp8 + 1.0_f64;
+    let tmp20: f64 = tmp16 * attachments_m[(2, 0)] + tmp17 * attachments_m[(0, 0)] + tmp19 * attachments_m[(1, 0)];
+    let tmp21: f64 = tmp20 - anchors_m[(1, 0)] + position_m[1];
+    let tmp22: f64 = tmp21 * tmp21;
+    let tmp23: f64 = tmp13 + tmp22 + epsilon;
+    let tmp24: f64 = tmp23.sqrt();
+    let tmp25: f64 = tmp14 + tmp15;
+    let tmp26: f64 = -tmp1 + tmp3;
+    let tmp27: f64 = tmp18 + tmp9;
+    let tmp28: f64 = tmp25 * attachments_m[(1, 0)] + tmp26 * attachments_m[(0, 0)] + tmp27 * attachments_m[(2, 0)];
+    let tmp29: f64 = tmp10 * attachments_m[(0, 1)] + tmp4 * attachments_m[(2, 1)] + tmp7 * attachments_m[(1, 1)];
+    let tmp30: f64 = tmp29 - anchors_m[(0, 1)] + position_m[0];
+    let tmp31: f64 = tmp30 * tmp30;
+    let tmp32: f64 = tmp16 * attachments_m[(2, 1)] + tmp17 * attachments_m[(0, 1)] + tmp19 * attachments_m[(1, 1)];
+    let tmp33: f64 = tmp32 - anchors_m[(1, 1)] + position_m[1];
+    let tmp34: f64 = tmp33 * tmp33;
+    let tmp35: f64 = tmp31 + tmp34 + epsilon;
+    let tmp36: f64 = tmp35.sqrt();
+    let tmp37: f64 = 1.0_f64 / tmp24;
+    let tmp38: f64 = tmp21 * tmp37;
+    let tmp39: f64 = tmp12 * tmp37;
+    let tmp40: f64 = tmp11 * tmp38 - tmp20 * tmp39;
+    let tmp41: f64 = tmp16 * attachments_m[(2, 2)] + tmp17 * attachments_m[(0, 2)] + tmp19 * attachments_m[(1, 2)];
+    let tmp42: f64 = tmp41 - anchors_m[(1, 2)] + position_m[1];
+    let tmp43: f64 = tmp10 * attachments_m[(0, 2)] + tmp4 * attachments_m[(2, 2)] + tmp7 * attachments_m[(1, 2)];
+    let tmp44: f64 = tmp43 - anchors_m[(0, 2)] + position_m[0];
+    let tmp45: f64 = tmp44 * tmp44;
+    let tmp46: f64 = tmp42 * tmp42;
+    let tmp47: f64 = tmp45 + tmp46 + epsilon;
     let tmp48: f64 = tmp47.sqrt();
-    let tmp49: f64 = tmp15 * attachments_m[(0, 3)] + tmp4 * attachments_m[(2, 3)] + tmp9 * attachments_m[(1, 3)];
-    let tmp50: f64 = tmp23 * attachments_m[(2, 3)] + tmp25 * attachments_m[(0, 3)] + tmp29 * attachments_m[(1, 3)];
-    let tmp51: f64 = tmp50 - anchors_m[(1, 3)] + position_m[1];
-    let tmp52: f64 = tmp49 - anchors_m[(0, 3)] + position_m[0];
+    let tmp49: f64 = 1.0_f64 / tmp48;
+    let tmp50: f64 = tmp42 * tmp49;
+    let tmp51: f64 = tmp10 * attachments_m[(0, 3)] + tmp4 * attachments_m[(2, 3)] + tmp7 * attachments_m[(1, 3)];
+    let tmp52: f64 = tmp51 - anchors_m[(0, 3)] + position_m[0];
     let tmp53: f64 = tmp52 * tmp52;
-    let tmp54: f64 = tmp51 * tmp51;
-    let tmp55: f64 = tmp53 + tmp54 + epsilon;
-    let tmp56: f64 = tmp55.sqrt();
-    let tmp57: f64 = 1.0_f64 / tmp56;
-    let tmp58: f64 = tmp51 * tmp57;
-    let tmp59: f64 = tmp50 * tmp57;
-    let tmp60: f64 = tmp49 * tmp58 - tmp52 * tmp59;
-    let tmp61: f64 = tmp23 * attachments_m[(2, 2)] + tmp25 * attachments_m[(0, 2)] + tmp29 * attachments_m[(1, 2)];
-    let tmp62: f64 = tmp61 - anchors_m[(1, 2)] + position_m[1];
-    let tmp63: f64 = tmp15 * attachments_m[(0, 2)] + tmp4 * attachments_m[(2, 2)] + tmp9 * attachments_m[(1, 2)];
-    let tmp64: f64 = tmp63 - anchors_m[(0, 2)] + position_m[0];
-    let tmp65: f64 = tmp64 * tmp64;
-    let tmp66: f64 = tmp62 * tmp62;
-    let tmp67: f64 = tmp65 + tmp66 + epsilon;
-    let tmp68: f64 = tmp67.sqrt();
-    let tmp69: f64 = 1.0_f64 / tmp68;
-    let tmp70: f64 = tmp62 * tmp69;
-    let tmp71: f64 = tmp61 * tmp69;
-    let tmp72: f64 = tmp63 * tmp70 - tmp64 * tmp71;
-    let tmp73: f64 = -tmp58 * tmp72 + tmp60 * tmp70;
-    let tmp74: f64 = 1.0_f64 / tmp48;
-    let tmp75: f64 = tmp42 * tmp74;
-    let tmp76: f64 = tmp64 * tmp69;
-    let tmp77: f64 = tmp52 * tmp57;
-    let tmp78: f64 = -tmp60 * tmp76 + tmp72 * tmp77;
-    let tmp79: f64 = tmp45 * tmp74;
-    let tmp80: f64 = tmp44 * tmp74;
-    let tmp81: f64 = tmp41 * tmp79 - tmp42 * tmp80;
-    let tmp82: f64 = tmp58 * tmp76 - tmp70 * tmp77;
-    let tmp83: f64 = -tmp73 * tmp75 - tmp78 * tmp79 - tmp81 * tmp82;
-    let tmp84: f64 = tmp83 + epsilon * tmp83.signum();
-    let tmp85: f64 = 1.0_f64 / tmp84;
-    let tmp86: f64 = 1.0_f64 / tmp35;
-    let tmp87: f64 = tmp32 * tmp86;
-    let tmp88: f64 = tmp78 * tmp87;
-    let tmp89: f64 = tmp18 * tmp86;
+    let tmp54: f64 = tmp16 * attachments_m[(2, 3)] + tmp17 * attachments_m[(0, 3)] + tmp19 * attachments_m[(1, 3)];
+    let tmp55: f64 = tmp54 - anchors_m[(1, 3)] + position_m[1];
+    let tmp56: f64 = tmp55 * tmp55;
+    let tmp57: f64 = tmp53 + tmp56 + epsilon;
+    let tmp58: f64 = tmp57.sqrt();
+    let tmp59: f64 = 1.0_f64 / tmp58;
+    let tmp60: f64 = tmp52 * tmp59;
+    let tmp61: f64 = tmp55 * tmp59;
+    let tmp62: f64 = tmp44 * tmp49;
+    let tmp63: f64 = -tmp50 * tmp60 + tmp61 * tmp62;
+    let tmp64: f64 = tmp51 * tmp61 - tmp54 * tmp60;
+    let tmp65: f64 = -tmp41 * tmp62 + tmp43 * tmp50;
+    let tmp66: f64 = tmp50 * tmp64 - tmp61 * tmp65;
+    let tmp67: f64 = 1.0_f64 / tmp36;
+    let tmp68: f64 = tmp30 * tmp67;
+    let tmp69: f64 = tmp60 * tmp65 - tmp62 * tmp64;
+    let tmp70: f64 = tmp33 * tmp67;
+    let tmp71: f64 = tmp29 * tmp70 - tmp32 * tmp68;
+    let tmp72: f64 = -tmp63 * tmp71 - tmp66 * tmp68 - tmp69 * tmp70;
+    let tmp73: f64 = 1.0_f64 / (tmp72 + epsilon * tmp72.signum());
+    let tmp74: f64 = tmp63 * tmp73;
+    let tmp75: f64 = tmp40 * tmp74;
+    let tmp76: f64 = tmp69 * tmp73;
+    let tmp77: f64 = tmp38 * reference_tension_n[0];
+    let tmp78: f64 = tmp66 * tmp73;
+    let tmp79: f64 = tmp39 * reference_tension_n[0];
+    let tmp80: f64 = tmp75 * reference_tension_n[0] + tmp76 * tmp77 + tmp78 * tmp79;
+    let tmp81: f64 = platform_weight_n - reference_tension_n[1];
+    let tmp82: f64 = -tmp41 * tmp51 + tmp43 * tmp54;
+    let tmp83: f64 = -tmp41 + tmp54;
+    let tmp84: f64 = -tmp43 + tmp51;
+    let tmp85: f64 = -tmp29 * tmp83 + tmp32 * tmp84 + tmp82;
+    let tmp86: f64 = 1.0_f64 / (tmp85 + epsilon * tmp85.signum());
+    let tmp87: f64 = tmp82 * tmp86;
+    let tmp88: f64 = tmp28 * tmp39;
+    let tmp89: f64 = tmp62 * tmp71 - tmp65 * tmp68;
     let tmp90: f64 = tmp73 * tmp89;
-    let tmp91: f64 = tmp31 * tmp86;
-    let tmp92: f64 = tmp17 * tmp87 - tmp18 * tmp91;
-    let tmp93: f64 = tmp82 * tmp92;
-    let tmp94: f64 = tmp88 * reference_tension_n[0] + tmp90 * reference_tension_n[0] + tmp93 * reference_tension_n[0];
-    let tmp95: f64 = tmp85 * tmp94;
-    let tmp96: f64 = tmp50 - tmp61;
-    let tmp97: f64 = tmp49 - tmp63;
-    let tmp98: f64 = -tmp49 * tmp61 + tmp50 * tmp63;
-    let tmp99: f64 = -tmp41 * tmp96 + tmp44 * tmp97 + tmp98;
-    let tmp100: f64 = tmp99 + epsilon * tmp99.signum();
-    let tmp101: f64 = 1.0_f64 / tmp100;
-    let tmp102: f64 = tmp40 * tmp87;
-    let tmp103: f64 = tmp36 * attachments_m[(1, 2)] + tmp38 * attachments_m[(0, 2)] + tmp39 * attachments_m[(2, 2)];
-    let tmp104: f64 = tmp92 * reference_tension_n[0];
-    let tmp105: f64 = tmp60 * tmp87;
-    let tmp106: f64 = tmp104 * tmp58 - tmp105 * reference_tension_n[0];
-    let tmp107: f64 = tmp60 * tmp89;
-    let tmp108: f64 = -tmp104 * tmp77 + tmp107 * reference_tension_n[0];
-    let tmp109: f64 = tmp77 * reference_tension_n[0];
-    let tmp110: f64 = tmp89 * reference_tension_n[0];
-    let tmp111: f64 = tmp109 * tmp87 - tmp110 * tmp58;
-    let tmp112: f64 = -tmp106 * tmp75 - tmp108 * tmp79 - tmp111 * tmp81;
-    let tmp113: f64 = tmp112 * tmp85;
-    let tmp114: f64 = tmp103 * tmp113;
-    let tmp115: f64 = tmp36 * attachments_m[(1, 3)] + tmp38 * attachments_m[(0, 3)] + tmp39 * attachments_m[(2, 3)];
-    let tmp116: f64 = tmp72 * tmp87;
-    let tmp117: f64 = -tmp104 * tmp70 + tmp116 * reference_tension_n[0];
-    let tmp118: f64 = tmp72 * tmp89;
-    let tmp119: f64 = tmp104 * tmp76 - tmp118 * reference_tension_n[0];
-    let tmp120: f64 = tmp76 * reference_tension_n[0];
-    let tmp121: f64 = tmp110 * tmp70 - tmp120 * tmp87;
-    let tmp122: f64 = -tmp117 * tmp75 - tmp119 * tmp79 - tmp121 * tmp81;
-    let tmp123: f64 = tmp122 * tmp85;
-    let tmp124: f64 = tmp115 * tmp123;
-    let tmp125: f64 = tmp36 * attachments_m[(1, 1)] + tmp38 * attachments_m[(0, 1)] + tmp39 * attachments_m[(2, 1)];
-    let tmp126: f64 = tmp125 * tmp95;
-    let tmp127: f64 = -tmp102 * reference_tension_n[0]
-        - tmp114 * tmp70
-        - tmp124 * tmp58
-        - tmp126 * tmp79
-        - tmp31 * reference_tension_n[1]
-        + platform_weight_n * (tmp23 * com_offset_m[2] + tmp25 * com_offset_m[0] + tmp29 * com_offset_m[1]);
-    let tmp128: f64 = tmp40 * tmp89;
-    let tmp129: f64 = tmp114 * tmp76
-        + tmp124 * tmp77
-        + tmp126 * tmp75
-        + tmp128 * reference_tension_n[0]
-        + tmp17 * reference_tension_n[1]
-        - platform_weight_n * (tmp15 * com_offset_m[0] + tmp4 * com_offset_m[2] + tmp9 * com_offset_m[1]);
-    let tmp130: f64 = platform_weight_n - reference_tension_n[1];
-    let tmp131: f64 = tmp127 * tmp97 + tmp129 * tmp96 + tmp130 * tmp98;
-    let tmp132: f64 = tmp129 + tmp130 * tmp49;
-    let tmp133: f64 = -tmp127 + tmp130 * tmp50;
-    let tmp134: f64 = -tmp127 * tmp49 - tmp129 * tmp50 + tmp132 * tmp44 - tmp133 * tmp41;
-    let tmp135: f64 = tmp127 - tmp130 * tmp61;
-    let tmp136: f64 = -tmp129 - tmp130 * tmp63;
-    let tmp137: f64 = tmp127 * tmp63 + tmp129 * tmp61 - tmp135 * tmp41 + tmp136 * tmp44;
-    let tmp138: f64 = -tmp8;
-    let tmp139: f64 = tmp138 + tmp6;
-    let tmp140: f64 = tmp139 * attachments_m[(2, 0)] + tmp4 * attachments_m[(1, 0)];
-    let tmp141: f64 = 2.0_f64 * tmp18;
-    let tmp142: f64 = -tmp11;
-    let tmp143: f64 = tmp13 + tmp142;
-    let tmp144: f64 = rotation_xyzw[3] * rotation_xyzw[3];
-    let tmp145: f64 = -tmp144;
-    let tmp146: f64 = tmp145 + tmp27;
-    let tmp147: f64 = tmp143 + tmp146;
-    let tmp148: f64 = tmp147 * attachments_m[(2, 0)] + tmp23 * attachments_m[(1, 0)];
-    let tmp149: f64 = 2.0_f64 * tmp32;
-    let tmp150: f64 = tmp140 * tmp141 + tmp148 * tmp149;
-    let tmp151: f64 = 0.5_f64 * tmp86;
-    let tmp152: f64 = -tmp22;
-    let tmp153: f64 = tmp152 + tmp21;
-    let tmp154: f64 = tmp153 * attachments_m[(2, 0)];
-    let tmp155: f64 = -tmp27;
-    let tmp156: f64 = tmp144 + tmp155;
-    let tmp157: f64 = tmp143 + tmp156;
-    let tmp158: f64 = tmp157 * attachments_m[(1, 0)];
-    let tmp159: f64 = tmp139 * attachments_m[(2, 1)] + tmp4 * attachments_m[(1, 1)];
-    let tmp160: f64 = 2.0_f64 * tmp42;
-    let tmp161: f64 = tmp147 * attachments_m[(2, 1)] + tmp23 * attachments_m[(1, 1)];
-    let tmp162: f64 = 2.0_f64 * tmp45;
-    let tmp163: f64 = tmp159 * tmp160 + tmp161 * tmp162;
-    let tmp164: f64 = 0.5_f64 * tmp74;
-    let tmp165: f64 = tmp73 * tmp74;
-    let tmp166: f64 = tmp74 * tmp78;
-    let tmp167: f64 = 1.0_f64 / (tmp67 * tmp67.sqrt());
-    let tmp168: f64 = tmp167 * tmp62;
-    let tmp169: f64 = tmp4 * attachments_m[(1, 2)];
-    let tmp170: f64 = tmp139 * attachments_m[(2, 2)];
-    let tmp171: f64 = tmp169 + tmp170;
-    let tmp172: f64 = 2.0_f64 * tmp64;
-    let tmp173: f64 = tmp23 * attachments_m[(1, 2)];
-    let tmp174: f64 = tmp147 * attachments_m[(2, 2)];
-    let tmp175: f64 = tmp173 + tmp174;
-    let tmp176: f64 = 2.0_f64 * tmp62;
-    let tmp177: f64 = tmp171 * tmp172 + tmp175 * tmp176;
-    let tmp178: f64 = 0.5_f64 * tmp177;
-    let tmp179: f64 = tmp168 * tmp178;
-    let tmp180: f64 = tmp147 * attachments_m[(2, 3)] + tmp23 * attachments_m[(1, 3)];
-    let tmp181: f64 = tmp57 * tmp76;
-    let tmp182: f64 = tmp139 * attachments_m[(2, 3)] + tmp4 * attachments_m[(1, 3)];
-    let tmp183: f64 = 2.0_f64 * tmp52;
-    let tmp184: f64 = 2.0_f64 * tmp51;
-    let tmp185: f64 = tmp180 * tmp184 + tmp182 * tmp183;
-    let tmp186: f64 = 1.0_f64 / (tmp55 * tmp55.sqrt());
-    let tmp187: f64 = 0.5_f64 * tmp186 * tmp51;
-    let tmp188: f64 = tmp187 * tmp76;
-    let tmp189: f64 = tmp186 * tmp52;
-    let tmp190: f64 = 0.5_f64 * tmp189;
-    let tmp191: f64 = tmp190 * tmp70;
-    let tmp192: f64 = tmp167 * tmp64;
-    let tmp193: f64 = tmp192 * tmp58;
-    let tmp194: f64 = tmp57 * tmp70;
-    let tmp195: f64 = tmp58 * tmp69;
-    let tmp196: f64 = tmp69 * tmp77;
-    let tmp197: f64 = tmp171 * tmp195 - tmp175 * tmp196 - tmp178 * tmp193 + tmp179 * tmp77 + tmp180 * tmp181
-        - tmp182 * tmp194
-        - tmp185 * tmp188
-        + tmp185 * tmp191;
-    let tmp198: f64 = tmp57 * tmp72;
-    let tmp199: f64 = tmp192 * tmp61;
-    let tmp200: f64 = tmp63 * tmp69;
-    let tmp201: f64 = tmp168 * tmp63;
-    let tmp202: f64 =
-        tmp171 * tmp70 - tmp171 * tmp71 + tmp175 * tmp200 - tmp175 * tmp76 + tmp178 * tmp199 - tmp178 * tmp201;
-    let tmp203: f64 = tmp190 * tmp72;
-    let tmp204: f64 = tmp178 * tmp60;
-    let tmp205: f64 = tmp49 * tmp57;
-    let tmp206: f64 = tmp190 * tmp50;
-    let tmp207: f64 = tmp187 * tmp49;
-    let tmp208: f64 =
-        tmp180 * tmp205 - tmp180 * tmp77 + tmp182 * tmp58 - tmp182 * tmp59 + tmp185 * tmp206 - tmp185 * tmp207;
-    let tmp209: f64 = tmp60 * tmp69;
-    let tmp210: f64 =
-        -tmp171 * tmp209 + tmp182 * tmp198 - tmp185 * tmp203 + tmp192 * tmp204 + tmp202 * tmp77 - tmp208 * tmp76;
-    let tmp211: f64 = tmp187 * tmp72;
-    let tmp212: f64 =
-        -tmp168 * tmp204 + tmp175 * tmp209 - tmp180 * tmp198 + tmp185 * tmp211 - tmp202 * tmp58 + tmp208 * tmp70;
-    let tmp213: f64 = 1.0_f64 / (tmp47 * tmp47.sqrt());
-    let tmp214: f64 = tmp213 * tmp45;
-    let tmp215: f64 = 0.5_f64 * tmp214;
-    let tmp216: f64 = tmp163 * tmp215;
-    let tmp217: f64 = 0.5_f64 * tmp213 * tmp42;
-    let tmp218: f64 = tmp217 * tmp44;
-    let tmp219: f64 = tmp41 * tmp74;
-    let tmp220: f64 = tmp215 * tmp41;
-    let tmp221: f64 =
-        tmp159 * tmp79 - tmp159 * tmp80 + tmp161 * tmp219 - tmp161 * tmp75 + tmp163 * tmp218 - tmp163 * tmp220;
-    let tmp222: f64 = tmp217 * tmp73;
-    let tmp223: f64 =
-        -tmp159 * tmp165 - tmp161 * tmp166 + tmp163 * tmp222 - tmp197 * tmp81 - tmp210 * tmp79 - tmp212 * tmp75
-            + tmp216 * tmp78
-            - tmp221 * tmp82;
-    let tmp224: f64 = 1.0_f64 / (tmp84 * tmp84);
-    let tmp225: f64 = tmp224 * tmp94;
-    let tmp226: f64 = tmp223 * tmp225;
-    let tmp227: f64 = tmp86 * reference_tension_n[0];
-    let tmp228: f64 = tmp227 * tmp78;
-    let tmp229: f64 = tmp227 * tmp73;
-    let tmp230: f64 = tmp87 * reference_tension_n[0];
-    let tmp231: f64 = 0.5_f64 * tmp150;
-    let tmp232: f64 = 1.0_f64 / (tmp34 * tmp34.sqrt());
-    let tmp233: f64 = tmp232 * reference_tension_n[0];
-    let tmp234: f64 = tmp233 * tmp32;
-    let tmp235: f64 = tmp234 * tmp78;
-    let tmp236: f64 = tmp17 * tmp86;
-    let tmp237: f64 = tmp17 * tmp232;
-    let tmp238: f64 = tmp237 * tmp32;
-    let tmp239: f64 = tmp232 * tmp31;
-    let tmp240: f64 = tmp18 * tmp239;
-    let tmp241: f64 =
-        tmp140 * tmp87 - tmp140 * tmp91 + tmp148 * tmp236 - tmp148 * tmp89 - tmp231 * tmp238 + tmp231 * tmp240;
-    let tmp242: f64 = tmp82 * reference_tension_n[0];
-    let tmp243: f64 = tmp18 * tmp231;
-    let tmp244: f64 = tmp233 * tmp73;
-    let tmp245: f64 = tmp85
-        * (tmp104 * tmp197 + tmp110 * tmp212 + tmp140 * tmp229 + tmp148 * tmp228 + tmp210 * tmp230 - tmp231 * tmp235
-            + tmp241 * tmp242
-            - tmp243 * tmp244);
-    let tmp246: f64 = -tmp173 - tmp174 + tmp180;
-    let tmp247: f64 = tmp125 * tmp75;
-    let tmp248: f64 = tmp226 * tmp247;
-    let tmp249: f64 = tmp233 * tmp40;
-    let tmp250: f64 = tmp243 * tmp249;
-    let tmp251: f64 = tmp126 * tmp217;
-    let tmp252: f64 = tmp163 * tmp251;
-    let tmp253: f64 = tmp124 * tmp190;
-    let tmp254: f64 = tmp185 * tmp253;
-    let tmp255: f64 = tmp227 * tmp40;
-    let tmp256: f64 = tmp140 * tmp255;
-    let tmp257: f64 = tmp122 * tmp224;
-    let tmp258: f64 = tmp223 * tmp257;
-    let tmp259: f64 = tmp115 * tmp77;
-    let tmp260: f64 = tmp258 * tmp259;
-    let tmp261: f64 = tmp108 * tmp74;
-    let tmp262: f64 = tmp227 * tmp60;
-    let tmp263: f64 = tmp104 * tmp57;
-    let tmp264: f64 = tmp233 * tmp60;
-    let tmp265: f64 = tmp104 * tmp190;
-    let tmp266: f64 = tmp110 * tmp187;
-    let tmp267: f64 = tmp110 * tmp57;
-    let tmp268: f64 = tmp227 * tmp58;
-    let tmp269: f64 = tmp230 * tmp57;
-    let tmp270: f64 = tmp227 * tmp77;
-    let tmp271: f64 = tmp233 * tmp58;
-    let tmp272: f64 = tmp190 * tmp230;
-    let tmp273: f64 = tmp232 * tmp32;
-    let tmp274: f64 = tmp109 * tmp273;
-    let tmp275: f64 = tmp104 * tmp187;
-    let tmp276: f64 = tmp58 * reference_tension_n[0];
-    let tmp277: f64 = tmp264 * tmp32;
-    let tmp278: f64 = tmp106 * tmp74;
-    let tmp279: f64 = tmp106 * tmp217;
-    let tmp280: f64 = tmp85
-        * (tmp108 * tmp216 - tmp111 * tmp221 - tmp159 * tmp278 - tmp161 * tmp261 + tmp163 * tmp279
-            - tmp75
-                * (-tmp148 * tmp262 + tmp180 * tmp263 - tmp185 * tmp275 - tmp208 * tmp230
-                    + tmp231 * tmp277
-                    + tmp241 * tmp276)
-            - tmp79
-                * (-tmp109 * tmp241 + tmp110 * tmp208 + tmp140 * tmp262 - tmp182 * tmp263 + tmp185 * tmp265
-                    - tmp243 * tmp264)
-            - tmp81
-                * (-tmp140 * tmp268 + tmp148 * tmp270 - tmp180 * tmp267 + tmp182 * tmp269 + tmp185 * tmp266
-                    - tmp185 * tmp272
-                    - tmp231 * tmp274
-                    + tmp243 * tmp271));
-    let tmp281: f64 = tmp103 * tmp76;
-    let tmp282: f64 = tmp280 * tmp281;
-    let tmp283: f64 = tmp124 * tmp57;
-    let tmp284: f64 = tmp182 * tmp283;
-    let tmp285: f64 = tmp112 * tmp224;
-    let tmp286: f64 = tmp223 * tmp285;
-    let tmp287: f64 = tmp281 * tmp286;
-    let tmp288: f64 = tmp178 * tmp192;
-    let tmp289: f64 = tmp114 * tmp288;
-    let tmp290: f64 = tmp114 * tmp69;
-    let tmp291: f64 = tmp171 * tmp290;
-    let tmp292: f64 = tmp126 * tmp74;
-    let tmp293: f64 = tmp159 * tmp292;
-    let tmp294: f64 = platform_weight_n * (tmp139 * com_offset_m[2] + tmp4 * com_offset_m[1]);
-    let tmp295: f64 = tmp104 * tmp69;
-    let tmp296: f64 = tmp227 * tmp72;
-    let tmp297: f64 = tmp233 * tmp72;
-    let tmp298: f64 = tmp117 * tmp74;
-    let tmp299: f64 = tmp70 * reference_tension_n[0];
-    let tmp300: f64 = tmp297 * tmp32;
-    let tmp301: f64 = tmp119 * tmp74;
-    let tmp302: f64 = tmp117 * tmp217;
-    let tmp303: f64 = tmp227 * tmp70;
-    let tmp304: f64 = tmp120 * tmp273;
-    let tmp305: f64 = tmp230 * tmp69;
-    let tmp306: f64 = tmp110 * tmp69;
-    let tmp307: f64 = tmp233 * tmp70;
-    let tmp308: f64 = tmp227 * tmp76;
-    let tmp309: f64 = tmp85
-        * (tmp119 * tmp216 - tmp121 * tmp221 - tmp159 * tmp298 - tmp161 * tmp301 + tmp163 * tmp302
-            - tmp75
-                * (tmp104 * tmp179 + tmp148 * tmp296 - tmp175 * tmp295 + tmp202 * tmp230
-                    - tmp231 * tmp300
-                    - tmp241 * tmp299)
-            - tmp79
-                * (-tmp104 * tmp288 - tmp110 * tmp202 + tmp120 * tmp241 - tmp140 * tmp296
-                    + tmp171 * tmp295
-                    + tmp243 * tmp297)
-            - tmp81
-                * (-tmp110 * tmp179 + tmp140 * tmp303 - tmp148 * tmp308 - tmp171 * tmp305
-                    + tmp175 * tmp306
-                    + tmp230 * tmp288
-                    + tmp231 * tmp304
-                    - tmp243 * tmp307));
-    let tmp310: f64 = tmp259 * tmp309;
-    let tmp311: f64 = tmp153 * attachments_m[(2, 2)];
-    let tmp312: f64 = tmp157 * attachments_m[(1, 2)];
-    let tmp313: f64 = tmp311 + tmp312;
-    let tmp314: f64 = tmp113 * tmp76;
-    let tmp315: f64 = tmp313 * tmp314;
-    let tmp316: f64 = tmp154 + tmp158;
-    let tmp317: f64 = tmp110 * tmp316;
-    let tmp318: f64 = tmp245 * tmp247;
-    let tmp319: f64 = tmp140 * reference_tension_n[1];
-    let tmp320: f64 = tmp153 * attachments_m[(2, 3)];
-    let tmp321: f64 = tmp157 * attachments_m[(1, 3)];
-    let tmp322: f64 = tmp320 + tmp321;
-    let tmp323: f64 = tmp123 * tmp77;
-    let tmp324: f64 = tmp322 * tmp323;
-    let tmp325: f64 = tmp153 * attachments_m[(2, 1)];
-    let tmp326: f64 = tmp157 * attachments_m[(1, 1)];
-    let tmp327: f64 = tmp325 + tmp326;
-    let tmp328: f64 = tmp75 * tmp95;
-    let tmp329: f64 = tmp327 * tmp328;
-    let tmp330: f64 =
-        -tmp248 - tmp250 - tmp252 - tmp254 + tmp256 - tmp260 + tmp282 + tmp284 - tmp287 - tmp289 + tmp291 + tmp293
-            - tmp294
-            + tmp310
-            + tmp315
-            + tmp317
-            + tmp318
-            + tmp319
-            + tmp324
-            + tmp329;
-    let tmp331: f64 = tmp171 * tmp50 - tmp175 * tmp49 + tmp180 * tmp63 - tmp182 * tmp61;
-    let tmp332: f64 = -tmp169 - tmp170 + tmp182;
-    let tmp333: f64 = tmp103 * tmp70;
-    let tmp334: f64 = tmp286 * tmp333;
-    let tmp335: f64 = tmp124 * tmp187;
-    let tmp336: f64 = tmp185 * tmp335;
-    let tmp337: f64 = tmp113 * tmp70;
-    let tmp338: f64 = tmp313 * tmp337;
-    let tmp339: f64 = platform_weight_n * (tmp147 * com_offset_m[2] + tmp23 * com_offset_m[1]);
-    let tmp340: f64 = tmp148 * tmp255;
-    let tmp341: f64 = tmp125 * tmp79;
-    let tmp342: f64 = tmp226 * tmp341;
-    let tmp343: f64 = tmp234 * tmp40;
-    let tmp344: f64 = tmp231 * tmp343;
-    let tmp345: f64 = tmp126 * tmp216;
-    let tmp346: f64 = tmp245 * tmp341;
-    let tmp347: f64 = tmp115 * tmp58;
-    let tmp348: f64 = tmp309 * tmp347;
-    let tmp349: f64 = tmp180 * tmp283;
-    let tmp350: f64 = tmp79 * tmp95;
-    let tmp351: f64 = tmp327 * tmp350;
-    let tmp352: f64 = tmp280 * tmp333;
-    let tmp353: f64 = tmp258 * tmp347;
-    let tmp354: f64 = tmp230 * tmp316;
-    let tmp355: f64 = tmp148 * reference_tension_n[1];
-    let tmp356: f64 = tmp123 * tmp58;
-    let tmp357: f64 = tmp322 * tmp356;
-    let tmp358: f64 = tmp161 * tmp292;
-    let tmp359: f64 = tmp175 * tmp290;
-    let tmp360: f64 = tmp114 * tmp179;
-    let tmp361: f64 = tmp334 + tmp336 - tmp338 + tmp339 - tmp340 + tmp342 + tmp344 + tmp345
-        - tmp346
-        - tmp348
-        - tmp349
-        - tmp351
-        - tmp352
-        + tmp353
-        - tmp354
-        - tmp355
-        - tmp357
-        - tmp358
-        - tmp359
-        + tmp360;
-    let tmp362: f64 = 1.0_f64 / (tmp100 * tmp100);
-    let tmp363: f64 = tmp362 * (-tmp159 * tmp96 + tmp161 * tmp97 - tmp246 * tmp41 + tmp331 + tmp332 * tmp44);
-    let tmp364: f64 = 0.5_f64 * tmp69;
-    let tmp365: f64 = 0.5_f64 * tmp57;
-    let tmp366: f64 = tmp152 + tmp20;
-    let tmp367: f64 = tmp25 * attachments_m[(2, 0)] + tmp366 * attachments_m[(0, 0)];
-    let tmp368: f64 = -tmp3;
-    let tmp369: f64 = tmp368 + tmp37;
-    let tmp370: f64 = -tmp13;
-    let tmp371: f64 = tmp142 + tmp144 + tmp27 + tmp370;
-    let tmp372: f64 = tmp369 * attachments_m[(0, 0)] + tmp371 * attachments_m[(2, 0)];
-    let tmp373: f64 = tmp141 * tmp372 + tmp149 * tmp367;
-    let tmp374: f64 = tmp38 * attachments_m[(2, 0)];
-    let tmp375: f64 = tmp11 + tmp370;
-    let tmp376: f64 = tmp146 + tmp375;
-    let tmp377: f64 = tmp376 * attachments_m[(0, 0)];
-    let tmp378: f64 = tmp25 * attachments_m[(2, 1)] + tmp366 * attachments_m[(0, 1)];
-    let tmp379: f64 = tmp369 * attachments_m[(0, 1)] + tmp371 * attachments_m[(2, 1)];
-    let tmp380: f64 = tmp160 * tmp379 + tmp162 * tmp378;
-    let tmp381: f64 = tmp366 * attachments_m[(0, 2)];
-    let tmp382: f64 = tmp25 * attachments_m[(2, 2)];
-    let tmp383: f64 = tmp381 + tmp382;
-    let tmp384: f64 = tmp369 * attachments_m[(0, 2)];
-    let tmp385: f64 = tmp371 * attachments_m[(2, 2)];
-    let tmp386: f64 = tmp384 + tmp385;
-    let tmp387: f64 = tmp172 * tmp386 + tmp176 * tmp383;
-    let tmp388: f64 = 0.5_f64 * tmp387;
-    let tmp389: f64 = tmp388 * tmp60;
-    let tmp390: f64 = tmp369 * attachments_m[(0, 3)] + tmp371 * attachments_m[(2, 3)];
-    let tmp391: f64 = tmp25 * attachments_m[(2, 3)] + tmp366 * attachments_m[(0, 3)];
-    let tmp392: f64 = tmp183 * tmp390 + tmp184 * tmp391;
-    let tmp393: f64 =
-        tmp205 * tmp391 + tmp206 * tmp392 - tmp207 * tmp392 + tmp390 * tmp58 - tmp390 * tmp59 - tmp391 * tmp77;
-    let tmp394: f64 =
-        tmp199 * tmp388 + tmp200 * tmp383 - tmp201 * tmp388 - tmp383 * tmp76 + tmp386 * tmp70 - tmp386 * tmp71;
-    let tmp395: f64 =
-        -tmp168 * tmp389 - tmp198 * tmp391 + tmp209 * tmp383 + tmp211 * tmp392 + tmp393 * tmp70 - tmp394 * tmp58;
-    let tmp396: f64 = 0.5_f64 * tmp373;
-    let tmp397: f64 =
-        tmp236 * tmp367 - tmp238 * tmp396 + tmp240 * tmp396 - tmp367 * tmp89 + tmp372 * tmp87 - tmp372 * tmp91;
-    let tmp398: f64 = tmp168 * tmp77;
-    let tmp399: f64 = tmp181 * tmp391 - tmp188 * tmp392 + tmp191 * tmp392 - tmp193 * tmp388 - tmp194 * tmp390
-        + tmp195 * tmp386
-        - tmp196 * tmp383
-        + tmp388 * tmp398;
-    let tmp400: f64 = tmp18 * tmp396;
-    let tmp401: f64 = tmp32 * tmp396;
-    let tmp402: f64 =
-        tmp192 * tmp389 + tmp198 * tmp390 - tmp203 * tmp392 - tmp209 * tmp386 - tmp393 * tmp76 + tmp394 * tmp77;
-    let tmp403: f64 = tmp85
-        * (tmp104 * tmp399 + tmp110 * tmp395 + tmp228 * tmp367 + tmp229 * tmp372 + tmp230 * tmp402
-            - tmp233 * tmp401 * tmp78
-            + tmp242 * tmp397
-            - tmp244 * tmp400);
-    let tmp404: f64 = tmp215 * tmp380;
-    let tmp405: f64 = tmp217 * tmp380;
-    let tmp406: f64 =
-        tmp219 * tmp378 - tmp220 * tmp380 - tmp378 * tmp75 + tmp379 * tmp79 - tmp379 * tmp80 + tmp405 * tmp44;
-    let tmp407: f64 = -tmp165 * tmp379 - tmp166 * tmp378 - tmp395 * tmp75 - tmp399 * tmp81 - tmp402 * tmp79
-        + tmp404 * tmp78
-        + tmp405 * tmp73
-        - tmp406 * tmp82;
-    let tmp408: f64 = tmp225 * tmp407;
-    let tmp409: f64 = -tmp381 - tmp382 + tmp391;
-    let tmp410: f64 = tmp290 * tmp386;
-    let tmp411: f64 = tmp255 * tmp372;
-    let tmp412: f64 = tmp247 * tmp403;
-    let tmp413: f64 = tmp257 * tmp407;
-    let tmp414: f64 = tmp259 * tmp413;
-    let tmp415: f64 = tmp397 * reference_tension_n[0];
-    let tmp416: f64 = tmp104 * tmp388;
-    let tmp417: f64 = tmp110 * tmp168;
-    let tmp418: f64 = tmp192 * tmp230;
-    let tmp419: f64 = tmp232 * tmp401;
-    let tmp420: f64 = tmp85
-        * (tmp119 * tmp404 - tmp121 * tmp406 - tmp298 * tmp379 - tmp301 * tmp378 + tmp302 * tmp380
-            - tmp75
-                * (tmp168 * tmp416 + tmp230 * tmp394 - tmp295 * tmp383 + tmp296 * tmp367
-                    - tmp297 * tmp401
-                    - tmp415 * tmp70)
-            - tmp79
-                * (-tmp110 * tmp394 + tmp120 * tmp397 - tmp192 * tmp416 + tmp295 * tmp386 - tmp296 * tmp372
-                    + tmp297 * tmp400)
-            - tmp81
-                * (tmp120 * tmp419 + tmp303 * tmp372 - tmp305 * tmp386 + tmp306 * tmp383
-                    - tmp307 * tmp400
-                    - tmp308 * tmp367
-                    - tmp388 * tmp417
-                    + tmp388 * tmp418));
-    let tmp421: f64 = tmp259 * tmp420;
-    let tmp422: f64 = tmp114 * tmp192;
-    let tmp423: f64 = tmp388 * tmp422;
-    let tmp424: f64 = tmp372 * reference_tension_n[1];
-    let tmp425: f64 = tmp38 * attachments_m[(2, 2)];
-    let tmp426: f64 = tmp376 * attachments_m[(0, 2)];
-    let tmp427: f64 = tmp425 + tmp426;
-    let tmp428: f64 = tmp314 * tmp427;
-    let tmp429: f64 = tmp283 * tmp390;
-    let tmp430: f64 = tmp38 * attachments_m[(2, 1)];
-    let tmp431: f64 = tmp376 * attachments_m[(0, 1)];
-    let tmp432: f64 = tmp430 + tmp431;
-    let tmp433: f64 = tmp328 * tmp432;
-    let tmp434: f64 = tmp126 * tmp405;
-    let tmp435: f64 = platform_weight_n * (tmp369 * com_offset_m[0] + tmp371 * com_offset_m[2]);
-    let tmp436: f64 = tmp85
-        * (tmp108 * tmp404 - tmp111 * tmp406 - tmp261 * tmp378 - tmp278 * tmp379 + tmp279 * tmp380
-            - tmp75
-                * (-tmp230 * tmp393 - tmp262 * tmp367 + tmp263 * tmp391 + tmp264 * tmp401 - tmp275 * tmp392
-                    + tmp415 * tmp58)
-            - tmp79
-                * (-tmp109 * tmp397 + tmp110 * tmp393 + tmp262 * tmp372 - tmp263 * tmp390 - tmp264 * tmp400
-                    + tmp265 * tmp392)
-            - tmp81
-                * (-tmp109 * tmp419 + tmp266 * tmp392 - tmp267 * tmp391 - tmp268 * tmp372
-                    + tmp269 * tmp390
-                    + tmp270 * tmp367
-                    + tmp271 * tmp400
-                    - tmp272 * tmp392));
-    let tmp437: f64 = tmp281 * tmp436;
-    let tmp438: f64 = tmp292 * tmp379;
-    let tmp439: f64 = tmp38 * attachments_m[(2, 3)];
-    let tmp440: f64 = tmp376 * attachments_m[(0, 3)];
-    let tmp441: f64 = tmp439 + tmp440;
-    let tmp442: f64 = tmp323 * tmp441;
-    let tmp443: f64 = tmp247 * tmp408;
-    let tmp444: f64 = tmp253 * tmp392;
-    let tmp445: f64 = tmp249 * tmp400;
-    let tmp446: f64 = tmp285 * tmp407;
-    let tmp447: f64 = tmp281 * tmp446;
-    let tmp448: f64 = tmp374 + tmp377;
-    let tmp449: f64 = tmp110 * tmp448;
-    let tmp450: f64 =
-        tmp410 + tmp411 + tmp412 - tmp414 + tmp421 - tmp423 + tmp424 + tmp428 + tmp429 + tmp433 - tmp434 - tmp435
-            + tmp437
-            + tmp438
-            + tmp442
-            - tmp443
-            - tmp444
-            - tmp445
-            - tmp447
-            + tmp449;
-    let tmp451: f64 = -tmp383 * tmp49 + tmp386 * tmp50 - tmp390 * tmp61 + tmp391 * tmp63;
-    let tmp452: f64 = -tmp384 - tmp385 + tmp390;
-    let tmp453: f64 = tmp333 * tmp446;
-    let tmp454: f64 = tmp283 * tmp391;
-    let tmp455: f64 = tmp292 * tmp378;
-    let tmp456: f64 = platform_weight_n * (tmp25 * com_offset_m[2] + tmp366 * com_offset_m[0]);
-    let tmp457: f64 = tmp367 * reference_tension_n[1];
-    let tmp458: f64 = tmp341 * tmp403;
-    let tmp459: f64 = tmp249 * tmp401;
-    let tmp460: f64 = tmp255 * tmp367;
-    let tmp461: f64 = tmp347 * tmp413;
-    let tmp462: f64 = tmp341 * tmp408;
-    let tmp463: f64 = tmp347 * tmp420;
-    let tmp464: f64 = tmp126 * tmp404;
-    let tmp465: f64 = tmp333 * tmp436;
-    let tmp466: f64 = tmp114 * tmp168;
-    let tmp467: f64 = tmp388 * tmp466;
-    let tmp468: f64 = tmp337 * tmp427;
-    let tmp469: f64 = tmp230 * tmp448;
-    let tmp470: f64 = tmp290 * tmp383;
-    let tmp471: f64 = tmp335 * tmp392;
-    let tmp472: f64 = tmp356 * tmp441;
-    let tmp473: f64 = tmp350 * tmp432;
-    let tmp474: f64 = tmp453 - tmp454 - tmp455 + tmp456 - tmp457 - tmp458 + tmp459 - tmp460 + tmp461 + tmp462 - tmp463
-        + tmp464
-        - tmp465
-        + tmp467
-        - tmp468
-        - tmp469
-        - tmp470
-        + tmp471
-        - tmp472
-        - tmp473;
-    let tmp475: f64 = tmp362 * (tmp378 * tmp97 - tmp379 * tmp96 - tmp409 * tmp41 + tmp44 * tmp452 + tmp451);
-    let tmp476: f64 = tmp138 + tmp7;
-    let tmp477: f64 = tmp156 + tmp375;
-    let tmp478: f64 = tmp476 * attachments_m[(1, 0)] + tmp477 * attachments_m[(0, 0)];
-    let tmp479: f64 = tmp11 + tmp13 + tmp145 + tmp155;
-    let tmp480: f64 = tmp479 * attachments_m[(1, 0)] + tmp9 * attachments_m[(0, 0)];
-    let tmp481: f64 = tmp141 * tmp480 + tmp149 * tmp478;
-    let tmp482: f64 = tmp1 + tmp368;
-    let tmp483: f64 = tmp482 * attachments_m[(1, 0)];
-    let tmp484: f64 = tmp36 * attachments_m[(0, 0)];
-    let tmp485: f64 = tmp476 * attachments_m[(1, 1)] + tmp477 * attachments_m[(0, 1)];
-    let tmp486: f64 = tmp479 * attachments_m[(1, 1)] + tmp9 * attachments_m[(0, 1)];
-    let tmp487: f64 = tmp160 * tmp486 + tmp162 * tmp485;
-    let tmp488: f64 = tmp476 * attachments_m[(1, 2)];
-    let tmp489: f64 = tmp477 * attachments_m[(0, 2)];
-    let tmp490: f64 = tmp488 + tmp489;
-    let tmp491: f64 = tmp9 * attachments_m[(0, 2)];
-    let tmp492: f64 = tmp479 * attachments_m[(1, 2)];
-    let tmp493: f64 = tmp491 + tmp492;
-    let tmp494: f64 = tmp172 * tmp493 + tmp176 * tmp490;
-    let tmp495: f64 = 0.5_f64 * tmp494;
-    let tmp496: f64 =
-        tmp199 * tmp495 + tmp200 * tmp490 - tmp201 * tmp495 - tmp490 * tmp76 + tmp493 * tmp70 - tmp493 * tmp71;
-    let tmp497: f64 = tmp476 * attachments_m[(1, 3)] + tmp477 * attachments_m[(0, 3)];
-    let tmp498: f64 = tmp479 * attachments_m[(1, 3)] + tmp9 * attachments_m[(0, 3)];
-    let tmp499: f64 = tmp183 * tmp498 + tmp184 * tmp497;
-    let tmp500: f64 =
-        tmp205 * tmp497 + tmp206 * tmp499 - tmp207 * tmp499 - tmp497 * tmp77 + tmp498 * tmp58 - tmp498 * tmp59;
-    let tmp501: f64 = tmp495 * tmp60;
-    let tmp502: f64 =
-        -tmp168 * tmp501 - tmp198 * tmp497 + tmp209 * tmp490 + tmp211 * tmp499 - tmp496 * tmp58 + tmp500 * tmp70;
-    let tmp503: f64 = 0.5_f64 * tmp481;
-    let tmp504: f64 =
-        tmp236 * tmp478 - tmp238 * tmp503 + tmp240 * tmp503 - tmp478 * tmp89 + tmp480 * tmp87 - tmp480 * tmp91;
-    let tmp505: f64 =
-        tmp192 * tmp501 + tmp198 * tmp498 - tmp203 * tmp499 - tmp209 * tmp493 + tmp496 * tmp77 - tmp500 * tmp76;
-    let tmp506: f64 = tmp181 * tmp497 - tmp188 * tmp499 + tmp191 * tmp499 - tmp193 * tmp495 - tmp194 * tmp498
-        + tmp195 * tmp493
-        - tmp196 * tmp490
-        + tmp398 * tmp495;
-    let tmp507: f64 = tmp18 * tmp503;
-    let tmp508: f64 = tmp85
-        * (tmp104 * tmp506 + tmp110 * tmp502 + tmp228 * tmp478 + tmp229 * tmp480 + tmp230 * tmp505 - tmp235 * tmp503
-            + tmp242 * tmp504
-            - tmp244 * tmp507);
-    let tmp509: f64 =
-        tmp218 * tmp487 + tmp219 * tmp485 - tmp220 * tmp487 - tmp485 * tmp75 + tmp486 * tmp79 - tmp486 * tmp80;
-    let tmp510: f64 = tmp215 * tmp487;
-    let tmp511: f64 = tmp224
-        * (-tmp165 * tmp486 - tmp166 * tmp485 + tmp222 * tmp487
-            - tmp502 * tmp75
-            - tmp505 * tmp79
-            - tmp506 * tmp81
-            - tmp509 * tmp82
-            + tmp510 * tmp78);
-    let tmp512: f64 = tmp511 * tmp94;
-    let tmp513: f64 = -tmp491 - tmp492 + tmp498;
-    let tmp514: f64 = -tmp488 - tmp489 + tmp497;
-    let tmp515: f64 = -tmp49 * tmp490 + tmp493 * tmp50 + tmp497 * tmp63 - tmp498 * tmp61;
-    let tmp516: f64 = tmp362 * (-tmp41 * tmp514 + tmp44 * tmp513 + tmp485 * tmp97 - tmp486 * tmp96 + tmp515);
-    let tmp517: f64 = tmp292 * tmp486;
-    let tmp518: f64 = tmp422 * tmp495;
-    let tmp519: f64 = tmp290 * tmp493;
-    let tmp520: f64 = tmp247 * tmp512;
-    let tmp521: f64 = tmp482 * attachments_m[(1, 1)];
-    let tmp522: f64 = tmp36 * attachments_m[(0, 1)];
-    let tmp523: f64 = tmp521 + tmp522;
-    let tmp524: f64 = tmp328 * tmp523;
-    let tmp525: f64 = tmp253 * tmp499;
-    let tmp526: f64 = tmp482 * attachments_m[(1, 3)];
-    let tmp527: f64 = tmp36 * attachments_m[(0, 3)];
-    let tmp528: f64 = tmp526 + tmp527;
-    let tmp529: f64 = tmp323 * tmp528;
-    let tmp530: f64 = tmp112 * tmp511;
-    let tmp531: f64 = tmp281 * tmp530;
-    let tmp532: f64 = tmp504 * reference_tension_n[0];
-    let tmp533: f64 = tmp85
-        * (tmp108 * tmp510 - tmp111 * tmp509 - tmp261 * tmp485 - tmp278 * tmp486 + tmp279 * tmp487
-            - tmp75
-                * (-tmp230 * tmp500 - tmp262 * tmp478 + tmp263 * tmp497 - tmp275 * tmp499
-                    + tmp277 * tmp503
-                    + tmp532 * tmp58)
-            - tmp79
-                * (-tmp109 * tmp504 + tmp110 * tmp500 + tmp262 * tmp480 - tmp263 * tmp498 - tmp264 * tmp507
-                    + tmp265 * tmp499)
-            - tmp81
-                * (tmp266 * tmp499 - tmp267 * tmp497 - tmp268 * tmp480
-                    + tmp269 * tmp498
-                    + tmp270 * tmp478
-                    + tmp271 * tmp507
-                    - tmp272 * tmp499
-                    - tmp274 * tmp503));
-    let tmp534: f64 = tmp281 * tmp533;
-    let tmp535: f64 = tmp104 * tmp495;
-    let tmp536: f64 = tmp85
-        * (tmp119 * tmp510 - tmp121 * tmp509 - tmp298 * tmp486 - tmp301 * tmp485 + tmp302 * tmp487
-            - tmp75
-                * (tmp168 * tmp535 + tmp230 * tmp496 - tmp295 * tmp490 + tmp296 * tmp478
-                    - tmp300 * tmp503
-                    - tmp532 * tmp70)
-            - tmp79
-                * (-tmp110 * tmp496 + tmp120 * tmp504 - tmp192 * tmp535 + tmp295 * tmp493 - tmp296 * tmp480
-                    + tmp297 * tmp507)
-            - tmp81
-                * (tmp303 * tmp480 + tmp304 * tmp503 - tmp305 * tmp493 + tmp306 * tmp490
-                    - tmp307 * tmp507
-                    - tmp308 * tmp478
-                    - tmp417 * tmp495
-                    + tmp418 * tmp495));
-    let tmp537: f64 = tmp259 * tmp536;
-    let tmp538: f64 = tmp122 * tmp511;
-    let tmp539: f64 = tmp259 * tmp538;
-    let tmp540: f64 = tmp255 * tmp480;
-    let tmp541: f64 = tmp480 * reference_tension_n[1];
-    let tmp542: f64 = tmp249 * tmp507;
-    let tmp543: f64 = tmp283 * tmp498;
-    let tmp544: f64 = platform_weight_n * (tmp479 * com_offset_m[1] + tmp9 * com_offset_m[0]);
-    let tmp545: f64 = tmp483 + tmp484;
-    let tmp546: f64 = tmp110 * tmp545;
-    let tmp547: f64 = tmp247 * tmp508;
-    let tmp548: f64 = tmp251 * tmp487;
-    let tmp549: f64 = tmp482 * attachments_m[(1, 2)];
-    let tmp550: f64 = tmp36 * attachments_m[(0, 2)];
-    let tmp551: f64 = tmp549 + tmp550;
-    let tmp552: f64 = tmp314 * tmp551;
-    let tmp553: f64 = tmp517 - tmp518 + tmp519 - tmp520 + tmp524 - tmp525 + tmp529 - tmp531 + tmp534 + tmp537 - tmp539
-        + tmp540
-        + tmp541
-        - tmp542
-        + tmp543
-        - tmp544
-        + tmp546
-        + tmp547
-        - tmp548
-        + tmp552;
-    let tmp554: f64 = tmp466 * tmp495;
-    let tmp555: f64 = tmp283 * tmp497;
-    let tmp556: f64 = tmp341 * tmp512;
-    let tmp557: f64 = tmp333 * tmp533;
-    let tmp558: f64 = tmp350 * tmp523;
-    let tmp559: f64 = tmp347 * tmp536;
-    let tmp560: f64 = tmp335 * tmp499;
-    let tmp561: f64 = tmp126 * tmp510;
-    let tmp562: f64 = tmp230 * tmp545;
-    let tmp563: f64 = tmp290 * tmp490;
-    let tmp564: f64 = tmp347 * tmp538;
-    let tmp565: f64 = platform_weight_n * (tmp476 * com_offset_m[1] + tmp477 * com_offset_m[0]);
-    let tmp566: f64 = tmp255 * tmp478;
-    let tmp567: f64 = tmp343 * tmp503;
-    let tmp568: f64 = tmp292 * tmp485;
-    let tmp569: f64 = tmp356 * tmp528;
-    let tmp570: f64 = tmp333 * tmp530;
-    let tmp571: f64 = tmp341 * tmp508;
-    let tmp572: f64 = tmp337 * tmp551;
-    let tmp573: f64 = tmp478 * reference_tension_n[1];
-    let tmp574: f64 =
-        tmp554 - tmp555 + tmp556 - tmp557 - tmp558 - tmp559 + tmp560 + tmp561 - tmp562 - tmp563 + tmp564 + tmp565
-            - tmp566
-            + tmp567
-            - tmp568
-            - tmp569
-            + tmp570
-            - tmp571
-            - tmp572
-            - tmp573;
-    let tmp575: f64 = tmp19 * tmp239;
-    let tmp576: f64 = tmp18 * tmp32;
-    let tmp577: f64 = tmp237 * tmp576;
-    let tmp578: f64 = tmp575 - tmp577 - tmp91;
-    let tmp579: f64 = tmp192 * tmp62;
-    let tmp580: f64 = tmp579 * tmp63;
-    let tmp581: f64 = tmp167 * tmp65;
-    let tmp582: f64 = tmp581 * tmp61;
-    let tmp583: f64 = -tmp580 + tmp582 - tmp71;
-    let tmp584: f64 = tmp186 * tmp53;
-    let tmp585: f64 = tmp50 * tmp584;
-    let tmp586: f64 = tmp189 * tmp51;
-    let tmp587: f64 = tmp49 * tmp586;
-    let tmp588: f64 = tmp585 - tmp587 - tmp59;
-    let tmp589: f64 = tmp586 * tmp72;
-    let tmp590: f64 = tmp579 * tmp60;
-    let tmp591: f64 = -tmp590;
-    let tmp592: f64 = -tmp58 * tmp583 + tmp588 * tmp70 + tmp589 + tmp591;
-    let tmp593: f64 = tmp19 * tmp233;
-    let tmp594: f64 = tmp593 * tmp73;
-    let tmp595: f64 = tmp584 * tmp70;
-    let tmp596: f64 = tmp579 * tmp77;
-    let tmp597: f64 = tmp586 * tmp76;
-    let tmp598: f64 = tmp58 * tmp581;
-    let tmp599: f64 = -tmp194 + tmp195 + tmp595 + tmp596 - tmp597 - tmp598;
-    let tmp600: f64 = tmp581 * tmp60;
-    let tmp601: f64 = -tmp209;
-    let tmp602: f64 = tmp584 * tmp72;
-    let tmp603: f64 = tmp198 + tmp583 * tmp77 - tmp588 * tmp76 + tmp600 + tmp601 - tmp602;
-    let tmp604: f64 = tmp233 * tmp576;
-    let tmp605: f64 = tmp604 * tmp78;
-    let tmp606: f64 =
-        tmp85 * (tmp104 * tmp599 + tmp110 * tmp592 + tmp229 + tmp230 * tmp603 + tmp242 * tmp578 - tmp594 - tmp605);
-    let tmp607: f64 = tmp213 * tmp43;
-    let tmp608: f64 = tmp607 * tmp73;
-    let tmp609: f64 = tmp214 * tmp42;
-    let tmp610: f64 = tmp609 * tmp78;
-    let tmp611: f64 = tmp41 * tmp609;
-    let tmp612: f64 = tmp44 * tmp607;
-    let tmp613: f64 = -tmp611 + tmp612 - tmp80;
-    let tmp614: f64 = -tmp165 - tmp592 * tmp75 - tmp599 * tmp81 - tmp603 * tmp79 + tmp608 + tmp610 - tmp613 * tmp82;
-    let tmp615: f64 = tmp225 * tmp614;
-    let tmp616: f64 = tmp285 * tmp614;
-    let tmp617: f64 = tmp281 * tmp616;
-    let tmp618: f64 = tmp108 * tmp609;
-    let tmp619: f64 = tmp106 * tmp607;
-    let tmp620: f64 = tmp232 * tmp576;
-    let tmp621: f64 = tmp109 * tmp620;
-    let tmp622: f64 = tmp230 * tmp584;
-    let tmp623: f64 = tmp58 * tmp593;
-    let tmp624: f64 = tmp110 * tmp586;
-    let tmp625: f64 = -tmp263;
-    let tmp626: f64 = tmp19 * tmp264;
-    let tmp627: f64 = tmp104 * tmp584;
-    let tmp628: f64 = tmp104 * tmp586;
-    let tmp629: f64 = -tmp628;
-    let tmp630: f64 = tmp264 * tmp576;
-    let tmp631: f64 = tmp85
-        * (-tmp111 * tmp613 - tmp278 + tmp618 + tmp619
-            - tmp75 * (-tmp230 * tmp588 + tmp276 * tmp578 + tmp629 + tmp630)
-            - tmp79 * (-tmp109 * tmp578 + tmp110 * tmp588 + tmp262 + tmp625 - tmp626 + tmp627)
-            - tmp81 * (-tmp268 + tmp269 - tmp621 - tmp622 + tmp623 + tmp624));
-    let tmp632: f64 = tmp281 * tmp631;
-    let tmp633: f64 = tmp117 * tmp607;
-    let tmp634: f64 = tmp119 * tmp609;
-    let tmp635: f64 = tmp230 * tmp581;
-    let tmp636: f64 = tmp120 * tmp620;
-    let tmp637: f64 = tmp110 * tmp579;
-    let tmp638: f64 = tmp593 * tmp70;
-    let tmp639: f64 = tmp104 * tmp579;
-    let tmp640: f64 = tmp297 * tmp576;
-    let tmp641: f64 = -tmp640;
-    let tmp642: f64 = -tmp296;
-    let tmp643: f64 = tmp104 * tmp581;
-    let tmp644: f64 = tmp19 * tmp297;
-    let tmp645: f64 = tmp85
-        * (-tmp121 * tmp613 - tmp298 + tmp633 + tmp634
-            - tmp75 * (tmp230 * tmp583 - tmp299 * tmp578 + tmp639 + tmp641)
-            - tmp79 * (-tmp110 * tmp583 + tmp120 * tmp578 + tmp295 + tmp642 - tmp643 + tmp644)
-            - tmp81 * (tmp303 - tmp305 + tmp635 + tmp636 - tmp637 - tmp638));
-    let tmp646: f64 = tmp259 * tmp645;
-    let tmp647: f64 = tmp247 * tmp606;
-    let tmp648: f64 = tmp247 * tmp615;
-    let tmp649: f64 = tmp257 * tmp614;
-    let tmp650: f64 = tmp259 * tmp649;
-    let tmp651: f64 = tmp40 * tmp593;
-    let tmp652: f64 = tmp255 - tmp651;
-    let tmp653: f64 = tmp114 * tmp581;
-    let tmp654: f64 = tmp290 - tmp653;
-    let tmp655: f64 = tmp126 * tmp607;
-    let tmp656: f64 = tmp292 - tmp655;
-    let tmp657: f64 = tmp124 * tmp584;
-    let tmp658: f64 = tmp283 - tmp657;
-    let tmp659: f64 = -tmp617 + tmp632 + tmp646 + tmp647 - tmp648 - tmp650 + tmp652 + tmp654 + tmp656 + tmp658;
-    let tmp660: f64 = tmp333 * tmp616;
-    let tmp661: f64 = tmp333 * tmp631;
-    let tmp662: f64 = tmp347 * tmp645;
-    let tmp663: f64 = tmp341 * tmp615;
-    let tmp664: f64 = tmp347 * tmp649;
-    let tmp665: f64 = tmp341 * tmp606;
-    let tmp666: f64 = tmp40 * tmp604;
-    let tmp667: f64 = tmp124 * tmp586;
-    let tmp668: f64 = tmp114 * tmp579;
-    let tmp669: f64 = tmp126 * tmp609;
-    let tmp670: f64 = tmp666 + tmp667 + tmp668 + tmp669;
-    let tmp671: f64 = tmp660 - tmp661 - tmp662 + tmp663 + tmp664 - tmp665 + tmp670;
-    let tmp672: f64 = -tmp666;
-    let tmp673: f64 = -tmp667;
-    let tmp674: f64 = -tmp669;
-    let tmp675: f64 = -tmp668;
-    let tmp676: f64 = tmp672 + tmp673 + tmp674 + tmp675;
-    let tmp677: f64 = -tmp255;
-    let tmp678: f64 = tmp651 + tmp677;
-    let tmp679: f64 = -tmp290;
-    let tmp680: f64 = tmp653 + tmp679;
-    let tmp681: f64 = -tmp283;
-    let tmp682: f64 = tmp657 + tmp681;
-    let tmp683: f64 = -tmp292;
-    let tmp684: f64 = tmp655 + tmp683;
-    let tmp685: f64 = tmp604 * tmp73;
-    let tmp686: f64 = tmp186 * tmp54;
-    let tmp687: f64 = tmp49 * tmp686;
-    let tmp688: f64 = tmp50 * tmp586;
-    let tmp689: f64 = tmp205 - tmp687 + tmp688;
-    let tmp690: f64 = tmp579 * tmp61;
-    let tmp691: f64 = tmp167 * tmp66;
-    let tmp692: f64 = tmp63 * tmp691;
-    let tmp693: f64 = tmp200 + tmp690 - tmp692;
-    let tmp694: f64 = -tmp589;
-    let tmp695: f64 = tmp590 - tmp689 * tmp76 + tmp693 * tmp77 + tmp694;
-    let tmp696: f64 = tmp233 * tmp33;
-    let tmp697: f64 = tmp696 * tmp78;
-    let tmp698: f64 = tmp579 * tmp58;
-    let tmp699: f64 = tmp586 * tmp70;
-    let tmp700: f64 = tmp691 * tmp77;
-    let tmp701: f64 = tmp686 * tmp76;
-    let tmp702: f64 = tmp181 - tmp196 - tmp698 + tmp699 + tmp700 - tmp701;
-    let tmp703: f64 = -tmp198;
-    let tmp704: f64 = tmp60 * tmp691;
-    let tmp705: f64 = tmp686 * tmp72;
-    let tmp706: f64 = tmp209 - tmp58 * tmp693 + tmp689 * tmp70 + tmp703 - tmp704 + tmp705;
-    let tmp707: f64 = tmp237 * tmp33;
-    let tmp708: f64 = tmp239 * tmp576;
-    let tmp709: f64 = tmp236 - tmp707 + tmp708;
-    let tmp710: f64 =
-        tmp85 * (tmp104 * tmp702 + tmp110 * tmp706 + tmp228 + tmp230 * tmp695 + tmp242 * tmp709 - tmp685 - tmp697);
-    let tmp711: f64 = tmp44 * tmp609;
-    let tmp712: f64 = tmp213 * tmp46;
-    let tmp713: f64 = tmp41 * tmp712;
-    let tmp714: f64 = tmp219 + tmp711 - tmp713;
-    let tmp715: f64 = tmp609 * tmp73;
-    let tmp716: f64 = tmp712 * tmp78;
-    let tmp717: f64 = -tmp166 - tmp695 * tmp79 - tmp702 * tmp81 - tmp706 * tmp75 - tmp714 * tmp82 + tmp715 + tmp716;
-    let tmp718: f64 = tmp225 * tmp717;
-    let tmp719: f64 = tmp285 * tmp717;
-    let tmp720: f64 = tmp281 * tmp719;
-    let tmp721: f64 = tmp257 * tmp717;
-    let tmp722: f64 = tmp259 * tmp721;
-    let tmp723: f64 = tmp247 * tmp718;
-    let tmp724: f64 = tmp108 * tmp712;
-    let tmp725: f64 = tmp106 * tmp609;
-    let tmp726: f64 = tmp104 * tmp686;
-    let tmp727: f64 = tmp709 * reference_tension_n[0];
-    let tmp728: f64 = -tmp262;
-    let tmp729: f64 = tmp264 * tmp33;
-    let tmp730: f64 = -tmp630;
-    let tmp731: f64 = tmp232 * tmp33;
-    let tmp732: f64 = tmp109 * tmp731;
-    let tmp733: f64 = tmp58 * tmp604;
-    let tmp734: f64 = tmp110 * tmp686;
-    let tmp735: f64 = tmp230 * tmp586;
-    let tmp736: f64 = tmp85
-        * (-tmp111 * tmp714 - tmp261 + tmp724 + tmp725
-            - tmp75 * (-tmp230 * tmp689 + tmp263 + tmp58 * tmp727 - tmp726 + tmp728 + tmp729)
-            - tmp79 * (-tmp109 * tmp709 + tmp110 * tmp689 + tmp628 + tmp730)
-            - tmp81 * (-tmp267 + tmp270 - tmp732 + tmp733 + tmp734 - tmp735));
-    let tmp737: f64 = tmp281 * tmp736;
-    let tmp738: f64 = tmp247 * tmp710;
-    let tmp739: f64 = tmp117 * tmp609;
-    let tmp740: f64 = tmp119 * tmp712;
-    let tmp741: f64 = -tmp295;
-    let tmp742: f64 = tmp104 * tmp691;
-    let tmp743: f64 = tmp297 * tmp33;
-    let tmp744: f64 = tmp230 * tmp579;
-    let tmp745: f64 = tmp120 * tmp731;
-    let tmp746: f64 = tmp604 * tmp70;
-    let tmp747: f64 = tmp110 * tmp691;
-    let tmp748: f64 = -tmp639;
-    let tmp749: f64 = tmp85
-        * (-tmp121 * tmp714 - tmp301 + tmp739 + tmp740
-            - tmp75 * (tmp230 * tmp693 + tmp296 - tmp70 * tmp727 + tmp741 + tmp742 - tmp743)
-            - tmp79 * (-tmp110 * tmp693 + tmp120 * tmp709 + tmp640 + tmp748)
-            - tmp81 * (tmp306 - tmp308 + tmp744 + tmp745 - tmp746 - tmp747));
-    let tmp750: f64 = tmp259 * tmp749;
-    let tmp751: f64 = tmp676 - tmp720 - tmp722 - tmp723 + tmp737 + tmp738 + tmp750;
-    let tmp752: f64 = tmp341 * tmp718;
-    let tmp753: f64 = tmp347 * tmp749;
-    let tmp754: f64 = tmp333 * tmp736;
-    let tmp755: f64 = tmp333 * tmp719;
-    let tmp756: f64 = tmp347 * tmp721;
-    let tmp757: f64 = tmp341 * tmp710;
-    let tmp758: f64 = tmp40 * tmp696;
-    let tmp759: f64 = tmp677 + tmp758;
-    let tmp760: f64 = tmp114 * tmp691;
-    let tmp761: f64 = tmp679 + tmp760;
-    let tmp762: f64 = tmp126 * tmp712;
-    let tmp763: f64 = tmp683 + tmp762;
-    let tmp764: f64 = tmp124 * tmp686;
-    let tmp765: f64 = tmp681 + tmp764;
-    let tmp766: f64 = tmp752 - tmp753 - tmp754 + tmp755 + tmp756 - tmp757 + tmp759 + tmp761 + tmp763 + tmp765;
-    let tmp767: f64 = tmp255 - tmp758;
-    let tmp768: f64 = tmp290 - tmp760;
-    let tmp769: f64 = tmp283 - tmp764;
-    let tmp770: f64 = tmp292 - tmp762;
-    let tmp771: f64 = tmp85 * (tmp88 + tmp90 + tmp93);
-    let tmp772: f64 = tmp85
-        * (-tmp75 * (tmp116 - tmp70 * tmp92)
-            - tmp79 * (-tmp118 + tmp76 * tmp92)
-            - tmp81 * (tmp70 * tmp89 - tmp76 * tmp87));
-    let tmp773: f64 = tmp259 * tmp772;
-    let tmp774: f64 = tmp85
-        * (-tmp75 * (-tmp105 + tmp58 * tmp92)
-            - tmp79 * (tmp107 - tmp77 * tmp92)
-            - tmp81 * (-tmp58 * tmp89 + tmp77 * tmp87));
-    let tmp775: f64 = tmp281 * tmp774;
-    let tmp776: f64 = tmp247 * tmp771;
-    let tmp777: f64 = tmp128 + tmp773 + tmp775 + tmp776;
-    let tmp778: f64 = tmp347 * tmp772;
-    let tmp779: f64 = tmp333 * tmp774;
-    let tmp780: f64 = tmp341 * tmp771;
-    let tmp781: f64 = -tmp102 - tmp778 - tmp779 - tmp780;
-    let tmp782: f64 = -tmp24 - tmp26 - tmp30;
-    let tmp783: f64 = -tmp575 + tmp577 + tmp91;
-    let tmp784: f64 = tmp85 * (-tmp229 + tmp242 * tmp783 + tmp594 + tmp605);
-    let tmp785: f64 = tmp85
-        * (-tmp75 * (tmp276 * tmp783 + tmp730)
-            - tmp79 * (-tmp109 * tmp783 + tmp626 + tmp728)
-            - tmp81 * (tmp268 + tmp621 - tmp623));
-    let tmp786: f64 = tmp333 * tmp785;
-    let tmp787: f64 = tmp341 * tmp784;
-    let tmp788: f64 = tmp85
-        * (-tmp75 * (-tmp299 * tmp783 + tmp640)
-            - tmp79 * (tmp120 * tmp783 + tmp296 - tmp644)
-            - tmp81 * (-tmp303 - tmp636 + tmp638));
-    let tmp789: f64 = tmp347 * tmp788;
-    let tmp790: f64 = tmp672 - tmp786 - tmp787 - tmp789;
-    let tmp791: f64 = tmp259 * tmp788;
-    let tmp792: f64 = tmp247 * tmp784;
-    let tmp793: f64 = tmp281 * tmp785;
-    let tmp794: f64 = tmp678 + tmp791 + tmp792 + tmp793;
-    let tmp795: f64 = -tmp236 + tmp707 - tmp708;
-    let tmp796: f64 = tmp85 * (-tmp228 + tmp242 * tmp795 + tmp685 + tmp697);
-    let tmp797: f64 = tmp247 * tmp796;
-    let tmp798: f64 = tmp795 * reference_tension_n[0];
-    let tmp799: f64 = tmp85
-        * (-tmp75 * (tmp642 - tmp70 * tmp798 + tmp743)
-            - tmp79 * (tmp120 * tmp795 + tmp641)
-            - tmp81 * (tmp308 - tmp745 + tmp746));
-    let tmp800: f64 = tmp259 * tmp799;
-    let tmp801: f64 = tmp85
-        * (-tmp75 * (tmp262 + tmp58 * tmp798 - tmp729)
-            - tmp79 * (-tmp109 * tmp795 + tmp630)
-            - tmp81 * (-tmp270 + tmp732 - tmp733));
-    let tmp802: f64 = tmp281 * tmp801;
-    let tmp803: f64 = tmp666 + tmp797 + tmp800 + tmp802;
-    let tmp804: f64 = tmp341 * tmp796;
-    let tmp805: f64 = tmp347 * tmp799;
-    let tmp806: f64 = tmp333 * tmp801;
-    let tmp807: f64 = tmp767 - tmp804 - tmp805 - tmp806;
-    let tmp808: f64 = tmp611 - tmp612 + tmp80;
-    let tmp809: f64 = tmp165 - tmp608 - tmp610 - tmp808 * tmp82;
-    let tmp810: f64 = tmp225 * tmp809;
-    let tmp811: f64 = tmp285 * tmp809;
-    let tmp812: f64 = tmp333 * tmp811;
-    let tmp813: f64 = tmp85 * (-tmp111 * tmp808 + tmp278 - tmp618 - tmp619);
-    let tmp814: f64 = tmp333 * tmp813;
-    let tmp815: f64 = tmp341 * tmp810;
-    let tmp816: f64 = tmp257 * tmp809;
-    let tmp817: f64 = tmp347 * tmp816;
-    let tmp818: f64 = tmp85 * (-tmp121 * tmp808 + tmp298 - tmp633 - tmp634);
-    let tmp819: f64 = tmp347 * tmp818;
-    let tmp820: f64 = tmp674 + tmp812 - tmp814 + tmp815 + tmp817 - tmp819;
-    let tmp821: f64 = tmp259 * tmp816;
-    let tmp822: f64 = tmp259 * tmp818;
-    let tmp823: f64 = tmp247 * tmp810;
-    let tmp824: f64 = tmp281 * tmp813;
-    let tmp825: f64 = tmp281 * tmp811;
-    let tmp826: f64 = tmp684 - tmp821 + tmp822 - tmp823 + tmp824 - tmp825;
-    let tmp827: f64 = -tmp219 - tmp711 + tmp713;
-    let tmp828: f64 = tmp166 - tmp715 - tmp716 - tmp82 * tmp827;
-    let tmp829: f64 = tmp225 * tmp828;
-    let tmp830: f64 = tmp257 * tmp828;
-    let tmp831: f64 = tmp259 * tmp830;
-    let tmp832: f64 = tmp285 * tmp828;
-    let tmp833: f64 = tmp281 * tmp832;
-    let tmp834: f64 = tmp247 * tmp829;
-    let tmp835: f64 = tmp85 * (-tmp111 * tmp827 + tmp261 - tmp724 - tmp725);
-    let tmp836: f64 = tmp281 * tmp835;
-    let tmp837: f64 = tmp85 * (-tmp121 * tmp827 + tmp301 - tmp739 - tmp740);
-    let tmp838: f64 = tmp259 * tmp837;
-    let tmp839: f64 = tmp669 - tmp831 - tmp833 - tmp834 + tmp836 + tmp838;
-    let tmp840: f64 = tmp347 * tmp837;
-    let tmp841: f64 = tmp333 * tmp835;
-    let tmp842: f64 = tmp341 * tmp829;
-    let tmp843: f64 = tmp347 * tmp830;
-    let tmp844: f64 = tmp333 * tmp832;
-    let tmp845: f64 = tmp770 - tmp840 - tmp841 + tmp842 + tmp843 + tmp844;
-    let tmp846: f64 = -tmp195 - tmp596 + tmp598;
-    let tmp847: f64 = tmp580 - tmp582 + tmp71;
-    let tmp848: f64 = tmp209 - tmp600 + tmp77 * tmp847;
-    let tmp849: f64 = -tmp58 * tmp847 + tmp590;
-    let tmp850: f64 = -tmp75 * tmp849 - tmp79 * tmp848 - tmp81 * tmp846;
-    let tmp851: f64 = tmp225 * tmp850;
-    let tmp852: f64 = tmp85 * (tmp104 * tmp846 + tmp110 * tmp849 + tmp230 * tmp848);
-    let tmp853: f64 = tmp257 * tmp850;
-    let tmp854: f64 = tmp259 * tmp853;
-    let tmp855: f64 = tmp285 * tmp850;
-    let tmp856: f64 = tmp281 * tmp855;
-    let tmp857: f64 = tmp247 * tmp851;
-    let tmp858: f64 = tmp247 * tmp852;
-    let tmp859: f64 = tmp85
-        * (-tmp75 * (tmp230 * tmp847 + tmp748)
-            - tmp79 * (-tmp110 * tmp847 + tmp643 + tmp741)
-            - tmp81 * (tmp305 - tmp635 + tmp637));
-    let tmp860: f64 = tmp259 * tmp859;
-    let tmp861: f64 = tmp680 - tmp854 - tmp856 - tmp857 + tmp858 + tmp860;
-    let tmp862: f64 = tmp341 * tmp851;
-    let tmp863: f64 = tmp341 * tmp852;
-    let tmp864: f64 = tmp333 * tmp855;
-    let tmp865: f64 = tmp347 * tmp853;
-    let tmp866: f64 = tmp347 * tmp859;
-    let tmp867: f64 = tmp675 + tmp862 - tmp863 + tmp864 + tmp865 - tmp866;
-    let tmp868: f64 = -tmp200 - tmp690 + tmp692;
-    let tmp869: f64 = tmp591 + tmp77 * tmp868;
-    let tmp870: f64 = -tmp58 * tmp868 + tmp601 + tmp704;
-    let tmp871: f64 = tmp196 + tmp698 - tmp700;
-    let tmp872: f64 = -tmp75 * tmp870 - tmp79 * tmp869 - tmp81 * tmp871;
-    let tmp873: f64 = tmp225 * tmp872;
-    let tmp874: f64 = tmp85 * (tmp104 * tmp871 + tmp110 * tmp870 + tmp230 * tmp869);
-    let tmp875: f64 = tmp85
-        * (-tmp75 * (tmp230 * tmp868 + tmp295 - tmp742)
-            - tmp79 * (-tmp110 * tmp868 + tmp639)
-            - tmp81 * (-tmp306 - tmp744 + tmp747));
-    let tmp876: f64 = tmp347 * tmp875;
-    let tmp877: f64 = tmp341 * tmp873;
-    let tmp878: f64 = tmp257 * tmp872;
-    let tmp879: f64 = tmp347 * tmp878;
-    let tmp880: f64 = tmp285 * tmp872;
-    let tmp881: f64 = tmp333 * tmp880;
-    let tmp882: f64 = tmp341 * tmp874;
-    let tmp883: f64 = tmp768 - tmp876 + tmp877 + tmp879 + tmp881 - tmp882;
-    let tmp884: f64 = tmp259 * tmp875;
-    let tmp885: f64 = tmp281 * tmp880;
-    let tmp886: f64 = tmp259 * tmp878;
-    let tmp887: f64 = tmp247 * tmp873;
-    let tmp888: f64 = tmp247 * tmp874;
-    let tmp889: f64 = tmp668 + tmp884 - tmp885 - tmp886 - tmp887 + tmp888;
-    let tmp890: f64 = -tmp585 + tmp587 + tmp59;
-    let tmp891: f64 = tmp694 + tmp70 * tmp890;
-    let tmp892: f64 = tmp194 - tmp595 + tmp597;
-    let tmp893: f64 = tmp602 + tmp703 - tmp76 * tmp890;
-    let tmp894: f64 = tmp85 * (tmp104 * tmp892 + tmp110 * tmp891 + tmp230 * tmp893);
-    let tmp895: f64 = -tmp75 * tmp891 - tmp79 * tmp893 - tmp81 * tmp892;
-    let tmp896: f64 = tmp225 * tmp895;
-    let tmp897: f64 = tmp341 * tmp896;
-    let tmp898: f64 = tmp341 * tmp894;
-    let tmp899: f64 = tmp85
-        * (-tmp75 * (-tmp230 * tmp890 + tmp628)
-            - tmp79 * (tmp110 * tmp890 + tmp263 - tmp627)
-            - tmp81 * (-tmp269 + tmp622 - tmp624));
-    let tmp900: f64 = tmp333 * tmp899;
-    let tmp901: f64 = tmp257 * tmp895;
-    let tmp902: f64 = tmp347 * tmp901;
-    let tmp903: f64 = tmp285 * tmp895;
-    let tmp904: f64 = tmp333 * tmp903;
-    let tmp905: f64 = tmp673 + tmp897 - tmp898 - tmp900 + tmp902 + tmp904;
-    let tmp906: f64 = tmp247 * tmp896;
-    let tmp907: f64 = tmp281 * tmp899;
-    let tmp908: f64 = tmp259 * tmp901;
-    let tmp909: f64 = tmp247 * tmp894;
-    let tmp910: f64 = tmp281 * tmp903;
-    let tmp911: f64 = tmp682 - tmp906 + tmp907 - tmp908 + tmp909 - tmp910;
-    let tmp912: f64 = -tmp205 + tmp687 - tmp688;
-    let tmp913: f64 = tmp589 - tmp76 * tmp912;
-    let tmp914: f64 = -tmp181 - tmp699 + tmp701;
-    let tmp915: f64 = tmp198 + tmp70 * tmp912 - tmp705;
-    let tmp916: f64 = -tmp75 * tmp915 - tmp79 * tmp913 - tmp81 * tmp914;
-    let tmp917: f64 = tmp225 * tmp916;
-    let tmp918: f64 = tmp85 * (tmp104 * tmp914 + tmp110 * tmp915 + tmp230 * tmp913);
-    let tmp919: f64 = tmp341 * tmp917;
-    let tmp920: f64 = tmp257 * tmp916;
-    let tmp921: f64 = tmp347 * tmp920;
-    let tmp922: f64 = tmp341 * tmp918;
-    let tmp923: f64 = tmp85
-        * (-tmp75 * (-tmp230 * tmp912 + tmp625 + tmp726)
-            - tmp79 * (tmp110 * tmp912 + tmp629)
-            - tmp81 * (tmp267 - tmp734 + tmp735));
-    let tmp924: f64 = tmp333 * tmp923;
-    let tmp925: f64 = tmp285 * tmp916;
-    let tmp926: f64 = tmp333 * tmp925;
-    let tmp927: f64 = tmp769 + tmp919 + tmp921 - tmp922 - tmp924 + tmp926;
-    let tmp928: f64 = tmp247 * tmp918;
-    let tmp929: f64 = tmp247 * tmp917;
-    let tmp930: f64 = tmp259 * tmp920;
-    let tmp931: f64 = tmp281 * tmp925;
-    let tmp932: f64 = tmp281 * tmp923;
-    let tmp933: f64 = tmp667 + tmp928 - tmp929 - tmp930 - tmp931 + tmp932;
-    let tmp934: f64 = tmp96 * platform_weight_n;
-    let tmp935: f64 = tmp97 * platform_weight_n;
-    let tmp936: f64 = tmp15 * platform_weight_n;
-    let tmp937: f64 = tmp44 * tmp936;
-    let tmp938: f64 = tmp25 * platform_weight_n;
-    let tmp939: f64 = tmp41 * tmp938;
-    let tmp940: f64 = tmp29 * platform_weight_n;
-    let tmp941: f64 = tmp41 * tmp940;
-    let tmp942: f64 = tmp9 * platform_weight_n;
-    let tmp943: f64 = tmp44 * tmp942;
-    let tmp944: f64 = tmp4 * platform_weight_n;
-    let tmp945: f64 = tmp44 * tmp944;
-    let tmp946: f64 = tmp23 * platform_weight_n;
-    let tmp947: f64 = tmp41 * tmp946;
+    let tmp91: f64 = tmp73 * (-tmp50 * tmp71 + tmp65 * tmp70);
+    let tmp92: f64 = tmp39 * tmp91;
+    let tmp93: f64 = tmp73 * (tmp50 * tmp68 - tmp62 * tmp70);
+    let tmp94: f64 = tmp40 * tmp93;
+    let tmp95: f64 = tmp77 * tmp90 + tmp92 * reference_tension_n[0] + tmp94 * reference_tension_n[0];
+    let tmp96: f64 = tmp25 * attachments_m[(1, 3)] + tmp26 * attachments_m[(0, 3)] + tmp27 * attachments_m[(2, 3)];
+    let tmp97: f64 = tmp95 * tmp96;
+    let tmp98: f64 = tmp25 * attachments_m[(1, 1)] + tmp26 * attachments_m[(0, 1)] + tmp27 * attachments_m[(2, 1)];
+    let tmp99: f64 = tmp80 * tmp98;
+    let tmp100: f64 = tmp73 * (tmp60 * tmp70 - tmp61 * tmp68);
+    let tmp101: f64 = tmp100 * tmp40;
+    let tmp102: f64 = -tmp60 * tmp71 + tmp64 * tmp68;
+    let tmp103: f64 = tmp102 * tmp73;
+    let tmp104: f64 = tmp73 * (tmp61 * tmp71 - tmp64 * tmp70);
+    let tmp105: f64 = tmp104 * tmp39;
+    let tmp106: f64 = tmp101 * reference_tension_n[0] + tmp103 * tmp77 + tmp105 * reference_tension_n[0];
+    let tmp107: f64 = tmp25 * attachments_m[(1, 2)] + tmp26 * attachments_m[(0, 2)] + tmp27 * attachments_m[(2, 2)];
+    let tmp108: f64 = tmp106 * tmp107;
+    let tmp109: f64 = tmp108 * tmp62
+        + tmp11 * reference_tension_n[1]
+        + tmp60 * tmp97
+        + tmp68 * tmp99
+        + tmp88 * reference_tension_n[0]
+        - platform_weight_n * (tmp10 * com_offset_m[0] + tmp4 * com_offset_m[2] + tmp7 * com_offset_m[1]);
+    let tmp110: f64 = tmp83 * tmp86;
+    let tmp111: f64 = tmp28 * tmp38;
+    let tmp112: f64 = -tmp108 * tmp50
+        - tmp111 * reference_tension_n[0]
+        - tmp20 * reference_tension_n[1]
+        - tmp61 * tmp97
+        - tmp70 * tmp99
+        + platform_weight_n * (tmp16 * com_offset_m[2] + tmp17 * com_offset_m[0] + tmp19 * com_offset_m[1]);
+    let tmp113: f64 = tmp84 * tmp86;
+    let tmp114: f64 = tmp109 * tmp110 + tmp112 * tmp113 + tmp81 * tmp87;
+    let tmp115: f64 = tmp86 * (-tmp29 * tmp54 + tmp32 * tmp51);
+    let tmp116: f64 = tmp32 - tmp54;
+    let tmp117: f64 = tmp116 * tmp86;
+    let tmp118: f64 = tmp86 * (tmp29 - tmp51);
+    let tmp119: f64 = tmp109 * tmp117 + tmp112 * tmp118 + tmp115 * tmp81;
+    let tmp120: f64 = -tmp32 + tmp41;
+    let tmp121: f64 = tmp120 * tmp86;
+    let tmp122: f64 = tmp86 * (tmp29 * tmp41 - tmp32 * tmp43);
+    let tmp123: f64 = tmp86 * (-tmp29 + tmp43);
+    let tmp124: f64 = tmp109 * tmp121 + tmp112 * tmp123 + tmp122 * tmp81;
+    let tmp125: f64 = tmp4 * attachments_m[(1, 0)] - tmp7 * attachments_m[(2, 0)];
+    let tmp126: f64 = tmp16 * attachments_m[(1, 0)] - tmp19 * attachments_m[(2, 0)];
+    let tmp127: f64 = tmp125 * tmp39 + tmp126 * tmp38;
+    let tmp128: f64 = -tmp25 * attachments_m[(2, 0)] + tmp27 * attachments_m[(1, 0)];
+    let tmp129: f64 = tmp4 * attachments_m[(1, 1)] - tmp7 * attachments_m[(2, 1)];
+    let tmp130: f64 = tmp16 * attachments_m[(1, 1)] - tmp19 * attachments_m[(2, 1)];
+    let tmp131: f64 = tmp129 * tmp68 + tmp130 * tmp70;
+    let tmp132: f64 = 1.0_f64 / tmp23;
+    let tmp133: f64 = tmp132 * tmp21;
+    let tmp134: f64 = tmp126 * tmp37;
+    let tmp135: f64 = reference_tension_n[0] * (-tmp127 * tmp133 + tmp134);
+    let tmp136: f64 = tmp130 * tmp67;
+    let tmp137: f64 = 1.0_f64 / tmp35;
+    let tmp138: f64 = tmp137 * tmp30;
+    let tmp139: f64 = tmp129 * tmp67 - tmp131 * tmp138;
+    let tmp140: f64 = tmp137 * tmp33;
+    let tmp141: f64 = -tmp131 * tmp140 + tmp136;
+    let tmp142: f64 = tmp16 * attachments_m[(1, 2)] - tmp19 * attachments_m[(2, 2)];
+    let tmp143: f64 = tmp142 * tmp49;
+    let tmp144: f64 = 1.0_f64 / tmp47;
+    let tmp145: f64 = tmp4 * attachments_m[(1, 2)] - tmp7 * attachments_m[(2, 2)];
+    let tmp146: f64 = tmp142 * tmp50 + tmp145 * tmp62;
+    let tmp147: f64 = tmp144 * tmp146;
+    let tmp148: f64 = tmp143 - tmp147 * tmp42;
+    let tmp149: f64 = tmp145 * tmp49 - tmp147 * tmp44;
+    let tmp150: f64 = tmp4 * attachments_m[(1, 3)] - tmp7 * attachments_m[(2, 3)];
+    let tmp151: f64 = tmp16 * attachments_m[(1, 3)] - tmp19 * attachments_m[(2, 3)];
+    let tmp152: f64 = tmp150 * tmp60 + tmp151 * tmp61;
+    let tmp153: f64 = 1.0_f64 / tmp57;
+    let tmp154: f64 = tmp153 * tmp55;
+    let tmp155: f64 = tmp151 * tmp59;
+    let tmp156: f64 = -tmp152 * tmp154 + tmp155;
+    let tmp157: f64 = tmp153 * tmp52;
+    let tmp158: f64 = tmp150 * tmp59 - tmp152 * tmp157;
+    let tmp159: f64 = tmp12 * tmp132;
+    let tmp160: f64 = reference_tension_n[0] * (tmp125 * tmp37 - tmp127 * tmp159);
+    let tmp161: f64 = tmp12 * reference_tension_n[0];
+    let tmp162: f64 =
+        -tmp106 * (tmp143 * tmp44 - tmp145 * tmp50 - tmp148 * tmp43 + tmp149 * tmp41) + tmp11 * tmp135 + tmp125 * tmp77
+            - tmp134 * tmp161
+            - tmp160 * tmp20
+            - tmp80 * (-tmp129 * tmp70 + tmp136 * tmp30 + tmp139 * tmp32 - tmp141 * tmp29)
+            - tmp95 * (-tmp150 * tmp61 + tmp155 * tmp52 - tmp156 * tmp51 + tmp158 * tmp54);
+    let tmp163: f64 = tmp139 * tmp80;
+    let tmp164: f64 = tmp158 * tmp95;
+    let tmp165: f64 = tmp106 * tmp149;
+    let tmp166: f64 = tmp160 + tmp163 + tmp164 + tmp165;
+    let tmp167: f64 = tmp106 * tmp148;
+    let tmp168: f64 = tmp141 * tmp80;
+    let tmp169: f64 = tmp156 * tmp95;
+    let tmp170: f64 = tmp135 + tmp167 + tmp168 + tmp169;
+    let tmp171: f64 = tmp162 * tmp74 + tmp166 * tmp78 + tmp170 * tmp76;
+    let tmp172: f64 = tmp68 * tmp98;
+    let tmp173: f64 = -tmp25 * attachments_m[(2, 2)] + tmp27 * attachments_m[(1, 2)];
+    let tmp174: f64 = tmp106 * tmp62;
+    let tmp175: f64 = tmp162 * tmp93 + tmp166 * tmp91 + tmp170 * tmp90;
+    let tmp176: f64 = tmp60 * tmp96;
+    let tmp177: f64 = tmp100 * tmp162 + tmp103 * tmp170 + tmp104 * tmp166;
+    let tmp178: f64 = tmp107 * tmp62;
+    let tmp179: f64 = -tmp25 * attachments_m[(2, 1)] + tmp27 * attachments_m[(1, 1)];
+    let tmp180: f64 = tmp68 * tmp80;
+    let tmp181: f64 = -tmp25 * attachments_m[(2, 3)] + tmp27 * attachments_m[(1, 3)];
+    let tmp182: f64 = tmp60 * tmp95;
+    let tmp183: f64 = tmp107 * tmp165
+        + tmp114 * tmp129
+        + tmp119 * tmp145
+        + tmp124 * tmp150
+        + tmp125 * reference_tension_n[1]
+        + tmp128 * tmp79
+        + tmp160 * tmp28
+        + tmp163 * tmp98
+        + tmp164 * tmp96
+        + tmp171 * tmp172
+        + tmp173 * tmp174
+        + tmp175 * tmp176
+        + tmp177 * tmp178
+        + tmp179 * tmp180
+        + tmp181 * tmp182
+        - platform_weight_n * (tmp4 * com_offset_m[1] - tmp7 * com_offset_m[2]);
+    let tmp184: f64 = tmp107 * tmp50;
+    let tmp185: f64 = tmp61 * tmp95;
+    let tmp186: f64 = tmp61 * tmp96;
+    let tmp187: f64 = tmp70 * tmp80;
+    let tmp188: f64 = tmp70 * tmp98;
+    let tmp189: f64 = tmp106 * tmp50;
+    let tmp190: f64 = -tmp107 * tmp167
+        - tmp114 * tmp130
+        - tmp119 * tmp142
+        - tmp124 * tmp151
+        - tmp126 * reference_tension_n[1]
+        - tmp128 * tmp77
+        - tmp135 * tmp28
+        - tmp168 * tmp98
+        - tmp169 * tmp96
+        - tmp171 * tmp188
+        - tmp173 * tmp189
+        - tmp175 * tmp186
+        - tmp177 * tmp184
+        - tmp179 * tmp187
+        - tmp181 * tmp185
+        + platform_weight_n * (tmp16 * com_offset_m[1] - tmp19 * com_offset_m[2]);
+    let tmp191: f64 = tmp10 * attachments_m[(2, 0)] - tmp4 * attachments_m[(0, 0)];
+    let tmp192: f64 = -tmp16 * attachments_m[(0, 0)] + tmp17 * attachments_m[(2, 0)];
+    let tmp193: f64 = tmp191 * tmp39 + tmp192 * tmp38;
+    let tmp194: f64 = tmp26 * attachments_m[(2, 0)] - tmp27 * attachments_m[(0, 0)];
+    let tmp195: f64 = tmp10 * attachments_m[(2, 1)] - tmp4 * attachments_m[(0, 1)];
+    let tmp196: f64 = -tmp16 * attachments_m[(0, 1)] + tmp17 * attachments_m[(2, 1)];
+    let tmp197: f64 = tmp195 * tmp68 + tmp196 * tmp70;
+    let tmp198: f64 = tmp196 * tmp67;
+    let tmp199: f64 = -tmp140 * tmp197 + tmp198;
+    let tmp200: f64 = tmp199 * tmp80;
+    let tmp201: f64 = tmp10 * attachments_m[(2, 3)] - tmp4 * attachments_m[(0, 3)];
+    let tmp202: f64 = -tmp16 * attachments_m[(0, 3)] + tmp17 * attachments_m[(2, 3)];
+    let tmp203: f64 = tmp201 * tmp60 + tmp202 * tmp61;
+    let tmp204: f64 = tmp202 * tmp59;
+    let tmp205: f64 = -tmp154 * tmp203 + tmp204;
+    let tmp206: f64 = tmp205 * tmp95;
+    let tmp207: f64 = tmp10 * attachments_m[(2, 2)] - tmp4 * attachments_m[(0, 2)];
+    let tmp208: f64 = -tmp16 * attachments_m[(0, 2)] + tmp17 * attachments_m[(2, 2)];
+    let tmp209: f64 = tmp207 * tmp62 + tmp208 * tmp50;
+    let tmp210: f64 = tmp144 * tmp209;
+    let tmp211: f64 = tmp208 * tmp49;
+    let tmp212: f64 = -tmp210 * tmp42 + tmp211;
+    let tmp213: f64 = tmp106 * tmp212;
+    let tmp214: f64 = tmp132 * tmp193;
+    let tmp215: f64 = tmp192 * tmp37;
+    let tmp216: f64 = reference_tension_n[0] * (-tmp21 * tmp214 + tmp215);
+    let tmp217: f64 = tmp200 + tmp206 + tmp213 + tmp216;
+    let tmp218: f64 = -tmp157 * tmp203 + tmp201 * tmp59;
+    let tmp219: f64 = tmp218 * tmp95;
+    let tmp220: f64 = -tmp138 * tmp197 + tmp195 * tmp67;
+    let tmp221: f64 = tmp220 * tmp80;
+    let tmp222: f64 = tmp207 * tmp49 - tmp210 * tmp44;
+    let tmp223: f64 = tmp106 * tmp222;
+    let tmp224: f64 = reference_tension_n[0] * (-tmp12 * tmp214 + tmp191 * tmp37);
+    let tmp225: f64 = tmp219 + tmp221 + tmp223 + tmp224;
+    let tmp226: f64 = -tmp106 * (-tmp207 * tmp50 + tmp211 * tmp44 - tmp212 * tmp43 + tmp222 * tmp41) + tmp11 * tmp216
+        - tmp161 * tmp215
+        + tmp191 * tmp77
+        - tmp20 * tmp224
+        - tmp80 * (-tmp195 * tmp70 + tmp198 * tmp30 - tmp199 * tmp29 + tmp220 * tmp32)
+        - tmp95 * (-tmp201 * tmp61 + tmp204 * tmp52 - tmp205 * tmp51 + tmp218 * tmp54);
+    let tmp227: f64 = tmp217 * tmp76 + tmp225 * tmp78 + tmp226 * tmp74;
+    let tmp228: f64 = tmp26 * attachments_m[(2, 3)] - tmp27 * attachments_m[(0, 3)];
+    let tmp229: f64 = tmp26 * attachments_m[(2, 2)] - tmp27 * attachments_m[(0, 2)];
+    let tmp230: f64 = tmp217 * tmp90 + tmp225 * tmp91 + tmp226 * tmp93;
+    let tmp231: f64 = tmp100 * tmp226 + tmp103 * tmp217 + tmp104 * tmp225;
+    let tmp232: f64 = tmp26 * attachments_m[(2, 1)] - tmp27 * attachments_m[(0, 1)];
+    let tmp233: f64 = tmp232 * tmp80;
+    let tmp234: f64 = tmp107 * tmp223
+        + tmp114 * tmp195
+        + tmp119 * tmp207
+        + tmp124 * tmp201
+        + tmp172 * tmp227
+        + tmp174 * tmp229
+        + tmp176 * tmp230
+        + tmp178 * tmp231
+        + tmp182 * tmp228
+        + tmp191 * reference_tension_n[1]
+        + tmp194 * tmp79
+        + tmp219 * tmp96
+        + tmp221 * tmp98
+        + tmp224 * tmp28
+        + tmp233 * tmp68
+        - platform_weight_n * (tmp10 * com_offset_m[2] - tmp4 * com_offset_m[0]);
+    let tmp235: f64 = -tmp107 * tmp213
+        - tmp114 * tmp196
+        - tmp119 * tmp208
+        - tmp124 * tmp202
+        - tmp184 * tmp231
+        - tmp185 * tmp228
+        - tmp186 * tmp230
+        - tmp188 * tmp227
+        - tmp189 * tmp229
+        - tmp192 * reference_tension_n[1]
+        - tmp194 * tmp77
+        - tmp200 * tmp98
+        - tmp206 * tmp96
+        - tmp216 * tmp28
+        - tmp233 * tmp70
+        + platform_weight_n * (-tmp16 * com_offset_m[0] + tmp17 * com_offset_m[2]);
+    let tmp236: f64 = -tmp10 * attachments_m[(1, 0)] + tmp7 * attachments_m[(0, 0)];
+    let tmp237: f64 = tmp236 * tmp37;
+    let tmp238: f64 = -tmp17 * attachments_m[(1, 0)] + tmp19 * attachments_m[(0, 0)];
+    let tmp239: f64 = tmp12 * tmp237 + tmp238 * tmp38;
+    let tmp240: f64 = tmp25 * attachments_m[(0, 0)] - tmp26 * attachments_m[(1, 0)];
+    let tmp241: f64 = -tmp17 * attachments_m[(1, 1)] + tmp19 * attachments_m[(0, 1)];
+    let tmp242: f64 = -tmp10 * attachments_m[(1, 1)] + tmp7 * attachments_m[(0, 1)];
+    let tmp243: f64 = tmp242 * tmp67;
+    let tmp244: f64 = tmp241 * tmp70 + tmp243 * tmp30;
+    let tmp245: f64 = reference_tension_n[0] * (-tmp133 * tmp239 + tmp238 * tmp37);
+    let tmp246: f64 = -tmp138 * tmp244 + tmp243;
+    let tmp247: f64 = -tmp140 * tmp244 + tmp241 * tmp67;
+    let tmp248: f64 = -tmp17 * attachments_m[(1, 2)] + tmp19 * attachments_m[(0, 2)];
+    let tmp249: f64 = -tmp10 * attachments_m[(1, 2)] + tmp7 * attachments_m[(0, 2)];
+    let tmp250: f64 = tmp249 * tmp49;
+    let tmp251: f64 = tmp248 * tmp50 + tmp250 * tmp44;
+    let tmp252: f64 = tmp144 * tmp251;
+    let tmp253: f64 = tmp248 * tmp49 - tmp252 * tmp42;
+    let tmp254: f64 = tmp250 - tmp252 * tmp44;
+    let tmp255: f64 = -tmp17 * attachments_m[(1, 3)] + tmp19 * attachments_m[(0, 3)];
+    let tmp256: f64 = -tmp10 * attachments_m[(1, 3)] + tmp7 * attachments_m[(0, 3)];
+    let tmp257: f64 = tmp256 * tmp59;
+    let tmp258: f64 = tmp255 * tmp61 + tmp257 * tmp52;
+    let tmp259: f64 = -tmp154 * tmp258 + tmp255 * tmp59;
+    let tmp260: f64 = -tmp157 * tmp258 + tmp257;
+    let tmp261: f64 = reference_tension_n[0] * (-tmp159 * tmp239 + tmp237);
+    let tmp262: f64 = -tmp106 * (tmp248 * tmp62 - tmp249 * tmp50 - tmp253 * tmp43 + tmp254 * tmp41) + tmp11 * tmp245
+        - tmp20 * tmp261
+        + tmp236 * tmp77
+        - tmp238 * tmp79
+        - tmp80 * (tmp241 * tmp68 - tmp242 * tmp70 + tmp246 * tmp32 - tmp247 * tmp29)
+        - tmp95 * (tmp255 * tmp60 - tmp256 * tmp61 - tmp259 * tmp51 + tmp260 * tmp54);
+    let tmp263: f64 = tmp106 * tmp254;
+    let tmp264: f64 = tmp246 * tmp80;
+    let tmp265: f64 = tmp260 * tmp95;
+    let tmp266: f64 = tmp261 + tmp263 + tmp264 + tmp265;
+    let tmp267: f64 = tmp247 * tmp80;
+    let tmp268: f64 = tmp106 * tmp253;
+    let tmp269: f64 = tmp259 * tmp95;
+    let tmp270: f64 = tmp73 * (tmp245 + tmp267 + tmp268 + tmp269);
+    let tmp271: f64 = tmp262 * tmp74 + tmp266 * tmp78 + tmp270 * tmp69;
+    let tmp272: f64 = tmp25 * attachments_m[(0, 1)] - tmp26 * attachments_m[(1, 1)];
+    let tmp273: f64 = tmp262 * tmp93 + tmp266 * tmp91 + tmp270 * tmp89;
+    let tmp274: f64 = tmp25 * attachments_m[(0, 3)] - tmp26 * attachments_m[(1, 3)];
+    let tmp275: f64 = tmp274 * tmp95;
+    let tmp276: f64 = tmp25 * attachments_m[(0, 2)] - tmp26 * attachments_m[(1, 2)];
+    let tmp277: f64 = tmp100 * tmp262 + tmp102 * tmp270 + tmp104 * tmp266;
+    let tmp278: f64 = -tmp107 * tmp268
+        - tmp114 * tmp241
+        - tmp119 * tmp248
+        - tmp124 * tmp255
+        - tmp184 * tmp277
+        - tmp186 * tmp273
+        - tmp187 * tmp272
+        - tmp188 * tmp271
+        - tmp189 * tmp276
+        - tmp238 * reference_tension_n[1]
+        - tmp240 * tmp77
+        - tmp245 * tmp28
+        - tmp267 * tmp98
+        - tmp269 * tmp96
+        - tmp275 * tmp61
+        + platform_weight_n * (-tmp17 * com_offset_m[1] + tmp19 * com_offset_m[0]);
+    let tmp279: f64 = tmp107 * tmp263
+        + tmp114 * tmp242
+        + tmp119 * tmp249
+        + tmp124 * tmp256
+        + tmp172 * tmp271
+        + tmp174 * tmp276
+        + tmp176 * tmp273
+        + tmp178 * tmp277
+        + tmp180 * tmp272
+        + tmp236 * reference_tension_n[1]
+        + tmp240 * tmp79
+        + tmp261 * tmp28
+        + tmp264 * tmp98
+        + tmp265 * tmp96
+        + tmp275 * tmp60
+        - platform_weight_n * (-tmp10 * com_offset_m[1] + tmp7 * com_offset_m[0]);
+    let tmp280: f64 = 1.0_f64 / (tmp57 * tmp57.sqrt());
+    let tmp281: f64 = tmp280 * tmp53;
+    let tmp282: f64 = -tmp281 + tmp59;
+    let tmp283: f64 = tmp280 * tmp52 * tmp55;
+    let tmp284: f64 = tmp283 * tmp51;
+    let tmp285: f64 = 1.0_f64 / (tmp35 * tmp35.sqrt());
+    let tmp286: f64 = tmp285 * tmp31;
+    let tmp287: f64 = -tmp286 + tmp67;
+    let tmp288: f64 = tmp285 * tmp30 * tmp33;
+    let tmp289: f64 = tmp288 * tmp29;
+    let tmp290: f64 = 1.0_f64 / (tmp47 * tmp47.sqrt());
+    let tmp291: f64 = tmp290 * tmp42 * tmp44;
+    let tmp292: f64 = tmp291 * tmp43;
+    let tmp293: f64 = tmp290 * tmp45;
+    let tmp294: f64 = -tmp293 + tmp49;
+    let tmp295: f64 = 1.0_f64 / (tmp23 * tmp23.sqrt());
+    let tmp296: f64 = tmp161 * tmp21 * tmp295;
+    let tmp297: f64 = tmp11 * tmp296;
+    let tmp298: f64 = tmp13 * tmp295;
+    let tmp299: f64 = reference_tension_n[0] * (-tmp298 + tmp37);
+    let tmp300: f64 = -tmp106 * (tmp292 + tmp294 * tmp41)
+        - tmp20 * tmp299
+        - tmp297
+        - tmp80 * (tmp287 * tmp32 + tmp289)
+        - tmp95 * (tmp282 * tmp54 + tmp284);
+    let tmp301: f64 = tmp282 * tmp95;
+    let tmp302: f64 = tmp106 * tmp294;
+    let tmp303: f64 = tmp287 * tmp80;
+    let tmp304: f64 = tmp299 + tmp301 + tmp302 + tmp303;
+    let tmp305: f64 = tmp106 * tmp291;
+    let tmp306: f64 = tmp288 * tmp80;
+    let tmp307: f64 = tmp283 * tmp95;
+    let tmp308: f64 = -tmp296 - tmp305 - tmp306 - tmp307;
+    let tmp309: f64 = tmp300 * tmp74 + tmp304 * tmp78 + tmp308 * tmp76;
+    let tmp310: f64 = tmp100 * tmp300 + tmp103 * tmp308 + tmp104 * tmp304;
+    let tmp311: f64 = tmp300 * tmp93 + tmp304 * tmp91 + tmp308 * tmp90;
+    let tmp312: f64 = tmp107 * tmp302
+        + tmp172 * tmp309
+        + tmp176 * tmp311
+        + tmp178 * tmp310
+        + tmp28 * tmp299
+        + tmp301 * tmp96
+        + tmp303 * tmp98;
+    let tmp313: f64 = tmp108 * tmp291;
+    let tmp314: f64 = tmp28 * tmp296;
+    let tmp315: f64 = tmp283 * tmp97;
+    let tmp316: f64 = tmp288 * tmp99;
+    let tmp317: f64 = -tmp184 * tmp310 - tmp186 * tmp311 - tmp188 * tmp309 + tmp313 + tmp314 + tmp315 + tmp316;
+    let tmp318: f64 = tmp22 * tmp295;
+    let tmp319: f64 = reference_tension_n[0] * (-tmp318 + tmp37);
+    let tmp320: f64 = tmp290 * tmp46;
+    let tmp321: f64 = -tmp320 + tmp49;
+    let tmp322: f64 = tmp106 * tmp321;
+    let tmp323: f64 = tmp280 * tmp56;
+    let tmp324: f64 = -tmp323 + tmp59;
+    let tmp325: f64 = tmp324 * tmp95;
+    let tmp326: f64 = tmp285 * tmp34;
+    let tmp327: f64 = -tmp326 + tmp67;
+    let tmp328: f64 = tmp327 * tmp80;
+    let tmp329: f64 = tmp319 + tmp322 + tmp325 + tmp328;
+    let tmp330: f64 = tmp283 * tmp54;
+    let tmp331: f64 = tmp288 * tmp32;
+    let tmp332: f64 = tmp291 * tmp41;
+    let tmp333: f64 = tmp20 * tmp296;
+    let tmp334: f64 = -tmp106 * (-tmp321 * tmp43 - tmp332) + tmp11 * tmp319 + tmp333
+        - tmp80 * (-tmp29 * tmp327 - tmp331)
+        - tmp95 * (-tmp324 * tmp51 - tmp330);
+    let tmp335: f64 = tmp308 * tmp78 + tmp329 * tmp76 + tmp334 * tmp74;
+    let tmp336: f64 = -tmp313;
+    let tmp337: f64 = -tmp314;
+    let tmp338: f64 = -tmp315;
+    let tmp339: f64 = tmp100 * tmp334 + tmp103 * tmp329 + tmp104 * tmp308;
+    let tmp340: f64 = tmp308 * tmp91 + tmp329 * tmp90 + tmp334 * tmp93;
+    let tmp341: f64 = -tmp316;
+    let tmp342: f64 = tmp172 * tmp335 + tmp176 * tmp340 + tmp178 * tmp339 + tmp336 + tmp337 + tmp338 + tmp341;
+    let tmp343: f64 = -tmp107 * tmp322
+        - tmp184 * tmp339
+        - tmp186 * tmp340
+        - tmp188 * tmp335
+        - tmp28 * tmp319
+        - tmp325 * tmp96
+        - tmp328 * tmp98;
+    let tmp344: f64 = tmp38 * tmp76 + tmp39 * tmp78 + tmp75;
+    let tmp345: f64 = tmp38 * tmp90 + tmp92 + tmp94;
+    let tmp346: f64 = tmp101 + tmp103 * tmp38 + tmp105;
+    let tmp347: f64 = tmp172 * tmp344 + tmp176 * tmp345 + tmp178 * tmp346 + tmp88;
+    let tmp348: f64 = -tmp111 - tmp184 * tmp346 - tmp186 * tmp345 - tmp188 * tmp344;
+    let tmp349: f64 = -tmp37;
+    let tmp350: f64 = reference_tension_n[0] * (tmp298 + tmp349);
+    let tmp351: f64 = -tmp20 * tmp350 + tmp297;
+    let tmp352: f64 = tmp296 * tmp76 + tmp350 * tmp78 + tmp351 * tmp74;
+    let tmp353: f64 = tmp296 * tmp90 + tmp350 * tmp91 + tmp351 * tmp93;
+    let tmp354: f64 = tmp100 * tmp351 + tmp103 * tmp296 + tmp104 * tmp350;
+    let tmp355: f64 = -tmp184 * tmp354 - tmp186 * tmp353 - tmp188 * tmp352 + tmp337;
+    let tmp356: f64 = tmp172 * tmp352 + tmp176 * tmp353 + tmp178 * tmp354 + tmp28 * tmp350;
+    let tmp357: f64 = reference_tension_n[0] * (tmp318 + tmp349);
+    let tmp358: f64 = tmp11 * tmp357 - tmp333;
+    let tmp359: f64 = tmp296 * tmp78 + tmp357 * tmp76 + tmp358 * tmp74;
+    let tmp360: f64 = tmp296 * tmp91 + tmp357 * tmp90 + tmp358 * tmp93;
+    let tmp361: f64 = tmp100 * tmp358 + tmp103 * tmp357 + tmp104 * tmp296;
+    let tmp362: f64 = -tmp184 * tmp361 - tmp186 * tmp360 - tmp188 * tmp359 - tmp28 * tmp357;
+    let tmp363: f64 = tmp172 * tmp359 + tmp176 * tmp360 + tmp178 * tmp361 + tmp314;
+    let tmp364: f64 = -tmp67;
+    let tmp365: f64 = tmp286 + tmp364;
+    let tmp366: f64 = -tmp289 + tmp32 * tmp365;
+    let tmp367: f64 = tmp74 * tmp80;
+    let tmp368: f64 = tmp365 * tmp80;
+    let tmp369: f64 = tmp306 * tmp76 - tmp366 * tmp367 + tmp368 * tmp78;
+    let tmp370: f64 = tmp366 * tmp80;
+    let tmp371: f64 = tmp306 * tmp90 + tmp368 * tmp91 - tmp370 * tmp93;
+    let tmp372: f64 = -tmp100 * tmp370 + tmp103 * tmp306 + tmp104 * tmp368;
+    let tmp373: f64 = -tmp184 * tmp372 - tmp186 * tmp371 - tmp188 * tmp369 + tmp341;
+    let tmp374: f64 = tmp86 * (tmp172 * tmp369 + tmp176 * tmp371 + tmp178 * tmp372 + tmp365 * tmp99);
+    let tmp375: f64 = tmp326 + tmp364;
+    let tmp376: f64 = tmp375 * tmp80;
+    let tmp377: f64 = -tmp29 * tmp375 + tmp331;
+    let tmp378: f64 = tmp306 * tmp78 - tmp367 * tmp377 + tmp376 * tmp76;
+    let tmp379: f64 = tmp377 * tmp80;
+    let tmp380: f64 = -tmp100 * tmp379 + tmp103 * tmp376 + tmp104 * tmp306;
+    let tmp381: f64 = tmp306 * tmp91 + tmp376 * tmp90 - tmp379 * tmp93;
+    let tmp382: f64 = tmp172 * tmp378 + tmp176 * tmp381 + tmp178 * tmp380 + tmp316;
+    let tmp383: f64 = -tmp184 * tmp380 - tmp186 * tmp381 - tmp188 * tmp378 - tmp375 * tmp99;
+    let tmp384: f64 = -tmp49;
+    let tmp385: f64 = tmp293 + tmp384;
+    let tmp386: f64 = -tmp292 + tmp385 * tmp41;
+    let tmp387: f64 = tmp106 * tmp74;
+    let tmp388: f64 = tmp106 * tmp385;
+    let tmp389: f64 = tmp305 * tmp76 - tmp386 * tmp387 + tmp388 * tmp78;
+    let tmp390: f64 = tmp100 * tmp106;
+    let tmp391: f64 = tmp103 * tmp305 + tmp104 * tmp388 - tmp386 * tmp390;
+    let tmp392: f64 = tmp106 * tmp93;
+    let tmp393: f64 = tmp305 * tmp90 - tmp386 * tmp392 + tmp388 * tmp91;
+    let tmp394: f64 = tmp108 * tmp385 + tmp172 * tmp389 + tmp176 * tmp393 + tmp178 * tmp391;
+    let tmp395: f64 = -tmp184 * tmp391 - tmp186 * tmp393 - tmp188 * tmp389 + tmp336;
+    let tmp396: f64 = tmp320 + tmp384;
+    let tmp397: f64 = tmp332 - tmp396 * tmp43;
+    let tmp398: f64 = tmp106 * tmp396;
+    let tmp399: f64 = tmp305 * tmp78 - tmp387 * tmp397 + tmp398 * tmp76;
+    let tmp400: f64 = tmp103 * tmp398 + tmp104 * tmp305 - tmp390 * tmp397;
+    let tmp401: f64 = tmp305 * tmp91 - tmp392 * tmp397 + tmp398 * tmp90;
+    let tmp402: f64 = -tmp108 * tmp396 - tmp184 * tmp400 - tmp186 * tmp401 - tmp188 * tmp399;
+    let tmp403: f64 = tmp172 * tmp399 + tmp176 * tmp401 + tmp178 * tmp400 + tmp313;
+    let tmp404: f64 = -tmp59;
+    let tmp405: f64 = tmp281 + tmp404;
+    let tmp406: f64 = tmp405 * tmp95;
+    let tmp407: f64 = -tmp284 + tmp405 * tmp54;
+    let tmp408: f64 = tmp407 * tmp95;
+    let tmp409: f64 = tmp307 * tmp76 + tmp406 * tmp78 - tmp408 * tmp74;
+    let tmp410: f64 = tmp93 * tmp95;
+    let tmp411: f64 = tmp307 * tmp90 + tmp406 * tmp91 - tmp407 * tmp410;
+    let tmp412: f64 = -tmp100 * tmp408 + tmp103 * tmp307 + tmp104 * tmp406;
+    let tmp413: f64 = tmp172 * tmp409 + tmp176 * tmp411 + tmp178 * tmp412 + tmp405 * tmp97;
+    let tmp414: f64 = -tmp184 * tmp412 - tmp186 * tmp411 - tmp188 * tmp409 + tmp338;
+    let tmp415: f64 = tmp323 + tmp404;
+    let tmp416: f64 = tmp415 * tmp95;
+    let tmp417: f64 = tmp330 - tmp415 * tmp51;
+    let tmp418: f64 = tmp417 * tmp95;
+    let tmp419: f64 = tmp307 * tmp78 + tmp416 * tmp76 - tmp418 * tmp74;
+    let tmp420: f64 = tmp307 * tmp91 - tmp410 * tmp417 + tmp416 * tmp90;
+    let tmp421: f64 = -tmp100 * tmp418 + tmp103 * tmp416 + tmp104 * tmp307;
+    let tmp422: f64 = -tmp184 * tmp421 - tmp186 * tmp420 - tmp188 * tmp419 - tmp415 * tmp97;
+    let tmp423: f64 = tmp172 * tmp419 + tmp176 * tmp420 + tmp178 * tmp421 + tmp315;
+    let tmp424: f64 = tmp113 * platform_weight_n;
+    let tmp425: f64 = tmp10 * platform_weight_n;
+    let tmp426: f64 = tmp118 * platform_weight_n;
+    let tmp427: f64 = tmp123 * platform_weight_n;
+    let tmp428: f64 = tmp7 * platform_weight_n;
+    let tmp429: f64 = tmp16 * platform_weight_n;
+    let tmp430: f64 = tmp4 * platform_weight_n;
 
     // Output terms (5)
     if let Some(jacobian_pose) = jacobian_pose {
-        jacobian_pose[(0, 0)] = tmp150 * tmp151;
+        jacobian_pose[(0, 0)] = tmp127;
         jacobian_pose[(1, 0)] = 0.0;
         jacobian_pose[(2, 0)] = 0.0;
-        jacobian_pose[(3, 0)] = -tmp154 - tmp158;
-        jacobian_pose[(4, 0)] = tmp163 * tmp164;
-        jacobian_pose[(5, 0)] = -tmp226 + tmp245;
-        jacobian_pose[(6, 0)] = tmp101
-            * (tmp127 * tmp332 + tmp129 * tmp246 + tmp130 * tmp331 + tmp330 * tmp96 + tmp361 * tmp97)
-            - tmp131 * tmp363;
-        jacobian_pose[(7, 0)] = -tmp325 - tmp326;
-        jacobian_pose[(8, 0)] = tmp177 * tmp364;
-        jacobian_pose[(9, 0)] = tmp280 - tmp286;
-        jacobian_pose[(10, 0)] = tmp101
-            * (-tmp127 * tmp182 - tmp129 * tmp180 + tmp132 * tmp161
-                - tmp133 * tmp159
-                - tmp330 * tmp50
-                - tmp361 * tmp49
-                - tmp41
-                    * (tmp130 * tmp180 - tmp334 - tmp336 + tmp338 - tmp339 + tmp340 - tmp342 - tmp344 - tmp345
-                        + tmp346
-                        + tmp348
-                        + tmp349
-                        + tmp351
-                        + tmp352
-                        - tmp353
-                        + tmp354
-                        + tmp355
-                        + tmp357
-                        + tmp358
-                        + tmp359
-                        - tmp360)
-                + tmp44 * (tmp130 * tmp182 + tmp330))
-            - tmp134 * tmp363;
-        jacobian_pose[(11, 0)] = -tmp311 - tmp312;
-        jacobian_pose[(12, 0)] = tmp185 * tmp365;
-        jacobian_pose[(13, 0)] = -tmp258 + tmp309;
-        jacobian_pose[(14, 0)] = tmp101
-            * (tmp127 * tmp171 + tmp129 * tmp175 - tmp135 * tmp159 + tmp136 * tmp161 + tmp330 * tmp61 + tmp361 * tmp63
-                - tmp41 * (-tmp130 * tmp175 + tmp361)
-                + tmp44
-                    * (-tmp130 * tmp171 + tmp248 + tmp250 + tmp252 + tmp254 - tmp256 + tmp260 - tmp282 - tmp284
-                        + tmp287
-                        + tmp289
-                        - tmp291
-                        - tmp293
-                        + tmp294
-                        - tmp310
-                        - tmp315
-                        - tmp317
-                        - tmp318
-                        - tmp319
-                        - tmp324
-                        - tmp329))
-            - tmp137 * tmp363;
-        jacobian_pose[(15, 0)] = -tmp320 - tmp321;
-        jacobian_pose[(0, 1)] = tmp151 * tmp373;
+        jacobian_pose[(3, 0)] = -tmp128;
+        jacobian_pose[(4, 0)] = tmp131;
+        jacobian_pose[(5, 0)] = tmp171;
+        jacobian_pose[(6, 0)] = tmp110 * tmp183 + tmp113 * tmp190;
+        jacobian_pose[(7, 0)] = -tmp179;
+        jacobian_pose[(8, 0)] = tmp146;
+        jacobian_pose[(9, 0)] = tmp177;
+        jacobian_pose[(10, 0)] = tmp117 * tmp183 + tmp118 * tmp190;
+        jacobian_pose[(11, 0)] = -tmp173;
+        jacobian_pose[(12, 0)] = tmp152;
+        jacobian_pose[(13, 0)] = tmp175;
+        jacobian_pose[(14, 0)] = tmp121 * tmp183 + tmp123 * tmp190;
+        jacobian_pose[(15, 0)] = -tmp181;
+        jacobian_pose[(0, 1)] = tmp193;
         jacobian_pose[(1, 1)] = 0.0;
         jacobian_pose[(2, 1)] = 0.0;
-        jacobian_pose[(3, 1)] = -tmp374 - tmp377;
-        jacobian_pose[(4, 1)] = tmp164 * tmp380;
-        jacobian_pose[(5, 1)] = tmp403 - tmp408;
-        jacobian_pose[(6, 1)] = tmp101
-            * (tmp127 * tmp452 + tmp129 * tmp409 + tmp130 * tmp451 + tmp450 * tmp96 + tmp474 * tmp97)
-            - tmp131 * tmp475;
-        jacobian_pose[(7, 1)] = -tmp430 - tmp431;
-        jacobian_pose[(8, 1)] = tmp364 * tmp387;
-        jacobian_pose[(9, 1)] = tmp436 - tmp446;
-        jacobian_pose[(10, 1)] = tmp101
-            * (-tmp127 * tmp390 - tmp129 * tmp391 + tmp132 * tmp378
-                - tmp133 * tmp379
-                - tmp41
-                    * (tmp130 * tmp391 - tmp453 + tmp454 + tmp455 - tmp456 + tmp457 + tmp458 - tmp459 + tmp460
-                        - tmp461
-                        - tmp462
-                        + tmp463
-                        - tmp464
-                        + tmp465
-                        - tmp467
-                        + tmp468
-                        + tmp469
-                        + tmp470
-                        - tmp471
-                        + tmp472
-                        + tmp473)
-                + tmp44 * (tmp130 * tmp390 + tmp450)
-                - tmp450 * tmp50
-                - tmp474 * tmp49)
-            - tmp134 * tmp475;
-        jacobian_pose[(11, 1)] = -tmp425 - tmp426;
-        jacobian_pose[(12, 1)] = tmp365 * tmp392;
-        jacobian_pose[(13, 1)] = -tmp413 + tmp420;
-        jacobian_pose[(14, 1)] = tmp101
-            * (tmp127 * tmp386 + tmp129 * tmp383 - tmp135 * tmp379 + tmp136 * tmp378
-                - tmp41 * (-tmp130 * tmp383 + tmp474)
-                + tmp44
-                    * (-tmp130 * tmp386 - tmp410 - tmp411 - tmp412 + tmp414 - tmp421 + tmp423
-                        - tmp424
-                        - tmp428
-                        - tmp429
-                        - tmp433
-                        + tmp434
-                        + tmp435
-                        - tmp437
-                        - tmp438
-                        - tmp442
-                        + tmp443
-                        + tmp444
-                        + tmp445
-                        + tmp447
-                        - tmp449)
-                + tmp450 * tmp61
-                + tmp474 * tmp63)
-            - tmp137 * tmp475;
-        jacobian_pose[(15, 1)] = -tmp439 - tmp440;
-        jacobian_pose[(0, 2)] = tmp151 * tmp481;
+        jacobian_pose[(3, 1)] = -tmp194;
+        jacobian_pose[(4, 1)] = tmp197;
+        jacobian_pose[(5, 1)] = tmp227;
+        jacobian_pose[(6, 1)] = tmp110 * tmp234 + tmp113 * tmp235;
+        jacobian_pose[(7, 1)] = -tmp232;
+        jacobian_pose[(8, 1)] = tmp209;
+        jacobian_pose[(9, 1)] = tmp231;
+        jacobian_pose[(10, 1)] = tmp117 * tmp234 + tmp118 * tmp235;
+        jacobian_pose[(11, 1)] = -tmp229;
+        jacobian_pose[(12, 1)] = tmp203;
+        jacobian_pose[(13, 1)] = tmp230;
+        jacobian_pose[(14, 1)] = tmp121 * tmp234 + tmp123 * tmp235;
+        jacobian_pose[(15, 1)] = -tmp228;
+        jacobian_pose[(0, 2)] = tmp239;
         jacobian_pose[(1, 2)] = 0.0;
         jacobian_pose[(2, 2)] = 0.0;
-        jacobian_pose[(3, 2)] = -tmp483 - tmp484;
-        jacobian_pose[(4, 2)] = tmp164 * tmp487;
-        jacobian_pose[(5, 2)] = tmp508 - tmp512;
-        jacobian_pose[(6, 2)] = tmp101
-            * (tmp127 * tmp513 + tmp129 * tmp514 + tmp130 * tmp515 + tmp553 * tmp96 + tmp574 * tmp97)
-            - tmp131 * tmp516;
-        jacobian_pose[(7, 2)] = -tmp521 - tmp522;
-        jacobian_pose[(8, 2)] = tmp364 * tmp494;
-        jacobian_pose[(9, 2)] = -tmp530 + tmp533;
-        jacobian_pose[(10, 2)] = tmp101
-            * (-tmp127 * tmp498 - tmp129 * tmp497 + tmp132 * tmp485
-                - tmp133 * tmp486
-                - tmp41
-                    * (tmp130 * tmp497 - tmp554 + tmp555 - tmp556 + tmp557 + tmp558 + tmp559 - tmp560 - tmp561
-                        + tmp562
-                        + tmp563
-                        - tmp564
-                        - tmp565
-                        + tmp566
-                        - tmp567
-                        + tmp568
-                        + tmp569
-                        - tmp570
-                        + tmp571
-                        + tmp572
-                        + tmp573)
-                + tmp44 * (tmp130 * tmp498 + tmp553)
-                - tmp49 * tmp574
-                - tmp50 * tmp553)
-            - tmp134 * tmp516;
-        jacobian_pose[(11, 2)] = -tmp549 - tmp550;
-        jacobian_pose[(12, 2)] = tmp365 * tmp499;
-        jacobian_pose[(13, 2)] = tmp536 - tmp538;
-        jacobian_pose[(14, 2)] = tmp101
-            * (tmp127 * tmp493 + tmp129 * tmp490 - tmp135 * tmp486 + tmp136 * tmp485
-                - tmp41 * (-tmp130 * tmp490 + tmp574)
-                + tmp44
-                    * (-tmp130 * tmp493 - tmp517 + tmp518 - tmp519 + tmp520 - tmp524 + tmp525 - tmp529 + tmp531
-                        - tmp534
-                        - tmp537
-                        + tmp539
-                        - tmp540
-                        - tmp541
-                        + tmp542
-                        - tmp543
-                        + tmp544
-                        - tmp546
-                        - tmp547
-                        + tmp548
-                        - tmp552)
-                + tmp553 * tmp61
-                + tmp574 * tmp63)
-            - tmp137 * tmp516;
-        jacobian_pose[(15, 2)] = -tmp526 - tmp527;
-        jacobian_pose[(0, 3)] = tmp89;
+        jacobian_pose[(3, 2)] = -tmp240;
+        jacobian_pose[(4, 2)] = tmp244;
+        jacobian_pose[(5, 2)] = tmp271;
+        jacobian_pose[(6, 2)] = tmp110 * tmp279 + tmp113 * tmp278;
+        jacobian_pose[(7, 2)] = -tmp272;
+        jacobian_pose[(8, 2)] = tmp251;
+        jacobian_pose[(9, 2)] = tmp277;
+        jacobian_pose[(10, 2)] = tmp117 * tmp279 + tmp118 * tmp278;
+        jacobian_pose[(11, 2)] = -tmp276;
+        jacobian_pose[(12, 2)] = tmp258;
+        jacobian_pose[(13, 2)] = tmp273;
+        jacobian_pose[(14, 2)] = tmp121 * tmp279 + tmp123 * tmp278;
+        jacobian_pose[(15, 2)] = -tmp274;
+        jacobian_pose[(0, 3)] = tmp39;
         jacobian_pose[(1, 3)] = 0.0;
         jacobian_pose[(2, 3)] = 0.0;
         jacobian_pose[(3, 3)] = 0.0;
-        jacobian_pose[(4, 3)] = tmp75;
-        jacobian_pose[(5, 3)] = tmp606 - tmp615;
-        jacobian_pose[(6, 3)] = tmp101 * (tmp659 * tmp96 + tmp671 * tmp97);
+        jacobian_pose[(4, 3)] = tmp68;
+        jacobian_pose[(5, 3)] = tmp309;
+        jacobian_pose[(6, 3)] = tmp110 * tmp312 + tmp113 * tmp317;
         jacobian_pose[(7, 3)] = 0.0;
-        jacobian_pose[(8, 3)] = tmp76;
-        jacobian_pose[(9, 3)] = -tmp616 + tmp631;
-        jacobian_pose[(10, 3)] = tmp101
-            * (-tmp41 * (-tmp660 + tmp661 + tmp662 - tmp663 - tmp664 + tmp665 + tmp676) + tmp44 * tmp659
-                - tmp49 * tmp671
-                - tmp50 * tmp659);
+        jacobian_pose[(8, 3)] = tmp62;
+        jacobian_pose[(9, 3)] = tmp310;
+        jacobian_pose[(10, 3)] = tmp117 * tmp312 + tmp118 * tmp317;
         jacobian_pose[(11, 3)] = 0.0;
-        jacobian_pose[(12, 3)] = tmp77;
-        jacobian_pose[(13, 3)] = tmp645 - tmp649;
-        jacobian_pose[(14, 3)] = tmp101
-            * (-tmp41 * tmp671
-                + tmp44 * (tmp617 - tmp632 - tmp646 - tmp647 + tmp648 + tmp650 + tmp678 + tmp680 + tmp682 + tmp684)
-                + tmp61 * tmp659
-                + tmp63 * tmp671);
+        jacobian_pose[(12, 3)] = tmp60;
+        jacobian_pose[(13, 3)] = tmp311;
+        jacobian_pose[(14, 3)] = tmp121 * tmp312 + tmp123 * tmp317;
         jacobian_pose[(15, 3)] = 0.0;
-        jacobian_pose[(0, 4)] = tmp87;
+        jacobian_pose[(0, 4)] = tmp38;
         jacobian_pose[(1, 4)] = 0.0;
         jacobian_pose[(2, 4)] = 0.0;
         jacobian_pose[(3, 4)] = 0.0;
-        jacobian_pose[(4, 4)] = tmp79;
-        jacobian_pose[(5, 4)] = tmp710 - tmp718;
-        jacobian_pose[(6, 4)] = tmp101 * (tmp751 * tmp96 + tmp766 * tmp97);
+        jacobian_pose[(4, 4)] = tmp70;
+        jacobian_pose[(5, 4)] = tmp335;
+        jacobian_pose[(6, 4)] = tmp110 * tmp342 + tmp113 * tmp343;
         jacobian_pose[(7, 4)] = 0.0;
-        jacobian_pose[(8, 4)] = tmp70;
-        jacobian_pose[(9, 4)] = -tmp719 + tmp736;
-        jacobian_pose[(10, 4)] = tmp101
-            * (-tmp41 * (-tmp752 + tmp753 + tmp754 - tmp755 - tmp756 + tmp757 + tmp767 + tmp768 + tmp769 + tmp770)
-                + tmp44 * tmp751
-                - tmp49 * tmp766
-                - tmp50 * tmp751);
+        jacobian_pose[(8, 4)] = tmp50;
+        jacobian_pose[(9, 4)] = tmp339;
+        jacobian_pose[(10, 4)] = tmp117 * tmp342 + tmp118 * tmp343;
         jacobian_pose[(11, 4)] = 0.0;
-        jacobian_pose[(12, 4)] = tmp58;
-        jacobian_pose[(13, 4)] = -tmp721 + tmp749;
-        jacobian_pose[(14, 4)] = tmp101
-            * (-tmp41 * tmp766
-                + tmp44 * (tmp670 + tmp720 + tmp722 + tmp723 - tmp737 - tmp738 - tmp750)
-                + tmp61 * tmp751
-                + tmp63 * tmp766);
+        jacobian_pose[(12, 4)] = tmp61;
+        jacobian_pose[(13, 4)] = tmp340;
+        jacobian_pose[(14, 4)] = tmp121 * tmp342 + tmp123 * tmp343;
         jacobian_pose[(15, 4)] = 0.0;
         jacobian_pose[(0, 5)] = 0.0;
         jacobian_pose[(1, 5)] = 0.0;
@@ -1481,18 +711,16 @@ pub fn cable_geometry(
         jacobian_reference_tension[(2, 0)] = 0.0;
         jacobian_reference_tension[(3, 0)] = 0.0;
         jacobian_reference_tension[(4, 0)] = 0.0;
-        jacobian_reference_tension[(5, 0)] = tmp771;
-        jacobian_reference_tension[(6, 0)] = tmp101 * (tmp777 * tmp96 + tmp781 * tmp97);
+        jacobian_reference_tension[(5, 0)] = tmp344;
+        jacobian_reference_tension[(6, 0)] = tmp110 * tmp347 + tmp113 * tmp348;
         jacobian_reference_tension[(7, 0)] = 0.0;
         jacobian_reference_tension[(8, 0)] = 0.0;
-        jacobian_reference_tension[(9, 0)] = tmp774;
-        jacobian_reference_tension[(10, 0)] =
-            tmp101 * (-tmp41 * (tmp102 + tmp778 + tmp779 + tmp780) + tmp44 * tmp777 - tmp49 * tmp781 - tmp50 * tmp777);
+        jacobian_reference_tension[(9, 0)] = tmp346;
+        jacobian_reference_tension[(10, 0)] = tmp117 * tmp347 + tmp118 * tmp348;
         jacobian_reference_tension[(11, 0)] = 0.0;
         jacobian_reference_tension[(12, 0)] = 0.0;
-        jacobian_reference_tension[(13, 0)] = tmp772;
-        jacobian_reference_tension[(14, 0)] =
-            tmp101 * (-tmp41 * tmp781 + tmp44 * (-tmp128 - tmp773 - tmp775 - tmp776) + tmp61 * tmp777 + tmp63 * tmp781);
+        jacobian_reference_tension[(13, 0)] = tmp345;
+        jacobian_reference_tension[(14, 0)] = tmp121 * tmp347 + tmp123 * tmp348;
         jacobian_reference_tension[(15, 0)] = 0.0;
         jacobian_reference_tension[(0, 1)] = 0.0;
         jacobian_reference_tension[(1, 1)] = 0.0;
@@ -1500,55 +728,49 @@ pub fn cable_geometry(
         jacobian_reference_tension[(3, 1)] = 0.0;
         jacobian_reference_tension[(4, 1)] = 0.0;
         jacobian_reference_tension[(5, 1)] = 0.0;
-        jacobian_reference_tension[(6, 1)] = tmp101 * (tmp17 * tmp96 + tmp782 * tmp97 - tmp98);
+        jacobian_reference_tension[(6, 1)] = tmp11 * tmp110 - tmp113 * tmp20 - tmp87;
         jacobian_reference_tension[(7, 1)] = 0.0;
         jacobian_reference_tension[(8, 1)] = 0.0;
         jacobian_reference_tension[(9, 1)] = 0.0;
-        jacobian_reference_tension[(10, 1)] =
-            tmp101 * (-tmp17 * tmp50 - tmp41 * (tmp31 - tmp50) + tmp44 * (tmp17 - tmp49) - tmp49 * tmp782);
+        jacobian_reference_tension[(10, 1)] = tmp11 * tmp117 - tmp115 - tmp118 * tmp20;
         jacobian_reference_tension[(11, 1)] = 0.0;
         jacobian_reference_tension[(12, 1)] = 0.0;
         jacobian_reference_tension[(13, 1)] = 0.0;
-        jacobian_reference_tension[(14, 1)] = tmp101
-            * (tmp17 * tmp61 - tmp41 * (tmp61 + tmp782) + tmp44 * (-tmp10 - tmp16 - tmp5 + tmp63) + tmp63 * tmp782);
+        jacobian_reference_tension[(14, 1)] = tmp11 * tmp121 - tmp122 - tmp123 * tmp20;
         jacobian_reference_tension[(15, 1)] = 0.0;
     }
     if let Some(jacobian_anchors) = jacobian_anchors {
-        jacobian_anchors[(0, 0)] = -tmp89;
+        jacobian_anchors[(0, 0)] = -tmp39;
         jacobian_anchors[(1, 0)] = 0.0;
         jacobian_anchors[(2, 0)] = 0.0;
         jacobian_anchors[(3, 0)] = 0.0;
         jacobian_anchors[(4, 0)] = 0.0;
-        jacobian_anchors[(5, 0)] = tmp784;
-        jacobian_anchors[(6, 0)] = tmp101 * (tmp790 * tmp97 + tmp794 * tmp96);
+        jacobian_anchors[(5, 0)] = tmp352;
+        jacobian_anchors[(6, 0)] = tmp110 * tmp356 + tmp113 * tmp355;
         jacobian_anchors[(7, 0)] = 0.0;
         jacobian_anchors[(8, 0)] = 0.0;
-        jacobian_anchors[(9, 0)] = tmp785;
-        jacobian_anchors[(10, 0)] =
-            tmp101 * (-tmp41 * (tmp666 + tmp786 + tmp787 + tmp789) + tmp44 * tmp794 - tmp49 * tmp790 - tmp50 * tmp794);
+        jacobian_anchors[(9, 0)] = tmp354;
+        jacobian_anchors[(10, 0)] = tmp117 * tmp356 + tmp118 * tmp355;
         jacobian_anchors[(11, 0)] = 0.0;
         jacobian_anchors[(12, 0)] = 0.0;
-        jacobian_anchors[(13, 0)] = tmp788;
-        jacobian_anchors[(14, 0)] =
-            tmp101 * (-tmp41 * tmp790 + tmp44 * (tmp652 - tmp791 - tmp792 - tmp793) + tmp61 * tmp794 + tmp63 * tmp790);
+        jacobian_anchors[(13, 0)] = tmp353;
+        jacobian_anchors[(14, 0)] = tmp121 * tmp356 + tmp123 * tmp355;
         jacobian_anchors[(15, 0)] = 0.0;
-        jacobian_anchors[(0, 1)] = -tmp87;
+        jacobian_anchors[(0, 1)] = -tmp38;
         jacobian_anchors[(1, 1)] = 0.0;
         jacobian_anchors[(2, 1)] = 0.0;
         jacobian_anchors[(3, 1)] = 0.0;
         jacobian_anchors[(4, 1)] = 0.0;
-        jacobian_anchors[(5, 1)] = tmp796;
-        jacobian_anchors[(6, 1)] = tmp101 * (tmp803 * tmp96 + tmp807 * tmp97);
+        jacobian_anchors[(5, 1)] = tmp359;
+        jacobian_anchors[(6, 1)] = tmp110 * tmp363 + tmp113 * tmp362;
         jacobian_anchors[(7, 1)] = 0.0;
         jacobian_anchors[(8, 1)] = 0.0;
-        jacobian_anchors[(9, 1)] = tmp801;
-        jacobian_anchors[(10, 1)] =
-            tmp101 * (-tmp41 * (tmp759 + tmp804 + tmp805 + tmp806) + tmp44 * tmp803 - tmp49 * tmp807 - tmp50 * tmp803);
+        jacobian_anchors[(9, 1)] = tmp361;
+        jacobian_anchors[(10, 1)] = tmp117 * tmp363 + tmp118 * tmp362;
         jacobian_anchors[(11, 1)] = 0.0;
         jacobian_anchors[(12, 1)] = 0.0;
-        jacobian_anchors[(13, 1)] = tmp799;
-        jacobian_anchors[(14, 1)] =
-            tmp101 * (-tmp41 * tmp807 + tmp44 * (tmp672 - tmp797 - tmp800 - tmp802) + tmp61 * tmp803 + tmp63 * tmp807);
+        jacobian_anchors[(13, 1)] = tmp360;
+        jacobian_anchors[(14, 1)] = tmp121 * tmp363 + tmp123 * tmp362;
         jacobian_anchors[(15, 1)] = 0.0;
         jacobian_anchors[(0, 2)] = 0.0;
         jacobian_anchors[(1, 2)] = 0.0;
@@ -1570,47 +792,33 @@ pub fn cable_geometry(
         jacobian_anchors[(1, 3)] = 0.0;
         jacobian_anchors[(2, 3)] = 0.0;
         jacobian_anchors[(3, 3)] = 0.0;
-        jacobian_anchors[(4, 3)] = -tmp75;
-        jacobian_anchors[(5, 3)] = -tmp810;
-        jacobian_anchors[(6, 3)] = tmp101 * (tmp820 * tmp97 + tmp826 * tmp96);
+        jacobian_anchors[(4, 3)] = -tmp68;
+        jacobian_anchors[(5, 3)] = tmp369;
+        jacobian_anchors[(6, 3)] = tmp113 * tmp373 + tmp374 * tmp83;
         jacobian_anchors[(7, 3)] = 0.0;
         jacobian_anchors[(8, 3)] = 0.0;
-        jacobian_anchors[(9, 3)] = -tmp811 + tmp813;
-        jacobian_anchors[(10, 3)] = tmp101
-            * (-tmp41 * (tmp669 - tmp812 + tmp814 - tmp815 - tmp817 + tmp819) + tmp44 * tmp826
-                - tmp49 * tmp820
-                - tmp50 * tmp826);
+        jacobian_anchors[(9, 3)] = tmp372;
+        jacobian_anchors[(10, 3)] = tmp116 * tmp374 + tmp118 * tmp373;
         jacobian_anchors[(11, 3)] = 0.0;
         jacobian_anchors[(12, 3)] = 0.0;
-        jacobian_anchors[(13, 3)] = -tmp816 + tmp818;
-        jacobian_anchors[(14, 3)] = tmp101
-            * (-tmp41 * tmp820
-                + tmp44 * (tmp656 + tmp821 - tmp822 + tmp823 - tmp824 + tmp825)
-                + tmp61 * tmp826
-                + tmp63 * tmp820);
+        jacobian_anchors[(13, 3)] = tmp371;
+        jacobian_anchors[(14, 3)] = tmp120 * tmp374 + tmp123 * tmp373;
         jacobian_anchors[(15, 3)] = 0.0;
         jacobian_anchors[(0, 4)] = 0.0;
         jacobian_anchors[(1, 4)] = 0.0;
         jacobian_anchors[(2, 4)] = 0.0;
         jacobian_anchors[(3, 4)] = 0.0;
-        jacobian_anchors[(4, 4)] = -tmp79;
-        jacobian_anchors[(5, 4)] = -tmp829;
-        jacobian_anchors[(6, 4)] = tmp101 * (tmp839 * tmp96 + tmp845 * tmp97);
+        jacobian_anchors[(4, 4)] = -tmp70;
+        jacobian_anchors[(5, 4)] = tmp378;
+        jacobian_anchors[(6, 4)] = tmp110 * tmp382 + tmp113 * tmp383;
         jacobian_anchors[(7, 4)] = 0.0;
         jacobian_anchors[(8, 4)] = 0.0;
-        jacobian_anchors[(9, 4)] = -tmp832 + tmp835;
-        jacobian_anchors[(10, 4)] = tmp101
-            * (-tmp41 * (tmp763 + tmp840 + tmp841 - tmp842 - tmp843 - tmp844) + tmp44 * tmp839
-                - tmp49 * tmp845
-                - tmp50 * tmp839);
+        jacobian_anchors[(9, 4)] = tmp380;
+        jacobian_anchors[(10, 4)] = tmp117 * tmp382 + tmp118 * tmp383;
         jacobian_anchors[(11, 4)] = 0.0;
         jacobian_anchors[(12, 4)] = 0.0;
-        jacobian_anchors[(13, 4)] = -tmp830 + tmp837;
-        jacobian_anchors[(14, 4)] = tmp101
-            * (-tmp41 * tmp845
-                + tmp44 * (tmp674 + tmp831 + tmp833 + tmp834 - tmp836 - tmp838)
-                + tmp61 * tmp839
-                + tmp63 * tmp845);
+        jacobian_anchors[(13, 4)] = tmp381;
+        jacobian_anchors[(14, 4)] = tmp121 * tmp382 + tmp123 * tmp383;
         jacobian_anchors[(15, 4)] = 0.0;
         jacobian_anchors[(0, 5)] = 0.0;
         jacobian_anchors[(1, 5)] = 0.0;
@@ -1633,46 +841,32 @@ pub fn cable_geometry(
         jacobian_anchors[(2, 6)] = 0.0;
         jacobian_anchors[(3, 6)] = 0.0;
         jacobian_anchors[(4, 6)] = 0.0;
-        jacobian_anchors[(5, 6)] = -tmp851 + tmp852;
-        jacobian_anchors[(6, 6)] = tmp101 * (tmp861 * tmp96 + tmp867 * tmp97);
+        jacobian_anchors[(5, 6)] = tmp389;
+        jacobian_anchors[(6, 6)] = tmp110 * tmp394 + tmp113 * tmp395;
         jacobian_anchors[(7, 6)] = 0.0;
-        jacobian_anchors[(8, 6)] = -tmp76;
-        jacobian_anchors[(9, 6)] = -tmp855;
-        jacobian_anchors[(10, 6)] = tmp101
-            * (-tmp41 * (tmp668 - tmp862 + tmp863 - tmp864 - tmp865 + tmp866) + tmp44 * tmp861
-                - tmp49 * tmp867
-                - tmp50 * tmp861);
+        jacobian_anchors[(8, 6)] = -tmp62;
+        jacobian_anchors[(9, 6)] = tmp391;
+        jacobian_anchors[(10, 6)] = tmp117 * tmp394 + tmp118 * tmp395;
         jacobian_anchors[(11, 6)] = 0.0;
         jacobian_anchors[(12, 6)] = 0.0;
-        jacobian_anchors[(13, 6)] = -tmp853 + tmp859;
-        jacobian_anchors[(14, 6)] = tmp101
-            * (-tmp41 * tmp867
-                + tmp44 * (tmp654 + tmp854 + tmp856 + tmp857 - tmp858 - tmp860)
-                + tmp61 * tmp861
-                + tmp63 * tmp867);
+        jacobian_anchors[(13, 6)] = tmp393;
+        jacobian_anchors[(14, 6)] = tmp121 * tmp394 + tmp123 * tmp395;
         jacobian_anchors[(15, 6)] = 0.0;
         jacobian_anchors[(0, 7)] = 0.0;
         jacobian_anchors[(1, 7)] = 0.0;
         jacobian_anchors[(2, 7)] = 0.0;
         jacobian_anchors[(3, 7)] = 0.0;
         jacobian_anchors[(4, 7)] = 0.0;
-        jacobian_anchors[(5, 7)] = -tmp873 + tmp874;
-        jacobian_anchors[(6, 7)] = tmp101 * (tmp883 * tmp97 + tmp889 * tmp96);
+        jacobian_anchors[(5, 7)] = tmp399;
+        jacobian_anchors[(6, 7)] = tmp110 * tmp403 + tmp113 * tmp402;
         jacobian_anchors[(7, 7)] = 0.0;
-        jacobian_anchors[(8, 7)] = -tmp70;
-        jacobian_anchors[(9, 7)] = -tmp880;
-        jacobian_anchors[(10, 7)] = tmp101
-            * (-tmp41 * (tmp761 + tmp876 - tmp877 - tmp879 - tmp881 + tmp882) + tmp44 * tmp889
-                - tmp49 * tmp883
-                - tmp50 * tmp889);
+        jacobian_anchors[(8, 7)] = -tmp50;
+        jacobian_anchors[(9, 7)] = tmp400;
+        jacobian_anchors[(10, 7)] = tmp117 * tmp403 + tmp118 * tmp402;
         jacobian_anchors[(11, 7)] = 0.0;
         jacobian_anchors[(12, 7)] = 0.0;
-        jacobian_anchors[(13, 7)] = tmp875 - tmp878;
-        jacobian_anchors[(14, 7)] = tmp101
-            * (-tmp41 * tmp883
-                + tmp44 * (tmp675 - tmp884 + tmp885 + tmp886 + tmp887 - tmp888)
-                + tmp61 * tmp889
-                + tmp63 * tmp883);
+        jacobian_anchors[(13, 7)] = tmp401;
+        jacobian_anchors[(14, 7)] = tmp121 * tmp403 + tmp123 * tmp402;
         jacobian_anchors[(15, 7)] = 0.0;
         jacobian_anchors[(0, 8)] = 0.0;
         jacobian_anchors[(1, 8)] = 0.0;
@@ -1695,46 +889,32 @@ pub fn cable_geometry(
         jacobian_anchors[(2, 9)] = 0.0;
         jacobian_anchors[(3, 9)] = 0.0;
         jacobian_anchors[(4, 9)] = 0.0;
-        jacobian_anchors[(5, 9)] = tmp894 - tmp896;
-        jacobian_anchors[(6, 9)] = tmp101 * (tmp905 * tmp97 + tmp911 * tmp96);
+        jacobian_anchors[(5, 9)] = tmp409;
+        jacobian_anchors[(6, 9)] = tmp110 * tmp413 + tmp113 * tmp414;
         jacobian_anchors[(7, 9)] = 0.0;
         jacobian_anchors[(8, 9)] = 0.0;
-        jacobian_anchors[(9, 9)] = tmp899 - tmp903;
-        jacobian_anchors[(10, 9)] = tmp101
-            * (-tmp41 * (tmp667 - tmp897 + tmp898 + tmp900 - tmp902 - tmp904) + tmp44 * tmp911
-                - tmp49 * tmp905
-                - tmp50 * tmp911);
+        jacobian_anchors[(9, 9)] = tmp412;
+        jacobian_anchors[(10, 9)] = tmp117 * tmp413 + tmp118 * tmp414;
         jacobian_anchors[(11, 9)] = 0.0;
-        jacobian_anchors[(12, 9)] = -tmp77;
-        jacobian_anchors[(13, 9)] = -tmp901;
-        jacobian_anchors[(14, 9)] = tmp101
-            * (-tmp41 * tmp905
-                + tmp44 * (tmp658 + tmp906 - tmp907 + tmp908 - tmp909 + tmp910)
-                + tmp61 * tmp911
-                + tmp63 * tmp905);
+        jacobian_anchors[(12, 9)] = -tmp60;
+        jacobian_anchors[(13, 9)] = tmp411;
+        jacobian_anchors[(14, 9)] = tmp121 * tmp413 + tmp123 * tmp414;
         jacobian_anchors[(15, 9)] = 0.0;
         jacobian_anchors[(0, 10)] = 0.0;
         jacobian_anchors[(1, 10)] = 0.0;
         jacobian_anchors[(2, 10)] = 0.0;
         jacobian_anchors[(3, 10)] = 0.0;
         jacobian_anchors[(4, 10)] = 0.0;
-        jacobian_anchors[(5, 10)] = -tmp917 + tmp918;
-        jacobian_anchors[(6, 10)] = tmp101 * (tmp927 * tmp97 + tmp933 * tmp96);
+        jacobian_anchors[(5, 10)] = tmp419;
+        jacobian_anchors[(6, 10)] = tmp110 * tmp423 + tmp113 * tmp422;
         jacobian_anchors[(7, 10)] = 0.0;
         jacobian_anchors[(8, 10)] = 0.0;
-        jacobian_anchors[(9, 10)] = tmp923 - tmp925;
-        jacobian_anchors[(10, 10)] = tmp101
-            * (-tmp41 * (tmp765 - tmp919 - tmp921 + tmp922 + tmp924 - tmp926) + tmp44 * tmp933
-                - tmp49 * tmp927
-                - tmp50 * tmp933);
+        jacobian_anchors[(9, 10)] = tmp421;
+        jacobian_anchors[(10, 10)] = tmp117 * tmp423 + tmp118 * tmp422;
         jacobian_anchors[(11, 10)] = 0.0;
-        jacobian_anchors[(12, 10)] = -tmp58;
-        jacobian_anchors[(13, 10)] = -tmp920;
-        jacobian_anchors[(14, 10)] = tmp101
-            * (-tmp41 * tmp927
-                + tmp44 * (tmp673 - tmp928 + tmp929 + tmp930 + tmp931 - tmp932)
-                + tmp61 * tmp933
-                + tmp63 * tmp927);
+        jacobian_anchors[(12, 10)] = -tmp61;
+        jacobian_anchors[(13, 10)] = tmp420;
+        jacobian_anchors[(14, 10)] = tmp121 * tmp423 + tmp123 * tmp422;
         jacobian_anchors[(15, 10)] = 0.0;
         jacobian_anchors[(0, 11)] = 0.0;
         jacobian_anchors[(1, 11)] = 0.0;
@@ -1760,15 +940,15 @@ pub fn cable_geometry(
         jacobian_com_offset[(3, 0)] = 0.0;
         jacobian_com_offset[(4, 0)] = 0.0;
         jacobian_com_offset[(5, 0)] = 0.0;
-        jacobian_com_offset[(6, 0)] = tmp101 * (-tmp15 * tmp934 + tmp25 * tmp935);
+        jacobian_com_offset[(6, 0)] = -tmp110 * tmp425 + tmp17 * tmp424;
         jacobian_com_offset[(7, 0)] = 0.0;
         jacobian_com_offset[(8, 0)] = 0.0;
         jacobian_com_offset[(9, 0)] = 0.0;
-        jacobian_com_offset[(10, 0)] = tmp101 * (-tmp49 * tmp938 + tmp50 * tmp936 - tmp937 + tmp939);
+        jacobian_com_offset[(10, 0)] = -tmp117 * tmp425 + tmp17 * tmp426;
         jacobian_com_offset[(11, 0)] = 0.0;
         jacobian_com_offset[(12, 0)] = 0.0;
         jacobian_com_offset[(13, 0)] = 0.0;
-        jacobian_com_offset[(14, 0)] = tmp101 * (-tmp61 * tmp936 + tmp63 * tmp938 + tmp937 - tmp939);
+        jacobian_com_offset[(14, 0)] = -tmp121 * tmp425 + tmp17 * tmp427;
         jacobian_com_offset[(15, 0)] = 0.0;
         jacobian_com_offset[(0, 1)] = 0.0;
         jacobian_com_offset[(1, 1)] = 0.0;
@@ -1776,15 +956,15 @@ pub fn cable_geometry(
         jacobian_com_offset[(3, 1)] = 0.0;
         jacobian_com_offset[(4, 1)] = 0.0;
         jacobian_com_offset[(5, 1)] = 0.0;
-        jacobian_com_offset[(6, 1)] = tmp101 * (tmp29 * tmp935 - tmp9 * tmp934);
+        jacobian_com_offset[(6, 1)] = -tmp110 * tmp428 + tmp19 * tmp424;
         jacobian_com_offset[(7, 1)] = 0.0;
         jacobian_com_offset[(8, 1)] = 0.0;
         jacobian_com_offset[(9, 1)] = 0.0;
-        jacobian_com_offset[(10, 1)] = tmp101 * (-tmp49 * tmp940 + tmp50 * tmp942 + tmp941 - tmp943);
+        jacobian_com_offset[(10, 1)] = -tmp117 * tmp428 + tmp19 * tmp426;
         jacobian_com_offset[(11, 1)] = 0.0;
         jacobian_com_offset[(12, 1)] = 0.0;
         jacobian_com_offset[(13, 1)] = 0.0;
-        jacobian_com_offset[(14, 1)] = tmp101 * (-tmp61 * tmp942 + tmp63 * tmp940 - tmp941 + tmp943);
+        jacobian_com_offset[(14, 1)] = -tmp121 * tmp428 + tmp19 * tmp427;
         jacobian_com_offset[(15, 1)] = 0.0;
         jacobian_com_offset[(0, 2)] = 0.0;
         jacobian_com_offset[(1, 2)] = 0.0;
@@ -1792,33 +972,33 @@ pub fn cable_geometry(
         jacobian_com_offset[(3, 2)] = 0.0;
         jacobian_com_offset[(4, 2)] = 0.0;
         jacobian_com_offset[(5, 2)] = 0.0;
-        jacobian_com_offset[(6, 2)] = tmp101 * (tmp23 * tmp935 - tmp4 * tmp934);
+        jacobian_com_offset[(6, 2)] = -tmp110 * tmp430 + tmp113 * tmp429;
         jacobian_com_offset[(7, 2)] = 0.0;
         jacobian_com_offset[(8, 2)] = 0.0;
         jacobian_com_offset[(9, 2)] = 0.0;
-        jacobian_com_offset[(10, 2)] = tmp101 * (-tmp49 * tmp946 + tmp50 * tmp944 - tmp945 + tmp947);
+        jacobian_com_offset[(10, 2)] = -tmp117 * tmp430 + tmp16 * tmp426;
         jacobian_com_offset[(11, 2)] = 0.0;
         jacobian_com_offset[(12, 2)] = 0.0;
         jacobian_com_offset[(13, 2)] = 0.0;
-        jacobian_com_offset[(14, 2)] = tmp101 * (-tmp61 * tmp944 + tmp63 * tmp946 + tmp945 - tmp947);
+        jacobian_com_offset[(14, 2)] = -tmp121 * tmp430 + tmp123 * tmp429;
         jacobian_com_offset[(15, 2)] = 0.0;
     }
     nalgebra::SVector::<f64, 16>::from([
-        tmp35,
+        tmp24,
         reference_tension_n[0],
         reference_tension_n[1],
-        -tmp40 + anchors_m[(2, 0)] - position_m[2],
+        -tmp28 + anchors_m[(2, 0)] - position_m[2],
+        tmp36,
+        tmp80,
+        tmp114,
+        -tmp98 + anchors_m[(2, 1)] - position_m[2],
         tmp48,
+        tmp106,
+        tmp119,
+        -tmp107 + anchors_m[(2, 2)] - position_m[2],
+        tmp58,
         tmp95,
-        tmp101 * tmp131,
-        -tmp125 + anchors_m[(2, 1)] - position_m[2],
-        tmp68,
-        tmp113,
-        tmp101 * tmp134,
-        -tmp103 + anchors_m[(2, 2)] - position_m[2],
-        tmp56,
-        tmp123,
-        tmp101 * tmp137,
-        -tmp115 + anchors_m[(2, 3)] - position_m[2],
+        tmp124,
+        -tmp96 + anchors_m[(2, 3)] - position_m[2],
     ])
 }

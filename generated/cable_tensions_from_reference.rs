@@ -35,1350 +35,616 @@ pub fn cable_tensions_from_reference(
     jacobian_reference_tension: Option<&mut nalgebra::SMatrix<f64, 8, 2>>,
     jacobian_anchors: Option<&mut nalgebra::SMatrix<f64, 8, 12>>,
 ) -> nalgebra::SVector<f64, 8> {
-    // Total ops: 3130
+    // Total ops: 1547
 
-    // Intermediate terms (893)
+    // Intermediate terms (427)
     let tmp0: f64 = 2.0_f64 * rotation_xyzw[3];
     let tmp1: f64 = tmp0 * rotation_xyzw[1];
     let tmp2: f64 = 2.0_f64 * rotation_xyzw[0];
     let tmp3: f64 = tmp2 * rotation_xyzw[2];
     let tmp4: f64 = tmp1 + tmp3;
     let tmp5: f64 = tmp0 * rotation_xyzw[2];
-    let tmp6: f64 = -tmp5;
-    let tmp7: f64 = tmp2 * rotation_xyzw[1];
-    let tmp8: f64 = tmp6 + tmp7;
-    let tmp9: f64 = rotation_xyzw[2] * rotation_xyzw[2];
-    let tmp10: f64 = -2.0_f64 * tmp9;
-    let tmp11: f64 = rotation_xyzw[1] * rotation_xyzw[1];
-    let tmp12: f64 = 1.0_f64 - 2.0_f64 * tmp11;
-    let tmp13: f64 = tmp10 + tmp12;
-    let tmp14: f64 = tmp13 * attachments_m[(0, 1)] + tmp4 * attachments_m[(2, 1)] + tmp8 * attachments_m[(1, 1)];
-    let tmp15: f64 = tmp14 - anchors_m[(0, 1)] + position_m[0];
-    let tmp16: f64 = tmp2 * rotation_xyzw[3];
-    let tmp17: f64 = -tmp16;
-    let tmp18: f64 = 2.0_f64 * rotation_xyzw[1] * rotation_xyzw[2];
-    let tmp19: f64 = tmp17 + tmp18;
-    let tmp20: f64 = tmp5 + tmp7;
-    let tmp21: f64 = rotation_xyzw[0] * rotation_xyzw[0];
-    let tmp22: f64 = -2.0_f64 * tmp21;
-    let tmp23: f64 = tmp10 + tmp22 + 1.0_f64;
-    let tmp24: f64 = tmp19 * attachments_m[(2, 2)] + tmp20 * attachments_m[(0, 2)] + tmp23 * attachments_m[(1, 2)];
-    let tmp25: f64 = tmp24 - anchors_m[(1, 2)] + position_m[1];
-    let tmp26: f64 = tmp13 * attachments_m[(0, 2)] + tmp4 * attachments_m[(2, 2)] + tmp8 * attachments_m[(1, 2)];
-    let tmp27: f64 = tmp26 - anchors_m[(0, 2)] + position_m[0];
-    let tmp28: f64 = tmp27 * tmp27;
-    let tmp29: f64 = tmp25 * tmp25;
-    let tmp30: f64 = tmp28 + tmp29 + epsilon;
-    let tmp31: f64 = 1.0_f64 / tmp30.sqrt();
-    let tmp32: f64 = tmp19 * attachments_m[(2, 3)] + tmp20 * attachments_m[(0, 3)] + tmp23 * attachments_m[(1, 3)];
-    let tmp33: f64 = tmp32 - anchors_m[(1, 3)] + position_m[1];
-    let tmp34: f64 = tmp13 * attachments_m[(0, 3)] + tmp4 * attachments_m[(2, 3)] + tmp8 * attachments_m[(1, 3)];
-    let tmp35: f64 = tmp34 - anchors_m[(0, 3)] + position_m[0];
-    let tmp36: f64 = tmp35 * tmp35;
-    let tmp37: f64 = tmp33 * tmp33;
-    let tmp38: f64 = tmp36 + tmp37 + epsilon;
-    let tmp39: f64 = 1.0_f64 / tmp38.sqrt();
-    let tmp40: f64 = tmp34 * tmp39;
-    let tmp41: f64 = tmp32 * tmp39;
-    let tmp42: f64 = tmp33 * tmp40 - tmp35 * tmp41;
-    let tmp43: f64 = tmp31 * tmp42;
-    let tmp44: f64 = tmp26 * tmp31;
-    let tmp45: f64 = tmp24 * tmp31;
-    let tmp46: f64 = tmp25 * tmp44 - tmp27 * tmp45;
-    let tmp47: f64 = tmp39 * tmp46;
-    let tmp48: f64 = tmp25 * tmp43 - tmp33 * tmp47;
-    let tmp49: f64 = tmp15 * tmp15;
-    let tmp50: f64 = tmp19 * attachments_m[(2, 1)] + tmp20 * attachments_m[(0, 1)] + tmp23 * attachments_m[(1, 1)];
-    let tmp51: f64 = tmp50 - anchors_m[(1, 1)] + position_m[1];
-    let tmp52: f64 = tmp51 * tmp51;
-    let tmp53: f64 = tmp49 + tmp52 + epsilon;
-    let tmp54: f64 = 1.0_f64 / tmp53.sqrt();
-    let tmp55: f64 = tmp48 * tmp54;
-    let tmp56: f64 = -tmp27 * tmp43 + tmp35 * tmp47;
-    let tmp57: f64 = tmp54 * tmp56;
-    let tmp58: f64 = tmp14 * tmp54;
-    let tmp59: f64 = tmp50 * tmp54;
-    let tmp60: f64 = -tmp15 * tmp59 + tmp51 * tmp58;
-    let tmp61: f64 = tmp25 * tmp31;
-    let tmp62: f64 = tmp35 * tmp39;
-    let tmp63: f64 = tmp33 * tmp39;
-    let tmp64: f64 = tmp27 * tmp31;
-    let tmp65: f64 = -tmp61 * tmp62 + tmp63 * tmp64;
-    let tmp66: f64 = -tmp15 * tmp55 - tmp51 * tmp57 - tmp60 * tmp65;
-    let tmp67: f64 = tmp66 + epsilon * tmp66.signum();
-    let tmp68: f64 = 1.0_f64 / tmp67;
-    let tmp69: f64 = tmp4 * attachments_m[(2, 0)];
-    let tmp70: f64 = tmp8 * attachments_m[(1, 0)];
-    let tmp71: f64 = tmp13 * attachments_m[(0, 0)];
-    let tmp72: f64 = tmp69 + tmp70 + tmp71;
-    let tmp73: f64 = tmp72 - anchors_m[(0, 0)] + position_m[0];
-    let tmp74: f64 = tmp73 * tmp73;
-    let tmp75: f64 = tmp19 * attachments_m[(2, 0)];
-    let tmp76: f64 = tmp20 * attachments_m[(0, 0)];
-    let tmp77: f64 = tmp23 * attachments_m[(1, 0)];
-    let tmp78: f64 = tmp75 + tmp76 + tmp77;
-    let tmp79: f64 = tmp78 - anchors_m[(1, 0)] + position_m[1];
-    let tmp80: f64 = tmp79 * tmp79;
-    let tmp81: f64 = tmp74 + tmp80 + epsilon;
-    let tmp82: f64 = 1.0_f64 / tmp81.sqrt();
-    let tmp83: f64 = tmp79 * tmp82;
-    let tmp84: f64 = tmp56 * tmp83;
-    let tmp85: f64 = tmp82 * reference_tension_n[0];
-    let tmp86: f64 = tmp48 * tmp85;
-    let tmp87: f64 = tmp72 * tmp82;
-    let tmp88: f64 = tmp78 * tmp82;
-    let tmp89: f64 = -tmp73 * tmp88 + tmp79 * tmp87;
-    let tmp90: f64 = tmp65 * tmp89;
-    let tmp91: f64 = tmp73 * tmp86 + tmp84 * reference_tension_n[0] + tmp90 * reference_tension_n[0];
-    let tmp92: f64 = tmp68 * tmp91;
-    let tmp93: f64 = -tmp24 + tmp32;
-    let tmp94: f64 = -tmp26 + tmp34;
-    let tmp95: f64 = -tmp24 * tmp34 + tmp26 * tmp32;
-    let tmp96: f64 = -tmp14 * tmp93 + tmp50 * tmp94 + tmp95;
-    let tmp97: f64 = tmp96 + epsilon * tmp96.signum();
-    let tmp98: f64 = 1.0_f64 / tmp97;
-    let tmp99: f64 = tmp16 + tmp18;
-    let tmp100: f64 = -tmp1;
-    let tmp101: f64 = tmp100 + tmp3;
-    let tmp102: f64 = tmp12 + tmp22;
-    let tmp103: f64 = tmp101 * attachments_m[(0, 0)] + tmp102 * attachments_m[(2, 0)] + tmp99 * attachments_m[(1, 0)];
-    let tmp104: f64 = tmp103 * tmp83;
-    let tmp105: f64 = tmp101 * attachments_m[(0, 2)] + tmp102 * attachments_m[(2, 2)] + tmp99 * attachments_m[(1, 2)];
-    let tmp106: f64 = tmp89 * reference_tension_n[0];
-    let tmp107: f64 = tmp42 * tmp83;
-    let tmp108: f64 = tmp106 * tmp63 - tmp107 * reference_tension_n[0];
-    let tmp109: f64 = tmp108 * tmp54;
-    let tmp110: f64 = tmp42 * tmp85;
-    let tmp111: f64 = -tmp106 * tmp62 + tmp110 * tmp73;
-    let tmp112: f64 = tmp111 * tmp54;
-    let tmp113: f64 = tmp83 * reference_tension_n[0];
-    let tmp114: f64 = tmp73 * tmp85;
-    let tmp115: f64 = tmp113 * tmp62 - tmp114 * tmp63;
-    let tmp116: f64 = -tmp109 * tmp15 - tmp112 * tmp51 - tmp115 * tmp60;
-    let tmp117: f64 = tmp116 * tmp68;
-    let tmp118: f64 = tmp105 * tmp117;
-    let tmp119: f64 = tmp101 * attachments_m[(0, 3)] + tmp102 * attachments_m[(2, 3)] + tmp99 * attachments_m[(1, 3)];
-    let tmp120: f64 = tmp46 * tmp83;
-    let tmp121: f64 = -tmp106 * tmp61 + tmp120 * reference_tension_n[0];
-    let tmp122: f64 = tmp121 * tmp54;
-    let tmp123: f64 = tmp46 * tmp85;
-    let tmp124: f64 = tmp106 * tmp64 - tmp123 * tmp73;
-    let tmp125: f64 = tmp124 * tmp54;
-    let tmp126: f64 = -tmp113 * tmp64 + tmp114 * tmp61;
-    let tmp127: f64 = -tmp122 * tmp15 - tmp125 * tmp51 - tmp126 * tmp60;
-    let tmp128: f64 = tmp127 * tmp68;
-    let tmp129: f64 = tmp119 * tmp128;
-    let tmp130: f64 = tmp51 * tmp54;
-    let tmp131: f64 = tmp101 * attachments_m[(0, 1)] + tmp102 * attachments_m[(2, 1)] + tmp99 * attachments_m[(1, 1)];
-    let tmp132: f64 = tmp131 * tmp92;
-    let tmp133: f64 = -tmp104 * reference_tension_n[0]
-        - tmp118 * tmp61
-        - tmp129 * tmp63
-        - tmp130 * tmp132
-        - tmp78 * reference_tension_n[1]
-        + platform_weight_n * (tmp19 * com_offset_m[2] + tmp20 * com_offset_m[0] + tmp23 * com_offset_m[1]);
-    let tmp134: f64 = tmp103 * tmp85;
-    let tmp135: f64 = tmp15 * tmp54;
-    let tmp136: f64 =
-        tmp118 * tmp64 + tmp129 * tmp62 + tmp132 * tmp135 + tmp134 * tmp73 + tmp72 * reference_tension_n[1]
-            - platform_weight_n * (tmp13 * com_offset_m[0] + tmp4 * com_offset_m[2] + tmp8 * com_offset_m[1]);
-    let tmp137: f64 = platform_weight_n - reference_tension_n[1];
-    let tmp138: f64 = tmp133 * tmp94 + tmp136 * tmp93 + tmp137 * tmp95;
-    let tmp139: f64 = tmp136 + tmp137 * tmp34;
-    let tmp140: f64 = -tmp133 + tmp137 * tmp32;
-    let tmp141: f64 = -tmp133 * tmp34 - tmp136 * tmp32 + tmp139 * tmp50 - tmp14 * tmp140;
-    let tmp142: f64 = tmp133 - tmp137 * tmp24;
-    let tmp143: f64 = -tmp136 - tmp137 * tmp26;
-    let tmp144: f64 = tmp133 * tmp26 + tmp136 * tmp24 - tmp14 * tmp142 + tmp143 * tmp50;
-    let tmp145: f64 = -tmp7;
-    let tmp146: f64 = tmp145 + tmp5;
-    let tmp147: f64 = tmp146 * attachments_m[(2, 1)] + tmp4 * attachments_m[(1, 1)];
-    let tmp148: f64 = -tmp11;
-    let tmp149: f64 = rotation_xyzw[3] * rotation_xyzw[3];
-    let tmp150: f64 = -tmp149;
-    let tmp151: f64 = tmp148 + tmp150 + tmp21 + tmp9;
-    let tmp152: f64 = tmp151 * attachments_m[(2, 1)] + tmp19 * attachments_m[(1, 1)];
-    let tmp153: f64 = tmp4 * attachments_m[(1, 2)];
-    let tmp154: f64 = tmp146 * attachments_m[(2, 2)];
-    let tmp155: f64 = tmp153 + tmp154;
-    let tmp156: f64 = 2.0_f64 * tmp27;
-    let tmp157: f64 = tmp19 * attachments_m[(1, 2)];
-    let tmp158: f64 = tmp151 * attachments_m[(2, 2)];
-    let tmp159: f64 = tmp157 + tmp158;
-    let tmp160: f64 = 2.0_f64 * tmp25;
-    let tmp161: f64 = tmp155 * tmp156 + tmp159 * tmp160;
-    let tmp162: f64 = 1.0_f64 / (tmp30 * tmp30.sqrt());
-    let tmp163: f64 = 0.5_f64 * tmp25;
-    let tmp164: f64 = tmp162 * tmp163;
-    let tmp165: f64 = tmp164 * tmp62;
-    let tmp166: f64 = tmp151 * attachments_m[(2, 3)] + tmp19 * attachments_m[(1, 3)];
-    let tmp167: f64 = tmp39 * tmp64;
-    let tmp168: f64 = tmp146 * attachments_m[(2, 3)] + tmp4 * attachments_m[(1, 3)];
-    let tmp169: f64 = 2.0_f64 * tmp35;
-    let tmp170: f64 = 2.0_f64 * tmp33;
-    let tmp171: f64 = tmp166 * tmp170 + tmp168 * tmp169;
-    let tmp172: f64 = 0.5_f64 * tmp171;
-    let tmp173: f64 = 1.0_f64 / (tmp38 * tmp38.sqrt());
-    let tmp174: f64 = tmp173 * tmp33;
-    let tmp175: f64 = tmp174 * tmp64;
-    let tmp176: f64 = tmp173 * tmp35;
-    let tmp177: f64 = tmp176 * tmp61;
-    let tmp178: f64 = 0.5_f64 * tmp27;
-    let tmp179: f64 = tmp161 * tmp178;
-    let tmp180: f64 = tmp162 * tmp63;
-    let tmp181: f64 = tmp39 * tmp61;
-    let tmp182: f64 = tmp31 * tmp63;
-    let tmp183: f64 = tmp31 * tmp62;
-    let tmp184: f64 =
-        tmp155 * tmp182 - tmp159 * tmp183 + tmp161 * tmp165 + tmp166 * tmp167 - tmp168 * tmp181 - tmp172 * tmp175
-            + tmp172 * tmp177
-            - tmp179 * tmp180;
-    let tmp185: f64 = tmp162 * tmp24;
-    let tmp186: f64 = tmp164 * tmp26;
-    let tmp187: f64 =
-        -tmp155 * tmp45 + tmp155 * tmp61 + tmp159 * tmp44 - tmp159 * tmp64 - tmp161 * tmp186 + tmp179 * tmp185;
-    let tmp188: f64 = tmp176 * tmp46;
-    let tmp189: f64 = 0.5_f64 * tmp188;
-    let tmp190: f64 = tmp162 * tmp42;
-    let tmp191: f64 = tmp176 * tmp32;
-    let tmp192: f64 = tmp174 * tmp34;
-    let tmp193: f64 =
-        tmp166 * tmp40 - tmp166 * tmp62 - tmp168 * tmp41 + tmp168 * tmp63 + tmp172 * tmp191 - tmp172 * tmp192;
-    let tmp194: f64 =
-        -tmp155 * tmp43 + tmp168 * tmp47 - tmp171 * tmp189 + tmp179 * tmp190 + tmp187 * tmp62 - tmp193 * tmp64;
-    let tmp195: f64 = tmp163 * tmp190;
-    let tmp196: f64 = tmp174 * tmp46;
-    let tmp197: f64 =
-        tmp159 * tmp43 - tmp161 * tmp195 - tmp166 * tmp47 + tmp172 * tmp196 - tmp187 * tmp63 + tmp193 * tmp61;
-    let tmp198: f64 = 2.0_f64 * tmp15;
-    let tmp199: f64 = 2.0_f64 * tmp51;
-    let tmp200: f64 = tmp147 * tmp198 + tmp152 * tmp199;
-    let tmp201: f64 = 1.0_f64 / (tmp53 * tmp53.sqrt());
-    let tmp202: f64 = tmp201 * tmp51;
-    let tmp203: f64 = 0.5_f64 * tmp202;
-    let tmp204: f64 = tmp200 * tmp203;
-    let tmp205: f64 = tmp15 * tmp201;
-    let tmp206: f64 = 0.5_f64 * tmp205;
-    let tmp207: f64 = tmp200 * tmp206;
-    let tmp208: f64 =
-        tmp130 * tmp147 - tmp135 * tmp152 - tmp14 * tmp204 - tmp147 * tmp59 + tmp152 * tmp58 + tmp207 * tmp50;
-    let tmp209: f64 = -tmp130 * tmp194 - tmp135 * tmp197 - tmp147 * tmp55 - tmp152 * tmp57 - tmp184 * tmp60
-        + tmp204 * tmp56
-        + tmp207 * tmp48
-        - tmp208 * tmp65;
-    let tmp210: f64 = 1.0_f64 / (tmp67 * tmp67);
-    let tmp211: f64 = tmp210 * tmp91;
-    let tmp212: f64 = tmp209 * tmp211;
-    let tmp213: f64 = tmp151 * attachments_m[(2, 0)] + tmp19 * attachments_m[(1, 0)];
-    let tmp214: f64 = tmp56 * tmp85;
-    let tmp215: f64 = tmp146 * attachments_m[(2, 0)] + tmp4 * attachments_m[(1, 0)];
-    let tmp216: f64 = 2.0_f64 * tmp73;
-    let tmp217: f64 = 2.0_f64 * tmp79;
-    let tmp218: f64 = 0.5_f64 * tmp213 * tmp217 + 0.5_f64 * tmp215 * tmp216;
-    let tmp219: f64 = 1.0_f64 / (tmp81 * tmp81.sqrt());
-    let tmp220: f64 = tmp219 * tmp79;
-    let tmp221: f64 = tmp220 * reference_tension_n[0];
-    let tmp222: f64 = tmp221 * tmp56;
-    let tmp223: f64 = tmp73 * tmp82;
-    let tmp224: f64 = tmp220 * tmp72;
-    let tmp225: f64 = tmp219 * tmp73;
-    let tmp226: f64 = tmp225 * tmp78;
-    let tmp227: f64 =
-        -tmp213 * tmp223 + tmp213 * tmp87 + tmp215 * tmp83 - tmp215 * tmp88 - tmp218 * tmp224 + tmp218 * tmp226;
-    let tmp228: f64 = tmp65 * reference_tension_n[0];
-    let tmp229: f64 = tmp225 * reference_tension_n[0];
-    let tmp230: f64 = tmp229 * tmp48;
-    let tmp231: f64 = tmp68
-        * (tmp106 * tmp184 + tmp113 * tmp194 + tmp114 * tmp197 + tmp213 * tmp214 + tmp215 * tmp86
-            - tmp218 * tmp222
-            - tmp218 * tmp230
-            + tmp227 * tmp228);
-    let tmp232: f64 = -tmp157 - tmp158 + tmp166;
-    let tmp233: f64 = tmp131 * tmp135;
-    let tmp234: f64 = tmp212 * tmp233;
-    let tmp235: f64 = tmp103 * tmp229;
-    let tmp236: f64 = tmp218 * tmp235;
-    let tmp237: f64 = tmp132 * tmp207;
-    let tmp238: f64 = tmp129 * tmp176;
-    let tmp239: f64 = tmp172 * tmp238;
-    let tmp240: f64 = tmp134 * tmp215;
-    let tmp241: f64 = tmp127 * tmp210;
-    let tmp242: f64 = tmp209 * tmp241;
-    let tmp243: f64 = tmp119 * tmp62;
-    let tmp244: f64 = tmp242 * tmp243;
-    let tmp245: f64 = tmp106 * tmp39;
-    let tmp246: f64 = tmp218 * tmp42;
-    let tmp247: f64 = tmp62 * reference_tension_n[0];
-    let tmp248: f64 = tmp106 * tmp176;
-    let tmp249: f64 = tmp114 * tmp174;
-    let tmp250: f64 = tmp114 * tmp39;
-    let tmp251: f64 = tmp63 * tmp85;
-    let tmp252: f64 = tmp113 * tmp39;
-    let tmp253: f64 = tmp62 * tmp85;
-    let tmp254: f64 = tmp63 * reference_tension_n[0];
-    let tmp255: f64 = tmp225 * tmp254;
-    let tmp256: f64 = tmp113 * tmp176;
-    let tmp257: f64 = tmp218 * tmp220;
-    let tmp258: f64 = tmp106 * tmp174;
-    let tmp259: f64 = tmp68
-        * (tmp108 * tmp207 - tmp109 * tmp147 + tmp111 * tmp204
-            - tmp112 * tmp152
-            - tmp115 * tmp208
-            - tmp130
-                * (tmp110 * tmp215 + tmp114 * tmp193 - tmp168 * tmp245 + tmp172 * tmp248
-                    - tmp227 * tmp247
-                    - tmp229 * tmp246)
-            - tmp135
-                * (-tmp110 * tmp213 - tmp113 * tmp193 + tmp166 * tmp245 - tmp172 * tmp258
-                    + tmp221 * tmp246
-                    + tmp227 * tmp254)
-            - tmp60
-                * (-tmp166 * tmp250 + tmp168 * tmp252 + tmp172 * tmp249 - tmp172 * tmp256 + tmp213 * tmp253
-                    - tmp215 * tmp251
-                    + tmp218 * tmp255
-                    - tmp247 * tmp257));
-    let tmp260: f64 = tmp105 * tmp64;
-    let tmp261: f64 = tmp259 * tmp260;
-    let tmp262: f64 = tmp129 * tmp39;
-    let tmp263: f64 = tmp168 * tmp262;
-    let tmp264: f64 = tmp116 * tmp210;
-    let tmp265: f64 = tmp209 * tmp264;
-    let tmp266: f64 = tmp260 * tmp265;
-    let tmp267: f64 = tmp162 * tmp179;
-    let tmp268: f64 = tmp118 * tmp267;
-    let tmp269: f64 = tmp118 * tmp31;
-    let tmp270: f64 = tmp155 * tmp269;
-    let tmp271: f64 = tmp132 * tmp54;
-    let tmp272: f64 = tmp147 * tmp271;
-    let tmp273: f64 = platform_weight_n * (tmp146 * com_offset_m[2] + tmp4 * com_offset_m[1]);
-    let tmp274: f64 = tmp106 * tmp162;
-    let tmp275: f64 = tmp106 * tmp31;
-    let tmp276: f64 = tmp64 * reference_tension_n[0];
-    let tmp277: f64 = tmp46 * reference_tension_n[0];
-    let tmp278: f64 = tmp225 * tmp277;
-    let tmp279: f64 = tmp106 * tmp164;
-    let tmp280: f64 = tmp61 * reference_tension_n[0];
-    let tmp281: f64 = tmp220 * tmp277;
-    let tmp282: f64 = tmp114 * tmp164;
-    let tmp283: f64 = tmp61 * tmp85;
-    let tmp284: f64 = tmp113 * tmp31;
-    let tmp285: f64 = tmp114 * tmp31;
-    let tmp286: f64 = tmp225 * tmp280;
-    let tmp287: f64 = tmp64 * tmp85;
-    let tmp288: f64 = tmp68
-        * (tmp121 * tmp207 - tmp122 * tmp147 + tmp124 * tmp204
-            - tmp125 * tmp152
-            - tmp126 * tmp208
-            - tmp130
-                * (-tmp114 * tmp187 - tmp123 * tmp215 + tmp155 * tmp275 - tmp179 * tmp274
-                    + tmp218 * tmp278
-                    + tmp227 * tmp276)
-            - tmp135
-                * (tmp113 * tmp187 + tmp123 * tmp213 - tmp159 * tmp275 + tmp161 * tmp279
-                    - tmp218 * tmp281
-                    - tmp227 * tmp280)
-            - tmp60
-                * (tmp113 * tmp267 - tmp155 * tmp284 + tmp159 * tmp285 - tmp161 * tmp282 - tmp213 * tmp287
-                    + tmp215 * tmp283
-                    - tmp218 * tmp286
-                    + tmp257 * tmp276));
-    let tmp289: f64 = tmp243 * tmp288;
-    let tmp290: f64 = -tmp18;
-    let tmp291: f64 = tmp17 + tmp290;
-    let tmp292: f64 = -tmp21;
-    let tmp293: f64 = tmp292 + tmp9;
-    let tmp294: f64 = tmp148 + tmp149;
-    let tmp295: f64 = tmp293 + tmp294;
-    let tmp296: f64 = tmp117 * (tmp291 * attachments_m[(2, 2)] + tmp295 * attachments_m[(1, 2)]);
-    let tmp297: f64 = tmp296 * tmp64;
-    let tmp298: f64 = tmp291 * attachments_m[(2, 0)] + tmp295 * attachments_m[(1, 0)];
-    let tmp299: f64 = tmp114 * tmp298;
-    let tmp300: f64 = tmp231 * tmp233;
-    let tmp301: f64 = tmp215 * reference_tension_n[1];
-    let tmp302: f64 = tmp291 * attachments_m[(2, 3)] + tmp295 * attachments_m[(1, 3)];
-    let tmp303: f64 = tmp128 * tmp62;
-    let tmp304: f64 = tmp302 * tmp303;
-    let tmp305: f64 = tmp291 * attachments_m[(2, 1)] + tmp295 * attachments_m[(1, 1)];
-    let tmp306: f64 = tmp135 * tmp92;
-    let tmp307: f64 = tmp305 * tmp306;
-    let tmp308: f64 =
-        -tmp234 - tmp236 - tmp237 - tmp239 + tmp240 - tmp244 + tmp261 + tmp263 - tmp266 - tmp268 + tmp270 + tmp272
-            - tmp273
-            + tmp289
-            + tmp297
-            + tmp299
-            + tmp300
-            + tmp301
-            + tmp304
-            + tmp307;
-    let tmp309: f64 = tmp155 * tmp32 - tmp159 * tmp34 + tmp166 * tmp26 - tmp168 * tmp24;
-    let tmp310: f64 = -tmp153 - tmp154 + tmp168;
-    let tmp311: f64 = tmp105 * tmp61;
-    let tmp312: f64 = tmp265 * tmp311;
-    let tmp313: f64 = tmp129 * tmp174;
-    let tmp314: f64 = tmp172 * tmp313;
-    let tmp315: f64 = tmp296 * tmp61;
-    let tmp316: f64 = platform_weight_n * (tmp151 * com_offset_m[2] + tmp19 * com_offset_m[1]);
-    let tmp317: f64 = tmp134 * tmp213;
-    let tmp318: f64 = tmp130 * tmp131;
-    let tmp319: f64 = tmp212 * tmp318;
-    let tmp320: f64 = tmp103 * tmp221;
-    let tmp321: f64 = tmp218 * tmp320;
-    let tmp322: f64 = tmp132 * tmp204;
-    let tmp323: f64 = tmp231 * tmp318;
-    let tmp324: f64 = tmp119 * tmp63;
-    let tmp325: f64 = tmp288 * tmp324;
-    let tmp326: f64 = tmp166 * tmp262;
-    let tmp327: f64 = tmp130 * tmp92;
-    let tmp328: f64 = tmp305 * tmp327;
-    let tmp329: f64 = tmp259 * tmp311;
-    let tmp330: f64 = tmp242 * tmp324;
-    let tmp331: f64 = tmp113 * tmp298;
-    let tmp332: f64 = tmp213 * reference_tension_n[1];
-    let tmp333: f64 = tmp128 * tmp63;
-    let tmp334: f64 = tmp302 * tmp333;
-    let tmp335: f64 = tmp152 * tmp271;
-    let tmp336: f64 = tmp159 * tmp269;
-    let tmp337: f64 = tmp118 * tmp164;
-    let tmp338: f64 = tmp161 * tmp337;
-    let tmp339: f64 = tmp312 + tmp314 - tmp315 + tmp316 - tmp317 + tmp319 + tmp321 + tmp322
-        - tmp323
-        - tmp325
-        - tmp326
-        - tmp328
-        - tmp329
-        + tmp330
-        - tmp331
-        - tmp332
-        - tmp334
-        - tmp335
-        - tmp336
-        + tmp338;
-    let tmp340: f64 = -tmp14 * tmp232 - tmp147 * tmp93 + tmp152 * tmp94 + tmp309 + tmp310 * tmp50;
-    let tmp341: f64 = 1.0_f64 / (tmp97 * tmp97);
-    let tmp342: f64 = tmp138 * tmp341;
-    let tmp343: f64 = tmp141 * tmp341;
-    let tmp344: f64 = tmp144 * tmp341;
-    let tmp345: f64 = tmp16 + tmp290;
-    let tmp346: f64 = tmp345 * attachments_m[(0, 2)];
-    let tmp347: f64 = tmp20 * attachments_m[(2, 2)];
-    let tmp348: f64 = tmp346 + tmp347;
-    let tmp349: f64 = -tmp3;
-    let tmp350: f64 = tmp100 + tmp349;
-    let tmp351: f64 = tmp350 * attachments_m[(0, 2)];
-    let tmp352: f64 = -tmp9;
-    let tmp353: f64 = tmp21 + tmp352;
-    let tmp354: f64 = tmp294 + tmp353;
-    let tmp355: f64 = tmp354 * attachments_m[(2, 2)];
-    let tmp356: f64 = tmp351 + tmp355;
-    let tmp357: f64 = tmp156 * tmp356 + tmp160 * tmp348;
-    let tmp358: f64 = tmp350 * attachments_m[(0, 3)] + tmp354 * attachments_m[(2, 3)];
-    let tmp359: f64 = tmp20 * attachments_m[(2, 3)] + tmp345 * attachments_m[(0, 3)];
-    let tmp360: f64 = tmp169 * tmp358 + tmp170 * tmp359;
-    let tmp361: f64 = 0.5_f64 * tmp360;
-    let tmp362: f64 =
-        tmp191 * tmp361 - tmp192 * tmp361 - tmp358 * tmp41 + tmp358 * tmp63 + tmp359 * tmp40 - tmp359 * tmp62;
-    let tmp363: f64 = tmp178 * tmp357;
-    let tmp364: f64 =
-        tmp185 * tmp363 - tmp186 * tmp357 + tmp348 * tmp44 - tmp348 * tmp64 - tmp356 * tmp45 + tmp356 * tmp61;
-    let tmp365: f64 =
-        -tmp195 * tmp357 + tmp196 * tmp361 + tmp348 * tmp43 - tmp359 * tmp47 + tmp362 * tmp61 - tmp364 * tmp63;
-    let tmp366: f64 = tmp350 * attachments_m[(0, 0)] + tmp354 * attachments_m[(2, 0)];
-    let tmp367: f64 = tmp20 * attachments_m[(2, 0)] + tmp345 * attachments_m[(0, 0)];
-    let tmp368: f64 = 0.5_f64 * tmp216 * tmp366 + 0.5_f64 * tmp217 * tmp367;
-    let tmp369: f64 =
-        -tmp223 * tmp367 - tmp224 * tmp368 + tmp226 * tmp368 + tmp366 * tmp83 - tmp366 * tmp88 + tmp367 * tmp87;
-    let tmp370: f64 = tmp162 * tmp363;
-    let tmp371: f64 = tmp165 * tmp357 + tmp167 * tmp359 - tmp175 * tmp361 + tmp177 * tmp361 - tmp181 * tmp358
-        + tmp182 * tmp356
-        - tmp183 * tmp348
-        - tmp370 * tmp63;
-    let tmp372: f64 =
-        -tmp189 * tmp360 + tmp190 * tmp363 - tmp356 * tmp43 + tmp358 * tmp47 - tmp362 * tmp64 + tmp364 * tmp62;
-    let tmp373: f64 = tmp68
-        * (tmp106 * tmp371 + tmp113 * tmp372 + tmp114 * tmp365 + tmp214 * tmp367 - tmp222 * tmp368 + tmp228 * tmp369
-            - tmp230 * tmp368
-            + tmp366 * tmp86);
-    let tmp374: f64 = tmp20 * attachments_m[(2, 1)] + tmp345 * attachments_m[(0, 1)];
-    let tmp375: f64 = tmp350 * attachments_m[(0, 1)] + tmp354 * attachments_m[(2, 1)];
-    let tmp376: f64 = tmp198 * tmp375 + tmp199 * tmp374;
-    let tmp377: f64 = tmp203 * tmp376;
-    let tmp378: f64 = tmp206 * tmp376;
-    let tmp379: f64 =
-        tmp130 * tmp375 - tmp135 * tmp374 - tmp14 * tmp377 + tmp374 * tmp58 - tmp375 * tmp59 + tmp378 * tmp50;
-    let tmp380: f64 = -tmp130 * tmp372 - tmp135 * tmp365 - tmp371 * tmp60 - tmp374 * tmp57 - tmp375 * tmp55
-        + tmp377 * tmp56
-        + tmp378 * tmp48
-        - tmp379 * tmp65;
-    let tmp381: f64 = tmp211 * tmp380;
-    let tmp382: f64 = -tmp346 - tmp347 + tmp359;
-    let tmp383: f64 = tmp269 * tmp356;
-    let tmp384: f64 = tmp134 * tmp366;
-    let tmp385: f64 = tmp233 * tmp373;
-    let tmp386: f64 = tmp241 * tmp380;
-    let tmp387: f64 = tmp243 * tmp386;
-    let tmp388: f64 = tmp220 * tmp368;
-    let tmp389: f64 = tmp68
-        * (tmp121 * tmp378 - tmp122 * tmp375 + tmp124 * tmp377
-            - tmp125 * tmp374
-            - tmp126 * tmp379
-            - tmp130
-                * (-tmp106 * tmp370 - tmp114 * tmp364 - tmp123 * tmp366
-                    + tmp275 * tmp356
-                    + tmp276 * tmp369
-                    + tmp278 * tmp368)
-            - tmp135
-                * (tmp113 * tmp364 + tmp123 * tmp367 - tmp275 * tmp348 + tmp279 * tmp357
-                    - tmp280 * tmp369
-                    - tmp281 * tmp368)
-            - tmp60
-                * (tmp113 * tmp370 + tmp276 * tmp388 - tmp282 * tmp357 + tmp283 * tmp366 - tmp284 * tmp356
-                    + tmp285 * tmp348
-                    - tmp286 * tmp368
-                    - tmp287 * tmp367));
-    let tmp390: f64 = tmp243 * tmp389;
-    let tmp391: f64 = tmp118 * tmp370;
-    let tmp392: f64 = tmp366 * reference_tension_n[1];
-    let tmp393: f64 = tmp11 + tmp150;
-    let tmp394: f64 = tmp353 + tmp393;
-    let tmp395: f64 = tmp117 * (tmp101 * attachments_m[(2, 2)] + tmp394 * attachments_m[(0, 2)]);
-    let tmp396: f64 = tmp395 * tmp64;
-    let tmp397: f64 = tmp262 * tmp358;
-    let tmp398: f64 = tmp92 * (tmp101 * attachments_m[(2, 1)] + tmp394 * attachments_m[(0, 1)]);
-    let tmp399: f64 = tmp135 * tmp398;
-    let tmp400: f64 = tmp132 * tmp378;
-    let tmp401: f64 = platform_weight_n * (tmp350 * com_offset_m[0] + tmp354 * com_offset_m[2]);
-    let tmp402: f64 = tmp368 * tmp42;
-    let tmp403: f64 = tmp68
-        * (tmp108 * tmp378 - tmp109 * tmp375 + tmp111 * tmp377
-            - tmp112 * tmp374
-            - tmp115 * tmp379
-            - tmp130
-                * (tmp110 * tmp366 + tmp114 * tmp362 - tmp229 * tmp402 - tmp245 * tmp358 - tmp247 * tmp369
-                    + tmp248 * tmp361)
-            - tmp135
-                * (-tmp110 * tmp367 - tmp113 * tmp362 + tmp221 * tmp402 + tmp245 * tmp359 + tmp254 * tmp369
-                    - tmp258 * tmp361)
-            - tmp60
-                * (-tmp247 * tmp388 + tmp249 * tmp361 - tmp250 * tmp359 - tmp251 * tmp366
-                    + tmp252 * tmp358
-                    + tmp253 * tmp367
-                    + tmp255 * tmp368
-                    - tmp256 * tmp361));
-    let tmp404: f64 = tmp260 * tmp403;
-    let tmp405: f64 = tmp271 * tmp375;
-    let tmp406: f64 = tmp101 * attachments_m[(2, 3)] + tmp394 * attachments_m[(0, 3)];
-    let tmp407: f64 = tmp303 * tmp406;
-    let tmp408: f64 = tmp233 * tmp381;
-    let tmp409: f64 = tmp238 * tmp361;
-    let tmp410: f64 = tmp235 * tmp368;
-    let tmp411: f64 = tmp264 * tmp380;
-    let tmp412: f64 = tmp260 * tmp411;
-    let tmp413: f64 = tmp101 * attachments_m[(2, 0)] + tmp394 * attachments_m[(0, 0)];
-    let tmp414: f64 = tmp114 * tmp413;
-    let tmp415: f64 =
-        tmp383 + tmp384 + tmp385 - tmp387 + tmp390 - tmp391 + tmp392 + tmp396 + tmp397 + tmp399 - tmp400 - tmp401
-            + tmp404
-            + tmp405
-            + tmp407
-            - tmp408
-            - tmp409
-            - tmp410
-            - tmp412
-            + tmp414;
-    let tmp416: f64 = -tmp24 * tmp358 + tmp26 * tmp359 + tmp32 * tmp356 - tmp34 * tmp348;
-    let tmp417: f64 = -tmp351 - tmp355 + tmp358;
-    let tmp418: f64 = tmp311 * tmp411;
-    let tmp419: f64 = tmp262 * tmp359;
-    let tmp420: f64 = tmp271 * tmp374;
-    let tmp421: f64 = platform_weight_n * (tmp20 * com_offset_m[2] + tmp345 * com_offset_m[0]);
-    let tmp422: f64 = tmp367 * reference_tension_n[1];
-    let tmp423: f64 = tmp318 * tmp373;
-    let tmp424: f64 = tmp320 * tmp368;
-    let tmp425: f64 = tmp134 * tmp367;
-    let tmp426: f64 = tmp324 * tmp386;
-    let tmp427: f64 = tmp318 * tmp381;
-    let tmp428: f64 = tmp324 * tmp389;
-    let tmp429: f64 = tmp132 * tmp377;
-    let tmp430: f64 = tmp311 * tmp403;
-    let tmp431: f64 = tmp337 * tmp357;
-    let tmp432: f64 = tmp395 * tmp61;
-    let tmp433: f64 = tmp113 * tmp413;
-    let tmp434: f64 = tmp269 * tmp348;
-    let tmp435: f64 = tmp313 * tmp361;
-    let tmp436: f64 = tmp333 * tmp406;
-    let tmp437: f64 = tmp130 * tmp398;
-    let tmp438: f64 = tmp418 - tmp419 - tmp420 + tmp421 - tmp422 - tmp423 + tmp424 - tmp425 + tmp426 + tmp427 - tmp428
-        + tmp429
-        - tmp430
-        + tmp431
-        - tmp432
-        - tmp433
-        - tmp434
-        + tmp435
-        - tmp436
-        - tmp437;
-    let tmp439: f64 = -tmp14 * tmp382 + tmp374 * tmp94 - tmp375 * tmp93 + tmp416 + tmp417 * tmp50;
-    let tmp440: f64 = tmp145 + tmp6;
-    let tmp441: f64 = tmp440 * attachments_m[(1, 2)];
-    let tmp442: f64 = tmp11 + tmp149 + tmp292 + tmp352;
-    let tmp443: f64 = tmp442 * attachments_m[(0, 2)];
-    let tmp444: f64 = tmp441 + tmp443;
-    let tmp445: f64 = tmp8 * attachments_m[(0, 2)];
-    let tmp446: f64 = tmp293 + tmp393;
-    let tmp447: f64 = tmp446 * attachments_m[(1, 2)];
-    let tmp448: f64 = tmp445 + tmp447;
-    let tmp449: f64 = tmp156 * tmp448 + tmp160 * tmp444;
-    let tmp450: f64 = tmp178 * tmp449;
-    let tmp451: f64 =
-        tmp185 * tmp450 - tmp186 * tmp449 + tmp44 * tmp444 - tmp444 * tmp64 - tmp448 * tmp45 + tmp448 * tmp61;
-    let tmp452: f64 = tmp440 * attachments_m[(1, 3)] + tmp442 * attachments_m[(0, 3)];
-    let tmp453: f64 = tmp446 * attachments_m[(1, 3)] + tmp8 * attachments_m[(0, 3)];
-    let tmp454: f64 = 0.5_f64 * tmp169 * tmp453 + 0.5_f64 * tmp170 * tmp452;
-    let tmp455: f64 =
-        tmp191 * tmp454 - tmp192 * tmp454 + tmp40 * tmp452 - tmp41 * tmp453 - tmp452 * tmp62 + tmp453 * tmp63;
-    let tmp456: f64 =
-        -tmp195 * tmp449 + tmp196 * tmp454 + tmp43 * tmp444 - tmp451 * tmp63 - tmp452 * tmp47 + tmp455 * tmp61;
-    let tmp457: f64 = tmp440 * attachments_m[(1, 0)] + tmp442 * attachments_m[(0, 0)];
-    let tmp458: f64 = tmp446 * attachments_m[(1, 0)] + tmp8 * attachments_m[(0, 0)];
-    let tmp459: f64 = 0.5_f64 * tmp216 * tmp458 + 0.5_f64 * tmp217 * tmp457;
-    let tmp460: f64 =
-        -tmp223 * tmp457 - tmp224 * tmp459 + tmp226 * tmp459 + tmp457 * tmp87 + tmp458 * tmp83 - tmp458 * tmp88;
-    let tmp461: f64 =
-        -tmp188 * tmp454 + tmp190 * tmp450 - tmp43 * tmp448 + tmp451 * tmp62 + tmp453 * tmp47 - tmp455 * tmp64;
-    let tmp462: f64 =
-        tmp165 * tmp449 + tmp167 * tmp452 - tmp175 * tmp454 + tmp177 * tmp454 - tmp180 * tmp450 - tmp181 * tmp453
-            + tmp182 * tmp448
-            - tmp183 * tmp444;
-    let tmp463: f64 = tmp68
-        * (tmp106 * tmp462 + tmp113 * tmp461 + tmp114 * tmp456 + tmp214 * tmp457 - tmp222 * tmp459 + tmp228 * tmp460
-            - tmp230 * tmp459
-            + tmp458 * tmp86);
-    let tmp464: f64 = tmp440 * attachments_m[(1, 1)] + tmp442 * attachments_m[(0, 1)];
-    let tmp465: f64 = tmp446 * attachments_m[(1, 1)] + tmp8 * attachments_m[(0, 1)];
-    let tmp466: f64 = 0.5_f64 * tmp198 * tmp465 + 0.5_f64 * tmp199 * tmp464;
-    let tmp467: f64 = tmp202 * tmp466;
-    let tmp468: f64 = tmp205 * tmp466;
-    let tmp469: f64 =
-        tmp130 * tmp465 - tmp135 * tmp464 - tmp14 * tmp467 + tmp464 * tmp58 - tmp465 * tmp59 + tmp468 * tmp50;
-    let tmp470: f64 = -tmp130 * tmp461 - tmp135 * tmp456 - tmp462 * tmp60 - tmp464 * tmp57 - tmp465 * tmp55
-        + tmp467 * tmp56
-        + tmp468 * tmp48
-        - tmp469 * tmp65;
-    let tmp471: f64 = tmp211 * tmp470;
-    let tmp472: f64 = -tmp445 - tmp447 + tmp453;
-    let tmp473: f64 = -tmp441 - tmp443 + tmp452;
-    let tmp474: f64 = -tmp24 * tmp453 + tmp26 * tmp452 + tmp32 * tmp448 - tmp34 * tmp444;
-    let tmp475: f64 = -tmp14 * tmp473 + tmp464 * tmp94 - tmp465 * tmp93 + tmp472 * tmp50 + tmp474;
-    let tmp476: f64 = tmp271 * tmp465;
-    let tmp477: f64 = tmp162 * tmp450;
-    let tmp478: f64 = tmp118 * tmp477;
-    let tmp479: f64 = tmp269 * tmp448;
-    let tmp480: f64 = tmp233 * tmp471;
-    let tmp481: f64 = tmp1 + tmp349;
-    let tmp482: f64 = tmp481 * attachments_m[(1, 1)] + tmp99 * attachments_m[(0, 1)];
-    let tmp483: f64 = tmp306 * tmp482;
-    let tmp484: f64 = tmp238 * tmp454;
-    let tmp485: f64 = tmp481 * attachments_m[(1, 3)] + tmp99 * attachments_m[(0, 3)];
-    let tmp486: f64 = tmp303 * tmp485;
-    let tmp487: f64 = tmp264 * tmp470;
-    let tmp488: f64 = tmp260 * tmp487;
-    let tmp489: f64 = tmp460 * reference_tension_n[0];
-    let tmp490: f64 = tmp221 * tmp459;
-    let tmp491: f64 = tmp220 * tmp459;
-    let tmp492: f64 = tmp68
-        * (tmp108 * tmp468 - tmp109 * tmp465 + tmp111 * tmp467
-            - tmp112 * tmp464
-            - tmp115 * tmp469
-            - tmp130
-                * (tmp110 * tmp458 + tmp114 * tmp455 - tmp229 * tmp42 * tmp459 - tmp245 * tmp453 + tmp248 * tmp454
-                    - tmp489 * tmp62)
-            - tmp135
-                * (-tmp110 * tmp457 - tmp113 * tmp455 + tmp245 * tmp452 - tmp258 * tmp454
-                    + tmp42 * tmp490
-                    + tmp489 * tmp63)
-            - tmp60
-                * (-tmp247 * tmp491 + tmp249 * tmp454 - tmp250 * tmp452 - tmp251 * tmp458
-                    + tmp252 * tmp453
-                    + tmp253 * tmp457
-                    + tmp255 * tmp459
-                    - tmp256 * tmp454));
-    let tmp493: f64 = tmp260 * tmp492;
-    let tmp494: f64 = tmp68
-        * (tmp121 * tmp468 - tmp122 * tmp465 + tmp124 * tmp467
-            - tmp125 * tmp464
-            - tmp126 * tmp469
-            - tmp130
-                * (-tmp114 * tmp451 - tmp123 * tmp458 - tmp274 * tmp450
-                    + tmp275 * tmp448
-                    + tmp278 * tmp459
-                    + tmp489 * tmp64)
-            - tmp135
-                * (tmp113 * tmp451 + tmp123 * tmp457 - tmp275 * tmp444 + tmp279 * tmp449
-                    - tmp281 * tmp459
-                    - tmp489 * tmp61)
-            - tmp60
-                * (tmp113 * tmp477 + tmp276 * tmp491 - tmp282 * tmp449 + tmp283 * tmp458 - tmp284 * tmp448
-                    + tmp285 * tmp444
-                    - tmp286 * tmp459
-                    - tmp287 * tmp457));
-    let tmp495: f64 = tmp243 * tmp494;
-    let tmp496: f64 = tmp241 * tmp470;
-    let tmp497: f64 = tmp243 * tmp496;
-    let tmp498: f64 = tmp134 * tmp458;
-    let tmp499: f64 = tmp458 * reference_tension_n[1];
-    let tmp500: f64 = tmp235 * tmp459;
-    let tmp501: f64 = tmp262 * tmp453;
-    let tmp502: f64 = platform_weight_n * (tmp446 * com_offset_m[1] + tmp8 * com_offset_m[0]);
-    let tmp503: f64 = tmp481 * attachments_m[(1, 0)] + tmp99 * attachments_m[(0, 0)];
-    let tmp504: f64 = tmp114 * tmp503;
-    let tmp505: f64 = tmp233 * tmp463;
-    let tmp506: f64 = tmp132 * tmp468;
-    let tmp507: f64 = tmp117 * (tmp481 * attachments_m[(1, 2)] + tmp99 * attachments_m[(0, 2)]);
-    let tmp508: f64 = tmp507 * tmp64;
-    let tmp509: f64 = tmp476 - tmp478 + tmp479 - tmp480 + tmp483 - tmp484 + tmp486 - tmp488 + tmp493 + tmp495 - tmp497
-        + tmp498
-        + tmp499
-        - tmp500
-        + tmp501
-        - tmp502
-        + tmp504
-        + tmp505
-        - tmp506
-        + tmp508;
-    let tmp510: f64 = tmp337 * tmp449;
-    let tmp511: f64 = tmp262 * tmp452;
-    let tmp512: f64 = tmp318 * tmp471;
-    let tmp513: f64 = tmp311 * tmp492;
-    let tmp514: f64 = tmp327 * tmp482;
-    let tmp515: f64 = tmp324 * tmp494;
-    let tmp516: f64 = tmp313 * tmp454;
-    let tmp517: f64 = tmp132 * tmp467;
-    let tmp518: f64 = tmp113 * tmp503;
-    let tmp519: f64 = tmp269 * tmp444;
-    let tmp520: f64 = tmp324 * tmp496;
-    let tmp521: f64 = platform_weight_n * (tmp440 * com_offset_m[1] + tmp442 * com_offset_m[0]);
-    let tmp522: f64 = tmp134 * tmp457;
-    let tmp523: f64 = tmp103 * tmp490;
-    let tmp524: f64 = tmp271 * tmp464;
-    let tmp525: f64 = tmp333 * tmp485;
-    let tmp526: f64 = tmp311 * tmp487;
-    let tmp527: f64 = tmp318 * tmp463;
-    let tmp528: f64 = tmp507 * tmp61;
-    let tmp529: f64 = tmp457 * reference_tension_n[1];
-    let tmp530: f64 =
-        tmp510 - tmp511 + tmp512 - tmp513 - tmp514 - tmp515 + tmp516 + tmp517 - tmp518 - tmp519 + tmp520 + tmp521
-            - tmp522
-            + tmp523
-            - tmp524
-            - tmp525
-            + tmp526
-            - tmp527
-            - tmp528
-            - tmp529;
-    let tmp531: f64 = tmp219 * tmp74;
-    let tmp532: f64 = tmp531 * tmp78;
-    let tmp533: f64 = tmp220 * tmp73;
-    let tmp534: f64 = tmp533 * tmp72;
-    let tmp535: f64 = tmp532 - tmp534 - tmp88;
-    let tmp536: f64 = tmp25 * tmp27;
-    let tmp537: f64 = tmp162 * tmp536;
-    let tmp538: f64 = tmp26 * tmp537;
-    let tmp539: f64 = tmp162 * tmp28;
-    let tmp540: f64 = tmp24 * tmp539;
-    let tmp541: f64 = -tmp45 - tmp538 + tmp540;
-    let tmp542: f64 = tmp173 * tmp36;
-    let tmp543: f64 = tmp32 * tmp542;
-    let tmp544: f64 = tmp176 * tmp33;
-    let tmp545: f64 = tmp34 * tmp544;
-    let tmp546: f64 = -tmp41 + tmp543 - tmp545;
-    let tmp547: f64 = tmp46 * tmp544;
-    let tmp548: f64 = tmp190 * tmp536;
-    let tmp549: f64 = -tmp548;
-    let tmp550: f64 = -tmp541 * tmp63 + tmp546 * tmp61 + tmp547 + tmp549;
-    let tmp551: f64 = tmp531 * reference_tension_n[0];
-    let tmp552: f64 = tmp48 * tmp551;
-    let tmp553: f64 = tmp542 * tmp61;
-    let tmp554: f64 = tmp537 * tmp62;
-    let tmp555: f64 = tmp544 * tmp64;
-    let tmp556: f64 = tmp539 * tmp63;
-    let tmp557: f64 = -tmp181 + tmp182 + tmp553 + tmp554 - tmp555 - tmp556;
-    let tmp558: f64 = tmp190 * tmp28;
-    let tmp559: f64 = -tmp43;
-    let tmp560: f64 = tmp46 * tmp542;
-    let tmp561: f64 = tmp47 + tmp541 * tmp62 - tmp546 * tmp64 + tmp558 + tmp559 - tmp560;
-    let tmp562: f64 = tmp533 * reference_tension_n[0];
-    let tmp563: f64 = tmp56 * tmp562;
-    let tmp564: f64 =
-        tmp68 * (tmp106 * tmp557 + tmp113 * tmp561 + tmp114 * tmp550 + tmp228 * tmp535 - tmp552 - tmp563 + tmp86);
-    let tmp565: f64 = tmp201 * tmp49;
-    let tmp566: f64 = tmp48 * tmp565;
-    let tmp567: f64 = tmp205 * tmp51;
-    let tmp568: f64 = tmp56 * tmp567;
-    let tmp569: f64 = tmp14 * tmp567;
-    let tmp570: f64 = tmp50 * tmp565;
-    let tmp571: f64 = -tmp569 + tmp570 - tmp59;
-    let tmp572: f64 = -tmp130 * tmp561 - tmp135 * tmp550 - tmp55 - tmp557 * tmp60 + tmp566 + tmp568 - tmp571 * tmp65;
-    let tmp573: f64 = tmp211 * tmp572;
-    let tmp574: f64 = tmp264 * tmp572;
-    let tmp575: f64 = tmp260 * tmp574;
-    let tmp576: f64 = tmp111 * tmp567;
-    let tmp577: f64 = tmp108 * tmp565;
-    let tmp578: f64 = tmp247 * tmp533;
-    let tmp579: f64 = tmp113 * tmp542;
-    let tmp580: f64 = tmp551 * tmp63;
-    let tmp581: f64 = tmp114 * tmp544;
-    let tmp582: f64 = -tmp245;
-    let tmp583: f64 = tmp42 * tmp551;
-    let tmp584: f64 = tmp106 * tmp542;
-    let tmp585: f64 = tmp106 * tmp544;
-    let tmp586: f64 = -tmp585;
-    let tmp587: f64 = tmp42 * tmp562;
-    let tmp588: f64 = tmp68
-        * (-tmp109
-            - tmp115 * tmp571
-            - tmp130 * (tmp110 + tmp114 * tmp546 - tmp247 * tmp535 + tmp582 - tmp583 + tmp584)
-            - tmp135 * (-tmp113 * tmp546 + tmp254 * tmp535 + tmp586 + tmp587)
-            + tmp576
-            + tmp577
-            - tmp60 * (-tmp251 + tmp252 - tmp578 - tmp579 + tmp580 + tmp581));
-    let tmp589: f64 = tmp260 * tmp588;
-    let tmp590: f64 = tmp121 * tmp565;
-    let tmp591: f64 = tmp124 * tmp567;
-    let tmp592: f64 = tmp113 * tmp539;
-    let tmp593: f64 = tmp276 * tmp533;
-    let tmp594: f64 = tmp114 * tmp537;
-    let tmp595: f64 = tmp551 * tmp61;
-    let tmp596: f64 = tmp106 * tmp537;
-    let tmp597: f64 = tmp277 * tmp533;
-    let tmp598: f64 = -tmp597;
-    let tmp599: f64 = -tmp123;
-    let tmp600: f64 = tmp106 * tmp539;
-    let tmp601: f64 = tmp277 * tmp531;
-    let tmp602: f64 = tmp68
-        * (-tmp122
-            - tmp126 * tmp571
-            - tmp130 * (-tmp114 * tmp541 + tmp275 + tmp276 * tmp535 + tmp599 - tmp600 + tmp601)
-            - tmp135 * (tmp113 * tmp541 - tmp280 * tmp535 + tmp596 + tmp598)
-            + tmp590
-            + tmp591
-            - tmp60 * (tmp283 - tmp284 + tmp592 + tmp593 - tmp594 - tmp595));
-    let tmp603: f64 = tmp243 * tmp602;
-    let tmp604: f64 = tmp233 * tmp564;
-    let tmp605: f64 = tmp233 * tmp573;
-    let tmp606: f64 = tmp241 * tmp572;
-    let tmp607: f64 = tmp243 * tmp606;
-    let tmp608: f64 = tmp103 * tmp551;
-    let tmp609: f64 = tmp134 - tmp608;
-    let tmp610: f64 = tmp118 * tmp539;
-    let tmp611: f64 = tmp269 - tmp610;
-    let tmp612: f64 = tmp129 * tmp542;
-    let tmp613: f64 = tmp262 - tmp612;
-    let tmp614: f64 = tmp132 * tmp565;
-    let tmp615: f64 = tmp271 - tmp614;
-    let tmp616: f64 = -tmp575 + tmp589 + tmp603 + tmp604 - tmp605 - tmp607 + tmp609 + tmp611 + tmp613 + tmp615;
-    let tmp617: f64 = tmp311 * tmp574;
-    let tmp618: f64 = tmp311 * tmp588;
-    let tmp619: f64 = tmp324 * tmp602;
-    let tmp620: f64 = tmp318 * tmp573;
-    let tmp621: f64 = tmp324 * tmp606;
-    let tmp622: f64 = tmp318 * tmp564;
-    let tmp623: f64 = tmp103 * tmp562;
-    let tmp624: f64 = tmp132 * tmp567;
-    let tmp625: f64 = tmp118 * tmp537;
-    let tmp626: f64 = tmp129 * tmp544;
-    let tmp627: f64 = tmp623 + tmp624 + tmp625 + tmp626;
-    let tmp628: f64 = tmp617 - tmp618 - tmp619 + tmp620 + tmp621 - tmp622 + tmp627;
-    let tmp629: f64 = -tmp623;
-    let tmp630: f64 = -tmp624;
-    let tmp631: f64 = -tmp625;
-    let tmp632: f64 = -tmp626;
-    let tmp633: f64 = tmp629 + tmp630 + tmp631 + tmp632;
-    let tmp634: f64 = -tmp134;
-    let tmp635: f64 = tmp608 + tmp634;
-    let tmp636: f64 = -tmp269;
-    let tmp637: f64 = tmp610 + tmp636;
-    let tmp638: f64 = -tmp271;
-    let tmp639: f64 = tmp614 + tmp638;
-    let tmp640: f64 = -tmp262;
-    let tmp641: f64 = tmp612 + tmp640;
-    let tmp642: f64 = tmp48 * tmp562;
-    let tmp643: f64 = tmp173 * tmp37;
-    let tmp644: f64 = tmp34 * tmp643;
-    let tmp645: f64 = tmp32 * tmp544;
-    let tmp646: f64 = tmp40 - tmp644 + tmp645;
-    let tmp647: f64 = tmp24 * tmp537;
-    let tmp648: f64 = tmp162 * tmp29;
-    let tmp649: f64 = tmp26 * tmp648;
-    let tmp650: f64 = tmp44 + tmp647 - tmp649;
-    let tmp651: f64 = -tmp547;
-    let tmp652: f64 = tmp548 + tmp62 * tmp650 - tmp64 * tmp646 + tmp651;
-    let tmp653: f64 = tmp219 * tmp80;
-    let tmp654: f64 = tmp653 * reference_tension_n[0];
-    let tmp655: f64 = tmp56 * tmp654;
-    let tmp656: f64 = tmp537 * tmp63;
-    let tmp657: f64 = tmp544 * tmp61;
-    let tmp658: f64 = tmp62 * tmp648;
-    let tmp659: f64 = tmp64 * tmp643;
-    let tmp660: f64 = tmp167 - tmp183 - tmp656 + tmp657 + tmp658 - tmp659;
-    let tmp661: f64 = -tmp47;
-    let tmp662: f64 = tmp190 * tmp29;
-    let tmp663: f64 = tmp46 * tmp643;
-    let tmp664: f64 = tmp43 + tmp61 * tmp646 - tmp63 * tmp650 + tmp661 - tmp662 + tmp663;
-    let tmp665: f64 = tmp653 * tmp72;
-    let tmp666: f64 = tmp533 * tmp78;
-    let tmp667: f64 = -tmp665 + tmp666 + tmp87;
-    let tmp668: f64 =
-        tmp68 * (tmp106 * tmp660 + tmp113 * tmp652 + tmp114 * tmp664 + tmp214 + tmp228 * tmp667 - tmp642 - tmp655);
-    let tmp669: f64 = tmp50 * tmp567;
-    let tmp670: f64 = tmp201 * tmp52;
-    let tmp671: f64 = tmp14 * tmp670;
-    let tmp672: f64 = tmp58 + tmp669 - tmp671;
-    let tmp673: f64 = tmp48 * tmp567;
-    let tmp674: f64 = tmp56 * tmp670;
-    let tmp675: f64 = -tmp130 * tmp652 - tmp135 * tmp664 - tmp57 - tmp60 * tmp660 - tmp65 * tmp672 + tmp673 + tmp674;
-    let tmp676: f64 = tmp211 * tmp675;
-    let tmp677: f64 = tmp264 * tmp675;
-    let tmp678: f64 = tmp260 * tmp677;
-    let tmp679: f64 = tmp241 * tmp675;
-    let tmp680: f64 = tmp243 * tmp679;
-    let tmp681: f64 = tmp233 * tmp676;
-    let tmp682: f64 = tmp111 * tmp670;
-    let tmp683: f64 = tmp108 * tmp567;
-    let tmp684: f64 = tmp106 * tmp643;
-    let tmp685: f64 = tmp667 * reference_tension_n[0];
-    let tmp686: f64 = -tmp110;
-    let tmp687: f64 = tmp42 * tmp654;
-    let tmp688: f64 = -tmp587;
-    let tmp689: f64 = tmp247 * tmp653;
-    let tmp690: f64 = tmp254 * tmp533;
-    let tmp691: f64 = tmp114 * tmp643;
-    let tmp692: f64 = tmp113 * tmp544;
-    let tmp693: f64 = tmp68
-        * (-tmp112
-            - tmp115 * tmp672
-            - tmp130 * (tmp114 * tmp646 - tmp247 * tmp667 + tmp585 + tmp688)
-            - tmp135 * (-tmp113 * tmp646 + tmp245 + tmp63 * tmp685 - tmp684 + tmp686 + tmp687)
-            - tmp60 * (-tmp250 + tmp253 - tmp689 + tmp690 + tmp691 - tmp692)
-            + tmp682
-            + tmp683);
-    let tmp694: f64 = tmp260 * tmp693;
-    let tmp695: f64 = tmp233 * tmp668;
-    let tmp696: f64 = tmp121 * tmp567;
-    let tmp697: f64 = tmp124 * tmp670;
-    let tmp698: f64 = -tmp275;
-    let tmp699: f64 = tmp106 * tmp648;
-    let tmp700: f64 = tmp277 * tmp653;
-    let tmp701: f64 = tmp113 * tmp537;
-    let tmp702: f64 = tmp64 * tmp654;
-    let tmp703: f64 = tmp280 * tmp533;
-    let tmp704: f64 = tmp114 * tmp648;
-    let tmp705: f64 = -tmp596;
-    let tmp706: f64 = tmp68
-        * (-tmp125
-            - tmp126 * tmp672
-            - tmp130 * (-tmp114 * tmp650 + tmp597 + tmp64 * tmp685 + tmp705)
-            - tmp135 * (tmp113 * tmp650 + tmp123 - tmp61 * tmp685 + tmp698 + tmp699 - tmp700)
-            - tmp60 * (tmp285 - tmp287 + tmp701 + tmp702 - tmp703 - tmp704)
-            + tmp696
-            + tmp697);
-    let tmp707: f64 = tmp243 * tmp706;
-    let tmp708: f64 = tmp633 - tmp678 - tmp680 - tmp681 + tmp694 + tmp695 + tmp707;
-    let tmp709: f64 = tmp318 * tmp676;
-    let tmp710: f64 = tmp324 * tmp706;
-    let tmp711: f64 = tmp311 * tmp693;
-    let tmp712: f64 = tmp311 * tmp677;
-    let tmp713: f64 = tmp324 * tmp679;
-    let tmp714: f64 = tmp318 * tmp668;
-    let tmp715: f64 = tmp103 * tmp654;
-    let tmp716: f64 = tmp634 + tmp715;
-    let tmp717: f64 = tmp132 * tmp670;
-    let tmp718: f64 = tmp638 + tmp717;
-    let tmp719: f64 = tmp129 * tmp643;
-    let tmp720: f64 = tmp640 + tmp719;
-    let tmp721: f64 = tmp118 * tmp648;
-    let tmp722: f64 = tmp636 + tmp721;
-    let tmp723: f64 = tmp709 - tmp710 - tmp711 + tmp712 + tmp713 - tmp714 + tmp716 + tmp718 + tmp720 + tmp722;
-    let tmp724: f64 = tmp134 - tmp715;
-    let tmp725: f64 = tmp271 - tmp717;
-    let tmp726: f64 = tmp262 - tmp719;
-    let tmp727: f64 = tmp269 - tmp721;
-    let tmp728: f64 = tmp68 * (tmp223 * tmp48 + tmp84 + tmp90);
-    let tmp729: f64 = tmp68
-        * (-tmp130 * (-tmp223 * tmp46 + tmp64 * tmp89)
-            - tmp135 * (tmp120 - tmp61 * tmp89)
-            - tmp60 * (tmp223 * tmp61 - tmp64 * tmp83));
-    let tmp730: f64 = tmp243 * tmp729;
-    let tmp731: f64 = tmp68
-        * (-tmp130 * (tmp223 * tmp42 - tmp62 * tmp89)
-            - tmp135 * (-tmp107 + tmp63 * tmp89)
-            - tmp60 * (-tmp223 * tmp63 + tmp62 * tmp83));
-    let tmp732: f64 = tmp260 * tmp731;
-    let tmp733: f64 = tmp233 * tmp728;
-    let tmp734: f64 = tmp103 * tmp223;
-    let tmp735: f64 = tmp730 + tmp732 + tmp733 + tmp734;
-    let tmp736: f64 = tmp324 * tmp729;
-    let tmp737: f64 = tmp311 * tmp731;
-    let tmp738: f64 = tmp318 * tmp728;
-    let tmp739: f64 = -tmp104 - tmp736 - tmp737 - tmp738;
-    let tmp740: f64 = -tmp75 - tmp76 - tmp77;
-    let tmp741: f64 = -tmp532 + tmp534 + tmp88;
-    let tmp742: f64 = tmp68 * (tmp228 * tmp741 + tmp552 + tmp563 - tmp86);
-    let tmp743: f64 = tmp68
-        * (-tmp130 * (-tmp247 * tmp741 + tmp583 + tmp686)
-            - tmp135 * (tmp254 * tmp741 + tmp688)
-            - tmp60 * (tmp251 + tmp578 - tmp580));
-    let tmp744: f64 = tmp311 * tmp743;
-    let tmp745: f64 = tmp318 * tmp742;
-    let tmp746: f64 = tmp68
-        * (-tmp130 * (tmp123 + tmp276 * tmp741 - tmp601)
-            - tmp135 * (-tmp280 * tmp741 + tmp597)
-            - tmp60 * (-tmp283 - tmp593 + tmp595));
-    let tmp747: f64 = tmp324 * tmp746;
-    let tmp748: f64 = tmp629 - tmp744 - tmp745 - tmp747;
-    let tmp749: f64 = tmp243 * tmp746;
-    let tmp750: f64 = tmp233 * tmp742;
-    let tmp751: f64 = tmp260 * tmp743;
-    let tmp752: f64 = tmp635 + tmp749 + tmp750 + tmp751;
-    let tmp753: f64 = tmp665 - tmp666 - tmp87;
-    let tmp754: f64 = tmp68 * (-tmp214 + tmp228 * tmp753 + tmp642 + tmp655);
-    let tmp755: f64 = tmp233 * tmp754;
-    let tmp756: f64 = tmp753 * reference_tension_n[0];
-    let tmp757: f64 = tmp68
-        * (-tmp130 * (tmp598 + tmp64 * tmp756)
-            - tmp135 * (tmp599 - tmp61 * tmp756 + tmp700)
-            - tmp60 * (tmp287 - tmp702 + tmp703));
-    let tmp758: f64 = tmp243 * tmp757;
-    let tmp759: f64 = tmp68
-        * (-tmp130 * (tmp587 - tmp62 * tmp756)
-            - tmp135 * (tmp110 + tmp63 * tmp756 - tmp687)
-            - tmp60 * (-tmp253 + tmp689 - tmp690));
-    let tmp760: f64 = tmp260 * tmp759;
-    let tmp761: f64 = tmp623 + tmp755 + tmp758 + tmp760;
-    let tmp762: f64 = tmp318 * tmp754;
-    let tmp763: f64 = tmp324 * tmp757;
-    let tmp764: f64 = tmp311 * tmp759;
-    let tmp765: f64 = tmp724 - tmp762 - tmp763 - tmp764;
-    let tmp766: f64 = tmp569 - tmp570 + tmp59;
-    let tmp767: f64 = tmp55 - tmp566 - tmp568 - tmp65 * tmp766;
-    let tmp768: f64 = tmp211 * tmp767;
-    let tmp769: f64 = tmp264 * tmp767;
-    let tmp770: f64 = tmp311 * tmp769;
-    let tmp771: f64 = tmp68 * (tmp109 - tmp115 * tmp766 - tmp576 - tmp577);
-    let tmp772: f64 = tmp311 * tmp771;
-    let tmp773: f64 = tmp318 * tmp768;
-    let tmp774: f64 = tmp241 * tmp767;
-    let tmp775: f64 = tmp324 * tmp774;
-    let tmp776: f64 = tmp68 * (tmp122 - tmp126 * tmp766 - tmp590 - tmp591);
-    let tmp777: f64 = tmp324 * tmp776;
-    let tmp778: f64 = tmp630 + tmp770 - tmp772 + tmp773 + tmp775 - tmp777;
-    let tmp779: f64 = tmp243 * tmp774;
-    let tmp780: f64 = tmp243 * tmp776;
-    let tmp781: f64 = tmp233 * tmp768;
-    let tmp782: f64 = tmp260 * tmp771;
-    let tmp783: f64 = tmp260 * tmp769;
-    let tmp784: f64 = tmp639 - tmp779 + tmp780 - tmp781 + tmp782 - tmp783;
-    let tmp785: f64 = -tmp58 - tmp669 + tmp671;
-    let tmp786: f64 = tmp57 - tmp65 * tmp785 - tmp673 - tmp674;
-    let tmp787: f64 = tmp211 * tmp786;
-    let tmp788: f64 = tmp241 * tmp786;
-    let tmp789: f64 = tmp243 * tmp788;
-    let tmp790: f64 = tmp264 * tmp786;
-    let tmp791: f64 = tmp260 * tmp790;
-    let tmp792: f64 = tmp233 * tmp787;
-    let tmp793: f64 = tmp68 * (tmp112 - tmp115 * tmp785 - tmp682 - tmp683);
-    let tmp794: f64 = tmp260 * tmp793;
-    let tmp795: f64 = tmp68 * (tmp125 - tmp126 * tmp785 - tmp696 - tmp697);
-    let tmp796: f64 = tmp243 * tmp795;
-    let tmp797: f64 = tmp624 - tmp789 - tmp791 - tmp792 + tmp794 + tmp796;
-    let tmp798: f64 = tmp324 * tmp795;
-    let tmp799: f64 = tmp311 * tmp793;
-    let tmp800: f64 = tmp318 * tmp787;
-    let tmp801: f64 = tmp324 * tmp788;
-    let tmp802: f64 = tmp311 * tmp790;
-    let tmp803: f64 = tmp725 - tmp798 - tmp799 + tmp800 + tmp801 + tmp802;
-    let tmp804: f64 = -tmp182 - tmp554 + tmp556;
-    let tmp805: f64 = tmp45 + tmp538 - tmp540;
-    let tmp806: f64 = tmp43 - tmp558 + tmp62 * tmp805;
-    let tmp807: f64 = tmp548 - tmp63 * tmp805;
-    let tmp808: f64 = -tmp130 * tmp806 - tmp135 * tmp807 - tmp60 * tmp804;
-    let tmp809: f64 = tmp211 * tmp808;
-    let tmp810: f64 = tmp68 * (tmp106 * tmp804 + tmp113 * tmp806 + tmp114 * tmp807);
-    let tmp811: f64 = tmp241 * tmp808;
-    let tmp812: f64 = tmp243 * tmp811;
-    let tmp813: f64 = tmp264 * tmp808;
-    let tmp814: f64 = tmp260 * tmp813;
-    let tmp815: f64 = tmp233 * tmp809;
-    let tmp816: f64 = tmp233 * tmp810;
-    let tmp817: f64 = tmp68
-        * (-tmp130 * (-tmp114 * tmp805 + tmp600 + tmp698)
-            - tmp135 * (tmp113 * tmp805 + tmp705)
-            - tmp60 * (tmp284 - tmp592 + tmp594));
-    let tmp818: f64 = tmp243 * tmp817;
-    let tmp819: f64 = tmp637 - tmp812 - tmp814 - tmp815 + tmp816 + tmp818;
-    let tmp820: f64 = tmp318 * tmp809;
-    let tmp821: f64 = tmp318 * tmp810;
-    let tmp822: f64 = tmp311 * tmp813;
-    let tmp823: f64 = tmp324 * tmp811;
-    let tmp824: f64 = tmp324 * tmp817;
-    let tmp825: f64 = tmp631 + tmp820 - tmp821 + tmp822 + tmp823 - tmp824;
-    let tmp826: f64 = -tmp44 - tmp647 + tmp649;
-    let tmp827: f64 = tmp549 + tmp62 * tmp826;
-    let tmp828: f64 = tmp559 - tmp63 * tmp826 + tmp662;
-    let tmp829: f64 = tmp183 + tmp656 - tmp658;
-    let tmp830: f64 = -tmp130 * tmp827 - tmp135 * tmp828 - tmp60 * tmp829;
-    let tmp831: f64 = tmp211 * tmp830;
-    let tmp832: f64 = tmp68 * (tmp106 * tmp829 + tmp113 * tmp827 + tmp114 * tmp828);
-    let tmp833: f64 = tmp68
-        * (-tmp130 * (-tmp114 * tmp826 + tmp596)
-            - tmp135 * (tmp113 * tmp826 + tmp275 - tmp699)
-            - tmp60 * (-tmp285 - tmp701 + tmp704));
-    let tmp834: f64 = tmp324 * tmp833;
-    let tmp835: f64 = tmp318 * tmp831;
-    let tmp836: f64 = tmp241 * tmp830;
-    let tmp837: f64 = tmp324 * tmp836;
-    let tmp838: f64 = tmp264 * tmp830;
-    let tmp839: f64 = tmp311 * tmp838;
-    let tmp840: f64 = tmp318 * tmp832;
-    let tmp841: f64 = tmp727 - tmp834 + tmp835 + tmp837 + tmp839 - tmp840;
-    let tmp842: f64 = tmp243 * tmp833;
-    let tmp843: f64 = tmp260 * tmp838;
-    let tmp844: f64 = tmp243 * tmp836;
-    let tmp845: f64 = tmp233 * tmp831;
-    let tmp846: f64 = tmp233 * tmp832;
-    let tmp847: f64 = tmp625 + tmp842 - tmp843 - tmp844 - tmp845 + tmp846;
-    let tmp848: f64 = tmp41 - tmp543 + tmp545;
-    let tmp849: f64 = tmp61 * tmp848 + tmp651;
-    let tmp850: f64 = tmp181 - tmp553 + tmp555;
-    let tmp851: f64 = tmp560 - tmp64 * tmp848 + tmp661;
-    let tmp852: f64 = tmp68 * (tmp106 * tmp850 + tmp113 * tmp851 + tmp114 * tmp849);
-    let tmp853: f64 = -tmp130 * tmp851 - tmp135 * tmp849 - tmp60 * tmp850;
-    let tmp854: f64 = tmp211 * tmp853;
-    let tmp855: f64 = tmp318 * tmp854;
-    let tmp856: f64 = tmp318 * tmp852;
-    let tmp857: f64 = tmp68
-        * (-tmp130 * (tmp114 * tmp848 + tmp245 - tmp584)
-            - tmp135 * (-tmp113 * tmp848 + tmp585)
-            - tmp60 * (-tmp252 + tmp579 - tmp581));
-    let tmp858: f64 = tmp311 * tmp857;
-    let tmp859: f64 = tmp241 * tmp853;
-    let tmp860: f64 = tmp324 * tmp859;
-    let tmp861: f64 = tmp264 * tmp853;
-    let tmp862: f64 = tmp311 * tmp861;
-    let tmp863: f64 = tmp632 + tmp855 - tmp856 - tmp858 + tmp860 + tmp862;
-    let tmp864: f64 = tmp233 * tmp854;
-    let tmp865: f64 = tmp260 * tmp857;
-    let tmp866: f64 = tmp243 * tmp859;
-    let tmp867: f64 = tmp233 * tmp852;
-    let tmp868: f64 = tmp260 * tmp861;
-    let tmp869: f64 = tmp641 - tmp864 + tmp865 - tmp866 + tmp867 - tmp868;
-    let tmp870: f64 = -tmp40 + tmp644 - tmp645;
-    let tmp871: f64 = tmp547 - tmp64 * tmp870;
-    let tmp872: f64 = -tmp167 - tmp657 + tmp659;
-    let tmp873: f64 = tmp47 + tmp61 * tmp870 - tmp663;
-    let tmp874: f64 = -tmp130 * tmp871 - tmp135 * tmp873 - tmp60 * tmp872;
-    let tmp875: f64 = tmp210 * tmp874;
-    let tmp876: f64 = tmp875 * tmp91;
-    let tmp877: f64 = tmp68 * (tmp106 * tmp872 + tmp113 * tmp871 + tmp114 * tmp873);
-    let tmp878: f64 = tmp318 * tmp876;
-    let tmp879: f64 = tmp127 * tmp875;
-    let tmp880: f64 = tmp324 * tmp879;
-    let tmp881: f64 = tmp318 * tmp877;
-    let tmp882: f64 = tmp68
-        * (-tmp130 * (tmp114 * tmp870 + tmp586)
-            - tmp135 * (-tmp113 * tmp870 + tmp582 + tmp684)
-            - tmp60 * (tmp250 - tmp691 + tmp692));
-    let tmp883: f64 = tmp311 * tmp882;
-    let tmp884: f64 = tmp264 * tmp874;
-    let tmp885: f64 = tmp311 * tmp884;
-    let tmp886: f64 = tmp726 + tmp878 + tmp880 - tmp881 - tmp883 + tmp885;
-    let tmp887: f64 = tmp233 * tmp877;
-    let tmp888: f64 = tmp233 * tmp876;
-    let tmp889: f64 = tmp243 * tmp879;
-    let tmp890: f64 = tmp260 * tmp884;
-    let tmp891: f64 = tmp260 * tmp882;
-    let tmp892: f64 = tmp626 + tmp887 - tmp888 - tmp889 - tmp890 + tmp891;
+    let tmp6: f64 = tmp2 * rotation_xyzw[1];
+    let tmp7: f64 = -tmp5 + tmp6;
+    let tmp8: f64 = -2.0_f64 * (rotation_xyzw[2] * rotation_xyzw[2]);
+    let tmp9: f64 = 1.0_f64 - 2.0_f64 * (rotation_xyzw[1] * rotation_xyzw[1]);
+    let tmp10: f64 = tmp8 + tmp9;
+    let tmp11: f64 = tmp10 * attachments_m[(0, 0)] + tmp4 * attachments_m[(2, 0)] + tmp7 * attachments_m[(1, 0)];
+    let tmp12: f64 = tmp11 - anchors_m[(0, 0)] + position_m[0];
+    let tmp13: f64 = tmp12 * tmp12;
+    let tmp14: f64 = tmp2 * rotation_xyzw[3];
+    let tmp15: f64 = 2.0_f64 * rotation_xyzw[1] * rotation_xyzw[2];
+    let tmp16: f64 = -tmp14 + tmp15;
+    let tmp17: f64 = tmp5 + tmp6;
+    let tmp18: f64 = -2.0_f64 * (rotation_xyzw[0] * rotation_xyzw[0]);
+    let tmp19: f64 = tmp18 + tmp8 + 1.0_f64;
+    let tmp20: f64 = tmp16 * attachments_m[(2, 0)] + tmp17 * attachments_m[(0, 0)] + tmp19 * attachments_m[(1, 0)];
+    let tmp21: f64 = tmp20 - anchors_m[(1, 0)] + position_m[1];
+    let tmp22: f64 = tmp21 * tmp21;
+    let tmp23: f64 = tmp13 + tmp22 + epsilon;
+    let tmp24: f64 = 1.0_f64 / tmp23.sqrt();
+    let tmp25: f64 = tmp21 * tmp24;
+    let tmp26: f64 = tmp12 * tmp24;
+    let tmp27: f64 = tmp11 * tmp25 - tmp20 * tmp26;
+    let tmp28: f64 = tmp10 * attachments_m[(0, 2)] + tmp4 * attachments_m[(2, 2)] + tmp7 * attachments_m[(1, 2)];
+    let tmp29: f64 = tmp28 - anchors_m[(0, 2)] + position_m[0];
+    let tmp30: f64 = tmp29 * tmp29;
+    let tmp31: f64 = tmp16 * attachments_m[(2, 2)] + tmp17 * attachments_m[(0, 2)] + tmp19 * attachments_m[(1, 2)];
+    let tmp32: f64 = tmp31 - anchors_m[(1, 2)] + position_m[1];
+    let tmp33: f64 = tmp32 * tmp32;
+    let tmp34: f64 = tmp30 + tmp33 + epsilon;
+    let tmp35: f64 = 1.0_f64 / tmp34.sqrt();
+    let tmp36: f64 = tmp32 * tmp35;
+    let tmp37: f64 = tmp10 * attachments_m[(0, 3)] + tmp4 * attachments_m[(2, 3)] + tmp7 * attachments_m[(1, 3)];
+    let tmp38: f64 = tmp37 - anchors_m[(0, 3)] + position_m[0];
+    let tmp39: f64 = tmp38 * tmp38;
+    let tmp40: f64 = tmp16 * attachments_m[(2, 3)] + tmp17 * attachments_m[(0, 3)] + tmp19 * attachments_m[(1, 3)];
+    let tmp41: f64 = tmp40 - anchors_m[(1, 3)] + position_m[1];
+    let tmp42: f64 = tmp41 * tmp41;
+    let tmp43: f64 = tmp39 + tmp42 + epsilon;
+    let tmp44: f64 = 1.0_f64 / tmp43.sqrt();
+    let tmp45: f64 = tmp38 * tmp44;
+    let tmp46: f64 = tmp29 * tmp35;
+    let tmp47: f64 = tmp41 * tmp44;
+    let tmp48: f64 = -tmp36 * tmp45 + tmp46 * tmp47;
+    let tmp49: f64 = tmp37 * tmp47 - tmp40 * tmp45;
+    let tmp50: f64 = tmp28 * tmp36 - tmp31 * tmp46;
+    let tmp51: f64 = tmp44 * tmp50;
+    let tmp52: f64 = tmp36 * tmp49 - tmp41 * tmp51;
+    let tmp53: f64 = tmp10 * attachments_m[(0, 1)] + tmp4 * attachments_m[(2, 1)] + tmp7 * attachments_m[(1, 1)];
+    let tmp54: f64 = tmp53 - anchors_m[(0, 1)] + position_m[0];
+    let tmp55: f64 = tmp54 * tmp54;
+    let tmp56: f64 = tmp16 * attachments_m[(2, 1)] + tmp17 * attachments_m[(0, 1)] + tmp19 * attachments_m[(1, 1)];
+    let tmp57: f64 = tmp56 - anchors_m[(1, 1)] + position_m[1];
+    let tmp58: f64 = tmp57 * tmp57;
+    let tmp59: f64 = tmp55 + tmp58 + epsilon;
+    let tmp60: f64 = 1.0_f64 / tmp59.sqrt();
+    let tmp61: f64 = tmp54 * tmp60;
+    let tmp62: f64 = tmp38 * tmp51 - tmp46 * tmp49;
+    let tmp63: f64 = tmp57 * tmp60;
+    let tmp64: f64 = tmp53 * tmp63 - tmp56 * tmp61;
+    let tmp65: f64 = -tmp48 * tmp64 - tmp52 * tmp61 - tmp62 * tmp63;
+    let tmp66: f64 = 1.0_f64 / (tmp65 + epsilon * tmp65.signum());
+    let tmp67: f64 = tmp48 * tmp66;
+    let tmp68: f64 = tmp27 * tmp67;
+    let tmp69: f64 = tmp62 * tmp66;
+    let tmp70: f64 = tmp25 * tmp69;
+    let tmp71: f64 = tmp52 * tmp66;
+    let tmp72: f64 = tmp26 * reference_tension_n[0];
+    let tmp73: f64 = tmp68 * reference_tension_n[0] + tmp70 * reference_tension_n[0] + tmp71 * tmp72;
+    let tmp74: f64 = platform_weight_n - reference_tension_n[1];
+    let tmp75: f64 = tmp28 * tmp40 - tmp31 * tmp37;
+    let tmp76: f64 = -tmp31 + tmp40;
+    let tmp77: f64 = -tmp28 + tmp37;
+    let tmp78: f64 = -tmp53 * tmp76 + tmp56 * tmp77 + tmp75;
+    let tmp79: f64 = 1.0_f64 / (tmp78 + epsilon * tmp78.signum());
+    let tmp80: f64 = tmp75 * tmp79;
+    let tmp81: f64 = tmp14 + tmp15;
+    let tmp82: f64 = -tmp1 + tmp3;
+    let tmp83: f64 = tmp18 + tmp9;
+    let tmp84: f64 = tmp81 * attachments_m[(1, 0)] + tmp82 * attachments_m[(0, 0)] + tmp83 * attachments_m[(2, 0)];
+    let tmp85: f64 = tmp26 * tmp84;
+    let tmp86: f64 = tmp66 * (tmp46 * tmp64 - tmp50 * tmp61);
+    let tmp87: f64 = tmp25 * reference_tension_n[0];
+    let tmp88: f64 = -tmp36 * tmp64 + tmp50 * tmp63;
+    let tmp89: f64 = tmp66 * tmp88;
+    let tmp90: f64 = tmp26 * tmp89;
+    let tmp91: f64 = tmp36 * tmp61 - tmp46 * tmp63;
+    let tmp92: f64 = tmp66 * tmp91;
+    let tmp93: f64 = tmp27 * tmp92;
+    let tmp94: f64 = tmp86 * tmp87 + tmp90 * reference_tension_n[0] + tmp93 * reference_tension_n[0];
+    let tmp95: f64 = tmp81 * attachments_m[(1, 3)] + tmp82 * attachments_m[(0, 3)] + tmp83 * attachments_m[(2, 3)];
+    let tmp96: f64 = tmp94 * tmp95;
+    let tmp97: f64 = tmp81 * attachments_m[(1, 1)] + tmp82 * attachments_m[(0, 1)] + tmp83 * attachments_m[(2, 1)];
+    let tmp98: f64 = tmp73 * tmp97;
+    let tmp99: f64 = tmp45 * tmp63 - tmp47 * tmp61;
+    let tmp100: f64 = tmp66 * tmp99;
+    let tmp101: f64 = tmp100 * tmp27;
+    let tmp102: f64 = -tmp45 * tmp64 + tmp49 * tmp61;
+    let tmp103: f64 = tmp102 * tmp66;
+    let tmp104: f64 = tmp47 * tmp64 - tmp49 * tmp63;
+    let tmp105: f64 = tmp104 * tmp66;
+    let tmp106: f64 = tmp105 * tmp26;
+    let tmp107: f64 = tmp101 * reference_tension_n[0] + tmp103 * tmp87 + tmp106 * reference_tension_n[0];
+    let tmp108: f64 = tmp81 * attachments_m[(1, 2)] + tmp82 * attachments_m[(0, 2)] + tmp83 * attachments_m[(2, 2)];
+    let tmp109: f64 = tmp107 * tmp108;
+    let tmp110: f64 = tmp109 * tmp46
+        + tmp11 * reference_tension_n[1]
+        + tmp45 * tmp96
+        + tmp61 * tmp98
+        + tmp85 * reference_tension_n[0]
+        - platform_weight_n * (tmp10 * com_offset_m[0] + tmp4 * com_offset_m[2] + tmp7 * com_offset_m[1]);
+    let tmp111: f64 = tmp76 * tmp79;
+    let tmp112: f64 = tmp25 * tmp84;
+    let tmp113: f64 = -tmp109 * tmp36
+        - tmp112 * reference_tension_n[0]
+        - tmp20 * reference_tension_n[1]
+        - tmp47 * tmp96
+        - tmp63 * tmp98
+        + platform_weight_n * (tmp16 * com_offset_m[2] + tmp17 * com_offset_m[0] + tmp19 * com_offset_m[1]);
+    let tmp114: f64 = tmp77 * tmp79;
+    let tmp115: f64 = tmp110 * tmp111 + tmp113 * tmp114 + tmp74 * tmp80;
+    let tmp116: f64 = tmp79 * (tmp37 * tmp56 - tmp40 * tmp53);
+    let tmp117: f64 = tmp79 * (-tmp40 + tmp56);
+    let tmp118: f64 = tmp79 * (-tmp37 + tmp53);
+    let tmp119: f64 = tmp110 * tmp117 + tmp113 * tmp118 + tmp116 * tmp74;
+    let tmp120: f64 = tmp79 * (tmp31 - tmp56);
+    let tmp121: f64 = tmp79 * (-tmp28 * tmp56 + tmp31 * tmp53);
+    let tmp122: f64 = tmp28 - tmp53;
+    let tmp123: f64 = tmp122 * tmp79;
+    let tmp124: f64 = tmp110 * tmp120 + tmp113 * tmp123 + tmp121 * tmp74;
+    let tmp125: f64 = tmp4 * attachments_m[(1, 0)] - tmp7 * attachments_m[(2, 0)];
+    let tmp126: f64 = tmp125 * tmp24;
+    let tmp127: f64 = tmp16 * attachments_m[(1, 0)] - tmp19 * attachments_m[(2, 0)];
+    let tmp128: f64 = tmp127 * tmp24;
+    let tmp129: f64 = tmp12 * tmp126 + tmp128 * tmp21;
+    let tmp130: f64 = 1.0_f64 / tmp23;
+    let tmp131: f64 = tmp130 * tmp21;
+    let tmp132: f64 = reference_tension_n[0] * (tmp128 - tmp129 * tmp131);
+    let tmp133: f64 = tmp21 * reference_tension_n[0];
+    let tmp134: f64 = tmp16 * attachments_m[(1, 1)] - tmp19 * attachments_m[(2, 1)];
+    let tmp135: f64 = tmp134 * tmp60;
+    let tmp136: f64 = tmp4 * attachments_m[(1, 1)] - tmp7 * attachments_m[(2, 1)];
+    let tmp137: f64 = tmp136 * tmp60;
+    let tmp138: f64 = tmp135 * tmp57 + tmp137 * tmp54;
+    let tmp139: f64 = 1.0_f64 / tmp59;
+    let tmp140: f64 = tmp139 * tmp54;
+    let tmp141: f64 = tmp137 - tmp138 * tmp140;
+    let tmp142: f64 = tmp139 * tmp57;
+    let tmp143: f64 = tmp135 - tmp138 * tmp142;
+    let tmp144: f64 = tmp16 * attachments_m[(1, 2)] - tmp19 * attachments_m[(2, 2)];
+    let tmp145: f64 = tmp144 * tmp35;
+    let tmp146: f64 = 1.0_f64 / tmp34;
+    let tmp147: f64 = tmp4 * attachments_m[(1, 2)] - tmp7 * attachments_m[(2, 2)];
+    let tmp148: f64 = tmp147 * tmp35;
+    let tmp149: f64 = tmp146 * (tmp145 * tmp32 + tmp148 * tmp29);
+    let tmp150: f64 = tmp145 - tmp149 * tmp32;
+    let tmp151: f64 = tmp148 - tmp149 * tmp29;
+    let tmp152: f64 = tmp4 * attachments_m[(1, 3)] - tmp7 * attachments_m[(2, 3)];
+    let tmp153: f64 = tmp152 * tmp44;
+    let tmp154: f64 = tmp16 * attachments_m[(1, 3)] - tmp19 * attachments_m[(2, 3)];
+    let tmp155: f64 = tmp154 * tmp44;
+    let tmp156: f64 = tmp153 * tmp38 + tmp155 * tmp41;
+    let tmp157: f64 = 1.0_f64 / tmp43;
+    let tmp158: f64 = tmp157 * tmp41;
+    let tmp159: f64 = tmp155 - tmp156 * tmp158;
+    let tmp160: f64 = tmp157 * tmp38;
+    let tmp161: f64 = tmp153 - tmp156 * tmp160;
+    let tmp162: f64 = tmp12 * tmp130;
+    let tmp163: f64 = reference_tension_n[0] * (tmp126 - tmp129 * tmp162);
+    let tmp164: f64 = tmp12 * reference_tension_n[0];
+    let tmp165: f64 = -tmp107 * (tmp145 * tmp29 - tmp148 * tmp32 - tmp150 * tmp28 + tmp151 * tmp31)
+        + tmp11 * tmp132
+        + tmp126 * tmp133
+        - tmp128 * tmp164
+        - tmp163 * tmp20
+        - tmp73 * (tmp135 * tmp54 - tmp137 * tmp57 + tmp141 * tmp56 - tmp143 * tmp53)
+        - tmp94 * (-tmp153 * tmp41 + tmp155 * tmp38 - tmp159 * tmp37 + tmp161 * tmp40);
+    let tmp166: f64 = tmp141 * tmp73;
+    let tmp167: f64 = tmp161 * tmp94;
+    let tmp168: f64 = tmp107 * tmp151;
+    let tmp169: f64 = tmp66 * (tmp163 + tmp166 + tmp167 + tmp168);
+    let tmp170: f64 = tmp107 * tmp150;
+    let tmp171: f64 = tmp143 * tmp73;
+    let tmp172: f64 = tmp159 * tmp94;
+    let tmp173: f64 = tmp132 + tmp170 + tmp171 + tmp172;
+    let tmp174: f64 = tmp165 * tmp67 + tmp169 * tmp52 + tmp173 * tmp69;
+    let tmp175: f64 = -tmp81 * attachments_m[(2, 0)] + tmp83 * attachments_m[(1, 0)];
+    let tmp176: f64 = tmp61 * tmp97;
+    let tmp177: f64 = -tmp81 * attachments_m[(2, 2)] + tmp83 * attachments_m[(1, 2)];
+    let tmp178: f64 = tmp107 * tmp46;
+    let tmp179: f64 = tmp165 * tmp92 + tmp169 * tmp88 + tmp173 * tmp86;
+    let tmp180: f64 = tmp45 * tmp95;
+    let tmp181: f64 = tmp100 * tmp165 + tmp103 * tmp173 + tmp104 * tmp169;
+    let tmp182: f64 = tmp108 * tmp46;
+    let tmp183: f64 = tmp73 * (-tmp81 * attachments_m[(2, 1)] + tmp83 * attachments_m[(1, 1)]);
+    let tmp184: f64 = tmp94 * (-tmp81 * attachments_m[(2, 3)] + tmp83 * attachments_m[(1, 3)]);
+    let tmp185: f64 = tmp108 * tmp168
+        + tmp115 * tmp136
+        + tmp119 * tmp147
+        + tmp124 * tmp152
+        + tmp125 * reference_tension_n[1]
+        + tmp163 * tmp84
+        + tmp166 * tmp97
+        + tmp167 * tmp95
+        + tmp174 * tmp176
+        + tmp175 * tmp72
+        + tmp177 * tmp178
+        + tmp179 * tmp180
+        + tmp181 * tmp182
+        + tmp183 * tmp61
+        + tmp184 * tmp45
+        - platform_weight_n * (tmp4 * com_offset_m[1] - tmp7 * com_offset_m[2]);
+    let tmp186: f64 = tmp108 * tmp36;
+    let tmp187: f64 = tmp47 * tmp95;
+    let tmp188: f64 = tmp63 * tmp97;
+    let tmp189: f64 = tmp107 * tmp36;
+    let tmp190: f64 = -tmp108 * tmp170
+        - tmp115 * tmp134
+        - tmp119 * tmp144
+        - tmp124 * tmp154
+        - tmp127 * reference_tension_n[1]
+        - tmp132 * tmp84
+        - tmp171 * tmp97
+        - tmp172 * tmp95
+        - tmp174 * tmp188
+        - tmp175 * tmp87
+        - tmp177 * tmp189
+        - tmp179 * tmp187
+        - tmp181 * tmp186
+        - tmp183 * tmp63
+        - tmp184 * tmp47
+        + platform_weight_n * (tmp16 * com_offset_m[1] - tmp19 * com_offset_m[2]);
+    let tmp191: f64 = tmp10 * attachments_m[(2, 1)] - tmp4 * attachments_m[(0, 1)];
+    let tmp192: f64 = tmp191 * tmp60;
+    let tmp193: f64 = -tmp16 * attachments_m[(0, 1)] + tmp17 * attachments_m[(2, 1)];
+    let tmp194: f64 = tmp193 * tmp60;
+    let tmp195: f64 = tmp192 * tmp54 + tmp194 * tmp57;
+    let tmp196: f64 = -tmp142 * tmp195 + tmp194;
+    let tmp197: f64 = tmp196 * tmp73;
+    let tmp198: f64 = tmp10 * attachments_m[(2, 3)] - tmp4 * attachments_m[(0, 3)];
+    let tmp199: f64 = tmp198 * tmp44;
+    let tmp200: f64 = -tmp16 * attachments_m[(0, 3)] + tmp17 * attachments_m[(2, 3)];
+    let tmp201: f64 = tmp200 * tmp44;
+    let tmp202: f64 = tmp199 * tmp38 + tmp201 * tmp41;
+    let tmp203: f64 = -tmp158 * tmp202 + tmp201;
+    let tmp204: f64 = tmp203 * tmp94;
+    let tmp205: f64 = tmp10 * attachments_m[(2, 2)] - tmp4 * attachments_m[(0, 2)];
+    let tmp206: f64 = tmp205 * tmp35;
+    let tmp207: f64 = -tmp16 * attachments_m[(0, 2)] + tmp17 * attachments_m[(2, 2)];
+    let tmp208: f64 = tmp207 * tmp35;
+    let tmp209: f64 = tmp146 * (tmp206 * tmp29 + tmp208 * tmp32);
+    let tmp210: f64 = tmp208 - tmp209 * tmp32;
+    let tmp211: f64 = tmp107 * tmp210;
+    let tmp212: f64 = tmp10 * attachments_m[(2, 0)] - tmp4 * attachments_m[(0, 0)];
+    let tmp213: f64 = tmp212 * tmp24;
+    let tmp214: f64 = -tmp16 * attachments_m[(0, 0)] + tmp17 * attachments_m[(2, 0)];
+    let tmp215: f64 = tmp214 * tmp24;
+    let tmp216: f64 = tmp12 * tmp213 + tmp21 * tmp215;
+    let tmp217: f64 = reference_tension_n[0] * (-tmp131 * tmp216 + tmp215);
+    let tmp218: f64 = tmp197 + tmp204 + tmp211 + tmp217;
+    let tmp219: f64 = -tmp160 * tmp202 + tmp199;
+    let tmp220: f64 = tmp219 * tmp94;
+    let tmp221: f64 = -tmp140 * tmp195 + tmp192;
+    let tmp222: f64 = tmp221 * tmp73;
+    let tmp223: f64 = tmp206 - tmp209 * tmp29;
+    let tmp224: f64 = tmp107 * tmp223;
+    let tmp225: f64 = reference_tension_n[0] * (-tmp162 * tmp216 + tmp213);
+    let tmp226: f64 = tmp220 + tmp222 + tmp224 + tmp225;
+    let tmp227: f64 = -tmp107 * (-tmp206 * tmp32 + tmp208 * tmp29 - tmp210 * tmp28 + tmp223 * tmp31)
+        + tmp11 * tmp217
+        + tmp133 * tmp213
+        - tmp164 * tmp215
+        - tmp20 * tmp225
+        - tmp73 * (-tmp192 * tmp57 + tmp194 * tmp54 - tmp196 * tmp53 + tmp221 * tmp56)
+        - tmp94 * (-tmp199 * tmp41 + tmp201 * tmp38 - tmp203 * tmp37 + tmp219 * tmp40);
+    let tmp228: f64 = tmp218 * tmp69 + tmp226 * tmp71 + tmp227 * tmp67;
+    let tmp229: f64 = tmp94 * (tmp82 * attachments_m[(2, 3)] - tmp83 * attachments_m[(0, 3)]);
+    let tmp230: f64 = tmp82 * attachments_m[(2, 2)] - tmp83 * attachments_m[(0, 2)];
+    let tmp231: f64 = tmp218 * tmp86 + tmp226 * tmp89 + tmp227 * tmp92;
+    let tmp232: f64 = tmp82 * attachments_m[(2, 0)] - tmp83 * attachments_m[(0, 0)];
+    let tmp233: f64 = tmp100 * tmp227 + tmp103 * tmp218 + tmp105 * tmp226;
+    let tmp234: f64 = tmp73 * (tmp82 * attachments_m[(2, 1)] - tmp83 * attachments_m[(0, 1)]);
+    let tmp235: f64 = tmp108 * tmp224
+        + tmp115 * tmp191
+        + tmp119 * tmp205
+        + tmp124 * tmp198
+        + tmp176 * tmp228
+        + tmp178 * tmp230
+        + tmp180 * tmp231
+        + tmp182 * tmp233
+        + tmp212 * reference_tension_n[1]
+        + tmp220 * tmp95
+        + tmp222 * tmp97
+        + tmp225 * tmp84
+        + tmp229 * tmp45
+        + tmp232 * tmp72
+        + tmp234 * tmp61
+        - platform_weight_n * (tmp10 * com_offset_m[2] - tmp4 * com_offset_m[0]);
+    let tmp236: f64 = -tmp108 * tmp211
+        - tmp115 * tmp193
+        - tmp119 * tmp207
+        - tmp124 * tmp200
+        - tmp186 * tmp233
+        - tmp187 * tmp231
+        - tmp188 * tmp228
+        - tmp189 * tmp230
+        - tmp197 * tmp97
+        - tmp204 * tmp95
+        - tmp214 * reference_tension_n[1]
+        - tmp217 * tmp84
+        - tmp229 * tmp47
+        - tmp232 * tmp87
+        - tmp234 * tmp63
+        + platform_weight_n * (-tmp16 * com_offset_m[0] + tmp17 * com_offset_m[2]);
+    let tmp237: f64 = -tmp17 * attachments_m[(1, 0)] + tmp19 * attachments_m[(0, 0)];
+    let tmp238: f64 = tmp237 * tmp24;
+    let tmp239: f64 = -tmp10 * attachments_m[(1, 0)] + tmp7 * attachments_m[(0, 0)];
+    let tmp240: f64 = tmp239 * tmp24;
+    let tmp241: f64 = tmp12 * tmp240 + tmp21 * tmp238;
+    let tmp242: f64 = reference_tension_n[0] * (-tmp131 * tmp241 + tmp238);
+    let tmp243: f64 = -tmp17 * attachments_m[(1, 1)] + tmp19 * attachments_m[(0, 1)];
+    let tmp244: f64 = tmp243 * tmp60;
+    let tmp245: f64 = -tmp10 * attachments_m[(1, 1)] + tmp7 * attachments_m[(0, 1)];
+    let tmp246: f64 = tmp245 * tmp60;
+    let tmp247: f64 = tmp244 * tmp57 + tmp246 * tmp54;
+    let tmp248: f64 = -tmp140 * tmp247 + tmp246;
+    let tmp249: f64 = -tmp142 * tmp247 + tmp244;
+    let tmp250: f64 = -tmp17 * attachments_m[(1, 2)] + tmp19 * attachments_m[(0, 2)];
+    let tmp251: f64 = tmp250 * tmp35;
+    let tmp252: f64 = -tmp10 * attachments_m[(1, 2)] + tmp7 * attachments_m[(0, 2)];
+    let tmp253: f64 = tmp252 * tmp35;
+    let tmp254: f64 = tmp146 * (tmp251 * tmp32 + tmp253 * tmp29);
+    let tmp255: f64 = tmp251 - tmp254 * tmp32;
+    let tmp256: f64 = tmp253 - tmp254 * tmp29;
+    let tmp257: f64 = -tmp17 * attachments_m[(1, 3)] + tmp19 * attachments_m[(0, 3)];
+    let tmp258: f64 = tmp257 * tmp44;
+    let tmp259: f64 = -tmp10 * attachments_m[(1, 3)] + tmp7 * attachments_m[(0, 3)];
+    let tmp260: f64 = tmp259 * tmp44;
+    let tmp261: f64 = tmp258 * tmp41 + tmp260 * tmp38;
+    let tmp262: f64 = -tmp158 * tmp261 + tmp258;
+    let tmp263: f64 = -tmp160 * tmp261 + tmp260;
+    let tmp264: f64 = reference_tension_n[0] * (-tmp162 * tmp241 + tmp240);
+    let tmp265: f64 = -tmp107 * (tmp251 * tmp29 - tmp253 * tmp32 - tmp255 * tmp28 + tmp256 * tmp31)
+        + tmp11 * tmp242
+        + tmp133 * tmp240
+        - tmp164 * tmp238
+        - tmp20 * tmp264
+        - tmp73 * (tmp244 * tmp54 - tmp246 * tmp57 + tmp248 * tmp56 - tmp249 * tmp53)
+        - tmp94 * (tmp258 * tmp38 - tmp260 * tmp41 - tmp262 * tmp37 + tmp263 * tmp40);
+    let tmp266: f64 = tmp107 * tmp256;
+    let tmp267: f64 = tmp248 * tmp73;
+    let tmp268: f64 = tmp263 * tmp94;
+    let tmp269: f64 = tmp264 + tmp266 + tmp267 + tmp268;
+    let tmp270: f64 = tmp249 * tmp73;
+    let tmp271: f64 = tmp107 * tmp255;
+    let tmp272: f64 = tmp262 * tmp94;
+    let tmp273: f64 = tmp242 + tmp270 + tmp271 + tmp272;
+    let tmp274: f64 = tmp273 * tmp66;
+    let tmp275: f64 = tmp265 * tmp67 + tmp269 * tmp71 + tmp274 * tmp62;
+    let tmp276: f64 = tmp73 * (tmp81 * attachments_m[(0, 1)] - tmp82 * attachments_m[(1, 1)]);
+    let tmp277: f64 = reference_tension_n[0] * (tmp81 * attachments_m[(0, 0)] - tmp82 * attachments_m[(1, 0)]);
+    let tmp278: f64 = tmp265 * tmp92 + tmp269 * tmp89 + tmp273 * tmp86;
+    let tmp279: f64 = tmp94 * (tmp81 * attachments_m[(0, 3)] - tmp82 * attachments_m[(1, 3)]);
+    let tmp280: f64 = tmp81 * attachments_m[(0, 2)] - tmp82 * attachments_m[(1, 2)];
+    let tmp281: f64 = tmp100 * tmp265 + tmp102 * tmp274 + tmp105 * tmp269;
+    let tmp282: f64 = -tmp108 * tmp271
+        - tmp115 * tmp243
+        - tmp119 * tmp250
+        - tmp124 * tmp257
+        - tmp186 * tmp281
+        - tmp187 * tmp278
+        - tmp188 * tmp275
+        - tmp189 * tmp280
+        - tmp237 * reference_tension_n[1]
+        - tmp242 * tmp84
+        - tmp25 * tmp277
+        - tmp270 * tmp97
+        - tmp272 * tmp95
+        - tmp276 * tmp63
+        - tmp279 * tmp47
+        + platform_weight_n * (-tmp17 * com_offset_m[1] + tmp19 * com_offset_m[0]);
+    let tmp283: f64 = tmp108 * tmp266
+        + tmp115 * tmp245
+        + tmp119 * tmp252
+        + tmp124 * tmp259
+        + tmp176 * tmp275
+        + tmp178 * tmp280
+        + tmp180 * tmp278
+        + tmp182 * tmp281
+        + tmp239 * reference_tension_n[1]
+        + tmp26 * tmp277
+        + tmp264 * tmp84
+        + tmp267 * tmp97
+        + tmp268 * tmp95
+        + tmp276 * tmp61
+        + tmp279 * tmp45
+        - platform_weight_n * (-tmp10 * com_offset_m[1] + tmp7 * com_offset_m[0]);
+    let tmp284: f64 = 1.0_f64 / (tmp43 * tmp43.sqrt());
+    let tmp285: f64 = tmp284 * tmp39;
+    let tmp286: f64 = -tmp285 + tmp44;
+    let tmp287: f64 = tmp284 * tmp38 * tmp41;
+    let tmp288: f64 = tmp287 * tmp37;
+    let tmp289: f64 = 1.0_f64 / (tmp59 * tmp59.sqrt());
+    let tmp290: f64 = tmp289 * tmp55;
+    let tmp291: f64 = -tmp290 + tmp60;
+    let tmp292: f64 = tmp289 * tmp54 * tmp57;
+    let tmp293: f64 = tmp292 * tmp53;
+    let tmp294: f64 = 1.0_f64 / (tmp34 * tmp34.sqrt());
+    let tmp295: f64 = tmp29 * tmp294 * tmp32;
+    let tmp296: f64 = tmp28 * tmp295;
+    let tmp297: f64 = tmp294 * tmp30;
+    let tmp298: f64 = -tmp297 + tmp35;
+    let tmp299: f64 = 1.0_f64 / (tmp23 * tmp23.sqrt());
+    let tmp300: f64 = tmp12 * tmp133 * tmp299;
+    let tmp301: f64 = tmp11 * tmp300;
+    let tmp302: f64 = tmp13 * tmp299;
+    let tmp303: f64 = reference_tension_n[0] * (tmp24 - tmp302);
+    let tmp304: f64 = tmp66
+        * (-tmp107 * (tmp296 + tmp298 * tmp31)
+            - tmp20 * tmp303
+            - tmp301
+            - tmp73 * (tmp291 * tmp56 + tmp293)
+            - tmp94 * (tmp286 * tmp40 + tmp288));
+    let tmp305: f64 = tmp286 * tmp94;
+    let tmp306: f64 = tmp107 * tmp298;
+    let tmp307: f64 = tmp291 * tmp73;
+    let tmp308: f64 = tmp303 + tmp305 + tmp306 + tmp307;
+    let tmp309: f64 = tmp107 * tmp295;
+    let tmp310: f64 = tmp292 * tmp73;
+    let tmp311: f64 = tmp287 * tmp94;
+    let tmp312: f64 = -tmp300 - tmp309 - tmp310 - tmp311;
+    let tmp313: f64 = tmp304 * tmp48 + tmp308 * tmp71 + tmp312 * tmp69;
+    let tmp314: f64 = tmp312 * tmp66;
+    let tmp315: f64 = tmp102 * tmp314 + tmp105 * tmp308 + tmp304 * tmp99;
+    let tmp316: f64 = tmp304 * tmp91 + tmp308 * tmp89 + tmp312 * tmp86;
+    let tmp317: f64 = tmp108 * tmp306
+        + tmp176 * tmp313
+        + tmp180 * tmp316
+        + tmp182 * tmp315
+        + tmp303 * tmp84
+        + tmp305 * tmp95
+        + tmp307 * tmp97;
+    let tmp318: f64 = tmp109 * tmp295;
+    let tmp319: f64 = tmp300 * tmp84;
+    let tmp320: f64 = tmp287 * tmp96;
+    let tmp321: f64 = tmp292 * tmp98;
+    let tmp322: f64 = -tmp186 * tmp315 - tmp187 * tmp316 - tmp188 * tmp313 + tmp318 + tmp319 + tmp320 + tmp321;
+    let tmp323: f64 = tmp22 * tmp299;
+    let tmp324: f64 = reference_tension_n[0] * (tmp24 - tmp323);
+    let tmp325: f64 = tmp294 * tmp33;
+    let tmp326: f64 = -tmp325 + tmp35;
+    let tmp327: f64 = tmp107 * tmp326;
+    let tmp328: f64 = tmp284 * tmp42;
+    let tmp329: f64 = -tmp328 + tmp44;
+    let tmp330: f64 = tmp329 * tmp94;
+    let tmp331: f64 = tmp289 * tmp58;
+    let tmp332: f64 = -tmp331 + tmp60;
+    let tmp333: f64 = tmp332 * tmp73;
+    let tmp334: f64 = tmp324 + tmp327 + tmp330 + tmp333;
+    let tmp335: f64 = tmp287 * tmp40;
+    let tmp336: f64 = tmp292 * tmp56;
+    let tmp337: f64 = tmp295 * tmp31;
+    let tmp338: f64 = tmp20 * tmp300;
+    let tmp339: f64 = -tmp107 * (-tmp28 * tmp326 - tmp337) + tmp11 * tmp324 + tmp338
+        - tmp73 * (-tmp332 * tmp53 - tmp336)
+        - tmp94 * (-tmp329 * tmp37 - tmp335);
+    let tmp340: f64 = tmp314 * tmp52 + tmp334 * tmp69 + tmp339 * tmp67;
+    let tmp341: f64 = -tmp318;
+    let tmp342: f64 = -tmp319;
+    let tmp343: f64 = -tmp320;
+    let tmp344: f64 = tmp100 * tmp339 + tmp103 * tmp334 + tmp105 * tmp312;
+    let tmp345: f64 = tmp314 * tmp88 + tmp334 * tmp86 + tmp339 * tmp92;
+    let tmp346: f64 = -tmp321;
+    let tmp347: f64 = tmp176 * tmp340 + tmp180 * tmp345 + tmp182 * tmp344 + tmp341 + tmp342 + tmp343 + tmp346;
+    let tmp348: f64 = -tmp108 * tmp327
+        - tmp186 * tmp344
+        - tmp187 * tmp345
+        - tmp188 * tmp340
+        - tmp324 * tmp84
+        - tmp330 * tmp95
+        - tmp333 * tmp97;
+    let tmp349: f64 = tmp26 * tmp71 + tmp68 + tmp70;
+    let tmp350: f64 = tmp25 * tmp86 + tmp90 + tmp93;
+    let tmp351: f64 = tmp101 + tmp103 * tmp25 + tmp106;
+    let tmp352: f64 = tmp176 * tmp349 + tmp180 * tmp350 + tmp182 * tmp351 + tmp85;
+    let tmp353: f64 = -tmp112 - tmp186 * tmp351 - tmp187 * tmp350 - tmp188 * tmp349;
+    let tmp354: f64 = -tmp24;
+    let tmp355: f64 = reference_tension_n[0] * (tmp302 + tmp354);
+    let tmp356: f64 = -tmp20 * tmp355 + tmp301;
+    let tmp357: f64 = tmp300 * tmp69 + tmp355 * tmp71 + tmp356 * tmp67;
+    let tmp358: f64 = tmp300 * tmp86 + tmp355 * tmp89 + tmp356 * tmp92;
+    let tmp359: f64 = tmp100 * tmp356 + tmp103 * tmp300 + tmp105 * tmp355;
+    let tmp360: f64 = -tmp186 * tmp359 - tmp187 * tmp358 - tmp188 * tmp357 + tmp342;
+    let tmp361: f64 = tmp176 * tmp357 + tmp180 * tmp358 + tmp182 * tmp359 + tmp355 * tmp84;
+    let tmp362: f64 = reference_tension_n[0] * (tmp323 + tmp354);
+    let tmp363: f64 = tmp11 * tmp362 - tmp338;
+    let tmp364: f64 = tmp300 * tmp71 + tmp362 * tmp69 + tmp363 * tmp67;
+    let tmp365: f64 = tmp300 * tmp89 + tmp362 * tmp86 + tmp363 * tmp92;
+    let tmp366: f64 = tmp100 * tmp363 + tmp103 * tmp362 + tmp105 * tmp300;
+    let tmp367: f64 = -tmp186 * tmp366 - tmp187 * tmp365 - tmp188 * tmp364 - tmp362 * tmp84;
+    let tmp368: f64 = tmp176 * tmp364 + tmp180 * tmp365 + tmp182 * tmp366 + tmp319;
+    let tmp369: f64 = -tmp60;
+    let tmp370: f64 = tmp290 + tmp369;
+    let tmp371: f64 = -tmp293 + tmp370 * tmp56;
+    let tmp372: f64 = tmp67 * tmp73;
+    let tmp373: f64 = tmp370 * tmp73;
+    let tmp374: f64 = tmp310 * tmp69 - tmp371 * tmp372 + tmp373 * tmp71;
+    let tmp375: f64 = tmp371 * tmp73;
+    let tmp376: f64 = tmp310 * tmp86 + tmp373 * tmp89 - tmp375 * tmp92;
+    let tmp377: f64 = -tmp100 * tmp375 + tmp103 * tmp310 + tmp105 * tmp373;
+    let tmp378: f64 = -tmp186 * tmp377 - tmp187 * tmp376 - tmp188 * tmp374 + tmp346;
+    let tmp379: f64 = tmp176 * tmp374 + tmp180 * tmp376 + tmp182 * tmp377 + tmp370 * tmp98;
+    let tmp380: f64 = tmp331 + tmp369;
+    let tmp381: f64 = tmp380 * tmp73;
+    let tmp382: f64 = tmp336 - tmp380 * tmp53;
+    let tmp383: f64 = tmp310 * tmp71 - tmp372 * tmp382 + tmp381 * tmp69;
+    let tmp384: f64 = tmp382 * tmp73;
+    let tmp385: f64 = -tmp100 * tmp384 + tmp103 * tmp381 + tmp105 * tmp310;
+    let tmp386: f64 = tmp310 * tmp89 + tmp381 * tmp86 - tmp384 * tmp92;
+    let tmp387: f64 = tmp176 * tmp383 + tmp180 * tmp386 + tmp182 * tmp385 + tmp321;
+    let tmp388: f64 = -tmp186 * tmp385 - tmp187 * tmp386 - tmp188 * tmp383 - tmp380 * tmp98;
+    let tmp389: f64 = -tmp35;
+    let tmp390: f64 = tmp297 + tmp389;
+    let tmp391: f64 = -tmp296 + tmp31 * tmp390;
+    let tmp392: f64 = tmp107 * tmp67;
+    let tmp393: f64 = tmp107 * tmp390;
+    let tmp394: f64 = tmp309 * tmp69 - tmp391 * tmp392 + tmp393 * tmp71;
+    let tmp395: f64 = tmp100 * tmp107;
+    let tmp396: f64 = tmp103 * tmp309 + tmp105 * tmp393 - tmp391 * tmp395;
+    let tmp397: f64 = tmp107 * tmp92;
+    let tmp398: f64 = tmp309 * tmp86 - tmp391 * tmp397 + tmp393 * tmp89;
+    let tmp399: f64 = tmp109 * tmp390 + tmp176 * tmp394 + tmp180 * tmp398 + tmp182 * tmp396;
+    let tmp400: f64 = -tmp186 * tmp396 - tmp187 * tmp398 - tmp188 * tmp394 + tmp341;
+    let tmp401: f64 = tmp400 * tmp79;
+    let tmp402: f64 = tmp325 + tmp389;
+    let tmp403: f64 = -tmp28 * tmp402 + tmp337;
+    let tmp404: f64 = tmp107 * tmp402;
+    let tmp405: f64 = tmp309 * tmp71 - tmp392 * tmp403 + tmp404 * tmp69;
+    let tmp406: f64 = tmp103 * tmp404 + tmp105 * tmp309 - tmp395 * tmp403;
+    let tmp407: f64 = tmp309 * tmp89 - tmp397 * tmp403 + tmp404 * tmp86;
+    let tmp408: f64 = -tmp109 * tmp402 - tmp186 * tmp406 - tmp187 * tmp407 - tmp188 * tmp405;
+    let tmp409: f64 = tmp176 * tmp405 + tmp180 * tmp407 + tmp182 * tmp406 + tmp318;
+    let tmp410: f64 = -tmp44;
+    let tmp411: f64 = tmp285 + tmp410;
+    let tmp412: f64 = tmp411 * tmp94;
+    let tmp413: f64 = tmp94 * (-tmp288 + tmp40 * tmp411);
+    let tmp414: f64 = tmp311 * tmp69 + tmp412 * tmp71 - tmp413 * tmp67;
+    let tmp415: f64 = tmp311 * tmp86 + tmp412 * tmp89 - tmp413 * tmp92;
+    let tmp416: f64 = -tmp100 * tmp413 + tmp103 * tmp311 + tmp105 * tmp412;
+    let tmp417: f64 = tmp176 * tmp414 + tmp180 * tmp415 + tmp182 * tmp416 + tmp411 * tmp96;
+    let tmp418: f64 = -tmp186 * tmp416 - tmp187 * tmp415 - tmp188 * tmp414 + tmp343;
+    let tmp419: f64 = tmp328 + tmp410;
+    let tmp420: f64 = tmp419 * tmp94;
+    let tmp421: f64 = tmp94 * (tmp335 - tmp37 * tmp419);
+    let tmp422: f64 = tmp311 * tmp71 + tmp420 * tmp69 - tmp421 * tmp67;
+    let tmp423: f64 = tmp311 * tmp89 + tmp420 * tmp86 - tmp421 * tmp92;
+    let tmp424: f64 = -tmp100 * tmp421 + tmp103 * tmp420 + tmp105 * tmp311;
+    let tmp425: f64 = -tmp186 * tmp424 - tmp187 * tmp423 - tmp188 * tmp422 - tmp419 * tmp96;
+    let tmp426: f64 = tmp176 * tmp422 + tmp180 * tmp423 + tmp182 * tmp424 + tmp320;
 
     // Output terms (4)
     if let Some(jacobian_pose) = jacobian_pose {
         jacobian_pose[(0, 0)] = 0.0;
         jacobian_pose[(1, 0)] = 0.0;
-        jacobian_pose[(2, 0)] = -tmp212 + tmp231;
-        jacobian_pose[(3, 0)] = -tmp340 * tmp342
-            + tmp98 * (tmp133 * tmp310 + tmp136 * tmp232 + tmp137 * tmp309 + tmp308 * tmp93 + tmp339 * tmp94);
-        jacobian_pose[(4, 0)] = tmp259 - tmp265;
-        jacobian_pose[(5, 0)] = -tmp340 * tmp343
-            + tmp98
-                * (-tmp133 * tmp168 - tmp136 * tmp166 + tmp139 * tmp152
-                    - tmp14
-                        * (tmp137 * tmp166 - tmp312 - tmp314 + tmp315 - tmp316 + tmp317 - tmp319 - tmp321 - tmp322
-                            + tmp323
-                            + tmp325
-                            + tmp326
-                            + tmp328
-                            + tmp329
-                            - tmp330
-                            + tmp331
-                            + tmp332
-                            + tmp334
-                            + tmp335
-                            + tmp336
-                            - tmp338)
-                    - tmp140 * tmp147
-                    - tmp308 * tmp32
-                    - tmp339 * tmp34
-                    + tmp50 * (tmp137 * tmp168 + tmp308));
-        jacobian_pose[(6, 0)] = -tmp242 + tmp288;
-        jacobian_pose[(7, 0)] = -tmp340 * tmp344
-            + tmp98
-                * (tmp133 * tmp155 + tmp136 * tmp159 - tmp14 * (-tmp137 * tmp159 + tmp339) - tmp142 * tmp147
-                    + tmp143 * tmp152
-                    + tmp24 * tmp308
-                    + tmp26 * tmp339
-                    + tmp50
-                        * (-tmp137 * tmp155 + tmp234 + tmp236 + tmp237 + tmp239 - tmp240 + tmp244 - tmp261 - tmp263
-                            + tmp266
-                            + tmp268
-                            - tmp270
-                            - tmp272
-                            + tmp273
-                            - tmp289
-                            - tmp297
-                            - tmp299
-                            - tmp300
-                            - tmp301
-                            - tmp304
-                            - tmp307));
+        jacobian_pose[(2, 0)] = tmp174;
+        jacobian_pose[(3, 0)] = tmp111 * tmp185 + tmp114 * tmp190;
+        jacobian_pose[(4, 0)] = tmp181;
+        jacobian_pose[(5, 0)] = tmp117 * tmp185 + tmp118 * tmp190;
+        jacobian_pose[(6, 0)] = tmp179;
+        jacobian_pose[(7, 0)] = tmp120 * tmp185 + tmp123 * tmp190;
         jacobian_pose[(0, 1)] = 0.0;
         jacobian_pose[(1, 1)] = 0.0;
-        jacobian_pose[(2, 1)] = tmp373 - tmp381;
-        jacobian_pose[(3, 1)] = -tmp342 * tmp439
-            + tmp98 * (tmp133 * tmp417 + tmp136 * tmp382 + tmp137 * tmp416 + tmp415 * tmp93 + tmp438 * tmp94);
-        jacobian_pose[(4, 1)] = tmp403 - tmp411;
-        jacobian_pose[(5, 1)] = -tmp343 * tmp439
-            + tmp98
-                * (-tmp133 * tmp358 - tmp136 * tmp359 + tmp139 * tmp374
-                    - tmp14
-                        * (tmp137 * tmp359 - tmp418 + tmp419 + tmp420 - tmp421 + tmp422 + tmp423 - tmp424 + tmp425
-                            - tmp426
-                            - tmp427
-                            + tmp428
-                            - tmp429
-                            + tmp430
-                            - tmp431
-                            + tmp432
-                            + tmp433
-                            + tmp434
-                            - tmp435
-                            + tmp436
-                            + tmp437)
-                    - tmp140 * tmp375
-                    - tmp32 * tmp415
-                    - tmp34 * tmp438
-                    + tmp50 * (tmp137 * tmp358 + tmp415));
-        jacobian_pose[(6, 1)] = -tmp386 + tmp389;
-        jacobian_pose[(7, 1)] = -tmp344 * tmp439
-            + tmp98
-                * (tmp133 * tmp356 + tmp136 * tmp348 - tmp14 * (-tmp137 * tmp348 + tmp438) - tmp142 * tmp375
-                    + tmp143 * tmp374
-                    + tmp24 * tmp415
-                    + tmp26 * tmp438
-                    + tmp50
-                        * (-tmp137 * tmp356 - tmp383 - tmp384 - tmp385 + tmp387 - tmp390 + tmp391
-                            - tmp392
-                            - tmp396
-                            - tmp397
-                            - tmp399
-                            + tmp400
-                            + tmp401
-                            - tmp404
-                            - tmp405
-                            - tmp407
-                            + tmp408
-                            + tmp409
-                            + tmp410
-                            + tmp412
-                            - tmp414));
+        jacobian_pose[(2, 1)] = tmp228;
+        jacobian_pose[(3, 1)] = tmp111 * tmp235 + tmp114 * tmp236;
+        jacobian_pose[(4, 1)] = tmp233;
+        jacobian_pose[(5, 1)] = tmp117 * tmp235 + tmp118 * tmp236;
+        jacobian_pose[(6, 1)] = tmp231;
+        jacobian_pose[(7, 1)] = tmp120 * tmp235 + tmp123 * tmp236;
         jacobian_pose[(0, 2)] = 0.0;
         jacobian_pose[(1, 2)] = 0.0;
-        jacobian_pose[(2, 2)] = tmp463 - tmp471;
-        jacobian_pose[(3, 2)] = -tmp342 * tmp475
-            + tmp98 * (tmp133 * tmp472 + tmp136 * tmp473 + tmp137 * tmp474 + tmp509 * tmp93 + tmp530 * tmp94);
-        jacobian_pose[(4, 2)] = -tmp487 + tmp492;
-        jacobian_pose[(5, 2)] = -tmp343 * tmp475
-            + tmp98
-                * (-tmp133 * tmp453 - tmp136 * tmp452 + tmp139 * tmp464
-                    - tmp14
-                        * (tmp137 * tmp452 - tmp510 + tmp511 - tmp512 + tmp513 + tmp514 + tmp515 - tmp516 - tmp517
-                            + tmp518
-                            + tmp519
-                            - tmp520
-                            - tmp521
-                            + tmp522
-                            - tmp523
-                            + tmp524
-                            + tmp525
-                            - tmp526
-                            + tmp527
-                            + tmp528
-                            + tmp529)
-                    - tmp140 * tmp465
-                    - tmp32 * tmp509
-                    - tmp34 * tmp530
-                    + tmp50 * (tmp137 * tmp453 + tmp509));
-        jacobian_pose[(6, 2)] = tmp494 - tmp496;
-        jacobian_pose[(7, 2)] = -tmp344 * tmp475
-            + tmp98
-                * (tmp133 * tmp448 + tmp136 * tmp444 - tmp14 * (-tmp137 * tmp444 + tmp530) - tmp142 * tmp465
-                    + tmp143 * tmp464
-                    + tmp24 * tmp509
-                    + tmp26 * tmp530
-                    + tmp50
-                        * (-tmp137 * tmp448 - tmp476 + tmp478 - tmp479 + tmp480 - tmp483 + tmp484 - tmp486 + tmp488
-                            - tmp493
-                            - tmp495
-                            + tmp497
-                            - tmp498
-                            - tmp499
-                            + tmp500
-                            - tmp501
-                            + tmp502
-                            - tmp504
-                            - tmp505
-                            + tmp506
-                            - tmp508));
+        jacobian_pose[(2, 2)] = tmp275;
+        jacobian_pose[(3, 2)] = tmp111 * tmp283 + tmp114 * tmp282;
+        jacobian_pose[(4, 2)] = tmp281;
+        jacobian_pose[(5, 2)] = tmp117 * tmp283 + tmp118 * tmp282;
+        jacobian_pose[(6, 2)] = tmp278;
+        jacobian_pose[(7, 2)] = tmp120 * tmp283 + tmp123 * tmp282;
         jacobian_pose[(0, 3)] = 0.0;
         jacobian_pose[(1, 3)] = 0.0;
-        jacobian_pose[(2, 3)] = tmp564 - tmp573;
-        jacobian_pose[(3, 3)] = tmp98 * (tmp616 * tmp93 + tmp628 * tmp94);
-        jacobian_pose[(4, 3)] = -tmp574 + tmp588;
-        jacobian_pose[(5, 3)] = tmp98
-            * (-tmp14 * (-tmp617 + tmp618 + tmp619 - tmp620 - tmp621 + tmp622 + tmp633)
-                - tmp32 * tmp616
-                - tmp34 * tmp628
-                + tmp50 * tmp616);
-        jacobian_pose[(6, 3)] = tmp602 - tmp606;
-        jacobian_pose[(7, 3)] = tmp98
-            * (-tmp14 * tmp628
-                + tmp24 * tmp616
-                + tmp26 * tmp628
-                + tmp50 * (tmp575 - tmp589 - tmp603 - tmp604 + tmp605 + tmp607 + tmp635 + tmp637 + tmp639 + tmp641));
+        jacobian_pose[(2, 3)] = tmp313;
+        jacobian_pose[(3, 3)] = tmp111 * tmp317 + tmp114 * tmp322;
+        jacobian_pose[(4, 3)] = tmp315;
+        jacobian_pose[(5, 3)] = tmp117 * tmp317 + tmp118 * tmp322;
+        jacobian_pose[(6, 3)] = tmp316;
+        jacobian_pose[(7, 3)] = tmp120 * tmp317 + tmp123 * tmp322;
         jacobian_pose[(0, 4)] = 0.0;
         jacobian_pose[(1, 4)] = 0.0;
-        jacobian_pose[(2, 4)] = tmp668 - tmp676;
-        jacobian_pose[(3, 4)] = tmp98 * (tmp708 * tmp93 + tmp723 * tmp94);
-        jacobian_pose[(4, 4)] = -tmp677 + tmp693;
-        jacobian_pose[(5, 4)] = tmp98
-            * (-tmp14 * (-tmp709 + tmp710 + tmp711 - tmp712 - tmp713 + tmp714 + tmp724 + tmp725 + tmp726 + tmp727)
-                - tmp32 * tmp708
-                - tmp34 * tmp723
-                + tmp50 * tmp708);
-        jacobian_pose[(6, 4)] = -tmp679 + tmp706;
-        jacobian_pose[(7, 4)] = tmp98
-            * (-tmp14 * tmp723
-                + tmp24 * tmp708
-                + tmp26 * tmp723
-                + tmp50 * (tmp627 + tmp678 + tmp680 + tmp681 - tmp694 - tmp695 - tmp707));
+        jacobian_pose[(2, 4)] = tmp340;
+        jacobian_pose[(3, 4)] = tmp111 * tmp347 + tmp114 * tmp348;
+        jacobian_pose[(4, 4)] = tmp344;
+        jacobian_pose[(5, 4)] = tmp117 * tmp347 + tmp118 * tmp348;
+        jacobian_pose[(6, 4)] = tmp345;
+        jacobian_pose[(7, 4)] = tmp120 * tmp347 + tmp123 * tmp348;
         jacobian_pose[(0, 5)] = 0.0;
         jacobian_pose[(1, 5)] = 0.0;
         jacobian_pose[(2, 5)] = 0.0;
@@ -1391,46 +657,38 @@ pub fn cable_tensions_from_reference(
     if let Some(jacobian_reference_tension) = jacobian_reference_tension {
         jacobian_reference_tension[(0, 0)] = 1.0_f64;
         jacobian_reference_tension[(1, 0)] = 0.0;
-        jacobian_reference_tension[(2, 0)] = tmp728;
-        jacobian_reference_tension[(3, 0)] = tmp98 * (tmp735 * tmp93 + tmp739 * tmp94);
-        jacobian_reference_tension[(4, 0)] = tmp731;
-        jacobian_reference_tension[(5, 0)] =
-            tmp98 * (-tmp14 * (tmp104 + tmp736 + tmp737 + tmp738) - tmp32 * tmp735 - tmp34 * tmp739 + tmp50 * tmp735);
-        jacobian_reference_tension[(6, 0)] = tmp729;
-        jacobian_reference_tension[(7, 0)] =
-            tmp98 * (-tmp14 * tmp739 + tmp24 * tmp735 + tmp26 * tmp739 + tmp50 * (-tmp730 - tmp732 - tmp733 - tmp734));
+        jacobian_reference_tension[(2, 0)] = tmp349;
+        jacobian_reference_tension[(3, 0)] = tmp111 * tmp352 + tmp114 * tmp353;
+        jacobian_reference_tension[(4, 0)] = tmp351;
+        jacobian_reference_tension[(5, 0)] = tmp117 * tmp352 + tmp118 * tmp353;
+        jacobian_reference_tension[(6, 0)] = tmp350;
+        jacobian_reference_tension[(7, 0)] = tmp120 * tmp352 + tmp123 * tmp353;
         jacobian_reference_tension[(0, 1)] = 0.0;
         jacobian_reference_tension[(1, 1)] = 1.0_f64;
         jacobian_reference_tension[(2, 1)] = 0.0;
-        jacobian_reference_tension[(3, 1)] = tmp98 * (tmp72 * tmp93 + tmp740 * tmp94 - tmp95);
+        jacobian_reference_tension[(3, 1)] = tmp11 * tmp111 - tmp114 * tmp20 - tmp80;
         jacobian_reference_tension[(4, 1)] = 0.0;
-        jacobian_reference_tension[(5, 1)] =
-            tmp98 * (-tmp14 * (-tmp32 + tmp78) - tmp32 * tmp72 - tmp34 * tmp740 + tmp50 * (-tmp34 + tmp72));
+        jacobian_reference_tension[(5, 1)] = tmp11 * tmp117 - tmp116 - tmp118 * tmp20;
         jacobian_reference_tension[(6, 1)] = 0.0;
-        jacobian_reference_tension[(7, 1)] = tmp98
-            * (-tmp14 * (tmp24 + tmp740) + tmp24 * tmp72 + tmp26 * tmp740 + tmp50 * (tmp26 - tmp69 - tmp70 - tmp71));
+        jacobian_reference_tension[(7, 1)] = tmp11 * tmp120 - tmp121 - tmp123 * tmp20;
     }
     if let Some(jacobian_anchors) = jacobian_anchors {
         jacobian_anchors[(0, 0)] = 0.0;
         jacobian_anchors[(1, 0)] = 0.0;
-        jacobian_anchors[(2, 0)] = tmp742;
-        jacobian_anchors[(3, 0)] = tmp98 * (tmp748 * tmp94 + tmp752 * tmp93);
-        jacobian_anchors[(4, 0)] = tmp743;
-        jacobian_anchors[(5, 0)] =
-            tmp98 * (-tmp14 * (tmp623 + tmp744 + tmp745 + tmp747) - tmp32 * tmp752 - tmp34 * tmp748 + tmp50 * tmp752);
-        jacobian_anchors[(6, 0)] = tmp746;
-        jacobian_anchors[(7, 0)] =
-            tmp98 * (-tmp14 * tmp748 + tmp24 * tmp752 + tmp26 * tmp748 + tmp50 * (tmp609 - tmp749 - tmp750 - tmp751));
+        jacobian_anchors[(2, 0)] = tmp357;
+        jacobian_anchors[(3, 0)] = tmp111 * tmp361 + tmp114 * tmp360;
+        jacobian_anchors[(4, 0)] = tmp359;
+        jacobian_anchors[(5, 0)] = tmp117 * tmp361 + tmp118 * tmp360;
+        jacobian_anchors[(6, 0)] = tmp358;
+        jacobian_anchors[(7, 0)] = tmp120 * tmp361 + tmp123 * tmp360;
         jacobian_anchors[(0, 1)] = 0.0;
         jacobian_anchors[(1, 1)] = 0.0;
-        jacobian_anchors[(2, 1)] = tmp754;
-        jacobian_anchors[(3, 1)] = tmp98 * (tmp761 * tmp93 + tmp765 * tmp94);
-        jacobian_anchors[(4, 1)] = tmp759;
-        jacobian_anchors[(5, 1)] =
-            tmp98 * (-tmp14 * (tmp716 + tmp762 + tmp763 + tmp764) - tmp32 * tmp761 - tmp34 * tmp765 + tmp50 * tmp761);
-        jacobian_anchors[(6, 1)] = tmp757;
-        jacobian_anchors[(7, 1)] =
-            tmp98 * (-tmp14 * tmp765 + tmp24 * tmp761 + tmp26 * tmp765 + tmp50 * (tmp629 - tmp755 - tmp758 - tmp760));
+        jacobian_anchors[(2, 1)] = tmp364;
+        jacobian_anchors[(3, 1)] = tmp111 * tmp368 + tmp114 * tmp367;
+        jacobian_anchors[(4, 1)] = tmp366;
+        jacobian_anchors[(5, 1)] = tmp117 * tmp368 + tmp118 * tmp367;
+        jacobian_anchors[(6, 1)] = tmp365;
+        jacobian_anchors[(7, 1)] = tmp120 * tmp368 + tmp123 * tmp367;
         jacobian_anchors[(0, 2)] = 0.0;
         jacobian_anchors[(1, 2)] = 0.0;
         jacobian_anchors[(2, 2)] = 0.0;
@@ -1441,32 +699,20 @@ pub fn cable_tensions_from_reference(
         jacobian_anchors[(7, 2)] = 0.0;
         jacobian_anchors[(0, 3)] = 0.0;
         jacobian_anchors[(1, 3)] = 0.0;
-        jacobian_anchors[(2, 3)] = -tmp768;
-        jacobian_anchors[(3, 3)] = tmp98 * (tmp778 * tmp94 + tmp784 * tmp93);
-        jacobian_anchors[(4, 3)] = -tmp769 + tmp771;
-        jacobian_anchors[(5, 3)] = tmp98
-            * (-tmp14 * (tmp624 - tmp770 + tmp772 - tmp773 - tmp775 + tmp777) - tmp32 * tmp784 - tmp34 * tmp778
-                + tmp50 * tmp784);
-        jacobian_anchors[(6, 3)] = -tmp774 + tmp776;
-        jacobian_anchors[(7, 3)] = tmp98
-            * (-tmp14 * tmp778
-                + tmp24 * tmp784
-                + tmp26 * tmp778
-                + tmp50 * (tmp615 + tmp779 - tmp780 + tmp781 - tmp782 + tmp783));
+        jacobian_anchors[(2, 3)] = tmp374;
+        jacobian_anchors[(3, 3)] = tmp111 * tmp379 + tmp114 * tmp378;
+        jacobian_anchors[(4, 3)] = tmp377;
+        jacobian_anchors[(5, 3)] = tmp117 * tmp379 + tmp118 * tmp378;
+        jacobian_anchors[(6, 3)] = tmp376;
+        jacobian_anchors[(7, 3)] = tmp120 * tmp379 + tmp123 * tmp378;
         jacobian_anchors[(0, 4)] = 0.0;
         jacobian_anchors[(1, 4)] = 0.0;
-        jacobian_anchors[(2, 4)] = -tmp787;
-        jacobian_anchors[(3, 4)] = tmp98 * (tmp797 * tmp93 + tmp803 * tmp94);
-        jacobian_anchors[(4, 4)] = -tmp790 + tmp793;
-        jacobian_anchors[(5, 4)] = tmp98
-            * (-tmp14 * (tmp718 + tmp798 + tmp799 - tmp800 - tmp801 - tmp802) - tmp32 * tmp797 - tmp34 * tmp803
-                + tmp50 * tmp797);
-        jacobian_anchors[(6, 4)] = -tmp788 + tmp795;
-        jacobian_anchors[(7, 4)] = tmp98
-            * (-tmp14 * tmp803
-                + tmp24 * tmp797
-                + tmp26 * tmp803
-                + tmp50 * (tmp630 + tmp789 + tmp791 + tmp792 - tmp794 - tmp796));
+        jacobian_anchors[(2, 4)] = tmp383;
+        jacobian_anchors[(3, 4)] = tmp111 * tmp387 + tmp114 * tmp388;
+        jacobian_anchors[(4, 4)] = tmp385;
+        jacobian_anchors[(5, 4)] = tmp117 * tmp387 + tmp118 * tmp388;
+        jacobian_anchors[(6, 4)] = tmp386;
+        jacobian_anchors[(7, 4)] = tmp120 * tmp387 + tmp123 * tmp388;
         jacobian_anchors[(0, 5)] = 0.0;
         jacobian_anchors[(1, 5)] = 0.0;
         jacobian_anchors[(2, 5)] = 0.0;
@@ -1477,32 +723,20 @@ pub fn cable_tensions_from_reference(
         jacobian_anchors[(7, 5)] = 0.0;
         jacobian_anchors[(0, 6)] = 0.0;
         jacobian_anchors[(1, 6)] = 0.0;
-        jacobian_anchors[(2, 6)] = -tmp809 + tmp810;
-        jacobian_anchors[(3, 6)] = tmp98 * (tmp819 * tmp93 + tmp825 * tmp94);
-        jacobian_anchors[(4, 6)] = -tmp813;
-        jacobian_anchors[(5, 6)] = tmp98
-            * (-tmp14 * (tmp625 - tmp820 + tmp821 - tmp822 - tmp823 + tmp824) - tmp32 * tmp819 - tmp34 * tmp825
-                + tmp50 * tmp819);
-        jacobian_anchors[(6, 6)] = -tmp811 + tmp817;
-        jacobian_anchors[(7, 6)] = tmp98
-            * (-tmp14 * tmp825
-                + tmp24 * tmp819
-                + tmp26 * tmp825
-                + tmp50 * (tmp611 + tmp812 + tmp814 + tmp815 - tmp816 - tmp818));
+        jacobian_anchors[(2, 6)] = tmp394;
+        jacobian_anchors[(3, 6)] = tmp111 * tmp399 + tmp401 * tmp77;
+        jacobian_anchors[(4, 6)] = tmp396;
+        jacobian_anchors[(5, 6)] = tmp117 * tmp399 + tmp118 * tmp400;
+        jacobian_anchors[(6, 6)] = tmp398;
+        jacobian_anchors[(7, 6)] = tmp120 * tmp399 + tmp122 * tmp401;
         jacobian_anchors[(0, 7)] = 0.0;
         jacobian_anchors[(1, 7)] = 0.0;
-        jacobian_anchors[(2, 7)] = -tmp831 + tmp832;
-        jacobian_anchors[(3, 7)] = tmp98 * (tmp841 * tmp94 + tmp847 * tmp93);
-        jacobian_anchors[(4, 7)] = -tmp838;
-        jacobian_anchors[(5, 7)] = tmp98
-            * (-tmp14 * (tmp722 + tmp834 - tmp835 - tmp837 - tmp839 + tmp840) - tmp32 * tmp847 - tmp34 * tmp841
-                + tmp50 * tmp847);
-        jacobian_anchors[(6, 7)] = tmp833 - tmp836;
-        jacobian_anchors[(7, 7)] = tmp98
-            * (-tmp14 * tmp841
-                + tmp24 * tmp847
-                + tmp26 * tmp841
-                + tmp50 * (tmp631 - tmp842 + tmp843 + tmp844 + tmp845 - tmp846));
+        jacobian_anchors[(2, 7)] = tmp405;
+        jacobian_anchors[(3, 7)] = tmp111 * tmp409 + tmp114 * tmp408;
+        jacobian_anchors[(4, 7)] = tmp406;
+        jacobian_anchors[(5, 7)] = tmp117 * tmp409 + tmp118 * tmp408;
+        jacobian_anchors[(6, 7)] = tmp407;
+        jacobian_anchors[(7, 7)] = tmp120 * tmp409 + tmp123 * tmp408;
         jacobian_anchors[(0, 8)] = 0.0;
         jacobian_anchors[(1, 8)] = 0.0;
         jacobian_anchors[(2, 8)] = 0.0;
@@ -1513,32 +747,20 @@ pub fn cable_tensions_from_reference(
         jacobian_anchors[(7, 8)] = 0.0;
         jacobian_anchors[(0, 9)] = 0.0;
         jacobian_anchors[(1, 9)] = 0.0;
-        jacobian_anchors[(2, 9)] = tmp852 - tmp854;
-        jacobian_anchors[(3, 9)] = tmp98 * (tmp863 * tmp94 + tmp869 * tmp93);
-        jacobian_anchors[(4, 9)] = tmp857 - tmp861;
-        jacobian_anchors[(5, 9)] = tmp98
-            * (-tmp14 * (tmp626 - tmp855 + tmp856 + tmp858 - tmp860 - tmp862) - tmp32 * tmp869 - tmp34 * tmp863
-                + tmp50 * tmp869);
-        jacobian_anchors[(6, 9)] = -tmp859;
-        jacobian_anchors[(7, 9)] = tmp98
-            * (-tmp14 * tmp863
-                + tmp24 * tmp869
-                + tmp26 * tmp863
-                + tmp50 * (tmp613 + tmp864 - tmp865 + tmp866 - tmp867 + tmp868));
+        jacobian_anchors[(2, 9)] = tmp414;
+        jacobian_anchors[(3, 9)] = tmp111 * tmp417 + tmp114 * tmp418;
+        jacobian_anchors[(4, 9)] = tmp416;
+        jacobian_anchors[(5, 9)] = tmp117 * tmp417 + tmp118 * tmp418;
+        jacobian_anchors[(6, 9)] = tmp415;
+        jacobian_anchors[(7, 9)] = tmp120 * tmp417 + tmp123 * tmp418;
         jacobian_anchors[(0, 10)] = 0.0;
         jacobian_anchors[(1, 10)] = 0.0;
-        jacobian_anchors[(2, 10)] = -tmp876 + tmp877;
-        jacobian_anchors[(3, 10)] = tmp98 * (tmp886 * tmp94 + tmp892 * tmp93);
-        jacobian_anchors[(4, 10)] = tmp882 - tmp884;
-        jacobian_anchors[(5, 10)] = tmp98
-            * (-tmp14 * (tmp720 - tmp878 - tmp880 + tmp881 + tmp883 - tmp885) - tmp32 * tmp892 - tmp34 * tmp886
-                + tmp50 * tmp892);
-        jacobian_anchors[(6, 10)] = -tmp879;
-        jacobian_anchors[(7, 10)] = tmp98
-            * (-tmp14 * tmp886
-                + tmp24 * tmp892
-                + tmp26 * tmp886
-                + tmp50 * (tmp632 - tmp887 + tmp888 + tmp889 + tmp890 - tmp891));
+        jacobian_anchors[(2, 10)] = tmp422;
+        jacobian_anchors[(3, 10)] = tmp111 * tmp426 + tmp114 * tmp425;
+        jacobian_anchors[(4, 10)] = tmp424;
+        jacobian_anchors[(5, 10)] = tmp117 * tmp426 + tmp118 * tmp425;
+        jacobian_anchors[(6, 10)] = tmp423;
+        jacobian_anchors[(7, 10)] = tmp120 * tmp426 + tmp123 * tmp425;
         jacobian_anchors[(0, 11)] = 0.0;
         jacobian_anchors[(1, 11)] = 0.0;
         jacobian_anchors[(2, 11)] = 0.0;
@@ -1551,11 +773,11 @@ pub fn cable_tensions_from_reference(
     nalgebra::SVector::<f64, 8>::from([
         reference_tension_n[0],
         reference_tension_n[1],
-        tmp92,
-        tmp138 * tmp98,
-        tmp117,
-        tmp141 * tmp98,
-        tmp128,
-        tmp144 * tmp98,
+        tmp73,
+        tmp115,
+        tmp107,
+        tmp119,
+        tmp94,
+        tmp124,
     ])
 }

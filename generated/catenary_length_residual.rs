@@ -44,1901 +44,752 @@ pub fn catenary_length_residual(
     jacobian_anchors: Option<&mut nalgebra::SMatrix<f64, 4, 12>>,
     jacobian_length_offsets: Option<&mut nalgebra::SMatrix<f64, 4, 4>>,
 ) -> nalgebra::SVector<f64, 4> {
-    // Total ops: 3904
+    // Total ops: 1925
 
-    // Intermediate terms (1077)
-    let tmp0: f64 = 2.0_f64 * rotation_xyzw[1] * rotation_xyzw[3];
-    let tmp1: f64 = 2.0_f64 * rotation_xyzw[0];
-    let tmp2: f64 = tmp1 * rotation_xyzw[2];
-    let tmp3: f64 = tmp0 + tmp2;
-    let tmp4: f64 = tmp3 * attachments_m[(2, 0)];
-    let tmp5: f64 = 2.0_f64 * rotation_xyzw[2];
-    let tmp6: f64 = tmp5 * rotation_xyzw[3];
-    let tmp7: f64 = -tmp6;
-    let tmp8: f64 = tmp1 * rotation_xyzw[1];
-    let tmp9: f64 = tmp7 + tmp8;
-    let tmp10: f64 = tmp9 * attachments_m[(1, 0)];
-    let tmp11: f64 = rotation_xyzw[1] * rotation_xyzw[1];
-    let tmp12: f64 = -2.0_f64 * tmp11;
-    let tmp13: f64 = rotation_xyzw[2] * rotation_xyzw[2];
-    let tmp14: f64 = -2.0_f64 * tmp13;
-    let tmp15: f64 = tmp12 + tmp14 + 1.0_f64;
-    let tmp16: f64 = tmp15 * attachments_m[(0, 0)];
-    let tmp17: f64 = tmp10 + tmp16 + tmp4;
-    let tmp18: f64 = tmp17 - anchors_m[(0, 0)] + position_m[0];
-    let tmp19: f64 = tmp18 * tmp18;
-    let tmp20: f64 = tmp1 * rotation_xyzw[3];
-    let tmp21: f64 = -tmp20;
-    let tmp22: f64 = tmp5 * rotation_xyzw[1];
-    let tmp23: f64 = tmp21 + tmp22;
-    let tmp24: f64 = tmp23 * attachments_m[(2, 0)];
-    let tmp25: f64 = tmp6 + tmp8;
-    let tmp26: f64 = tmp25 * attachments_m[(0, 0)];
-    let tmp27: f64 = rotation_xyzw[0] * rotation_xyzw[0];
-    let tmp28: f64 = 1.0_f64 - 2.0_f64 * tmp27;
-    let tmp29: f64 = tmp14 + tmp28;
-    let tmp30: f64 = tmp29 * attachments_m[(1, 0)];
-    let tmp31: f64 = tmp24 + tmp26 + tmp30;
-    let tmp32: f64 = tmp31 - anchors_m[(1, 0)] + position_m[1];
-    let tmp33: f64 = tmp32 * tmp32;
-    let tmp34: f64 = tmp19 + tmp33 + epsilon;
-    let tmp35: f64 = tmp34.sqrt();
-    let tmp36: f64 = 1.0_f64 / reference_tension_n[0];
-    let tmp37: f64 = 0.5_f64 * cable_weight_n_per_m;
-    let tmp38: f64 = tmp35 * tmp36;
-    let tmp39: f64 = tmp37 * tmp38;
-    let tmp40: f64 = tmp39 + (tmp36 * reference_tension_n[1]).asinh();
-    let tmp41: f64 = tmp40.cosh();
-    let tmp42: f64 = tmp39 + epsilon * tmp39.signum();
-    let tmp43: f64 = 1.0_f64 / tmp42;
-    let tmp44: f64 = tmp42.sinh();
-    let tmp45: f64 = tmp43 * tmp44;
-    let tmp46: f64 = tmp41 * tmp45;
-    let tmp47: f64 = tmp15 * attachments_m[(0, 1)] + tmp3 * attachments_m[(2, 1)] + tmp9 * attachments_m[(1, 1)];
-    let tmp48: f64 = tmp47 - anchors_m[(0, 1)] + position_m[0];
-    let tmp49: f64 = tmp23 * attachments_m[(2, 2)] + tmp25 * attachments_m[(0, 2)] + tmp29 * attachments_m[(1, 2)];
-    let tmp50: f64 = tmp49 - anchors_m[(1, 2)] + position_m[1];
-    let tmp51: f64 = tmp15 * attachments_m[(0, 2)] + tmp3 * attachments_m[(2, 2)] + tmp9 * attachments_m[(1, 2)];
-    let tmp52: f64 = tmp51 - anchors_m[(0, 2)] + position_m[0];
+    // Intermediate terms (525)
+    let tmp0: f64 = 2.0_f64 * rotation_xyzw[3];
+    let tmp1: f64 = tmp0 * rotation_xyzw[1];
+    let tmp2: f64 = 2.0_f64 * rotation_xyzw[2];
+    let tmp3: f64 = tmp2 * rotation_xyzw[0];
+    let tmp4: f64 = tmp1 + tmp3;
+    let tmp5: f64 = tmp2 * rotation_xyzw[3];
+    let tmp6: f64 = 2.0_f64 * rotation_xyzw[0] * rotation_xyzw[1];
+    let tmp7: f64 = -tmp5 + tmp6;
+    let tmp8: f64 = -2.0_f64 * (rotation_xyzw[2] * rotation_xyzw[2]);
+    let tmp9: f64 = 1.0_f64 - 2.0_f64 * (rotation_xyzw[1] * rotation_xyzw[1]);
+    let tmp10: f64 = tmp8 + tmp9;
+    let tmp11: f64 = tmp10 * attachments_m[(0, 0)] + tmp4 * attachments_m[(2, 0)] + tmp7 * attachments_m[(1, 0)];
+    let tmp12: f64 = tmp11 - anchors_m[(0, 0)] + position_m[0];
+    let tmp13: f64 = tmp12 * tmp12;
+    let tmp14: f64 = tmp0 * rotation_xyzw[0];
+    let tmp15: f64 = tmp2 * rotation_xyzw[1];
+    let tmp16: f64 = -tmp14 + tmp15;
+    let tmp17: f64 = tmp5 + tmp6;
+    let tmp18: f64 = -2.0_f64 * (rotation_xyzw[0] * rotation_xyzw[0]);
+    let tmp19: f64 = tmp18 + tmp8 + 1.0_f64;
+    let tmp20: f64 = tmp16 * attachments_m[(2, 0)] + tmp17 * attachments_m[(0, 0)] + tmp19 * attachments_m[(1, 0)];
+    let tmp21: f64 = tmp20 - anchors_m[(1, 0)] + position_m[1];
+    let tmp22: f64 = tmp21 * tmp21;
+    let tmp23: f64 = tmp13 + tmp22 + epsilon;
+    let tmp24: f64 = tmp23.sqrt();
+    let tmp25: f64 = 1.0_f64 / reference_tension_n[0];
+    let tmp26: f64 = 0.5_f64 * cable_weight_n_per_m;
+    let tmp27: f64 = tmp24 * tmp26;
+    let tmp28: f64 = tmp25 * tmp27;
+    let tmp29: f64 = tmp28 + (tmp25 * reference_tension_n[1]).asinh();
+    let tmp30: f64 = tmp29.cosh();
+    let tmp31: f64 = tmp28 + epsilon * tmp28.signum();
+    let tmp32: f64 = 1.0_f64 / tmp31;
+    let tmp33: f64 = tmp31.sinh();
+    let tmp34: f64 = tmp32 * tmp33;
+    let tmp35: f64 = tmp30 * tmp34;
+    let tmp36: f64 = tmp10 * attachments_m[(0, 1)] + tmp4 * attachments_m[(2, 1)] + tmp7 * attachments_m[(1, 1)];
+    let tmp37: f64 = tmp36 - anchors_m[(0, 1)] + position_m[0];
+    let tmp38: f64 = tmp37 * tmp37;
+    let tmp39: f64 = tmp16 * attachments_m[(2, 1)] + tmp17 * attachments_m[(0, 1)] + tmp19 * attachments_m[(1, 1)];
+    let tmp40: f64 = tmp39 - anchors_m[(1, 1)] + position_m[1];
+    let tmp41: f64 = tmp40 * tmp40;
+    let tmp42: f64 = tmp38 + tmp41 + epsilon;
+    let tmp43: f64 = tmp42.sqrt();
+    let tmp44: f64 = 1.0_f64 / tmp24;
+    let tmp45: f64 = tmp21 * tmp44;
+    let tmp46: f64 = tmp12 * tmp44;
+    let tmp47: f64 = tmp11 * tmp45 - tmp20 * tmp46;
+    let tmp48: f64 = tmp10 * attachments_m[(0, 3)] + tmp4 * attachments_m[(2, 3)] + tmp7 * attachments_m[(1, 3)];
+    let tmp49: f64 = tmp48 - anchors_m[(0, 3)] + position_m[0];
+    let tmp50: f64 = tmp49 * tmp49;
+    let tmp51: f64 = tmp16 * attachments_m[(2, 3)] + tmp17 * attachments_m[(0, 3)] + tmp19 * attachments_m[(1, 3)];
+    let tmp52: f64 = tmp51 - anchors_m[(1, 3)] + position_m[1];
     let tmp53: f64 = tmp52 * tmp52;
-    let tmp54: f64 = tmp50 * tmp50;
-    let tmp55: f64 = tmp53 + tmp54 + epsilon;
-    let tmp56: f64 = tmp55.sqrt();
-    let tmp57: f64 = 1.0_f64 / tmp56;
-    let tmp58: f64 = tmp23 * attachments_m[(2, 3)] + tmp25 * attachments_m[(0, 3)] + tmp29 * attachments_m[(1, 3)];
-    let tmp59: f64 = tmp58 - anchors_m[(1, 3)] + position_m[1];
-    let tmp60: f64 = tmp15 * attachments_m[(0, 3)] + tmp3 * attachments_m[(2, 3)] + tmp9 * attachments_m[(1, 3)];
-    let tmp61: f64 = tmp60 - anchors_m[(0, 3)] + position_m[0];
-    let tmp62: f64 = tmp61 * tmp61;
-    let tmp63: f64 = tmp59 * tmp59;
-    let tmp64: f64 = tmp62 + tmp63 + epsilon;
+    let tmp54: f64 = tmp50 + tmp53 + epsilon;
+    let tmp55: f64 = tmp54.sqrt();
+    let tmp56: f64 = 1.0_f64 / tmp55;
+    let tmp57: f64 = tmp49 * tmp56;
+    let tmp58: f64 = tmp10 * attachments_m[(0, 2)] + tmp4 * attachments_m[(2, 2)] + tmp7 * attachments_m[(1, 2)];
+    let tmp59: f64 = tmp58 - anchors_m[(0, 2)] + position_m[0];
+    let tmp60: f64 = tmp59 * tmp59;
+    let tmp61: f64 = tmp16 * attachments_m[(2, 2)] + tmp17 * attachments_m[(0, 2)] + tmp19 * attachments_m[(1, 2)];
+    let tmp62: f64 = tmp61 - anchors_m[(1, 2)] + position_m[1];
+    let tmp63: f64 = tmp62 * tmp62;
+    let tmp64: f64 = tmp60 + tmp63 + epsilon;
     let tmp65: f64 = tmp64.sqrt();
     let tmp66: f64 = 1.0_f64 / tmp65;
-    let tmp67: f64 = tmp60 * tmp66;
-    let tmp68: f64 = tmp58 * tmp66;
-    let tmp69: f64 = tmp59 * tmp67 - tmp61 * tmp68;
-    let tmp70: f64 = tmp57 * tmp69;
-    let tmp71: f64 = tmp51 * tmp57;
-    let tmp72: f64 = tmp49 * tmp57;
-    let tmp73: f64 = tmp50 * tmp71 - tmp52 * tmp72;
-    let tmp74: f64 = tmp66 * tmp73;
-    let tmp75: f64 = tmp50 * tmp70 - tmp59 * tmp74;
-    let tmp76: f64 = tmp48 * tmp48;
-    let tmp77: f64 = tmp23 * attachments_m[(2, 1)] + tmp25 * attachments_m[(0, 1)] + tmp29 * attachments_m[(1, 1)];
-    let tmp78: f64 = tmp77 - anchors_m[(1, 1)] + position_m[1];
-    let tmp79: f64 = tmp78 * tmp78;
-    let tmp80: f64 = tmp76 + tmp79 + epsilon;
-    let tmp81: f64 = tmp80.sqrt();
-    let tmp82: f64 = 1.0_f64 / tmp81;
-    let tmp83: f64 = tmp75 * tmp82;
-    let tmp84: f64 = -tmp52 * tmp70 + tmp61 * tmp74;
-    let tmp85: f64 = tmp82 * tmp84;
-    let tmp86: f64 = tmp47 * tmp82;
-    let tmp87: f64 = tmp77 * tmp82;
-    let tmp88: f64 = -tmp48 * tmp87 + tmp78 * tmp86;
-    let tmp89: f64 = tmp61 * tmp66;
-    let tmp90: f64 = tmp50 * tmp57;
-    let tmp91: f64 = tmp59 * tmp66;
-    let tmp92: f64 = tmp52 * tmp57;
-    let tmp93: f64 = -tmp89 * tmp90 + tmp91 * tmp92;
-    let tmp94: f64 = -tmp48 * tmp83 - tmp78 * tmp85 - tmp88 * tmp93;
-    let tmp95: f64 = tmp94 + epsilon * tmp94.signum();
-    let tmp96: f64 = 1.0_f64 / tmp35;
-    let tmp97: f64 = tmp32 * tmp96;
-    let tmp98: f64 = tmp84 * tmp97;
-    let tmp99: f64 = tmp18 * tmp96;
-    let tmp100: f64 = tmp75 * tmp99;
-    let tmp101: f64 = tmp17 * tmp96;
-    let tmp102: f64 = tmp31 * tmp96;
-    let tmp103: f64 = tmp101 * tmp32 - tmp102 * tmp18;
-    let tmp104: f64 = tmp103 * tmp93;
-    let tmp105: f64 =
-        tmp100 * reference_tension_n[0] + tmp104 * reference_tension_n[0] + tmp98 * reference_tension_n[0];
-    let tmp106: f64 = 1.0_f64 / tmp105;
-    let tmp107: f64 = tmp106 * tmp81;
-    let tmp108: f64 = tmp107 * tmp37;
-    let tmp109: f64 = tmp108 * tmp95;
-    let tmp110: f64 = tmp109 + epsilon * tmp109.signum();
-    let tmp111: f64 = 1.0_f64 / tmp110;
-    let tmp112: f64 = tmp20 + tmp22;
-    let tmp113: f64 = -tmp0;
-    let tmp114: f64 = tmp113 + tmp2;
-    let tmp115: f64 = tmp12 + tmp28;
-    let tmp116: f64 = tmp112 * attachments_m[(1, 0)] + tmp114 * attachments_m[(0, 0)] + tmp115 * attachments_m[(2, 0)];
-    let tmp117: f64 = tmp116 * tmp97;
-    let tmp118: f64 = tmp112 * attachments_m[(1, 2)] + tmp114 * attachments_m[(0, 2)] + tmp115 * attachments_m[(2, 2)];
-    let tmp119: f64 = 1.0_f64 / tmp95;
-    let tmp120: f64 = tmp103 * reference_tension_n[0];
-    let tmp121: f64 = tmp69 * tmp97;
-    let tmp122: f64 = tmp120 * tmp91 - tmp121 * reference_tension_n[0];
-    let tmp123: f64 = tmp122 * tmp82;
-    let tmp124: f64 = tmp69 * tmp99;
-    let tmp125: f64 = -tmp120 * tmp89 + tmp124 * reference_tension_n[0];
-    let tmp126: f64 = tmp125 * tmp82;
-    let tmp127: f64 = tmp97 * reference_tension_n[0];
-    let tmp128: f64 = tmp99 * reference_tension_n[0];
-    let tmp129: f64 = tmp127 * tmp89 - tmp128 * tmp91;
-    let tmp130: f64 = -tmp123 * tmp48 - tmp126 * tmp78 - tmp129 * tmp88;
-    let tmp131: f64 = tmp119 * tmp130;
-    let tmp132: f64 = tmp118 * tmp131;
-    let tmp133: f64 = tmp112 * attachments_m[(1, 3)] + tmp114 * attachments_m[(0, 3)] + tmp115 * attachments_m[(2, 3)];
-    let tmp134: f64 = tmp73 * tmp97;
-    let tmp135: f64 = -tmp120 * tmp90 + tmp134 * reference_tension_n[0];
-    let tmp136: f64 = tmp135 * tmp82;
-    let tmp137: f64 = tmp73 * tmp96;
-    let tmp138: f64 = tmp137 * reference_tension_n[0];
-    let tmp139: f64 = tmp120 * tmp92 - tmp138 * tmp18;
-    let tmp140: f64 = tmp139 * tmp82;
-    let tmp141: f64 = -tmp127 * tmp92 + tmp128 * tmp90;
-    let tmp142: f64 = -tmp136 * tmp48 - tmp140 * tmp78 - tmp141 * tmp88;
-    let tmp143: f64 = tmp119 * tmp142;
-    let tmp144: f64 = tmp133 * tmp143;
-    let tmp145: f64 = tmp78 * tmp82;
-    let tmp146: f64 = tmp112 * attachments_m[(1, 1)] + tmp114 * attachments_m[(0, 1)] + tmp115 * attachments_m[(2, 1)];
-    let tmp147: f64 = tmp119 * tmp146;
-    let tmp148: f64 = tmp105 * tmp147;
-    let tmp149: f64 = -tmp117 * reference_tension_n[0]
-        - tmp132 * tmp90
-        - tmp144 * tmp91
-        - tmp145 * tmp148
-        - tmp31 * reference_tension_n[1]
-        + platform_weight_n * (tmp23 * com_offset_m[2] + tmp25 * com_offset_m[0] + tmp29 * com_offset_m[1]);
-    let tmp150: f64 = -tmp51 + tmp60;
-    let tmp151: f64 = -tmp49 + tmp58;
-    let tmp152: f64 = tmp116 * tmp99;
-    let tmp153: f64 = tmp48 * tmp82;
-    let tmp154: f64 = tmp132 * tmp92
-        + tmp144 * tmp89
-        + tmp148 * tmp153
-        + tmp152 * reference_tension_n[0]
-        + tmp17 * reference_tension_n[1]
-        - platform_weight_n * (tmp15 * com_offset_m[0] + tmp3 * com_offset_m[2] + tmp9 * com_offset_m[1]);
-    let tmp155: f64 = -tmp49 * tmp60 + tmp51 * tmp58;
-    let tmp156: f64 = platform_weight_n - reference_tension_n[1];
-    let tmp157: f64 = tmp149 * tmp150 + tmp151 * tmp154 + tmp155 * tmp156;
-    let tmp158: f64 = tmp150 * tmp77 - tmp151 * tmp47 + tmp155;
-    let tmp159: f64 = tmp158 + epsilon * tmp158.signum();
-    let tmp160: f64 = 1.0_f64 / tmp159;
-    let tmp161: f64 = tmp106 * tmp160;
-    let tmp162: f64 = tmp157 * tmp161;
-    let tmp163: f64 = tmp109 + (tmp162 * tmp95).asinh();
-    let tmp164: f64 = tmp163.cosh();
-    let tmp165: f64 = tmp111 * tmp164;
-    let tmp166: f64 = tmp110.sinh();
-    let tmp167: f64 = tmp166 * tmp81;
-    let tmp168: f64 = 1.0_f64 / tmp130;
-    let tmp169: f64 = tmp168 * tmp56;
-    let tmp170: f64 = tmp169 * tmp37;
-    let tmp171: f64 = tmp170 * tmp95;
-    let tmp172: f64 = tmp171 + epsilon * tmp171.signum();
-    let tmp173: f64 = 1.0_f64 / tmp172;
-    let tmp174: f64 = tmp154 + tmp156 * tmp60;
-    let tmp175: f64 = -tmp149 + tmp156 * tmp58;
-    let tmp176: f64 = -tmp149 * tmp60 - tmp154 * tmp58 + tmp174 * tmp77 - tmp175 * tmp47;
-    let tmp177: f64 = tmp168 * tmp176;
-    let tmp178: f64 = tmp160 * tmp95;
-    let tmp179: f64 = tmp171 + (tmp177 * tmp178).asinh();
-    let tmp180: f64 = tmp179.cosh();
-    let tmp181: f64 = tmp173 * tmp180;
-    let tmp182: f64 = tmp172.sinh();
-    let tmp183: f64 = tmp182 * tmp56;
-    let tmp184: f64 = 1.0_f64 / tmp142;
-    let tmp185: f64 = tmp184 * tmp65;
-    let tmp186: f64 = tmp185 * tmp37;
-    let tmp187: f64 = tmp186 * tmp95;
-    let tmp188: f64 = tmp187 + epsilon * tmp187.signum();
-    let tmp189: f64 = 1.0_f64 / tmp188;
-    let tmp190: f64 = tmp149 - tmp156 * tmp49;
-    let tmp191: f64 = -tmp154 - tmp156 * tmp51;
-    let tmp192: f64 = tmp149 * tmp51 + tmp154 * tmp49 - tmp190 * tmp47 + tmp191 * tmp77;
-    let tmp193: f64 = tmp178 * tmp184;
-    let tmp194: f64 = tmp187 + (tmp192 * tmp193).asinh();
-    let tmp195: f64 = tmp194.cosh();
-    let tmp196: f64 = tmp189 * tmp195;
-    let tmp197: f64 = tmp188.sinh();
-    let tmp198: f64 = tmp197 * tmp65;
-    let tmp199: f64 = -tmp8;
-    let tmp200: f64 = tmp199 + tmp6;
-    let tmp201: f64 = tmp200 * attachments_m[(2, 0)] + tmp3 * attachments_m[(1, 0)];
-    let tmp202: f64 = 2.0_f64 * tmp18;
-    let tmp203: f64 = -tmp11;
-    let tmp204: f64 = rotation_xyzw[3] * rotation_xyzw[3];
-    let tmp205: f64 = -tmp204;
-    let tmp206: f64 = tmp13 + tmp203 + tmp205 + tmp27;
-    let tmp207: f64 = tmp206 * attachments_m[(2, 0)] + tmp23 * attachments_m[(1, 0)];
-    let tmp208: f64 = 2.0_f64 * tmp32;
-    let tmp209: f64 = tmp201 * tmp202 + tmp207 * tmp208;
-    let tmp210: f64 = tmp43 * tmp42.cosh();
-    let tmp211: f64 = 0.25_f64 * cable_weight_n_per_m;
-    let tmp212: f64 = tmp36 * tmp41;
-    let tmp213: f64 = tmp211 * tmp212;
-    let tmp214: f64 = tmp210 * tmp213;
-    let tmp215: f64 = tmp45 * tmp40.sinh();
-    let tmp216: f64 = tmp215 * tmp36;
-    let tmp217: f64 = tmp211 * tmp216;
-    let tmp218: f64 = tmp44 / (tmp42 * tmp42);
-    let tmp219: f64 = tmp213 * tmp218;
-    let tmp220: f64 = 0.5_f64 * tmp209;
-    let tmp221: f64 = tmp46 * tmp96;
-    let tmp222: f64 = tmp3 * attachments_m[(1, 2)];
-    let tmp223: f64 = tmp200 * attachments_m[(2, 2)];
-    let tmp224: f64 = tmp222 + tmp223;
-    let tmp225: f64 = 2.0_f64 * tmp52;
-    let tmp226: f64 = tmp23 * attachments_m[(1, 2)];
-    let tmp227: f64 = tmp206 * attachments_m[(2, 2)];
-    let tmp228: f64 = tmp226 + tmp227;
-    let tmp229: f64 = 2.0_f64 * tmp50;
-    let tmp230: f64 = tmp224 * tmp225 + tmp228 * tmp229;
-    let tmp231: f64 = 1.0_f64 / (tmp55 * tmp55.sqrt());
-    let tmp232: f64 = tmp231 * tmp50;
-    let tmp233: f64 = 0.5_f64 * tmp232;
-    let tmp234: f64 = tmp230 * tmp233;
-    let tmp235: f64 = tmp206 * attachments_m[(2, 3)] + tmp23 * attachments_m[(1, 3)];
-    let tmp236: f64 = tmp66 * tmp92;
-    let tmp237: f64 = tmp200 * attachments_m[(2, 3)] + tmp3 * attachments_m[(1, 3)];
-    let tmp238: f64 = 2.0_f64 * tmp61;
-    let tmp239: f64 = 2.0_f64 * tmp59;
-    let tmp240: f64 = tmp235 * tmp239 + tmp237 * tmp238;
-    let tmp241: f64 = 0.5_f64 * tmp59;
-    let tmp242: f64 = tmp240 * tmp241;
-    let tmp243: f64 = 1.0_f64 / (tmp64 * tmp64.sqrt());
-    let tmp244: f64 = tmp243 * tmp92;
-    let tmp245: f64 = 0.5_f64 * tmp61;
-    let tmp246: f64 = tmp240 * tmp245;
-    let tmp247: f64 = tmp243 * tmp90;
-    let tmp248: f64 = 0.5_f64 * tmp230;
-    let tmp249: f64 = tmp231 * tmp52;
-    let tmp250: f64 = tmp248 * tmp249;
-    let tmp251: f64 = tmp66 * tmp90;
-    let tmp252: f64 = tmp57 * tmp91;
-    let tmp253: f64 = tmp57 * tmp89;
-    let tmp254: f64 =
-        tmp224 * tmp252 - tmp228 * tmp253 + tmp234 * tmp89 + tmp235 * tmp236 - tmp237 * tmp251 - tmp242 * tmp244
-            + tmp246 * tmp247
-            - tmp250 * tmp91;
-    let tmp255: f64 = tmp96 * reference_tension_n[0];
-    let tmp256: f64 = tmp255 * tmp84;
-    let tmp257: f64 = tmp255 * tmp75;
-    let tmp258: f64 = tmp243 * tmp58;
-    let tmp259: f64 = tmp243 * tmp60;
-    let tmp260: f64 = tmp241 * tmp259;
-    let tmp261: f64 =
-        tmp235 * tmp67 - tmp235 * tmp89 - tmp237 * tmp68 + tmp237 * tmp91 - tmp240 * tmp260 + tmp246 * tmp258;
-    let tmp262: f64 = tmp243 * tmp73;
-    let tmp263: f64 = tmp241 * tmp262;
-    let tmp264: f64 =
-        -tmp224 * tmp72 + tmp224 * tmp90 + tmp228 * tmp71 - tmp228 * tmp92 - tmp234 * tmp51 + tmp250 * tmp49;
-    let tmp265: f64 =
-        tmp228 * tmp70 - tmp234 * tmp69 - tmp235 * tmp74 + tmp240 * tmp263 + tmp261 * tmp90 - tmp264 * tmp91;
-    let tmp266: f64 =
-        -tmp224 * tmp70 + tmp237 * tmp74 - tmp246 * tmp262 + tmp250 * tmp69 - tmp261 * tmp92 + tmp264 * tmp89;
-    let tmp267: f64 = 1.0_f64 / (tmp34 * tmp34.sqrt());
-    let tmp268: f64 = tmp267 * reference_tension_n[0];
-    let tmp269: f64 = tmp268 * tmp32;
-    let tmp270: f64 = tmp220 * tmp269;
-    let tmp271: f64 = tmp17 * tmp267;
-    let tmp272: f64 = tmp271 * tmp32;
-    let tmp273: f64 = tmp267 * tmp31;
-    let tmp274: f64 = tmp18 * tmp273;
-    let tmp275: f64 =
-        tmp101 * tmp207 - tmp102 * tmp201 + tmp201 * tmp97 - tmp207 * tmp99 - tmp220 * tmp272 + tmp220 * tmp274;
-    let tmp276: f64 = tmp93 * reference_tension_n[0];
-    let tmp277: f64 = tmp18 * tmp268;
-    let tmp278: f64 = tmp220 * tmp277;
-    let tmp279: f64 = tmp120 * tmp254 + tmp127 * tmp266 + tmp128 * tmp265 + tmp201 * tmp257 + tmp207 * tmp256
-        - tmp270 * tmp84
-        + tmp275 * tmp276
-        - tmp278 * tmp75;
-    let tmp280: f64 = 1.0_f64 / (tmp105 * tmp105);
-    let tmp281: f64 = tmp37 * tmp95;
-    let tmp282: f64 = tmp281 * tmp81;
-    let tmp283: f64 = tmp280 * tmp282;
-    let tmp284: f64 = tmp200 * attachments_m[(2, 1)] + tmp3 * attachments_m[(1, 1)];
-    let tmp285: f64 = 2.0_f64 * tmp48;
-    let tmp286: f64 = tmp206 * attachments_m[(2, 1)] + tmp23 * attachments_m[(1, 1)];
-    let tmp287: f64 = 2.0_f64 * tmp78;
-    let tmp288: f64 = tmp284 * tmp285 + tmp286 * tmp287;
-    let tmp289: f64 = tmp211 * tmp95;
-    let tmp290: f64 = tmp106 * tmp289 * tmp82;
-    let tmp291: f64 = 1.0_f64 / (tmp80 * tmp80.sqrt());
-    let tmp292: f64 = tmp291 * tmp78;
-    let tmp293: f64 = 0.5_f64 * tmp292;
-    let tmp294: f64 = tmp288 * tmp293;
-    let tmp295: f64 = 0.5_f64 * tmp288;
-    let tmp296: f64 = tmp291 * tmp48;
-    let tmp297: f64 = tmp296 * tmp77;
-    let tmp298: f64 =
-        tmp145 * tmp284 - tmp153 * tmp286 - tmp284 * tmp87 + tmp286 * tmp86 - tmp294 * tmp47 + tmp295 * tmp297;
-    let tmp299: f64 = tmp296 * tmp75;
-    let tmp300: f64 = -tmp145 * tmp266 - tmp153 * tmp265 - tmp254 * tmp88 - tmp284 * tmp83 - tmp286 * tmp85
-        + tmp294 * tmp84
-        + tmp295 * tmp299
-        - tmp298 * tmp93;
-    let tmp301: f64 = tmp108 * tmp300 - tmp279 * tmp283 + tmp288 * tmp290;
-    let tmp302: f64 = tmp164 / (tmp110 * tmp110);
-    let tmp303: f64 = tmp167 * tmp302;
-    let tmp304: f64 = tmp165 * tmp110.cosh();
-    let tmp305: f64 = tmp304 * tmp81;
-    let tmp306: f64 = tmp106 * tmp157;
-    let tmp307: f64 = -tmp222 - tmp223 + tmp237;
-    let tmp308: f64 = -tmp226 - tmp227 + tmp235;
-    let tmp309: f64 = tmp224 * tmp58 - tmp228 * tmp60 + tmp235 * tmp51 - tmp237 * tmp49;
-    let tmp310: f64 = 1.0_f64 / (tmp159 * tmp159);
-    let tmp311: f64 = tmp310 * tmp95;
-    let tmp312: f64 = tmp311 * (tmp150 * tmp286 - tmp151 * tmp284 + tmp307 * tmp77 - tmp308 * tmp47 + tmp309);
-    let tmp313: f64 = tmp95 * tmp95;
-    let tmp314: f64 = 1.0_f64 / tmp313;
-    let tmp315: f64 = tmp105 * tmp146;
-    let tmp316: f64 = tmp153 * tmp315;
-    let tmp317: f64 = tmp314 * tmp316;
-    let tmp318: f64 = tmp300 * tmp317;
-    let tmp319: f64 = tmp116 * tmp278;
-    let tmp320: f64 = tmp148 * tmp296;
-    let tmp321: f64 = tmp295 * tmp320;
-    let tmp322: f64 = tmp144 * tmp243;
-    let tmp323: f64 = tmp246 * tmp322;
-    let tmp324: f64 = tmp116 * tmp255;
-    let tmp325: f64 = tmp201 * tmp324;
-    let tmp326: f64 = tmp133 * tmp142;
-    let tmp327: f64 = tmp326 * tmp89;
-    let tmp328: f64 = tmp314 * tmp327;
-    let tmp329: f64 = tmp300 * tmp328;
-    let tmp330: f64 = tmp255 * tmp69;
-    let tmp331: f64 = tmp120 * tmp66;
-    let tmp332: f64 = tmp89 * reference_tension_n[0];
-    let tmp333: f64 = tmp120 * tmp243;
-    let tmp334: f64 = tmp128 * tmp243;
-    let tmp335: f64 = tmp128 * tmp66;
-    let tmp336: f64 = tmp255 * tmp91;
-    let tmp337: f64 = tmp127 * tmp66;
-    let tmp338: f64 = tmp255 * tmp89;
-    let tmp339: f64 = tmp127 * tmp243;
-    let tmp340: f64 = tmp91 * reference_tension_n[0];
-    let tmp341: f64 = tmp122 * tmp296;
-    let tmp342: f64 = -tmp123 * tmp284 + tmp125 * tmp294
-        - tmp126 * tmp286
-        - tmp129 * tmp298
-        - tmp145
-            * (tmp128 * tmp261 + tmp201 * tmp330 - tmp237 * tmp331 + tmp246 * tmp333
-                - tmp275 * tmp332
-                - tmp278 * tmp69)
-        - tmp153
-            * (-tmp127 * tmp261 - tmp207 * tmp330 + tmp235 * tmp331 - tmp242 * tmp333
-                + tmp270 * tmp69
-                + tmp275 * tmp340)
-        + tmp295 * tmp341
-        - tmp88
-            * (-tmp201 * tmp336 + tmp207 * tmp338 - tmp235 * tmp335 + tmp237 * tmp337 + tmp242 * tmp334
-                - tmp246 * tmp339
-                - tmp270 * tmp89
-                + tmp278 * tmp91);
-    let tmp343: f64 = tmp118 * tmp119;
-    let tmp344: f64 = tmp343 * tmp92;
-    let tmp345: f64 = tmp342 * tmp344;
-    let tmp346: f64 = tmp144 * tmp66;
-    let tmp347: f64 = tmp237 * tmp346;
-    let tmp348: f64 = tmp118 * tmp130;
-    let tmp349: f64 = tmp348 * tmp92;
-    let tmp350: f64 = tmp314 * tmp349;
-    let tmp351: f64 = tmp300 * tmp350;
-    let tmp352: f64 = tmp132 * tmp250;
-    let tmp353: f64 = tmp132 * tmp57;
-    let tmp354: f64 = tmp224 * tmp353;
-    let tmp355: f64 = tmp148 * tmp82;
-    let tmp356: f64 = tmp284 * tmp355;
-    let tmp357: f64 = platform_weight_n * (tmp200 * com_offset_m[2] + tmp3 * com_offset_m[1]);
-    let tmp358: f64 = tmp139 * tmp293;
-    let tmp359: f64 = tmp120 * tmp57;
-    let tmp360: f64 = tmp92 * reference_tension_n[0];
-    let tmp361: f64 = tmp90 * reference_tension_n[0];
-    let tmp362: f64 = tmp135 * tmp296;
-    let tmp363: f64 = tmp255 * tmp90;
-    let tmp364: f64 = tmp127 * tmp57;
-    let tmp365: f64 = tmp128 * tmp57;
-    let tmp366: f64 = tmp255 * tmp92;
-    let tmp367: f64 = -tmp136 * tmp284
-        - tmp140 * tmp286
-        - tmp141 * tmp298
-        - tmp145
-            * (-tmp120 * tmp250 - tmp128 * tmp264 - tmp138 * tmp201
-                + tmp224 * tmp359
-                + tmp275 * tmp360
-                + tmp278 * tmp73)
-        - tmp153
-            * (tmp120 * tmp234 + tmp127 * tmp264 + tmp138 * tmp207
-                - tmp228 * tmp359
-                - tmp270 * tmp73
-                - tmp275 * tmp361)
-        + tmp288 * tmp358
-        + tmp295 * tmp362
-        - tmp88
-            * (tmp127 * tmp250 - tmp128 * tmp234 + tmp201 * tmp363 - tmp207 * tmp366 - tmp224 * tmp364
-                + tmp228 * tmp365
-                + tmp270 * tmp92
-                - tmp278 * tmp90);
-    let tmp368: f64 = tmp119 * tmp133;
-    let tmp369: f64 = tmp368 * tmp89;
-    let tmp370: f64 = tmp367 * tmp369;
-    let tmp371: f64 = -tmp22;
-    let tmp372: f64 = tmp21 + tmp371;
-    let tmp373: f64 = -tmp27;
-    let tmp374: f64 = tmp13 + tmp373;
-    let tmp375: f64 = tmp203 + tmp204;
-    let tmp376: f64 = tmp374 + tmp375;
-    let tmp377: f64 = tmp131 * (tmp372 * attachments_m[(2, 2)] + tmp376 * attachments_m[(1, 2)]);
-    let tmp378: f64 = tmp377 * tmp92;
-    let tmp379: f64 = tmp372 * attachments_m[(2, 0)] + tmp376 * attachments_m[(1, 0)];
-    let tmp380: f64 = tmp128 * tmp379;
-    let tmp381: f64 = tmp147 * tmp153;
-    let tmp382: f64 = tmp279 * tmp381;
-    let tmp383: f64 = tmp201 * reference_tension_n[1];
-    let tmp384: f64 = tmp372 * attachments_m[(2, 3)] + tmp376 * attachments_m[(1, 3)];
-    let tmp385: f64 = tmp143 * tmp89;
-    let tmp386: f64 = tmp384 * tmp385;
-    let tmp387: f64 = tmp372 * attachments_m[(2, 1)] + tmp376 * attachments_m[(1, 1)];
-    let tmp388: f64 = tmp105 * tmp119;
-    let tmp389: f64 = tmp153 * tmp388;
-    let tmp390: f64 = tmp387 * tmp389;
-    let tmp391: f64 =
-        -tmp318 - tmp319 - tmp321 - tmp323 + tmp325 - tmp329 + tmp345 + tmp347 - tmp351 - tmp352 + tmp354 + tmp356
-            - tmp357
-            + tmp370
-            + tmp378
-            + tmp380
-            + tmp382
-            + tmp383
-            + tmp386
-            + tmp390;
-    let tmp392: f64 = tmp348 * tmp90;
-    let tmp393: f64 = tmp314 * tmp392;
-    let tmp394: f64 = tmp300 * tmp393;
-    let tmp395: f64 = tmp242 * tmp322;
-    let tmp396: f64 = tmp377 * tmp90;
-    let tmp397: f64 = platform_weight_n * (tmp206 * com_offset_m[2] + tmp23 * com_offset_m[1]);
-    let tmp398: f64 = tmp207 * tmp324;
-    let tmp399: f64 = tmp145 * tmp315;
-    let tmp400: f64 = tmp314 * tmp399;
-    let tmp401: f64 = tmp300 * tmp400;
-    let tmp402: f64 = tmp116 * tmp270;
-    let tmp403: f64 = tmp148 * tmp294;
-    let tmp404: f64 = tmp145 * tmp147;
-    let tmp405: f64 = tmp279 * tmp404;
-    let tmp406: f64 = tmp368 * tmp91;
-    let tmp407: f64 = tmp367 * tmp406;
-    let tmp408: f64 = tmp235 * tmp346;
-    let tmp409: f64 = tmp145 * tmp388;
-    let tmp410: f64 = tmp387 * tmp409;
-    let tmp411: f64 = tmp343 * tmp90;
-    let tmp412: f64 = tmp342 * tmp411;
-    let tmp413: f64 = tmp326 * tmp91;
-    let tmp414: f64 = tmp314 * tmp413;
-    let tmp415: f64 = tmp300 * tmp414;
-    let tmp416: f64 = tmp127 * tmp379;
-    let tmp417: f64 = tmp207 * reference_tension_n[1];
-    let tmp418: f64 = tmp143 * tmp91;
-    let tmp419: f64 = tmp384 * tmp418;
-    let tmp420: f64 = tmp286 * tmp355;
-    let tmp421: f64 = tmp228 * tmp353;
-    let tmp422: f64 = tmp132 * tmp234;
-    let tmp423: f64 = tmp394 + tmp395 - tmp396 + tmp397 - tmp398 + tmp401 + tmp402 + tmp403
-        - tmp405
-        - tmp407
-        - tmp408
-        - tmp410
-        - tmp412
-        + tmp415
-        - tmp416
-        - tmp417
-        - tmp419
-        - tmp420
-        - tmp421
-        + tmp422;
-    let tmp424: f64 = tmp161 * tmp95;
-    let tmp425: f64 = tmp157 * tmp178;
-    let tmp426: f64 = tmp280 * tmp425;
-    let tmp427: f64 = tmp310 * tmp313;
-    let tmp428: f64 = 1.0_f64 / (((tmp157 * tmp157) * tmp280 * tmp427 + 1.0_f64).sqrt());
-    let tmp429: f64 = tmp111 * tmp167 * tmp163.sinh();
-    let tmp430: f64 = tmp165 * tmp166;
-    let tmp431: f64 = tmp430 * tmp82;
-    let tmp432: f64 = tmp181 * tmp182;
-    let tmp433: f64 = tmp432 * tmp57;
-    let tmp434: f64 = tmp168 * tmp289;
-    let tmp435: f64 = tmp434 * tmp57;
-    let tmp436: f64 = 1.0_f64 / (tmp130 * tmp130);
-    let tmp437: f64 = tmp281 * tmp56;
-    let tmp438: f64 = tmp436 * tmp437;
-    let tmp439: f64 = tmp170 * tmp300 + tmp230 * tmp435 - tmp342 * tmp438;
-    let tmp440: f64 = tmp181 * tmp172.cosh();
-    let tmp441: f64 = tmp440 * tmp56;
-    let tmp442: f64 = tmp180 / (tmp172 * tmp172);
-    let tmp443: f64 = tmp183 * tmp442;
-    let tmp444: f64 = tmp176 * tmp178;
-    let tmp445: f64 = tmp436 * tmp444;
-    let tmp446: f64 = tmp168 * tmp178;
-    let tmp447: f64 = tmp160 * tmp177;
-    let tmp448: f64 = 1.0_f64 / (((tmp176 * tmp176) * tmp427 * tmp436 + 1.0_f64).sqrt());
-    let tmp449: f64 = tmp173 * tmp183 * tmp179.sinh();
-    let tmp450: f64 = 1.0_f64 / (tmp142 * tmp142);
-    let tmp451: f64 = tmp281 * tmp65;
-    let tmp452: f64 = tmp450 * tmp451;
-    let tmp453: f64 = tmp240 * tmp66;
-    let tmp454: f64 = tmp184 * tmp289;
-    let tmp455: f64 = tmp186 * tmp300 - tmp367 * tmp452 + tmp453 * tmp454;
-    let tmp456: f64 = tmp196 * tmp188.cosh();
-    let tmp457: f64 = tmp456 * tmp65;
-    let tmp458: f64 = tmp195 / (tmp188 * tmp188);
-    let tmp459: f64 = tmp198 * tmp458;
-    let tmp460: f64 = 1.0_f64 / (((tmp192 * tmp192) * tmp427 * tmp450 + 1.0_f64).sqrt());
-    let tmp461: f64 = tmp178 * tmp192;
-    let tmp462: f64 = tmp450 * tmp461;
-    let tmp463: f64 = tmp184 * tmp192;
-    let tmp464: f64 = tmp160 * tmp463;
-    let tmp465: f64 = tmp189 * tmp198 * tmp194.sinh();
-    let tmp466: f64 = tmp196 * tmp197;
-    let tmp467: f64 = 0.5_f64 * tmp466;
-    let tmp468: f64 = tmp20 + tmp371;
-    let tmp469: f64 = tmp25 * attachments_m[(2, 0)] + tmp468 * attachments_m[(0, 0)];
-    let tmp470: f64 = -tmp2;
-    let tmp471: f64 = tmp113 + tmp470;
-    let tmp472: f64 = -tmp13;
-    let tmp473: f64 = tmp27 + tmp472;
-    let tmp474: f64 = tmp375 + tmp473;
-    let tmp475: f64 = tmp471 * attachments_m[(0, 0)] + tmp474 * attachments_m[(2, 0)];
-    let tmp476: f64 = tmp202 * tmp475 + tmp208 * tmp469;
-    let tmp477: f64 = 0.5_f64 * tmp476;
-    let tmp478: f64 = tmp25 * attachments_m[(2, 1)] + tmp468 * attachments_m[(0, 1)];
-    let tmp479: f64 = tmp471 * attachments_m[(0, 1)] + tmp474 * attachments_m[(2, 1)];
-    let tmp480: f64 = tmp285 * tmp479 + tmp287 * tmp478;
-    let tmp481: f64 = tmp293 * tmp480;
-    let tmp482: f64 = tmp468 * attachments_m[(0, 2)];
-    let tmp483: f64 = tmp25 * attachments_m[(2, 2)];
-    let tmp484: f64 = tmp482 + tmp483;
-    let tmp485: f64 = tmp471 * attachments_m[(0, 2)];
-    let tmp486: f64 = tmp474 * attachments_m[(2, 2)];
-    let tmp487: f64 = tmp485 + tmp486;
-    let tmp488: f64 = tmp225 * tmp487 + tmp229 * tmp484;
-    let tmp489: f64 = tmp233 * tmp488;
-    let tmp490: f64 = tmp471 * attachments_m[(0, 3)] + tmp474 * attachments_m[(2, 3)];
-    let tmp491: f64 = tmp25 * attachments_m[(2, 3)] + tmp468 * attachments_m[(0, 3)];
-    let tmp492: f64 = tmp238 * tmp490 + tmp239 * tmp491;
-    let tmp493: f64 = tmp245 * tmp258;
-    let tmp494: f64 =
-        -tmp260 * tmp492 - tmp490 * tmp68 + tmp490 * tmp91 + tmp491 * tmp67 - tmp491 * tmp89 + tmp492 * tmp493;
-    let tmp495: f64 = 0.5_f64 * tmp249;
-    let tmp496: f64 = tmp488 * tmp495;
-    let tmp497: f64 =
-        tmp484 * tmp71 - tmp484 * tmp92 - tmp487 * tmp72 + tmp487 * tmp90 - tmp489 * tmp51 + tmp49 * tmp496;
-    let tmp498: f64 =
-        tmp263 * tmp492 + tmp484 * tmp70 - tmp489 * tmp69 - tmp491 * tmp74 + tmp494 * tmp90 - tmp497 * tmp91;
-    let tmp499: f64 = tmp241 * tmp492;
-    let tmp500: f64 = tmp245 * tmp492;
-    let tmp501: f64 = tmp236 * tmp491 - tmp244 * tmp499 + tmp247 * tmp500 - tmp251 * tmp490 + tmp252 * tmp487
-        - tmp253 * tmp484
-        + tmp489 * tmp89
-        - tmp496 * tmp91;
-    let tmp502: f64 = 0.5_f64 * tmp480;
-    let tmp503: f64 =
-        tmp145 * tmp479 - tmp153 * tmp478 + tmp297 * tmp502 - tmp47 * tmp481 + tmp478 * tmp86 - tmp479 * tmp87;
-    let tmp504: f64 = tmp245 * tmp262;
-    let tmp505: f64 =
-        -tmp487 * tmp70 + tmp490 * tmp74 - tmp492 * tmp504 - tmp494 * tmp92 + tmp496 * tmp69 + tmp497 * tmp89;
-    let tmp506: f64 = -tmp145 * tmp505 - tmp153 * tmp498 + tmp299 * tmp502 - tmp478 * tmp85 - tmp479 * tmp83
-        + tmp481 * tmp84
-        - tmp501 * tmp88
-        - tmp503 * tmp93;
-    let tmp507: f64 = tmp160 * tmp506;
-    let tmp508: f64 = -tmp482 - tmp483 + tmp491;
-    let tmp509: f64 = tmp353 * tmp487;
-    let tmp510: f64 = tmp324 * tmp475;
-    let tmp511: f64 =
-        tmp101 * tmp469 - tmp102 * tmp475 - tmp272 * tmp477 + tmp274 * tmp477 - tmp469 * tmp99 + tmp475 * tmp97;
-    let tmp512: f64 = tmp277 * tmp477;
-    let tmp513: f64 = tmp269 * tmp477;
-    let tmp514: f64 =
-        tmp120 * tmp501 + tmp127 * tmp505 + tmp128 * tmp498 + tmp256 * tmp469 + tmp257 * tmp475 + tmp276 * tmp511
-            - tmp512 * tmp75
-            - tmp513 * tmp84;
-    let tmp515: f64 = tmp381 * tmp514;
-    let tmp516: f64 = tmp314 * tmp506;
-    let tmp517: f64 = tmp327 * tmp516;
-    let tmp518: f64 = -tmp136 * tmp479
-        - tmp140 * tmp478
-        - tmp141 * tmp503
-        - tmp145
-            * (-tmp120 * tmp496 - tmp128 * tmp497 - tmp138 * tmp475
-                + tmp359 * tmp487
-                + tmp360 * tmp511
-                + tmp512 * tmp73)
-        - tmp153
-            * (tmp120 * tmp489 + tmp127 * tmp497 + tmp138 * tmp469
-                - tmp359 * tmp484
-                - tmp361 * tmp511
-                - tmp513 * tmp73)
-        + tmp358 * tmp480
-        + tmp362 * tmp502
-        - tmp88
-            * (tmp127 * tmp496 - tmp128 * tmp489 + tmp363 * tmp475 - tmp364 * tmp487 + tmp365 * tmp484
-                - tmp366 * tmp469
-                - tmp512 * tmp90
-                + tmp513 * tmp92);
-    let tmp519: f64 = tmp369 * tmp518;
-    let tmp520: f64 = tmp132 * tmp496;
-    let tmp521: f64 = tmp475 * reference_tension_n[1];
-    let tmp522: f64 = tmp11 + tmp205;
-    let tmp523: f64 = tmp473 + tmp522;
-    let tmp524: f64 = tmp131 * (tmp114 * attachments_m[(2, 2)] + tmp523 * attachments_m[(0, 2)]);
-    let tmp525: f64 = tmp524 * tmp92;
-    let tmp526: f64 = tmp346 * tmp490;
-    let tmp527: f64 = tmp114 * attachments_m[(2, 1)] + tmp523 * attachments_m[(0, 1)];
-    let tmp528: f64 = tmp389 * tmp527;
-    let tmp529: f64 = tmp320 * tmp502;
-    let tmp530: f64 = platform_weight_n * (tmp471 * com_offset_m[0] + tmp474 * com_offset_m[2]);
-    let tmp531: f64 = -tmp123 * tmp479 + tmp125 * tmp481
-        - tmp126 * tmp478
-        - tmp129 * tmp503
-        - tmp145
-            * (tmp128 * tmp494 + tmp330 * tmp475 - tmp331 * tmp490 - tmp332 * tmp511 + tmp333 * tmp500
-                - tmp512 * tmp69)
-        - tmp153
-            * (-tmp127 * tmp494 - tmp330 * tmp469 + tmp331 * tmp491 - tmp333 * tmp499
-                + tmp340 * tmp511
-                + tmp513 * tmp69)
-        + tmp341 * tmp502
-        - tmp88
-            * (tmp334 * tmp499 - tmp335 * tmp491 - tmp336 * tmp475 + tmp337 * tmp490 + tmp338 * tmp469
-                - tmp339 * tmp500
-                + tmp512 * tmp91
-                - tmp513 * tmp89);
-    let tmp532: f64 = tmp344 * tmp531;
-    let tmp533: f64 = tmp355 * tmp479;
-    let tmp534: f64 = tmp114 * attachments_m[(2, 3)] + tmp523 * attachments_m[(0, 3)];
-    let tmp535: f64 = tmp385 * tmp534;
-    let tmp536: f64 = tmp316 * tmp516;
-    let tmp537: f64 = tmp322 * tmp500;
-    let tmp538: f64 = tmp116 * tmp512;
-    let tmp539: f64 = tmp349 * tmp516;
-    let tmp540: f64 = tmp114 * attachments_m[(2, 0)] + tmp523 * attachments_m[(0, 0)];
-    let tmp541: f64 = tmp128 * tmp540;
-    let tmp542: f64 =
-        tmp509 + tmp510 + tmp515 - tmp517 + tmp519 - tmp520 + tmp521 + tmp525 + tmp526 + tmp528 - tmp529 - tmp530
-            + tmp532
-            + tmp533
-            + tmp535
-            - tmp536
-            - tmp537
-            - tmp538
-            - tmp539
-            + tmp541;
-    let tmp543: f64 = -tmp484 * tmp60 + tmp487 * tmp58 - tmp49 * tmp490 + tmp491 * tmp51;
-    let tmp544: f64 = -tmp485 - tmp486 + tmp490;
-    let tmp545: f64 = tmp392 * tmp516;
-    let tmp546: f64 = tmp346 * tmp491;
-    let tmp547: f64 = tmp355 * tmp478;
-    let tmp548: f64 = platform_weight_n * (tmp25 * com_offset_m[2] + tmp468 * com_offset_m[0]);
-    let tmp549: f64 = tmp469 * reference_tension_n[1];
-    let tmp550: f64 = tmp404 * tmp514;
-    let tmp551: f64 = tmp116 * tmp513;
-    let tmp552: f64 = tmp324 * tmp469;
-    let tmp553: f64 = tmp413 * tmp516;
-    let tmp554: f64 = tmp399 * tmp516;
-    let tmp555: f64 = tmp406 * tmp518;
-    let tmp556: f64 = tmp148 * tmp481;
-    let tmp557: f64 = tmp411 * tmp531;
-    let tmp558: f64 = tmp132 * tmp489;
-    let tmp559: f64 = tmp524 * tmp90;
-    let tmp560: f64 = tmp127 * tmp540;
-    let tmp561: f64 = tmp353 * tmp484;
-    let tmp562: f64 = tmp322 * tmp499;
-    let tmp563: f64 = tmp418 * tmp534;
-    let tmp564: f64 = tmp409 * tmp527;
-    let tmp565: f64 = tmp545 - tmp546 - tmp547 + tmp548 - tmp549 - tmp550 + tmp551 - tmp552 + tmp553 + tmp554 - tmp555
-        + tmp556
-        - tmp557
-        + tmp558
-        - tmp559
-        - tmp560
-        - tmp561
-        + tmp562
-        - tmp563
-        - tmp564;
-    let tmp566: f64 = tmp311 * (tmp150 * tmp478 - tmp151 * tmp479 - tmp47 * tmp508 + tmp543 + tmp544 * tmp77);
-    let tmp567: f64 = tmp108 * tmp506 - tmp283 * tmp514 + tmp290 * tmp480;
-    let tmp568: f64 = tmp488 * tmp57;
-    let tmp569: f64 = tmp170 * tmp506 + tmp434 * tmp568 - tmp438 * tmp531;
-    let tmp570: f64 = tmp492 * tmp66;
-    let tmp571: f64 = tmp186 * tmp506 - tmp452 * tmp518 + tmp454 * tmp570;
-    let tmp572: f64 = tmp199 + tmp7;
-    let tmp573: f64 = tmp11 + tmp204 + tmp373 + tmp472;
-    let tmp574: f64 = tmp572 * attachments_m[(1, 0)] + tmp573 * attachments_m[(0, 0)];
-    let tmp575: f64 = tmp374 + tmp522;
-    let tmp576: f64 = tmp575 * attachments_m[(1, 0)] + tmp9 * attachments_m[(0, 0)];
-    let tmp577: f64 = tmp202 * tmp576 + tmp208 * tmp574;
-    let tmp578: f64 = 0.5_f64 * tmp577;
-    let tmp579: f64 = tmp211 * tmp577;
-    let tmp580: f64 = tmp212 * tmp579;
-    let tmp581: f64 = tmp572 * attachments_m[(1, 1)] + tmp573 * attachments_m[(0, 1)];
-    let tmp582: f64 = tmp575 * attachments_m[(1, 1)] + tmp9 * attachments_m[(0, 1)];
-    let tmp583: f64 = tmp285 * tmp582 + tmp287 * tmp581;
-    let tmp584: f64 = 0.5_f64 * tmp583;
-    let tmp585: f64 = tmp572 * attachments_m[(1, 2)];
-    let tmp586: f64 = tmp573 * attachments_m[(0, 2)];
-    let tmp587: f64 = tmp585 + tmp586;
-    let tmp588: f64 = tmp9 * attachments_m[(0, 2)];
-    let tmp589: f64 = tmp575 * attachments_m[(1, 2)];
-    let tmp590: f64 = tmp588 + tmp589;
-    let tmp591: f64 = tmp225 * tmp590 + tmp229 * tmp587;
-    let tmp592: f64 = tmp495 * tmp591;
-    let tmp593: f64 = tmp233 * tmp591;
-    let tmp594: f64 =
-        tmp49 * tmp592 - tmp51 * tmp593 + tmp587 * tmp71 - tmp587 * tmp92 - tmp590 * tmp72 + tmp590 * tmp90;
-    let tmp595: f64 = tmp572 * attachments_m[(1, 3)] + tmp573 * attachments_m[(0, 3)];
-    let tmp596: f64 = tmp575 * attachments_m[(1, 3)] + tmp9 * attachments_m[(0, 3)];
-    let tmp597: f64 = tmp238 * tmp596 + tmp239 * tmp595;
-    let tmp598: f64 =
-        -tmp260 * tmp597 + tmp493 * tmp597 + tmp595 * tmp67 - tmp595 * tmp89 - tmp596 * tmp68 + tmp596 * tmp91;
-    let tmp599: f64 =
-        tmp263 * tmp597 + tmp587 * tmp70 - tmp593 * tmp69 - tmp594 * tmp91 - tmp595 * tmp74 + tmp598 * tmp90;
-    let tmp600: f64 =
-        tmp101 * tmp574 - tmp102 * tmp576 - tmp272 * tmp578 + tmp274 * tmp578 - tmp574 * tmp99 + tmp576 * tmp97;
-    let tmp601: f64 =
-        -tmp504 * tmp597 - tmp590 * tmp70 + tmp592 * tmp69 + tmp594 * tmp89 + tmp596 * tmp74 - tmp598 * tmp92;
-    let tmp602: f64 = tmp269 * tmp578;
-    let tmp603: f64 = tmp245 * tmp597;
-    let tmp604: f64 = tmp241 * tmp597;
-    let tmp605: f64 = tmp236 * tmp595 - tmp244 * tmp604 + tmp247 * tmp603 - tmp251 * tmp596 + tmp252 * tmp590
-        - tmp253 * tmp587
-        - tmp592 * tmp91
-        + tmp593 * tmp89;
-    let tmp606: f64 = tmp277 * tmp578;
-    let tmp607: f64 =
-        tmp120 * tmp605 + tmp127 * tmp601 + tmp128 * tmp599 + tmp256 * tmp574 + tmp257 * tmp576 + tmp276 * tmp600
-            - tmp602 * tmp84
-            - tmp606 * tmp75;
-    let tmp608: f64 = tmp293 * tmp583;
-    let tmp609: f64 =
-        tmp145 * tmp582 - tmp153 * tmp581 + tmp297 * tmp584 - tmp47 * tmp608 + tmp581 * tmp86 - tmp582 * tmp87;
-    let tmp610: f64 =
-        -tmp145 * tmp601 - tmp153 * tmp599 + tmp299 * tmp584 - tmp581 * tmp85 - tmp582 * tmp83 - tmp605 * tmp88
-            + tmp608 * tmp84
-            - tmp609 * tmp93;
-    let tmp611: f64 = tmp108 * tmp610 - tmp283 * tmp607 + tmp290 * tmp583;
-    let tmp612: f64 = -tmp585 - tmp586 + tmp595;
-    let tmp613: f64 = tmp355 * tmp582;
-    let tmp614: f64 = tmp132 * tmp592;
-    let tmp615: f64 = tmp353 * tmp590;
-    let tmp616: f64 = tmp314 * tmp610;
-    let tmp617: f64 = tmp316 * tmp616;
-    let tmp618: f64 = tmp0 + tmp470;
-    let tmp619: f64 = tmp112 * attachments_m[(0, 1)] + tmp618 * attachments_m[(1, 1)];
-    let tmp620: f64 = tmp389 * tmp619;
-    let tmp621: f64 = tmp322 * tmp603;
-    let tmp622: f64 = tmp112 * attachments_m[(0, 3)] + tmp618 * attachments_m[(1, 3)];
-    let tmp623: f64 = tmp385 * tmp622;
-    let tmp624: f64 = tmp349 * tmp616;
-    let tmp625: f64 = -tmp123 * tmp582 + tmp125 * tmp608
-        - tmp126 * tmp581
-        - tmp129 * tmp609
-        - tmp145
-            * (tmp128 * tmp598 + tmp330 * tmp576 - tmp331 * tmp596 - tmp332 * tmp600 + tmp333 * tmp603
-                - tmp606 * tmp69)
-        - tmp153
-            * (-tmp127 * tmp598 - tmp330 * tmp574 + tmp331 * tmp595 - tmp333 * tmp604
-                + tmp340 * tmp600
-                + tmp602 * tmp69)
-        + tmp341 * tmp584
-        - tmp88
-            * (tmp334 * tmp604 - tmp335 * tmp595 - tmp336 * tmp576 + tmp337 * tmp596 + tmp338 * tmp574
-                - tmp339 * tmp603
-                - tmp602 * tmp89
-                + tmp606 * tmp91);
-    let tmp626: f64 = tmp344 * tmp625;
-    let tmp627: f64 = -tmp136 * tmp582
-        - tmp140 * tmp581
-        - tmp141 * tmp609
-        - tmp145
-            * (-tmp120 * tmp592 - tmp128 * tmp594 - tmp138 * tmp576
-                + tmp359 * tmp590
-                + tmp360 * tmp600
-                + tmp606 * tmp73)
-        - tmp153
-            * (tmp120 * tmp593 + tmp127 * tmp594 + tmp138 * tmp574
-                - tmp359 * tmp587
-                - tmp361 * tmp600
-                - tmp602 * tmp73)
-        + tmp358 * tmp583
-        + tmp362 * tmp584
-        - tmp88
-            * (tmp127 * tmp592 - tmp128 * tmp593 + tmp363 * tmp576 - tmp364 * tmp590 + tmp365 * tmp587
-                - tmp366 * tmp574
-                + tmp602 * tmp92
-                - tmp606 * tmp90);
-    let tmp628: f64 = tmp369 * tmp627;
-    let tmp629: f64 = tmp327 * tmp616;
-    let tmp630: f64 = tmp324 * tmp576;
-    let tmp631: f64 = tmp576 * reference_tension_n[1];
-    let tmp632: f64 = tmp116 * tmp606;
-    let tmp633: f64 = tmp346 * tmp596;
-    let tmp634: f64 = platform_weight_n * (tmp575 * com_offset_m[1] + tmp9 * com_offset_m[0]);
-    let tmp635: f64 = tmp112 * attachments_m[(0, 0)] + tmp618 * attachments_m[(1, 0)];
-    let tmp636: f64 = tmp128 * tmp635;
-    let tmp637: f64 = tmp381 * tmp607;
-    let tmp638: f64 = tmp320 * tmp584;
-    let tmp639: f64 = tmp131 * (tmp112 * attachments_m[(0, 2)] + tmp618 * attachments_m[(1, 2)]);
-    let tmp640: f64 = tmp639 * tmp92;
-    let tmp641: f64 = tmp613 - tmp614 + tmp615 - tmp617 + tmp620 - tmp621 + tmp623 - tmp624 + tmp626 + tmp628 - tmp629
-        + tmp630
-        + tmp631
-        - tmp632
-        + tmp633
-        - tmp634
-        + tmp636
-        + tmp637
-        - tmp638
-        + tmp640;
-    let tmp642: f64 = -tmp49 * tmp596 + tmp51 * tmp595 + tmp58 * tmp590 - tmp587 * tmp60;
-    let tmp643: f64 = -tmp588 - tmp589 + tmp596;
-    let tmp644: f64 = tmp132 * tmp593;
-    let tmp645: f64 = tmp346 * tmp595;
-    let tmp646: f64 = tmp400 * tmp610;
-    let tmp647: f64 = tmp411 * tmp625;
-    let tmp648: f64 = tmp409 * tmp619;
-    let tmp649: f64 = tmp406 * tmp627;
-    let tmp650: f64 = tmp322 * tmp604;
-    let tmp651: f64 = tmp148 * tmp608;
-    let tmp652: f64 = tmp127 * tmp635;
-    let tmp653: f64 = tmp353 * tmp587;
-    let tmp654: f64 = tmp413 * tmp616;
-    let tmp655: f64 = platform_weight_n * (tmp572 * com_offset_m[1] + tmp573 * com_offset_m[0]);
-    let tmp656: f64 = tmp324 * tmp574;
-    let tmp657: f64 = tmp116 * tmp602;
-    let tmp658: f64 = tmp355 * tmp581;
-    let tmp659: f64 = tmp418 * tmp622;
-    let tmp660: f64 = tmp392 * tmp616;
-    let tmp661: f64 = tmp404 * tmp607;
-    let tmp662: f64 = tmp639 * tmp90;
-    let tmp663: f64 = tmp574 * reference_tension_n[1];
-    let tmp664: f64 =
-        tmp644 - tmp645 + tmp646 - tmp647 - tmp648 - tmp649 + tmp650 + tmp651 - tmp652 - tmp653 + tmp654 + tmp655
-            - tmp656
-            + tmp657
-            - tmp658
-            - tmp659
-            + tmp660
-            - tmp661
-            - tmp662
-            - tmp663;
-    let tmp665: f64 = tmp311 * (tmp150 * tmp581 - tmp151 * tmp582 - tmp47 * tmp612 + tmp642 + tmp643 * tmp77);
-    let tmp666: f64 = tmp170 * tmp610 + tmp435 * tmp591 - tmp438 * tmp625;
-    let tmp667: f64 = tmp597 * tmp66;
-    let tmp668: f64 = tmp186 * tmp610 - tmp452 * tmp627 + tmp454 * tmp667;
-    let tmp669: f64 = tmp212 * tmp37;
-    let tmp670: f64 = tmp18 * tmp669;
-    let tmp671: f64 = tmp218 * tmp670;
-    let tmp672: f64 = tmp216 * tmp37;
-    let tmp673: f64 = tmp18 * tmp672;
-    let tmp674: f64 = tmp210 * tmp670;
-    let tmp675: f64 = tmp46 * tmp99;
-    let tmp676: f64 = tmp291 * tmp76;
-    let tmp677: f64 = tmp676 * tmp75;
-    let tmp678: f64 = tmp292 * tmp48;
-    let tmp679: f64 = tmp678 * tmp84;
-    let tmp680: f64 = tmp243 * tmp62;
-    let tmp681: f64 = tmp680 * tmp90;
-    let tmp682: f64 = tmp232 * tmp52;
-    let tmp683: f64 = tmp682 * tmp89;
-    let tmp684: f64 = tmp59 * tmp61;
-    let tmp685: f64 = tmp243 * tmp684;
-    let tmp686: f64 = tmp685 * tmp92;
-    let tmp687: f64 = tmp231 * tmp53;
-    let tmp688: f64 = tmp687 * tmp91;
-    let tmp689: f64 = -tmp251 + tmp252 + tmp681 + tmp683 - tmp686 - tmp688;
-    let tmp690: f64 = tmp51 * tmp682;
-    let tmp691: f64 = tmp49 * tmp687;
-    let tmp692: f64 = -tmp690 + tmp691 - tmp72;
-    let tmp693: f64 = tmp258 * tmp62;
-    let tmp694: f64 = tmp259 * tmp684;
-    let tmp695: f64 = -tmp68 + tmp693 - tmp694;
-    let tmp696: f64 = tmp262 * tmp684;
-    let tmp697: f64 = tmp682 * tmp69;
-    let tmp698: f64 = -tmp697;
-    let tmp699: f64 = -tmp692 * tmp91 + tmp695 * tmp90 + tmp696 + tmp698;
-    let tmp700: f64 = tmp47 * tmp678;
-    let tmp701: f64 = tmp676 * tmp77;
-    let tmp702: f64 = -tmp700 + tmp701 - tmp87;
-    let tmp703: f64 = tmp687 * tmp69;
-    let tmp704: f64 = -tmp70;
-    let tmp705: f64 = tmp262 * tmp62;
-    let tmp706: f64 = tmp692 * tmp89 - tmp695 * tmp92 + tmp703 + tmp704 - tmp705 + tmp74;
-    let tmp707: f64 = -tmp145 * tmp706 - tmp153 * tmp699 + tmp677 + tmp679 - tmp689 * tmp88 - tmp702 * tmp93 - tmp83;
-    let tmp708: f64 = tmp314 * tmp707;
-    let tmp709: f64 = tmp349 * tmp708;
-    let tmp710: f64 = tmp125 * tmp678;
-    let tmp711: f64 = tmp122 * tmp676;
-    let tmp712: f64 = tmp18 * tmp32;
-    let tmp713: f64 = tmp268 * tmp712;
-    let tmp714: f64 = tmp713 * tmp89;
-    let tmp715: f64 = tmp127 * tmp680;
-    let tmp716: f64 = tmp19 * tmp268;
-    let tmp717: f64 = tmp716 * tmp91;
-    let tmp718: f64 = tmp128 * tmp685;
-    let tmp719: f64 = -tmp331;
-    let tmp720: f64 = tmp69 * tmp716;
-    let tmp721: f64 = tmp120 * tmp680;
-    let tmp722: f64 = tmp19 * tmp273;
-    let tmp723: f64 = tmp271 * tmp712;
-    let tmp724: f64 = -tmp102 + tmp722 - tmp723;
-    let tmp725: f64 = tmp120 * tmp685;
-    let tmp726: f64 = -tmp725;
-    let tmp727: f64 = tmp69 * tmp713;
-    let tmp728: f64 = -tmp123
-        - tmp129 * tmp702
-        - tmp145 * (tmp128 * tmp695 + tmp330 - tmp332 * tmp724 + tmp719 - tmp720 + tmp721)
-        - tmp153 * (-tmp127 * tmp695 + tmp340 * tmp724 + tmp726 + tmp727)
-        + tmp710
-        + tmp711
-        - tmp88 * (-tmp336 + tmp337 - tmp714 - tmp715 + tmp717 + tmp718);
-    let tmp729: f64 = tmp344 * tmp728;
-    let tmp730: f64 = tmp135 * tmp676;
-    let tmp731: f64 = tmp139 * tmp678;
-    let tmp732: f64 = tmp127 * tmp687;
-    let tmp733: f64 = tmp713 * tmp92;
-    let tmp734: f64 = tmp128 * tmp682;
-    let tmp735: f64 = tmp716 * tmp90;
-    let tmp736: f64 = tmp120 * tmp682;
-    let tmp737: f64 = tmp713 * tmp73;
-    let tmp738: f64 = -tmp737;
-    let tmp739: f64 = -tmp138;
-    let tmp740: f64 = tmp120 * tmp687;
-    let tmp741: f64 = tmp716 * tmp73;
-    let tmp742: f64 = -tmp136
-        - tmp141 * tmp702
-        - tmp145 * (-tmp128 * tmp692 + tmp359 + tmp360 * tmp724 + tmp739 - tmp740 + tmp741)
-        - tmp153 * (tmp127 * tmp692 - tmp361 * tmp724 + tmp736 + tmp738)
-        + tmp730
-        + tmp731
-        - tmp88 * (tmp363 - tmp364 + tmp732 + tmp733 - tmp734 - tmp735);
-    let tmp743: f64 = tmp369 * tmp742;
-    let tmp744: f64 = tmp716 * tmp75;
-    let tmp745: f64 = tmp713 * tmp84;
-    let tmp746: f64 = tmp120 * tmp689 + tmp127 * tmp706 + tmp128 * tmp699 + tmp257 + tmp276 * tmp724 - tmp744 - tmp745;
-    let tmp747: f64 = tmp381 * tmp746;
-    let tmp748: f64 = tmp316 * tmp708;
-    let tmp749: f64 = tmp327 * tmp708;
-    let tmp750: f64 = tmp116 * tmp716;
-    let tmp751: f64 = tmp324 - tmp750;
-    let tmp752: f64 = tmp148 * tmp676;
-    let tmp753: f64 = tmp355 - tmp752;
-    let tmp754: f64 = tmp144 * tmp680;
-    let tmp755: f64 = tmp346 - tmp754;
-    let tmp756: f64 = tmp132 * tmp687;
-    let tmp757: f64 = tmp353 - tmp756;
-    let tmp758: f64 = -tmp709 + tmp729 + tmp743 + tmp747 - tmp748 - tmp749 + tmp751 + tmp753 + tmp755 + tmp757;
-    let tmp759: f64 = tmp392 * tmp708;
-    let tmp760: f64 = tmp411 * tmp728;
-    let tmp761: f64 = tmp406 * tmp742;
-    let tmp762: f64 = tmp400 * tmp707;
-    let tmp763: f64 = tmp413 * tmp708;
-    let tmp764: f64 = tmp404 * tmp746;
-    let tmp765: f64 = tmp116 * tmp713;
-    let tmp766: f64 = tmp144 * tmp685;
-    let tmp767: f64 = tmp148 * tmp678;
-    let tmp768: f64 = tmp132 * tmp682;
-    let tmp769: f64 = tmp765 + tmp766 + tmp767 + tmp768;
-    let tmp770: f64 = tmp759 - tmp760 - tmp761 + tmp762 + tmp763 - tmp764 + tmp769;
-    let tmp771: f64 = tmp106 * tmp281;
-    let tmp772: f64 = tmp153 * tmp771;
-    let tmp773: f64 = tmp108 * tmp707 - tmp283 * tmp746 + tmp772;
-    let tmp774: f64 = tmp153 * tmp430;
-    let tmp775: f64 = tmp432 * tmp92;
-    let tmp776: f64 = -tmp765;
-    let tmp777: f64 = -tmp766;
-    let tmp778: f64 = -tmp768;
-    let tmp779: f64 = -tmp767;
-    let tmp780: f64 = tmp776 + tmp777 + tmp778 + tmp779;
-    let tmp781: f64 = tmp168 * tmp281;
-    let tmp782: f64 = tmp781 * tmp92;
-    let tmp783: f64 = tmp170 * tmp707 - tmp438 * tmp728 + tmp782;
-    let tmp784: f64 = tmp184 * tmp281;
-    let tmp785: f64 = tmp784 * tmp89;
-    let tmp786: f64 = tmp186 * tmp707 - tmp452 * tmp742 + tmp785;
-    let tmp787: f64 = -tmp324;
-    let tmp788: f64 = tmp750 + tmp787;
-    let tmp789: f64 = -tmp355;
-    let tmp790: f64 = tmp752 + tmp789;
-    let tmp791: f64 = -tmp346;
-    let tmp792: f64 = tmp754 + tmp791;
-    let tmp793: f64 = -tmp353;
-    let tmp794: f64 = tmp756 + tmp793;
-    let tmp795: f64 = tmp466 * tmp89;
-    let tmp796: f64 = tmp32 * tmp669;
-    let tmp797: f64 = tmp210 * tmp796;
-    let tmp798: f64 = tmp32 * tmp672;
-    let tmp799: f64 = tmp218 * tmp796;
-    let tmp800: f64 = tmp46 * tmp97;
-    let tmp801: f64 = tmp713 * tmp75;
-    let tmp802: f64 = tmp259 * tmp63;
-    let tmp803: f64 = tmp258 * tmp684;
-    let tmp804: f64 = tmp67 - tmp802 + tmp803;
-    let tmp805: f64 = tmp49 * tmp682;
-    let tmp806: f64 = tmp231 * tmp54;
-    let tmp807: f64 = tmp51 * tmp806;
-    let tmp808: f64 = tmp71 + tmp805 - tmp807;
-    let tmp809: f64 = -tmp696;
-    let tmp810: f64 = tmp697 - tmp804 * tmp92 + tmp808 * tmp89 + tmp809;
-    let tmp811: f64 = tmp268 * tmp33;
-    let tmp812: f64 = tmp811 * tmp84;
-    let tmp813: f64 = tmp682 * tmp91;
-    let tmp814: f64 = tmp685 * tmp90;
-    let tmp815: f64 = tmp806 * tmp89;
-    let tmp816: f64 = tmp243 * tmp63;
-    let tmp817: f64 = tmp816 * tmp92;
-    let tmp818: f64 = tmp236 - tmp253 - tmp813 + tmp814 + tmp815 - tmp817;
-    let tmp819: f64 = -tmp74;
-    let tmp820: f64 = tmp69 * tmp806;
-    let tmp821: f64 = tmp262 * tmp63;
-    let tmp822: f64 = tmp70 + tmp804 * tmp90 - tmp808 * tmp91 + tmp819 - tmp820 + tmp821;
-    let tmp823: f64 = tmp271 * tmp33;
-    let tmp824: f64 = tmp273 * tmp712;
-    let tmp825: f64 = tmp101 - tmp823 + tmp824;
-    let tmp826: f64 = tmp120 * tmp818 + tmp127 * tmp810 + tmp128 * tmp822 + tmp256 + tmp276 * tmp825 - tmp801 - tmp812;
-    let tmp827: f64 = tmp678 * tmp77;
-    let tmp828: f64 = tmp291 * tmp79;
-    let tmp829: f64 = tmp47 * tmp828;
-    let tmp830: f64 = tmp827 - tmp829 + tmp86;
-    let tmp831: f64 = tmp678 * tmp75;
-    let tmp832: f64 = tmp828 * tmp84;
-    let tmp833: f64 = -tmp145 * tmp810 - tmp153 * tmp822 - tmp818 * tmp88 - tmp830 * tmp93 + tmp831 + tmp832 - tmp85;
-    let tmp834: f64 = tmp145 * tmp771;
-    let tmp835: f64 = tmp108 * tmp833 - tmp283 * tmp826 + tmp834;
-    let tmp836: f64 = tmp350 * tmp833;
-    let tmp837: f64 = tmp328 * tmp833;
-    let tmp838: f64 = tmp317 * tmp833;
-    let tmp839: f64 = tmp125 * tmp828;
-    let tmp840: f64 = tmp122 * tmp678;
-    let tmp841: f64 = tmp120 * tmp816;
-    let tmp842: f64 = -tmp330;
-    let tmp843: f64 = tmp69 * tmp811;
-    let tmp844: f64 = -tmp727;
-    let tmp845: f64 = tmp811 * tmp89;
-    let tmp846: f64 = tmp713 * tmp91;
-    let tmp847: f64 = tmp128 * tmp816;
-    let tmp848: f64 = tmp127 * tmp685;
-    let tmp849: f64 = -tmp126
-        - tmp129 * tmp830
-        - tmp145 * (tmp128 * tmp804 - tmp332 * tmp825 + tmp725 + tmp844)
-        - tmp153 * (-tmp127 * tmp804 + tmp331 + tmp340 * tmp825 - tmp841 + tmp842 + tmp843)
-        + tmp839
-        + tmp840
-        - tmp88 * (-tmp335 + tmp338 - tmp845 + tmp846 + tmp847 - tmp848);
-    let tmp850: f64 = tmp344 * tmp849;
-    let tmp851: f64 = tmp381 * tmp826;
-    let tmp852: f64 = tmp135 * tmp678;
-    let tmp853: f64 = tmp139 * tmp828;
-    let tmp854: f64 = -tmp359;
-    let tmp855: f64 = tmp120 * tmp806;
-    let tmp856: f64 = tmp73 * tmp811;
-    let tmp857: f64 = tmp127 * tmp682;
-    let tmp858: f64 = tmp811 * tmp92;
-    let tmp859: f64 = tmp713 * tmp90;
-    let tmp860: f64 = tmp128 * tmp806;
-    let tmp861: f64 = -tmp736;
-    let tmp862: f64 = -tmp140
-        - tmp141 * tmp830
-        - tmp145 * (-tmp128 * tmp808 + tmp360 * tmp825 + tmp737 + tmp861)
-        - tmp153 * (tmp127 * tmp808 + tmp138 - tmp361 * tmp825 + tmp854 + tmp855 - tmp856)
-        + tmp852
-        + tmp853
-        - tmp88 * (tmp365 - tmp366 + tmp857 + tmp858 - tmp859 - tmp860);
-    let tmp863: f64 = tmp369 * tmp862;
-    let tmp864: f64 = tmp780 - tmp836 - tmp837 - tmp838 + tmp850 + tmp851 + tmp863;
-    let tmp865: f64 = tmp400 * tmp833;
-    let tmp866: f64 = tmp406 * tmp862;
-    let tmp867: f64 = tmp411 * tmp849;
-    let tmp868: f64 = tmp393 * tmp833;
-    let tmp869: f64 = tmp414 * tmp833;
-    let tmp870: f64 = tmp404 * tmp826;
-    let tmp871: f64 = tmp116 * tmp811;
-    let tmp872: f64 = tmp787 + tmp871;
-    let tmp873: f64 = tmp132 * tmp806;
-    let tmp874: f64 = tmp793 + tmp873;
-    let tmp875: f64 = tmp148 * tmp828;
-    let tmp876: f64 = tmp789 + tmp875;
-    let tmp877: f64 = tmp144 * tmp816;
-    let tmp878: f64 = tmp791 + tmp877;
-    let tmp879: f64 = tmp865 - tmp866 - tmp867 + tmp868 + tmp869 - tmp870 + tmp872 + tmp874 + tmp876 + tmp878;
-    let tmp880: f64 = tmp145 * tmp430;
-    let tmp881: f64 = tmp324 - tmp871;
-    let tmp882: f64 = tmp353 - tmp873;
-    let tmp883: f64 = tmp346 - tmp877;
-    let tmp884: f64 = tmp355 - tmp875;
-    let tmp885: f64 = tmp781 * tmp90;
-    let tmp886: f64 = tmp170 * tmp833 - tmp438 * tmp849 + tmp885;
-    let tmp887: f64 = tmp432 * tmp90;
-    let tmp888: f64 = tmp466 * tmp91;
-    let tmp889: f64 = tmp450 * tmp862;
-    let tmp890: f64 = tmp784 * tmp91;
-    let tmp891: f64 = tmp186 * tmp833 - tmp451 * tmp889 + tmp890;
-    let tmp892: f64 = 1.0_f64 / (reference_tension_n[0] * reference_tension_n[0]);
-    let tmp893: f64 = tmp37 * tmp892;
-    let tmp894: f64 = tmp34 * tmp41 * tmp893;
-    let tmp895: f64 = 1.0_f64 / ((tmp892 * (reference_tension_n[1] * reference_tension_n[1]) + 1.0_f64).sqrt());
-    let tmp896: f64 = tmp100 + tmp104 + tmp98;
-    let tmp897: f64 = -tmp145 * (tmp103 * tmp92 - tmp137 * tmp18)
-        - tmp153 * (-tmp103 * tmp90 + tmp134)
-        - tmp88 * (tmp90 * tmp99 - tmp92 * tmp97);
-    let tmp898: f64 = tmp369 * tmp897;
-    let tmp899: f64 = -tmp145 * (-tmp103 * tmp89 + tmp124)
-        - tmp153 * (tmp103 * tmp91 - tmp121)
-        - tmp88 * (tmp89 * tmp97 - tmp91 * tmp99);
-    let tmp900: f64 = tmp344 * tmp899;
-    let tmp901: f64 = tmp381 * tmp896;
-    let tmp902: f64 = tmp152 + tmp898 + tmp900 + tmp901;
-    let tmp903: f64 = tmp406 * tmp897;
-    let tmp904: f64 = tmp411 * tmp899;
-    let tmp905: f64 = tmp404 * tmp896;
-    let tmp906: f64 = -tmp117 - tmp903 - tmp904 - tmp905;
-    let tmp907: f64 = tmp280 * tmp281 * tmp80;
-    let tmp908: f64 = tmp166 * tmp302 * tmp907;
-    let tmp909: f64 = tmp304 * tmp907;
-    let tmp910: f64 = tmp281 * tmp436 * tmp55;
-    let tmp911: f64 = tmp899 * tmp910;
-    let tmp912: f64 = tmp182 * tmp442;
-    let tmp913: f64 = tmp197 * tmp458;
-    let tmp914: f64 = tmp281 * tmp450 * tmp64;
-    let tmp915: f64 = tmp897 * tmp914;
-    let tmp916: f64 = -tmp24 - tmp26 - tmp30;
-    let tmp917: f64 = tmp102 - tmp722 + tmp723;
-    let tmp918: f64 = -tmp257 + tmp276 * tmp917 + tmp744 + tmp745;
-    let tmp919: f64 = -tmp145 * (-tmp332 * tmp917 + tmp720 + tmp842)
-        - tmp153 * (tmp340 * tmp917 + tmp844)
-        - tmp88 * (tmp336 + tmp714 - tmp717);
-    let tmp920: f64 = tmp411 * tmp919;
-    let tmp921: f64 = tmp404 * tmp918;
-    let tmp922: f64 = -tmp145 * (tmp138 + tmp360 * tmp917 - tmp741)
-        - tmp153 * (-tmp361 * tmp917 + tmp737)
-        - tmp88 * (-tmp363 - tmp733 + tmp735);
-    let tmp923: f64 = tmp406 * tmp922;
-    let tmp924: f64 = tmp776 - tmp920 - tmp921 - tmp923;
-    let tmp925: f64 = tmp369 * tmp922;
-    let tmp926: f64 = tmp381 * tmp918;
-    let tmp927: f64 = tmp344 * tmp919;
-    let tmp928: f64 = tmp788 + tmp925 + tmp926 + tmp927;
-    let tmp929: f64 = tmp910 * tmp919;
-    let tmp930: f64 = tmp914 * tmp922;
-    let tmp931: f64 = -tmp101 + tmp823 - tmp824;
-    let tmp932: f64 = -tmp256 + tmp276 * tmp931 + tmp801 + tmp812;
-    let tmp933: f64 = tmp381 * tmp932;
-    let tmp934: f64 = -tmp145 * (tmp360 * tmp931 + tmp738)
-        - tmp153 * (-tmp361 * tmp931 + tmp739 + tmp856)
-        - tmp88 * (tmp366 - tmp858 + tmp859);
-    let tmp935: f64 = tmp369 * tmp934;
-    let tmp936: f64 = -tmp145 * (-tmp332 * tmp931 + tmp727)
-        - tmp153 * (tmp330 + tmp340 * tmp931 - tmp843)
-        - tmp88 * (-tmp338 + tmp845 - tmp846);
-    let tmp937: f64 = tmp344 * tmp936;
-    let tmp938: f64 = tmp765 + tmp933 + tmp935 + tmp937;
-    let tmp939: f64 = tmp404 * tmp932;
-    let tmp940: f64 = tmp406 * tmp934;
-    let tmp941: f64 = tmp411 * tmp936;
-    let tmp942: f64 = tmp881 - tmp939 - tmp940 - tmp941;
-    let tmp943: f64 = tmp910 * tmp936;
-    let tmp944: f64 = tmp914 * tmp934;
-    let tmp945: f64 = tmp700 - tmp701 + tmp87;
-    let tmp946: f64 = -tmp677 - tmp679 + tmp83 - tmp93 * tmp945;
-    let tmp947: f64 = tmp393 * tmp946;
-    let tmp948: f64 = tmp123 - tmp129 * tmp945 - tmp710 - tmp711;
-    let tmp949: f64 = tmp411 * tmp948;
-    let tmp950: f64 = tmp400 * tmp946;
-    let tmp951: f64 = tmp414 * tmp946;
-    let tmp952: f64 = tmp136 - tmp141 * tmp945 - tmp730 - tmp731;
-    let tmp953: f64 = tmp406 * tmp952;
-    let tmp954: f64 = tmp779 + tmp947 - tmp949 + tmp950 + tmp951 - tmp953;
-    let tmp955: f64 = tmp328 * tmp946;
-    let tmp956: f64 = tmp369 * tmp952;
-    let tmp957: f64 = tmp317 * tmp946;
-    let tmp958: f64 = tmp344 * tmp948;
-    let tmp959: f64 = tmp350 * tmp946;
-    let tmp960: f64 = tmp790 - tmp955 + tmp956 - tmp957 + tmp958 - tmp959;
-    let tmp961: f64 = tmp108 * tmp946 - tmp772;
-    let tmp962: f64 = tmp436 * tmp948;
-    let tmp963: f64 = tmp170 * tmp946 - tmp437 * tmp962;
-    let tmp964: f64 = tmp186 * tmp946 - tmp452 * tmp952;
-    let tmp965: f64 = -tmp827 + tmp829 - tmp86;
-    let tmp966: f64 = -tmp831 - tmp832 + tmp85 - tmp93 * tmp965;
-    let tmp967: f64 = tmp328 * tmp966;
-    let tmp968: f64 = tmp350 * tmp966;
-    let tmp969: f64 = tmp317 * tmp966;
-    let tmp970: f64 = tmp126 - tmp129 * tmp965 - tmp839 - tmp840;
-    let tmp971: f64 = tmp344 * tmp970;
-    let tmp972: f64 = tmp140 - tmp141 * tmp965 - tmp852 - tmp853;
-    let tmp973: f64 = tmp369 * tmp972;
-    let tmp974: f64 = tmp767 - tmp967 - tmp968 - tmp969 + tmp971 + tmp973;
-    let tmp975: f64 = tmp406 * tmp972;
-    let tmp976: f64 = tmp411 * tmp970;
-    let tmp977: f64 = tmp400 * tmp966;
-    let tmp978: f64 = tmp414 * tmp966;
-    let tmp979: f64 = tmp393 * tmp966;
-    let tmp980: f64 = tmp884 - tmp975 - tmp976 + tmp977 + tmp978 + tmp979;
-    let tmp981: f64 = tmp108 * tmp966 - tmp834;
-    let tmp982: f64 = tmp170 * tmp966 - tmp438 * tmp970;
-    let tmp983: f64 = tmp186 * tmp966 - tmp452 * tmp972;
-    let tmp984: f64 = -tmp252 - tmp683 + tmp688;
-    let tmp985: f64 = tmp690 - tmp691 + tmp72;
-    let tmp986: f64 = tmp70 - tmp703 + tmp89 * tmp985;
-    let tmp987: f64 = tmp697 - tmp91 * tmp985;
-    let tmp988: f64 = -tmp145 * tmp986 - tmp153 * tmp987 - tmp88 * tmp984;
-    let tmp989: f64 = tmp120 * tmp984 + tmp127 * tmp986 + tmp128 * tmp987;
-    let tmp990: f64 = tmp328 * tmp988;
-    let tmp991: f64 = tmp350 * tmp988;
-    let tmp992: f64 = tmp317 * tmp988;
-    let tmp993: f64 = tmp381 * tmp989;
-    let tmp994: f64 = -tmp145 * (-tmp128 * tmp985 + tmp740 + tmp854)
-        - tmp153 * (tmp127 * tmp985 + tmp861)
-        - tmp88 * (tmp364 - tmp732 + tmp734);
-    let tmp995: f64 = tmp369 * tmp994;
-    let tmp996: f64 = tmp794 - tmp990 - tmp991 - tmp992 + tmp993 + tmp995;
-    let tmp997: f64 = tmp400 * tmp988;
-    let tmp998: f64 = tmp404 * tmp989;
-    let tmp999: f64 = tmp393 * tmp988;
-    let tmp1000: f64 = tmp414 * tmp988;
-    let tmp1001: f64 = tmp406 * tmp994;
-    let tmp1002: f64 = tmp1000 - tmp1001 + tmp778 + tmp997 - tmp998 + tmp999;
-    let tmp1003: f64 = tmp37 * tmp988;
-    let tmp1004: f64 = tmp1003 * tmp107 - tmp283 * tmp989;
-    let tmp1005: f64 = tmp1003 * tmp169 - tmp782;
-    let tmp1006: f64 = tmp1003 * tmp185 - tmp452 * tmp994;
-    let tmp1007: f64 = -tmp71 - tmp805 + tmp807;
-    let tmp1008: f64 = -tmp1007 * tmp91 + tmp704 + tmp820;
-    let tmp1009: f64 = tmp1007 * tmp89 + tmp698;
-    let tmp1010: f64 = tmp253 + tmp813 - tmp815;
-    let tmp1011: f64 = tmp1008 * tmp128 + tmp1009 * tmp127 + tmp1010 * tmp120;
-    let tmp1012: f64 = -tmp145 * (-tmp1007 * tmp128 + tmp736)
-        - tmp153 * (tmp1007 * tmp127 + tmp359 - tmp855)
-        - tmp88 * (-tmp365 - tmp857 + tmp860);
-    let tmp1013: f64 = tmp1012 * tmp406;
-    let tmp1014: f64 = -tmp1008 * tmp153 - tmp1009 * tmp145 - tmp1010 * tmp88;
-    let tmp1015: f64 = tmp1014 * tmp314;
-    let tmp1016: f64 = tmp1015 * tmp399;
-    let tmp1017: f64 = tmp1015 * tmp413;
-    let tmp1018: f64 = tmp1015 * tmp392;
-    let tmp1019: f64 = tmp1011 * tmp404;
-    let tmp1020: f64 = -tmp1013 + tmp1016 + tmp1017 + tmp1018 - tmp1019 + tmp882;
-    let tmp1021: f64 = tmp1012 * tmp369;
-    let tmp1022: f64 = tmp1015 * tmp349;
-    let tmp1023: f64 = tmp1015 * tmp327;
-    let tmp1024: f64 = tmp1015 * tmp316;
-    let tmp1025: f64 = tmp1011 * tmp381;
-    let tmp1026: f64 = tmp1021 - tmp1022 - tmp1023 - tmp1024 + tmp1025 + tmp768;
-    let tmp1027: f64 = tmp1014 * tmp37;
-    let tmp1028: f64 = -tmp1011 * tmp283 + tmp1027 * tmp107;
-    let tmp1029: f64 = tmp1027 * tmp169 - tmp885;
-    let tmp1030: f64 = -tmp1012 * tmp452 + tmp1027 * tmp185;
-    let tmp1031: f64 = tmp68 - tmp693 + tmp694;
-    let tmp1032: f64 = tmp1031 * tmp90 + tmp809;
-    let tmp1033: f64 = tmp251 - tmp681 + tmp686;
-    let tmp1034: f64 = -tmp1031 * tmp92 + tmp705 + tmp819;
-    let tmp1035: f64 = tmp1032 * tmp128 + tmp1033 * tmp120 + tmp1034 * tmp127;
-    let tmp1036: f64 = -tmp1032 * tmp153 - tmp1033 * tmp88 - tmp1034 * tmp145;
-    let tmp1037: f64 = -tmp1035 * tmp283 + tmp1036 * tmp108;
-    let tmp1038: f64 = tmp1036 * tmp400;
-    let tmp1039: f64 = tmp1035 * tmp404;
-    let tmp1040: f64 = -tmp145 * (tmp1031 * tmp128 + tmp331 - tmp721)
-        - tmp153 * (-tmp1031 * tmp127 + tmp725)
-        - tmp88 * (-tmp337 + tmp715 - tmp718);
-    let tmp1041: f64 = tmp1040 * tmp411;
-    let tmp1042: f64 = tmp1036 * tmp314;
-    let tmp1043: f64 = tmp1042 * tmp413;
-    let tmp1044: f64 = tmp1042 * tmp392;
-    let tmp1045: f64 = tmp1038 - tmp1039 - tmp1041 + tmp1043 + tmp1044 + tmp777;
-    let tmp1046: f64 = tmp1042 * tmp316;
-    let tmp1047: f64 = tmp1040 * tmp344;
-    let tmp1048: f64 = tmp1042 * tmp327;
-    let tmp1049: f64 = tmp1035 * tmp381;
-    let tmp1050: f64 = tmp1036 * tmp350;
-    let tmp1051: f64 = -tmp1046 + tmp1047 - tmp1048 + tmp1049 - tmp1050 + tmp792;
-    let tmp1052: f64 = tmp1036 * tmp170 - tmp1040 * tmp438;
-    let tmp1053: f64 = tmp1036 * tmp186 - tmp785;
-    let tmp1054: f64 = -tmp67 + tmp802 - tmp803;
-    let tmp1055: f64 = -tmp1054 * tmp92 + tmp696;
-    let tmp1056: f64 = -tmp236 - tmp814 + tmp817;
-    let tmp1057: f64 = tmp1054 * tmp90 + tmp74 - tmp821;
-    let tmp1058: f64 = -tmp1055 * tmp145 - tmp1056 * tmp88 - tmp1057 * tmp153;
-    let tmp1059: f64 = tmp1055 * tmp127 + tmp1056 * tmp120 + tmp1057 * tmp128;
-    let tmp1060: f64 = tmp1059 * tmp280;
-    let tmp1061: f64 = tmp1058 * tmp108 - tmp1060 * tmp282;
-    let tmp1062: f64 = tmp1058 * tmp400;
-    let tmp1063: f64 = tmp1058 * tmp414;
-    let tmp1064: f64 = tmp1059 * tmp404;
-    let tmp1065: f64 = -tmp145 * (tmp1054 * tmp128 + tmp726)
-        - tmp153 * (-tmp1054 * tmp127 + tmp719 + tmp841)
-        - tmp88 * (tmp335 - tmp847 + tmp848);
-    let tmp1066: f64 = tmp1065 * tmp411;
-    let tmp1067: f64 = tmp1058 * tmp393;
-    let tmp1068: f64 = tmp1062 + tmp1063 - tmp1064 - tmp1066 + tmp1067 + tmp883;
-    let tmp1069: f64 = tmp1059 * tmp381;
-    let tmp1070: f64 = tmp1058 * tmp317;
-    let tmp1071: f64 = tmp1058 * tmp328;
-    let tmp1072: f64 = tmp1058 * tmp350;
-    let tmp1073: f64 = tmp1065 * tmp344;
-    let tmp1074: f64 = tmp1069 - tmp1070 - tmp1071 - tmp1072 + tmp1073 + tmp766;
-    let tmp1075: f64 = tmp1058 * tmp170 - tmp1065 * tmp438;
-    let tmp1076: f64 = tmp1058 * tmp186 - tmp890;
+    let tmp67: f64 = tmp62 * tmp66;
+    let tmp68: f64 = tmp52 * tmp56;
+    let tmp69: f64 = tmp59 * tmp66;
+    let tmp70: f64 = -tmp57 * tmp67 + tmp68 * tmp69;
+    let tmp71: f64 = tmp48 * tmp68 - tmp51 * tmp57;
+    let tmp72: f64 = tmp58 * tmp67 - tmp61 * tmp69;
+    let tmp73: f64 = tmp67 * tmp71 - tmp68 * tmp72;
+    let tmp74: f64 = 1.0_f64 / tmp43;
+    let tmp75: f64 = tmp37 * tmp74;
+    let tmp76: f64 = tmp57 * tmp72 - tmp69 * tmp71;
+    let tmp77: f64 = tmp40 * tmp74;
+    let tmp78: f64 = tmp36 * tmp77 - tmp39 * tmp75;
+    let tmp79: f64 = -tmp70 * tmp78 - tmp73 * tmp75 - tmp76 * tmp77;
+    let tmp80: f64 = 1.0_f64 / (tmp79 + epsilon * tmp79.signum());
+    let tmp81: f64 = tmp70 * tmp80;
+    let tmp82: f64 = tmp47 * tmp81;
+    let tmp83: f64 = tmp76 * tmp80;
+    let tmp84: f64 = tmp45 * tmp83;
+    let tmp85: f64 = tmp73 * tmp80;
+    let tmp86: f64 = tmp46 * tmp85;
+    let tmp87: f64 = tmp82 * reference_tension_n[0] + tmp84 * reference_tension_n[0] + tmp86 * reference_tension_n[0];
+    let tmp88: f64 = 1.0_f64 / tmp87;
+    let tmp89: f64 = platform_weight_n - reference_tension_n[1];
+    let tmp90: f64 = -tmp48 * tmp61 + tmp51 * tmp58;
+    let tmp91: f64 = tmp51 - tmp61;
+    let tmp92: f64 = tmp48 - tmp58;
+    let tmp93: f64 = -tmp36 * tmp91 + tmp39 * tmp92 + tmp90;
+    let tmp94: f64 = 1.0_f64 / (tmp93 + epsilon * tmp93.signum());
+    let tmp95: f64 = tmp90 * tmp94;
+    let tmp96: f64 = tmp14 + tmp15;
+    let tmp97: f64 = -tmp1 + tmp3;
+    let tmp98: f64 = tmp18 + tmp9;
+    let tmp99: f64 = tmp96 * attachments_m[(1, 0)] + tmp97 * attachments_m[(0, 0)] + tmp98 * attachments_m[(2, 0)];
+    let tmp100: f64 = tmp46 * tmp99;
+    let tmp101: f64 = tmp80 * (tmp69 * tmp78 - tmp72 * tmp75);
+    let tmp102: f64 = tmp45 * reference_tension_n[0];
+    let tmp103: f64 = tmp80 * (-tmp67 * tmp78 + tmp72 * tmp77);
+    let tmp104: f64 = tmp103 * tmp46;
+    let tmp105: f64 = tmp67 * tmp75 - tmp69 * tmp77;
+    let tmp106: f64 = tmp105 * tmp80;
+    let tmp107: f64 = tmp106 * tmp47;
+    let tmp108: f64 = tmp101 * tmp102 + tmp104 * reference_tension_n[0] + tmp107 * reference_tension_n[0];
+    let tmp109: f64 = tmp96 * attachments_m[(1, 3)] + tmp97 * attachments_m[(0, 3)] + tmp98 * attachments_m[(2, 3)];
+    let tmp110: f64 = tmp108 * tmp109;
+    let tmp111: f64 = tmp96 * attachments_m[(1, 1)] + tmp97 * attachments_m[(0, 1)] + tmp98 * attachments_m[(2, 1)];
+    let tmp112: f64 = tmp111 * tmp87;
+    let tmp113: f64 = tmp57 * tmp77 - tmp68 * tmp75;
+    let tmp114: f64 = tmp113 * tmp80;
+    let tmp115: f64 = tmp114 * tmp47;
+    let tmp116: f64 = tmp80 * (-tmp57 * tmp78 + tmp71 * tmp75);
+    let tmp117: f64 = tmp68 * tmp78 - tmp71 * tmp77;
+    let tmp118: f64 = tmp117 * tmp80;
+    let tmp119: f64 = tmp118 * tmp46;
+    let tmp120: f64 = tmp102 * tmp116 + tmp115 * reference_tension_n[0] + tmp119 * reference_tension_n[0];
+    let tmp121: f64 = tmp96 * attachments_m[(1, 2)] + tmp97 * attachments_m[(0, 2)] + tmp98 * attachments_m[(2, 2)];
+    let tmp122: f64 = tmp120 * tmp121;
+    let tmp123: f64 = tmp100 * reference_tension_n[0]
+        + tmp11 * reference_tension_n[1]
+        + tmp110 * tmp57
+        + tmp112 * tmp75
+        + tmp122 * tmp69
+        - platform_weight_n * (tmp10 * com_offset_m[0] + tmp4 * com_offset_m[2] + tmp7 * com_offset_m[1]);
+    let tmp124: f64 = tmp91 * tmp94;
+    let tmp125: f64 = tmp45 * tmp99;
+    let tmp126: f64 = -tmp110 * tmp68
+        - tmp112 * tmp77
+        - tmp122 * tmp67
+        - tmp125 * reference_tension_n[0]
+        - tmp20 * reference_tension_n[1]
+        + platform_weight_n * (tmp16 * com_offset_m[2] + tmp17 * com_offset_m[0] + tmp19 * com_offset_m[1]);
+    let tmp127: f64 = tmp92 * tmp94;
+    let tmp128: f64 = tmp123 * tmp124 + tmp126 * tmp127 + tmp89 * tmp95;
+    let tmp129: f64 = tmp26 * tmp43;
+    let tmp130: f64 = tmp129 * tmp88;
+    let tmp131: f64 = tmp130 + (tmp128 * tmp88).asinh();
+    let tmp132: f64 = tmp131.cosh();
+    let tmp133: f64 = tmp130 + epsilon * tmp130.signum();
+    let tmp134: f64 = 1.0_f64 / tmp133;
+    let tmp135: f64 = tmp133.sinh();
+    let tmp136: f64 = tmp134 * tmp135;
+    let tmp137: f64 = tmp132 * tmp136;
+    let tmp138: f64 = tmp94 * (-tmp36 * tmp51 + tmp39 * tmp48);
+    let tmp139: f64 = tmp94 * (tmp39 - tmp51);
+    let tmp140: f64 = tmp94 * (tmp36 - tmp48);
+    let tmp141: f64 = tmp123 * tmp139 + tmp126 * tmp140 + tmp138 * tmp89;
+    let tmp142: f64 = 1.0_f64 / tmp120;
+    let tmp143: f64 = tmp26 * tmp65;
+    let tmp144: f64 = tmp142 * tmp143;
+    let tmp145: f64 = tmp144 + (tmp141 * tmp142).asinh();
+    let tmp146: f64 = tmp145.cosh();
+    let tmp147: f64 = tmp144 + epsilon * tmp144.signum();
+    let tmp148: f64 = 1.0_f64 / tmp147;
+    let tmp149: f64 = tmp147.sinh();
+    let tmp150: f64 = tmp148 * tmp149;
+    let tmp151: f64 = tmp146 * tmp150;
+    let tmp152: f64 = 1.0_f64 / tmp108;
+    let tmp153: f64 = tmp94 * (-tmp39 + tmp61);
+    let tmp154: f64 = tmp94 * (tmp36 * tmp61 - tmp39 * tmp58);
+    let tmp155: f64 = tmp94 * (-tmp36 + tmp58);
+    let tmp156: f64 = tmp123 * tmp153 + tmp126 * tmp155 + tmp154 * tmp89;
+    let tmp157: f64 = tmp152 * tmp55;
+    let tmp158: f64 = tmp157 * tmp26;
+    let tmp159: f64 = tmp158 + (tmp152 * tmp156).asinh();
+    let tmp160: f64 = tmp159.cosh();
+    let tmp161: f64 = tmp158 + epsilon * tmp158.signum();
+    let tmp162: f64 = 1.0_f64 / tmp161;
+    let tmp163: f64 = tmp161.sinh();
+    let tmp164: f64 = tmp162 * tmp163;
+    let tmp165: f64 = tmp160 * tmp164;
+    let tmp166: f64 = tmp28 * tmp30;
+    let tmp167: f64 = tmp32 * tmp31.cosh();
+    let tmp168: f64 = tmp33 / (tmp31 * tmp31);
+    let tmp169: f64 = tmp34 * tmp29.sinh();
+    let tmp170: f64 = tmp166 * tmp167 - tmp166 * tmp168 + tmp169 * tmp28 + tmp35;
+    let tmp171: f64 = tmp4 * attachments_m[(1, 0)] - tmp7 * attachments_m[(2, 0)];
+    let tmp172: f64 = tmp171 * tmp44;
+    let tmp173: f64 = tmp16 * attachments_m[(1, 0)] - tmp19 * attachments_m[(2, 0)];
+    let tmp174: f64 = tmp173 * tmp44;
+    let tmp175: f64 = tmp12 * tmp172 + tmp174 * tmp21;
+    let tmp176: f64 = tmp4 * attachments_m[(1, 3)] - tmp7 * attachments_m[(2, 3)];
+    let tmp177: f64 = tmp176 * tmp56;
+    let tmp178: f64 = tmp16 * attachments_m[(1, 3)] - tmp19 * attachments_m[(2, 3)];
+    let tmp179: f64 = tmp178 * tmp56;
+    let tmp180: f64 = tmp177 * tmp49 + tmp179 * tmp52;
+    let tmp181: f64 = 1.0_f64 / tmp54;
+    let tmp182: f64 = tmp181 * tmp49;
+    let tmp183: f64 = tmp177 - tmp180 * tmp182;
+    let tmp184: f64 = tmp108 * tmp183;
+    let tmp185: f64 = tmp4 * attachments_m[(1, 2)] - tmp7 * attachments_m[(2, 2)];
+    let tmp186: f64 = tmp4 * attachments_m[(1, 1)] - tmp7 * attachments_m[(2, 1)];
+    let tmp187: f64 = tmp185 * tmp66;
+    let tmp188: f64 = tmp16 * attachments_m[(1, 2)] - tmp19 * attachments_m[(2, 2)];
+    let tmp189: f64 = tmp188 * tmp66;
+    let tmp190: f64 = tmp187 * tmp59 + tmp189 * tmp62;
+    let tmp191: f64 = 1.0_f64 / tmp64;
+    let tmp192: f64 = tmp191 * tmp59;
+    let tmp193: f64 = tmp187 - tmp190 * tmp192;
+    let tmp194: f64 = tmp120 * tmp193;
+    let tmp195: f64 = -tmp96 * attachments_m[(2, 0)] + tmp98 * attachments_m[(1, 0)];
+    let tmp196: f64 = tmp46 * reference_tension_n[0];
+    let tmp197: f64 = tmp186 * tmp74;
+    let tmp198: f64 = tmp16 * attachments_m[(1, 1)] - tmp19 * attachments_m[(2, 1)];
+    let tmp199: f64 = tmp198 * tmp74;
+    let tmp200: f64 = tmp197 * tmp37 + tmp199 * tmp40;
+    let tmp201: f64 = 1.0_f64 / tmp42;
+    let tmp202: f64 = tmp201 * tmp37;
+    let tmp203: f64 = tmp197 - tmp200 * tmp202;
+    let tmp204: f64 = tmp203 * tmp87;
+    let tmp205: f64 = 1.0_f64 / tmp23;
+    let tmp206: f64 = tmp12 * tmp205;
+    let tmp207: f64 = reference_tension_n[0] * (tmp172 - tmp175 * tmp206);
+    let tmp208: f64 = tmp205 * tmp21;
+    let tmp209: f64 = reference_tension_n[0] * (tmp174 - tmp175 * tmp208);
+    let tmp210: f64 = tmp21 * reference_tension_n[0];
+    let tmp211: f64 = tmp201 * tmp40;
+    let tmp212: f64 = tmp199 - tmp200 * tmp211;
+    let tmp213: f64 = tmp191 * tmp62;
+    let tmp214: f64 = tmp189 - tmp190 * tmp213;
+    let tmp215: f64 = tmp181 * tmp52;
+    let tmp216: f64 = tmp179 - tmp180 * tmp215;
+    let tmp217: f64 = tmp12 * reference_tension_n[0];
+    let tmp218: f64 = -tmp108 * (-tmp177 * tmp52 + tmp179 * tmp49 + tmp183 * tmp51 - tmp216 * tmp48) + tmp11 * tmp209
+        - tmp120 * (-tmp187 * tmp62 + tmp189 * tmp59 + tmp193 * tmp61 - tmp214 * tmp58)
+        + tmp172 * tmp210
+        - tmp174 * tmp217
+        - tmp20 * tmp207
+        - tmp87 * (-tmp197 * tmp40 + tmp199 * tmp37 + tmp203 * tmp39 - tmp212 * tmp36);
+    let tmp219: f64 = tmp184 + tmp194 + tmp204 + tmp207;
+    let tmp220: f64 = tmp120 * tmp214;
+    let tmp221: f64 = tmp212 * tmp87;
+    let tmp222: f64 = tmp108 * tmp216;
+    let tmp223: f64 = tmp209 + tmp220 + tmp221 + tmp222;
+    let tmp224: f64 = tmp218 * tmp81 + tmp219 * tmp85 + tmp223 * tmp83;
+    let tmp225: f64 = tmp111 * tmp75;
+    let tmp226: f64 = -tmp96 * attachments_m[(2, 2)] + tmp98 * attachments_m[(1, 2)];
+    let tmp227: f64 = tmp120 * tmp69;
+    let tmp228: f64 = tmp101 * tmp223 + tmp103 * tmp219 + tmp106 * tmp218;
+    let tmp229: f64 = tmp109 * tmp57;
+    let tmp230: f64 = tmp114 * tmp218 + tmp116 * tmp223 + tmp118 * tmp219;
+    let tmp231: f64 = tmp121 * tmp69;
+    let tmp232: f64 = -tmp96 * attachments_m[(2, 1)] + tmp98 * attachments_m[(1, 1)];
+    let tmp233: f64 = tmp75 * tmp87;
+    let tmp234: f64 = -tmp96 * attachments_m[(2, 3)] + tmp98 * attachments_m[(1, 3)];
+    let tmp235: f64 = tmp108 * tmp57;
+    let tmp236: f64 = tmp109 * tmp184
+        + tmp111 * tmp204
+        + tmp121 * tmp194
+        + tmp128 * tmp186
+        + tmp141 * tmp185
+        + tmp156 * tmp176
+        + tmp171 * reference_tension_n[1]
+        + tmp195 * tmp196
+        + tmp207 * tmp99
+        + tmp224 * tmp225
+        + tmp226 * tmp227
+        + tmp228 * tmp229
+        + tmp230 * tmp231
+        + tmp232 * tmp233
+        + tmp234 * tmp235
+        - platform_weight_n * (tmp4 * com_offset_m[1] - tmp7 * com_offset_m[2]);
+    let tmp237: f64 = tmp121 * tmp67;
+    let tmp238: f64 = tmp108 * tmp68;
+    let tmp239: f64 = tmp109 * tmp68;
+    let tmp240: f64 = tmp77 * tmp87;
+    let tmp241: f64 = tmp111 * tmp77;
+    let tmp242: f64 = tmp120 * tmp67;
+    let tmp243: f64 = -tmp102 * tmp195
+        - tmp109 * tmp222
+        - tmp111 * tmp221
+        - tmp121 * tmp220
+        - tmp128 * tmp198
+        - tmp141 * tmp188
+        - tmp156 * tmp178
+        - tmp173 * reference_tension_n[1]
+        - tmp209 * tmp99
+        - tmp224 * tmp241
+        - tmp226 * tmp242
+        - tmp228 * tmp239
+        - tmp230 * tmp237
+        - tmp232 * tmp240
+        - tmp234 * tmp238
+        + platform_weight_n * (tmp16 * com_offset_m[1] - tmp19 * com_offset_m[2]);
+    let tmp244: f64 = 1.0_f64 / (tmp87 * tmp87);
+    let tmp245: f64 = 1.0_f64 / (((tmp128 * tmp128) * tmp244 + 1.0_f64).sqrt());
+    let tmp246: f64 = tmp136 * tmp131.sinh();
+    let tmp247: f64 = tmp246 * tmp43;
+    let tmp248: f64 = tmp245 * tmp247 * tmp88;
+    let tmp249: f64 = tmp130 * tmp132;
+    let tmp250: f64 = tmp134 * tmp133.cosh();
+    let tmp251: f64 = tmp135 / (tmp133 * tmp133);
+    let tmp252: f64 = tmp130 * tmp246 + tmp137 + tmp249 * tmp250 - tmp249 * tmp251;
+    let tmp253: f64 = tmp132 * tmp244 * tmp26 * tmp42;
+    let tmp254: f64 = tmp247 * (-tmp128 * tmp244 * tmp245 - tmp129 * tmp244) - tmp250 * tmp253 + tmp251 * tmp253;
+    let tmp255: f64 = 1.0_f64 / (tmp120 * tmp120);
+    let tmp256: f64 = 1.0_f64 / (((tmp141 * tmp141) * tmp255 + 1.0_f64).sqrt());
+    let tmp257: f64 = tmp150 * tmp145.sinh();
+    let tmp258: f64 = tmp257 * tmp65;
+    let tmp259: f64 = tmp142 * tmp256 * tmp258;
+    let tmp260: f64 = tmp146 * tmp149 / (tmp147 * tmp147);
+    let tmp261: f64 = tmp146 * tmp148 * tmp147.cosh();
+    let tmp262: f64 = tmp144 * tmp257 - tmp144 * tmp260 + tmp144 * tmp261 + tmp151;
+    let tmp263: f64 = tmp255 * tmp26 * tmp64;
+    let tmp264: f64 = tmp258 * (-tmp141 * tmp255 * tmp256 - tmp143 * tmp255) + tmp260 * tmp263 - tmp261 * tmp263;
+    let tmp265: f64 = 1.0_f64 / (tmp108 * tmp108);
+    let tmp266: f64 = 1.0_f64 / (((tmp156 * tmp156) * tmp265 + 1.0_f64).sqrt());
+    let tmp267: f64 = tmp26 * tmp265;
+    let tmp268: f64 = tmp164 * tmp159.sinh();
+    let tmp269: f64 = tmp160 * tmp267 * tmp54;
+    let tmp270: f64 = tmp162 * tmp161.cosh();
+    let tmp271: f64 = tmp163 / (tmp161 * tmp161);
+    let tmp272: f64 = tmp268 * tmp55 * (-tmp156 * tmp265 * tmp266 - tmp267 * tmp55) - tmp269 * tmp270 + tmp269 * tmp271;
+    let tmp273: f64 = tmp158 * tmp160;
+    let tmp274: f64 = tmp158 * tmp268 + tmp165 + tmp270 * tmp273 - tmp271 * tmp273;
+    let tmp275: f64 = tmp157 * tmp266 * tmp268;
+    let tmp276: f64 = tmp10 * attachments_m[(2, 0)] - tmp4 * attachments_m[(0, 0)];
+    let tmp277: f64 = tmp276 * tmp44;
+    let tmp278: f64 = -tmp16 * attachments_m[(0, 0)] + tmp17 * attachments_m[(2, 0)];
+    let tmp279: f64 = tmp278 * tmp44;
+    let tmp280: f64 = tmp12 * tmp277 + tmp21 * tmp279;
+    let tmp281: f64 = tmp10 * attachments_m[(2, 1)] - tmp4 * attachments_m[(0, 1)];
+    let tmp282: f64 = tmp281 * tmp74;
+    let tmp283: f64 = -tmp16 * attachments_m[(0, 1)] + tmp17 * attachments_m[(2, 1)];
+    let tmp284: f64 = tmp283 * tmp74;
+    let tmp285: f64 = tmp282 * tmp37 + tmp284 * tmp40;
+    let tmp286: f64 = -tmp211 * tmp285 + tmp284;
+    let tmp287: f64 = tmp286 * tmp87;
+    let tmp288: f64 = tmp10 * attachments_m[(2, 3)] - tmp4 * attachments_m[(0, 3)];
+    let tmp289: f64 = tmp288 * tmp56;
+    let tmp290: f64 = -tmp16 * attachments_m[(0, 3)] + tmp17 * attachments_m[(2, 3)];
+    let tmp291: f64 = tmp290 * tmp56;
+    let tmp292: f64 = tmp289 * tmp49 + tmp291 * tmp52;
+    let tmp293: f64 = -tmp215 * tmp292 + tmp291;
+    let tmp294: f64 = tmp108 * tmp293;
+    let tmp295: f64 = tmp10 * attachments_m[(2, 2)] - tmp4 * attachments_m[(0, 2)];
+    let tmp296: f64 = tmp295 * tmp66;
+    let tmp297: f64 = -tmp16 * attachments_m[(0, 2)] + tmp17 * attachments_m[(2, 2)];
+    let tmp298: f64 = tmp297 * tmp66;
+    let tmp299: f64 = tmp296 * tmp59 + tmp298 * tmp62;
+    let tmp300: f64 = -tmp213 * tmp299 + tmp298;
+    let tmp301: f64 = tmp120 * tmp300;
+    let tmp302: f64 = tmp205 * tmp280;
+    let tmp303: f64 = reference_tension_n[0] * (-tmp21 * tmp302 + tmp279);
+    let tmp304: f64 = tmp287 + tmp294 + tmp301 + tmp303;
+    let tmp305: f64 = -tmp182 * tmp292 + tmp289;
+    let tmp306: f64 = tmp108 * tmp305;
+    let tmp307: f64 = -tmp202 * tmp285 + tmp282;
+    let tmp308: f64 = tmp307 * tmp87;
+    let tmp309: f64 = -tmp192 * tmp299 + tmp296;
+    let tmp310: f64 = tmp120 * tmp309;
+    let tmp311: f64 = reference_tension_n[0] * (-tmp12 * tmp302 + tmp277);
+    let tmp312: f64 = tmp306 + tmp308 + tmp310 + tmp311;
+    let tmp313: f64 = tmp80
+        * (-tmp108 * (-tmp289 * tmp52 + tmp291 * tmp49 - tmp293 * tmp48 + tmp305 * tmp51) + tmp11 * tmp303
+            - tmp120 * (-tmp296 * tmp62 + tmp298 * tmp59 - tmp300 * tmp58 + tmp309 * tmp61)
+            - tmp20 * tmp311
+            + tmp210 * tmp277
+            - tmp217 * tmp279
+            - tmp87 * (-tmp282 * tmp40 + tmp284 * tmp37 - tmp286 * tmp36 + tmp307 * tmp39));
+    let tmp314: f64 = tmp304 * tmp83 + tmp312 * tmp85 + tmp313 * tmp70;
+    let tmp315: f64 = tmp97 * attachments_m[(2, 3)] - tmp98 * attachments_m[(0, 3)];
+    let tmp316: f64 = tmp97 * attachments_m[(2, 2)] - tmp98 * attachments_m[(0, 2)];
+    let tmp317: f64 = tmp101 * tmp304 + tmp103 * tmp312 + tmp105 * tmp313;
+    let tmp318: f64 = tmp97 * attachments_m[(2, 0)] - tmp98 * attachments_m[(0, 0)];
+    let tmp319: f64 = tmp113 * tmp313 + tmp116 * tmp304 + tmp118 * tmp312;
+    let tmp320: f64 = tmp87 * (tmp97 * attachments_m[(2, 1)] - tmp98 * attachments_m[(0, 1)]);
+    let tmp321: f64 = tmp109 * tmp306
+        + tmp111 * tmp308
+        + tmp121 * tmp310
+        + tmp128 * tmp281
+        + tmp141 * tmp295
+        + tmp156 * tmp288
+        + tmp196 * tmp318
+        + tmp225 * tmp314
+        + tmp227 * tmp316
+        + tmp229 * tmp317
+        + tmp231 * tmp319
+        + tmp235 * tmp315
+        + tmp276 * reference_tension_n[1]
+        + tmp311 * tmp99
+        + tmp320 * tmp75
+        - platform_weight_n * (tmp10 * com_offset_m[2] - tmp4 * com_offset_m[0]);
+    let tmp322: f64 = -tmp102 * tmp318
+        - tmp109 * tmp294
+        - tmp111 * tmp287
+        - tmp121 * tmp301
+        - tmp128 * tmp283
+        - tmp141 * tmp297
+        - tmp156 * tmp290
+        - tmp237 * tmp319
+        - tmp238 * tmp315
+        - tmp239 * tmp317
+        - tmp241 * tmp314
+        - tmp242 * tmp316
+        - tmp278 * reference_tension_n[1]
+        - tmp303 * tmp99
+        - tmp320 * tmp77
+        + platform_weight_n * (-tmp16 * com_offset_m[0] + tmp17 * com_offset_m[2]);
+    let tmp323: f64 = -tmp10 * attachments_m[(1, 0)] + tmp7 * attachments_m[(0, 0)];
+    let tmp324: f64 = tmp323 * tmp44;
+    let tmp325: f64 = -tmp17 * attachments_m[(1, 0)] + tmp19 * attachments_m[(0, 0)];
+    let tmp326: f64 = tmp325 * tmp44;
+    let tmp327: f64 = tmp12 * tmp324 + tmp21 * tmp326;
+    let tmp328: f64 = reference_tension_n[0] * (-tmp208 * tmp327 + tmp326);
+    let tmp329: f64 = -tmp17 * attachments_m[(1, 1)] + tmp19 * attachments_m[(0, 1)];
+    let tmp330: f64 = tmp329 * tmp74;
+    let tmp331: f64 = -tmp10 * attachments_m[(1, 1)] + tmp7 * attachments_m[(0, 1)];
+    let tmp332: f64 = tmp331 * tmp74;
+    let tmp333: f64 = tmp330 * tmp40 + tmp332 * tmp37;
+    let tmp334: f64 = tmp201 * tmp333;
+    let tmp335: f64 = tmp332 - tmp334 * tmp37;
+    let tmp336: f64 = tmp330 - tmp334 * tmp40;
+    let tmp337: f64 = -tmp17 * attachments_m[(1, 2)] + tmp19 * attachments_m[(0, 2)];
+    let tmp338: f64 = tmp337 * tmp66;
+    let tmp339: f64 = -tmp10 * attachments_m[(1, 2)] + tmp7 * attachments_m[(0, 2)];
+    let tmp340: f64 = tmp339 * tmp66;
+    let tmp341: f64 = tmp338 * tmp62 + tmp340 * tmp59;
+    let tmp342: f64 = -tmp213 * tmp341 + tmp338;
+    let tmp343: f64 = -tmp192 * tmp341 + tmp340;
+    let tmp344: f64 = -tmp17 * attachments_m[(1, 3)] + tmp19 * attachments_m[(0, 3)];
+    let tmp345: f64 = tmp344 * tmp56;
+    let tmp346: f64 = -tmp10 * attachments_m[(1, 3)] + tmp7 * attachments_m[(0, 3)];
+    let tmp347: f64 = tmp346 * tmp56;
+    let tmp348: f64 = tmp345 * tmp52 + tmp347 * tmp49;
+    let tmp349: f64 = -tmp215 * tmp348 + tmp345;
+    let tmp350: f64 = -tmp182 * tmp348 + tmp347;
+    let tmp351: f64 = reference_tension_n[0] * (-tmp206 * tmp327 + tmp324);
+    let tmp352: f64 = -tmp108 * (tmp345 * tmp49 - tmp347 * tmp52 - tmp349 * tmp48 + tmp350 * tmp51) + tmp11 * tmp328
+        - tmp120 * (tmp338 * tmp59 - tmp340 * tmp62 - tmp342 * tmp58 + tmp343 * tmp61)
+        - tmp20 * tmp351
+        + tmp210 * tmp324
+        - tmp217 * tmp326
+        - tmp87 * (tmp330 * tmp37 - tmp332 * tmp40 + tmp335 * tmp39 - tmp336 * tmp36);
+    let tmp353: f64 = tmp120 * tmp343;
+    let tmp354: f64 = tmp335 * tmp87;
+    let tmp355: f64 = tmp108 * tmp350;
+    let tmp356: f64 = tmp351 + tmp353 + tmp354 + tmp355;
+    let tmp357: f64 = tmp336 * tmp87;
+    let tmp358: f64 = tmp120 * tmp342;
+    let tmp359: f64 = tmp108 * tmp349;
+    let tmp360: f64 = tmp328 + tmp357 + tmp358 + tmp359;
+    let tmp361: f64 = tmp352 * tmp81 + tmp356 * tmp85 + tmp360 * tmp83;
+    let tmp362: f64 = tmp96 * attachments_m[(0, 1)] - tmp97 * attachments_m[(1, 1)];
+    let tmp363: f64 = tmp96 * attachments_m[(0, 0)] - tmp97 * attachments_m[(1, 0)];
+    let tmp364: f64 = tmp101 * tmp360 + tmp103 * tmp356 + tmp106 * tmp352;
+    let tmp365: f64 = tmp108 * (tmp96 * attachments_m[(0, 3)] - tmp97 * attachments_m[(1, 3)]);
+    let tmp366: f64 = tmp96 * attachments_m[(0, 2)] - tmp97 * attachments_m[(1, 2)];
+    let tmp367: f64 = tmp114 * tmp352 + tmp116 * tmp360 + tmp118 * tmp356;
+    let tmp368: f64 = -tmp102 * tmp363
+        - tmp109 * tmp359
+        - tmp111 * tmp357
+        - tmp121 * tmp358
+        - tmp128 * tmp329
+        - tmp141 * tmp337
+        - tmp156 * tmp344
+        - tmp237 * tmp367
+        - tmp239 * tmp364
+        - tmp240 * tmp362
+        - tmp241 * tmp361
+        - tmp242 * tmp366
+        - tmp325 * reference_tension_n[1]
+        - tmp328 * tmp99
+        - tmp365 * tmp68
+        + platform_weight_n * (-tmp17 * com_offset_m[1] + tmp19 * com_offset_m[0]);
+    let tmp369: f64 = tmp109 * tmp355
+        + tmp111 * tmp354
+        + tmp121 * tmp353
+        + tmp128 * tmp331
+        + tmp141 * tmp339
+        + tmp156 * tmp346
+        + tmp196 * tmp363
+        + tmp225 * tmp361
+        + tmp227 * tmp366
+        + tmp229 * tmp364
+        + tmp231 * tmp367
+        + tmp233 * tmp362
+        + tmp323 * reference_tension_n[1]
+        + tmp351 * tmp99
+        + tmp365 * tmp57
+        - platform_weight_n * (-tmp10 * com_offset_m[1] + tmp7 * com_offset_m[0]);
+    let tmp370: f64 = tmp170 * tmp46;
+    let tmp371: f64 = 1.0_f64 / (tmp54 * tmp54.sqrt());
+    let tmp372: f64 = tmp371 * tmp50;
+    let tmp373: f64 = -tmp372 + tmp56;
+    let tmp374: f64 = tmp371 * tmp49 * tmp52;
+    let tmp375: f64 = tmp374 * tmp48;
+    let tmp376: f64 = 1.0_f64 / (tmp42 * tmp42.sqrt());
+    let tmp377: f64 = tmp376 * tmp38;
+    let tmp378: f64 = -tmp377 + tmp74;
+    let tmp379: f64 = tmp37 * tmp376 * tmp40;
+    let tmp380: f64 = tmp36 * tmp379;
+    let tmp381: f64 = 1.0_f64 / (tmp64 * tmp64.sqrt());
+    let tmp382: f64 = tmp381 * tmp59 * tmp62;
+    let tmp383: f64 = tmp382 * tmp58;
+    let tmp384: f64 = tmp381 * tmp60;
+    let tmp385: f64 = -tmp384 + tmp66;
+    let tmp386: f64 = 1.0_f64 / (tmp23 * tmp23.sqrt());
+    let tmp387: f64 = tmp12 * tmp210 * tmp386;
+    let tmp388: f64 = tmp11 * tmp387;
+    let tmp389: f64 = tmp13 * tmp386;
+    let tmp390: f64 = reference_tension_n[0] * (-tmp389 + tmp44);
+    let tmp391: f64 = -tmp108 * (tmp373 * tmp51 + tmp375)
+        - tmp120 * (tmp383 + tmp385 * tmp61)
+        - tmp20 * tmp390
+        - tmp388
+        - tmp87 * (tmp378 * tmp39 + tmp380);
+    let tmp392: f64 = tmp108 * tmp373;
+    let tmp393: f64 = tmp120 * tmp385;
+    let tmp394: f64 = tmp378 * tmp87;
+    let tmp395: f64 = tmp390 + tmp392 + tmp393 + tmp394;
+    let tmp396: f64 = tmp395 * tmp80;
+    let tmp397: f64 = tmp120 * tmp382;
+    let tmp398: f64 = tmp379 * tmp87;
+    let tmp399: f64 = tmp108 * tmp374;
+    let tmp400: f64 = -tmp387 - tmp397 - tmp398 - tmp399;
+    let tmp401: f64 = tmp391 * tmp81 + tmp396 * tmp73 + tmp400 * tmp83;
+    let tmp402: f64 = tmp252 * tmp75;
+    let tmp403: f64 = tmp114 * tmp391 + tmp116 * tmp400 + tmp117 * tmp396;
+    let tmp404: f64 = tmp101 * tmp400 + tmp103 * tmp395 + tmp106 * tmp391;
+    let tmp405: f64 = tmp109 * tmp392
+        + tmp111 * tmp394
+        + tmp121 * tmp393
+        + tmp225 * tmp401
+        + tmp229 * tmp404
+        + tmp231 * tmp403
+        + tmp390 * tmp99;
+    let tmp406: f64 = tmp122 * tmp382;
+    let tmp407: f64 = tmp387 * tmp99;
+    let tmp408: f64 = tmp110 * tmp374;
+    let tmp409: f64 = tmp112 * tmp379;
+    let tmp410: f64 = -tmp237 * tmp403 - tmp239 * tmp404 - tmp241 * tmp401 + tmp406 + tmp407 + tmp408 + tmp409;
+    let tmp411: f64 = tmp262 * tmp66;
+    let tmp412: f64 = tmp411 * tmp59;
+    let tmp413: f64 = tmp274 * tmp57;
+    let tmp414: f64 = tmp170 * tmp45;
+    let tmp415: f64 = tmp252 * tmp77;
+    let tmp416: f64 = -tmp406;
+    let tmp417: f64 = -tmp407;
+    let tmp418: f64 = -tmp408;
+    let tmp419: f64 = tmp22 * tmp386;
+    let tmp420: f64 = reference_tension_n[0] * (-tmp419 + tmp44);
+    let tmp421: f64 = tmp381 * tmp63;
+    let tmp422: f64 = -tmp421 + tmp66;
+    let tmp423: f64 = tmp120 * tmp422;
+    let tmp424: f64 = tmp371 * tmp53;
+    let tmp425: f64 = -tmp424 + tmp56;
+    let tmp426: f64 = tmp108 * tmp425;
+    let tmp427: f64 = tmp376 * tmp41;
+    let tmp428: f64 = -tmp427 + tmp74;
+    let tmp429: f64 = tmp428 * tmp87;
+    let tmp430: f64 = tmp420 + tmp423 + tmp426 + tmp429;
+    let tmp431: f64 = tmp374 * tmp51;
+    let tmp432: f64 = tmp379 * tmp39;
+    let tmp433: f64 = tmp382 * tmp61;
+    let tmp434: f64 = tmp20 * tmp387;
+    let tmp435: f64 = -tmp108 * (-tmp425 * tmp48 - tmp431) + tmp11 * tmp420 - tmp120 * (-tmp422 * tmp58 - tmp433)
+        + tmp434
+        - tmp87 * (-tmp36 * tmp428 - tmp432);
+    let tmp436: f64 = tmp114 * tmp435 + tmp116 * tmp430 + tmp118 * tmp400;
+    let tmp437: f64 = tmp400 * tmp85 + tmp430 * tmp83 + tmp435 * tmp81;
+    let tmp438: f64 = tmp101 * tmp430 + tmp103 * tmp400 + tmp106 * tmp435;
+    let tmp439: f64 = -tmp409;
+    let tmp440: f64 = tmp225 * tmp437 + tmp229 * tmp438 + tmp231 * tmp436 + tmp416 + tmp417 + tmp418 + tmp439;
+    let tmp441: f64 = -tmp109 * tmp426
+        - tmp111 * tmp429
+        - tmp121 * tmp423
+        - tmp237 * tmp436
+        - tmp239 * tmp438
+        - tmp241 * tmp437
+        - tmp420 * tmp99;
+    let tmp442: f64 = tmp411 * tmp62;
+    let tmp443: f64 = tmp274 * tmp68;
+    let tmp444: f64 = 1.0_f64 / (reference_tension_n[0] * reference_tension_n[0]);
+    let tmp445: f64 = tmp23 * tmp26 * tmp30 * tmp444;
+    let tmp446: f64 = 1.0_f64 / ((tmp444 * (reference_tension_n[1] * reference_tension_n[1]) + 1.0_f64).sqrt());
+    let tmp447: f64 = tmp169 * tmp24;
+    let tmp448: f64 = tmp82 + tmp84 + tmp86;
+    let tmp449: f64 = tmp101 * tmp45 + tmp104 + tmp107;
+    let tmp450: f64 = tmp115 + tmp116 * tmp45 + tmp119;
+    let tmp451: f64 = tmp100 + tmp225 * tmp448 + tmp229 * tmp449 + tmp231 * tmp450;
+    let tmp452: f64 = -tmp125 - tmp237 * tmp450 - tmp239 * tmp449 - tmp241 * tmp448;
+    let tmp453: f64 = -tmp44;
+    let tmp454: f64 = reference_tension_n[0] * (tmp389 + tmp453);
+    let tmp455: f64 = -tmp20 * tmp454 + tmp388;
+    let tmp456: f64 = tmp387 * tmp83 + tmp454 * tmp85 + tmp455 * tmp81;
+    let tmp457: f64 = tmp101 * tmp387 + tmp103 * tmp454 + tmp106 * tmp455;
+    let tmp458: f64 = tmp114 * tmp455 + tmp116 * tmp387 + tmp118 * tmp454;
+    let tmp459: f64 = -tmp237 * tmp458 - tmp239 * tmp457 - tmp241 * tmp456 + tmp417;
+    let tmp460: f64 = tmp225 * tmp456 + tmp229 * tmp457 + tmp231 * tmp458 + tmp454 * tmp99;
+    let tmp461: f64 = reference_tension_n[0] * (tmp419 + tmp453);
+    let tmp462: f64 = tmp11 * tmp461 - tmp434;
+    let tmp463: f64 = tmp101 * tmp461 + tmp103 * tmp387 + tmp106 * tmp462;
+    let tmp464: f64 = tmp114 * tmp462 + tmp116 * tmp461 + tmp118 * tmp387;
+    let tmp465: f64 = tmp387 * tmp85 + tmp461 * tmp83 + tmp462 * tmp81;
+    let tmp466: f64 = -tmp237 * tmp464 - tmp239 * tmp463 - tmp241 * tmp465 - tmp461 * tmp99;
+    let tmp467: f64 = tmp225 * tmp465 + tmp229 * tmp463 + tmp231 * tmp464 + tmp407;
+    let tmp468: f64 = -tmp74;
+    let tmp469: f64 = tmp377 + tmp468;
+    let tmp470: f64 = -tmp380 + tmp39 * tmp469;
+    let tmp471: f64 = tmp81 * tmp87;
+    let tmp472: f64 = tmp469 * tmp87;
+    let tmp473: f64 = tmp398 * tmp83 - tmp470 * tmp471 + tmp472 * tmp85;
+    let tmp474: f64 = tmp470 * tmp87;
+    let tmp475: f64 = tmp101 * tmp398 + tmp103 * tmp472 - tmp106 * tmp474;
+    let tmp476: f64 = -tmp114 * tmp474 + tmp116 * tmp398 + tmp118 * tmp472;
+    let tmp477: f64 = -tmp237 * tmp476 - tmp239 * tmp475 - tmp241 * tmp473 + tmp439;
+    let tmp478: f64 = tmp112 * tmp469 + tmp225 * tmp473 + tmp229 * tmp475 + tmp231 * tmp476;
+    let tmp479: f64 = tmp427 + tmp468;
+    let tmp480: f64 = tmp479 * tmp87;
+    let tmp481: f64 = -tmp36 * tmp479 + tmp432;
+    let tmp482: f64 = tmp398 * tmp85 - tmp471 * tmp481 + tmp480 * tmp83;
+    let tmp483: f64 = tmp481 * tmp87;
+    let tmp484: f64 = -tmp114 * tmp483 + tmp116 * tmp480 + tmp118 * tmp398;
+    let tmp485: f64 = tmp101 * tmp480 + tmp103 * tmp398 - tmp106 * tmp483;
+    let tmp486: f64 = tmp225 * tmp482 + tmp229 * tmp485 + tmp231 * tmp484 + tmp409;
+    let tmp487: f64 = -tmp112 * tmp479 - tmp237 * tmp484 - tmp239 * tmp485 - tmp241 * tmp482;
+    let tmp488: f64 = -tmp66;
+    let tmp489: f64 = tmp384 + tmp488;
+    let tmp490: f64 = -tmp383 + tmp489 * tmp61;
+    let tmp491: f64 = tmp120 * tmp490;
+    let tmp492: f64 = tmp120 * tmp489;
+    let tmp493: f64 = tmp397 * tmp83 - tmp491 * tmp81 + tmp492 * tmp85;
+    let tmp494: f64 = -tmp114 * tmp491 + tmp116 * tmp397 + tmp118 * tmp492;
+    let tmp495: f64 = tmp106 * tmp120;
+    let tmp496: f64 = tmp101 * tmp397 + tmp103 * tmp492 - tmp490 * tmp495;
+    let tmp497: f64 = tmp122 * tmp489 + tmp225 * tmp493 + tmp229 * tmp496 + tmp231 * tmp494;
+    let tmp498: f64 = -tmp237 * tmp494 - tmp239 * tmp496 - tmp241 * tmp493 + tmp416;
+    let tmp499: f64 = tmp421 + tmp488;
+    let tmp500: f64 = tmp433 - tmp499 * tmp58;
+    let tmp501: f64 = tmp120 * tmp500;
+    let tmp502: f64 = tmp120 * tmp499;
+    let tmp503: f64 = tmp397 * tmp85 - tmp501 * tmp81 + tmp502 * tmp83;
+    let tmp504: f64 = -tmp114 * tmp501 + tmp116 * tmp502 + tmp118 * tmp397;
+    let tmp505: f64 = tmp101 * tmp502 + tmp103 * tmp397 - tmp495 * tmp500;
+    let tmp506: f64 = -tmp122 * tmp499 - tmp237 * tmp504 - tmp239 * tmp505 - tmp241 * tmp503;
+    let tmp507: f64 = tmp225 * tmp503 + tmp229 * tmp505 + tmp231 * tmp504 + tmp406;
+    let tmp508: f64 = -tmp56;
+    let tmp509: f64 = tmp372 + tmp508;
+    let tmp510: f64 = tmp108 * tmp509;
+    let tmp511: f64 = tmp108 * (-tmp375 + tmp509 * tmp51);
+    let tmp512: f64 = tmp399 * tmp83 + tmp510 * tmp85 - tmp511 * tmp81;
+    let tmp513: f64 = tmp101 * tmp399 + tmp103 * tmp510 - tmp106 * tmp511;
+    let tmp514: f64 = -tmp114 * tmp511 + tmp116 * tmp399 + tmp118 * tmp510;
+    let tmp515: f64 = tmp110 * tmp509 + tmp225 * tmp512 + tmp229 * tmp513 + tmp231 * tmp514;
+    let tmp516: f64 = -tmp237 * tmp514 - tmp239 * tmp513 - tmp241 * tmp512 + tmp418;
+    let tmp517: f64 = tmp424 + tmp508;
+    let tmp518: f64 = tmp108 * (tmp431 - tmp48 * tmp517);
+    let tmp519: f64 = tmp108 * tmp517;
+    let tmp520: f64 = tmp101 * tmp519 + tmp103 * tmp399 - tmp106 * tmp518;
+    let tmp521: f64 = -tmp114 * tmp518 + tmp116 * tmp519 + tmp118 * tmp399;
+    let tmp522: f64 = tmp399 * tmp85 - tmp518 * tmp81 + tmp519 * tmp83;
+    let tmp523: f64 = -tmp110 * tmp517 - tmp237 * tmp521 - tmp239 * tmp520 - tmp241 * tmp522;
+    let tmp524: f64 = tmp225 * tmp522 + tmp229 * tmp520 + tmp231 * tmp521 + tmp408;
 
     // Output terms (5)
     if let Some(jacobian_pose) = jacobian_pose {
-        jacobian_pose[(0, 0)] = tmp209 * tmp214 + tmp209 * tmp217 - tmp209 * tmp219 + tmp220 * tmp221;
-        jacobian_pose[(1, 0)] = tmp295 * tmp431 - tmp301 * tmp303
-            + tmp301 * tmp305
-            + tmp429
-                * (tmp301
-                    + tmp428
-                        * (tmp162 * tmp300 - tmp279 * tmp426 - tmp306 * tmp312
-                            + tmp424
-                                * (tmp149 * tmp307
-                                    + tmp150 * tmp423
-                                    + tmp151 * tmp391
-                                    + tmp154 * tmp308
-                                    + tmp156 * tmp309)));
-        jacobian_pose[(2, 0)] = tmp248 * tmp433 + tmp439 * tmp441 - tmp439 * tmp443
-            + tmp449
-                * (tmp439
-                    + tmp448
-                        * (-tmp177 * tmp312 + tmp300 * tmp447 - tmp342 * tmp445
-                            + tmp446
-                                * (-tmp149 * tmp237 - tmp154 * tmp235 + tmp174 * tmp286
-                                    - tmp175 * tmp284
-                                    - tmp391 * tmp58
-                                    - tmp423 * tmp60
-                                    - tmp47
-                                        * (tmp156 * tmp235 - tmp394 - tmp395 + tmp396 - tmp397 + tmp398
-                                            - tmp401
-                                            - tmp402
-                                            - tmp403
-                                            + tmp405
-                                            + tmp407
-                                            + tmp408
-                                            + tmp410
-                                            + tmp412
-                                            - tmp415
-                                            + tmp416
-                                            + tmp417
-                                            + tmp419
-                                            + tmp420
-                                            + tmp421
-                                            - tmp422)
-                                    + tmp77 * (tmp156 * tmp237 + tmp391))));
-        jacobian_pose[(3, 0)] = tmp453 * tmp467 + tmp455 * tmp457 - tmp455 * tmp459
-            + tmp465
-                * (tmp455
-                    + tmp460
-                        * (tmp193
-                            * (tmp149 * tmp224 + tmp154 * tmp228 - tmp190 * tmp284
-                                + tmp191 * tmp286
-                                + tmp391 * tmp49
-                                + tmp423 * tmp51
-                                - tmp47 * (-tmp156 * tmp228 + tmp423)
-                                + tmp77
-                                    * (-tmp156 * tmp224 + tmp318 + tmp319 + tmp321 + tmp323 - tmp325 + tmp329
-                                        - tmp345
-                                        - tmp347
-                                        + tmp351
-                                        + tmp352
-                                        - tmp354
-                                        - tmp356
-                                        + tmp357
-                                        - tmp370
-                                        - tmp378
-                                        - tmp380
-                                        - tmp382
-                                        - tmp383
-                                        - tmp386
-                                        - tmp390))
-                            + tmp300 * tmp464
-                            - tmp312 * tmp463
-                            - tmp367 * tmp462));
-        jacobian_pose[(0, 1)] = tmp214 * tmp476 + tmp217 * tmp476 - tmp219 * tmp476 + tmp221 * tmp477;
-        jacobian_pose[(1, 1)] = -tmp303 * tmp567
-            + tmp305 * tmp567
-            + tmp429
-                * (tmp428
-                    * (tmp306 * tmp507 - tmp306 * tmp566
-                        + tmp424
-                            * (tmp149 * tmp544
-                                + tmp150 * tmp565
-                                + tmp151 * tmp542
-                                + tmp154 * tmp508
-                                + tmp156 * tmp543)
-                        - tmp426 * tmp514)
-                    + tmp567)
-            + tmp431 * tmp502;
-        jacobian_pose[(2, 1)] = 0.5_f64 * tmp432 * tmp568 + tmp441 * tmp569 - tmp443 * tmp569
-            + tmp449
-                * (tmp448
-                    * (tmp177 * tmp507 - tmp177 * tmp566 - tmp445 * tmp531
-                        + tmp446
-                            * (-tmp149 * tmp490 - tmp154 * tmp491 + tmp174 * tmp478
-                                - tmp175 * tmp479
-                                - tmp47
-                                    * (tmp156 * tmp491 - tmp545 + tmp546 + tmp547 - tmp548 + tmp549 + tmp550
-                                        - tmp551
-                                        + tmp552
-                                        - tmp553
-                                        - tmp554
-                                        + tmp555
-                                        - tmp556
-                                        + tmp557
-                                        - tmp558
-                                        + tmp559
-                                        + tmp560
-                                        + tmp561
-                                        - tmp562
-                                        + tmp563
-                                        + tmp564)
-                                - tmp542 * tmp58
-                                - tmp565 * tmp60
-                                + tmp77 * (tmp156 * tmp490 + tmp542)))
-                    + tmp569);
-        jacobian_pose[(3, 1)] = tmp457 * tmp571 - tmp459 * tmp571
-            + tmp465
-                * (tmp460
-                    * (tmp193
-                        * (tmp149 * tmp487 + tmp154 * tmp484 - tmp190 * tmp479 + tmp191 * tmp478
-                            - tmp47 * (-tmp156 * tmp484 + tmp565)
-                            + tmp49 * tmp542
-                            + tmp51 * tmp565
-                            + tmp77
-                                * (-tmp156 * tmp487 - tmp509 - tmp510 - tmp515 + tmp517 - tmp519 + tmp520
-                                    - tmp521
-                                    - tmp525
-                                    - tmp526
-                                    - tmp528
-                                    + tmp529
-                                    + tmp530
-                                    - tmp532
-                                    - tmp533
-                                    - tmp535
-                                    + tmp536
-                                    + tmp537
-                                    + tmp538
-                                    + tmp539
-                                    - tmp541))
-                        - tmp462 * tmp518
-                        + tmp463 * tmp507
-                        - tmp463 * tmp566)
-                    + tmp571)
-            + tmp467 * tmp570;
-        jacobian_pose[(0, 2)] = tmp210 * tmp580 + tmp216 * tmp579 - tmp218 * tmp580 + tmp221 * tmp578;
-        jacobian_pose[(1, 2)] = -tmp303 * tmp611
-            + tmp305 * tmp611
-            + tmp429
-                * (tmp428
-                    * (tmp162 * tmp610 - tmp306 * tmp665
-                        + tmp424
-                            * (tmp149 * tmp643
-                                + tmp150 * tmp664
-                                + tmp151 * tmp641
-                                + tmp154 * tmp612
-                                + tmp156 * tmp642)
-                        - tmp426 * tmp607)
-                    + tmp611)
-            + tmp431 * tmp584;
-        jacobian_pose[(2, 2)] = 0.5_f64 * tmp433 * tmp591 + tmp441 * tmp666 - tmp443 * tmp666
-            + tmp449
-                * (tmp448
-                    * (-tmp177 * tmp665 - tmp445 * tmp625
-                        + tmp446
-                            * (-tmp149 * tmp596 - tmp154 * tmp595 + tmp174 * tmp581
-                                - tmp175 * tmp582
-                                - tmp47
-                                    * (tmp156 * tmp595 - tmp644 + tmp645 - tmp646 + tmp647 + tmp648 + tmp649
-                                        - tmp650
-                                        - tmp651
-                                        + tmp652
-                                        + tmp653
-                                        - tmp654
-                                        - tmp655
-                                        + tmp656
-                                        - tmp657
-                                        + tmp658
-                                        + tmp659
-                                        - tmp660
-                                        + tmp661
-                                        + tmp662
-                                        + tmp663)
-                                - tmp58 * tmp641
-                                - tmp60 * tmp664
-                                + tmp77 * (tmp156 * tmp596 + tmp641))
-                        + tmp447 * tmp610)
-                    + tmp666);
-        jacobian_pose[(3, 2)] = tmp457 * tmp668 - tmp459 * tmp668
-            + tmp465
-                * (tmp460
-                    * (tmp193
-                        * (tmp149 * tmp590 + tmp154 * tmp587 - tmp190 * tmp582 + tmp191 * tmp581
-                            - tmp47 * (-tmp156 * tmp587 + tmp664)
-                            + tmp49 * tmp641
-                            + tmp51 * tmp664
-                            + tmp77
-                                * (-tmp156 * tmp590 - tmp613 + tmp614 - tmp615 + tmp617 - tmp620 + tmp621 - tmp623
-                                    + tmp624
-                                    - tmp626
-                                    - tmp628
-                                    + tmp629
-                                    - tmp630
-                                    - tmp631
-                                    + tmp632
-                                    - tmp633
-                                    + tmp634
-                                    - tmp636
-                                    - tmp637
-                                    + tmp638
-                                    - tmp640))
-                        - tmp462 * tmp627
-                        - tmp463 * tmp665
-                        + tmp464 * tmp610)
-                    + tmp668)
-            + tmp467 * tmp667;
-        jacobian_pose[(0, 3)] = -tmp671 + tmp673 + tmp674 + tmp675;
-        jacobian_pose[(1, 3)] = -tmp303 * tmp773
-            + tmp305 * tmp773
-            + tmp429
-                * (tmp428 * (tmp162 * tmp707 + tmp424 * (tmp150 * tmp770 + tmp151 * tmp758) - tmp426 * tmp746)
-                    + tmp773)
-            + tmp774;
-        jacobian_pose[(2, 3)] = tmp441 * tmp783 - tmp443 * tmp783
-            + tmp449
-                * (tmp448
-                    * (-tmp445 * tmp728
-                        + tmp446
-                            * (-tmp47 * (-tmp759 + tmp760 + tmp761 - tmp762 - tmp763 + tmp764 + tmp780)
-                                - tmp58 * tmp758
-                                - tmp60 * tmp770
-                                + tmp758 * tmp77)
-                        + tmp447 * tmp707)
-                    + tmp783)
-            + tmp775;
-        jacobian_pose[(3, 3)] = tmp457 * tmp786 - tmp459 * tmp786
-            + tmp465
-                * (tmp460
-                    * (tmp193
-                        * (-tmp47 * tmp770
-                            + tmp49 * tmp758
-                            + tmp51 * tmp770
-                            + tmp77
-                                * (tmp709 - tmp729 - tmp743 - tmp747
-                                    + tmp748
-                                    + tmp749
-                                    + tmp788
-                                    + tmp790
-                                    + tmp792
-                                    + tmp794))
-                        - tmp462 * tmp742
-                        + tmp464 * tmp707)
-                    + tmp786)
-            + tmp795;
-        jacobian_pose[(0, 4)] = tmp797 + tmp798 - tmp799 + tmp800;
-        jacobian_pose[(1, 4)] = -tmp303 * tmp835
-            + tmp305 * tmp835
-            + tmp429
-                * (tmp428 * (tmp162 * tmp833 + tmp424 * (tmp150 * tmp879 + tmp151 * tmp864) - tmp426 * tmp826)
-                    + tmp835)
-            + tmp880;
-        jacobian_pose[(2, 4)] = tmp441 * tmp886 - tmp443 * tmp886
-            + tmp449
-                * (tmp448
-                    * (-tmp445 * tmp849
-                        + tmp446
-                            * (-tmp47
-                                * (-tmp865 + tmp866 + tmp867 - tmp868 - tmp869
-                                    + tmp870
-                                    + tmp881
-                                    + tmp882
-                                    + tmp883
-                                    + tmp884)
-                                - tmp58 * tmp864
-                                - tmp60 * tmp879
-                                + tmp77 * tmp864)
-                        + tmp447 * tmp833)
-                    + tmp886)
-            + tmp887;
-        jacobian_pose[(3, 4)] = tmp457 * tmp891 - tmp459 * tmp891
-            + tmp465
-                * (tmp460
-                    * (tmp193
-                        * (-tmp47 * tmp879
-                            + tmp49 * tmp864
-                            + tmp51 * tmp879
-                            + tmp77 * (tmp769 + tmp836 + tmp837 + tmp838 - tmp850 - tmp851 - tmp863))
-                        - tmp461 * tmp889
-                        + tmp464 * tmp833)
-                    + tmp891)
-            + tmp888;
+        jacobian_pose[(0, 0)] = tmp170 * tmp175;
+        jacobian_pose[(1, 0)] = tmp200 * tmp252 + tmp224 * tmp254 + tmp248 * (tmp124 * tmp236 + tmp127 * tmp243);
+        jacobian_pose[(2, 0)] = tmp190 * tmp262 + tmp230 * tmp264 + tmp259 * (tmp139 * tmp236 + tmp140 * tmp243);
+        jacobian_pose[(3, 0)] = tmp180 * tmp274 + tmp228 * tmp272 + tmp275 * (tmp153 * tmp236 + tmp155 * tmp243);
+        jacobian_pose[(0, 1)] = tmp170 * tmp280;
+        jacobian_pose[(1, 1)] = tmp248 * (tmp124 * tmp321 + tmp127 * tmp322) + tmp252 * tmp285 + tmp254 * tmp314;
+        jacobian_pose[(2, 1)] = tmp259 * (tmp139 * tmp321 + tmp140 * tmp322) + tmp262 * tmp299 + tmp264 * tmp319;
+        jacobian_pose[(3, 1)] = tmp272 * tmp317 + tmp274 * tmp292 + tmp275 * (tmp153 * tmp321 + tmp155 * tmp322);
+        jacobian_pose[(0, 2)] = tmp170 * tmp327;
+        jacobian_pose[(1, 2)] = tmp248 * (tmp124 * tmp369 + tmp127 * tmp368) + tmp252 * tmp333 + tmp254 * tmp361;
+        jacobian_pose[(2, 2)] = tmp259 * (tmp139 * tmp369 + tmp140 * tmp368) + tmp262 * tmp341 + tmp264 * tmp367;
+        jacobian_pose[(3, 2)] = tmp272 * tmp364 + tmp274 * tmp348 + tmp275 * (tmp153 * tmp369 + tmp155 * tmp368);
+        jacobian_pose[(0, 3)] = tmp370;
+        jacobian_pose[(1, 3)] = tmp248 * (tmp124 * tmp405 + tmp127 * tmp410) + tmp254 * tmp401 + tmp402;
+        jacobian_pose[(2, 3)] = tmp259 * (tmp139 * tmp405 + tmp140 * tmp410) + tmp264 * tmp403 + tmp412;
+        jacobian_pose[(3, 3)] = tmp272 * tmp404 + tmp275 * (tmp153 * tmp405 + tmp155 * tmp410) + tmp413;
+        jacobian_pose[(0, 4)] = tmp414;
+        jacobian_pose[(1, 4)] = tmp248 * (tmp124 * tmp440 + tmp127 * tmp441) + tmp254 * tmp437 + tmp415;
+        jacobian_pose[(2, 4)] = tmp259 * (tmp139 * tmp440 + tmp140 * tmp441) + tmp264 * tmp436 + tmp442;
+        jacobian_pose[(3, 4)] = tmp272 * tmp438 + tmp275 * (tmp153 * tmp440 + tmp155 * tmp441) + tmp443;
         jacobian_pose[(0, 5)] = 0.0;
         jacobian_pose[(1, 5)] = 0.0;
         jacobian_pose[(2, 5)] = 0.0;
         jacobian_pose[(3, 5)] = 0.0;
     }
     if let Some(jacobian_reference_tension) = jacobian_reference_tension {
-        jacobian_reference_tension[(0, 0)] = -tmp210 * tmp894
-            + tmp215 * tmp35 * (-tmp35 * tmp893 - tmp892 * tmp895 * reference_tension_n[1])
-            + tmp218 * tmp894;
-        jacobian_reference_tension[(1, 0)] = tmp429
-            * (-tmp283 * tmp896 + tmp428 * (tmp424 * (tmp150 * tmp906 + tmp151 * tmp902) - tmp426 * tmp896))
-            + tmp896 * tmp908
-            - tmp896 * tmp909;
-        jacobian_reference_tension[(2, 0)] = -tmp440 * tmp911
-            + tmp449
-                * (-tmp438 * tmp899
-                    + tmp448
-                        * (-tmp445 * tmp899
-                            + tmp446
-                                * (-tmp47 * (tmp117 + tmp903 + tmp904 + tmp905) - tmp58 * tmp902 - tmp60 * tmp906
-                                    + tmp77 * tmp902)))
-            + tmp911 * tmp912;
-        jacobian_reference_tension[(3, 0)] = -tmp456 * tmp915
-            + tmp465
-                * (-tmp452 * tmp897
-                    + tmp460
-                        * (tmp193
-                            * (-tmp47 * tmp906
-                                + tmp49 * tmp902
-                                + tmp51 * tmp906
-                                + tmp77 * (-tmp152 - tmp898 - tmp900 - tmp901))
-                            - tmp462 * tmp897))
-            + tmp913 * tmp915;
-        jacobian_reference_tension[(0, 1)] = tmp215 * tmp38 * tmp895;
-        jacobian_reference_tension[(1, 1)] = tmp424 * tmp428 * tmp429 * (tmp150 * tmp916 + tmp151 * tmp17 - tmp155);
-        jacobian_reference_tension[(2, 1)] = tmp446
-            * tmp448
-            * tmp449
-            * (-tmp17 * tmp58 - tmp47 * (tmp31 - tmp58) - tmp60 * tmp916 + tmp77 * (tmp17 - tmp60));
-        jacobian_reference_tension[(3, 1)] = tmp193
-            * tmp460
-            * tmp465
-            * (tmp17 * tmp49 - tmp47 * (tmp49 + tmp916) + tmp51 * tmp916 + tmp77 * (-tmp10 - tmp16 - tmp4 + tmp51));
+        jacobian_reference_tension[(0, 0)] =
+            -tmp167 * tmp445 + tmp168 * tmp445 + tmp447 * (-tmp27 * tmp444 - tmp444 * tmp446 * reference_tension_n[1]);
+        jacobian_reference_tension[(1, 0)] = tmp248 * (tmp124 * tmp451 + tmp127 * tmp452) + tmp254 * tmp448;
+        jacobian_reference_tension[(2, 0)] = tmp259 * (tmp139 * tmp451 + tmp140 * tmp452) + tmp264 * tmp450;
+        jacobian_reference_tension[(3, 0)] = tmp272 * tmp449 + tmp275 * (tmp153 * tmp451 + tmp155 * tmp452);
+        jacobian_reference_tension[(0, 1)] = tmp25 * tmp446 * tmp447;
+        jacobian_reference_tension[(1, 1)] = tmp248 * (tmp11 * tmp124 - tmp127 * tmp20 - tmp95);
+        jacobian_reference_tension[(2, 1)] = tmp259 * (tmp11 * tmp139 - tmp138 - tmp140 * tmp20);
+        jacobian_reference_tension[(3, 1)] = tmp275 * (tmp11 * tmp153 - tmp154 - tmp155 * tmp20);
     }
     if let Some(jacobian_anchors) = jacobian_anchors {
-        jacobian_anchors[(0, 0)] = tmp671 - tmp673 - tmp674 - tmp675;
-        jacobian_anchors[(1, 0)] = tmp429
-            * (-tmp283 * tmp918 + tmp428 * (tmp424 * (tmp150 * tmp924 + tmp151 * tmp928) - tmp426 * tmp918))
-            + tmp908 * tmp918
-            - tmp909 * tmp918;
-        jacobian_anchors[(2, 0)] = -tmp440 * tmp929
-            + tmp449
-                * (-tmp438 * tmp919
-                    + tmp448
-                        * (-tmp445 * tmp919
-                            + tmp446
-                                * (-tmp47 * (tmp765 + tmp920 + tmp921 + tmp923) - tmp58 * tmp928 - tmp60 * tmp924
-                                    + tmp77 * tmp928)))
-            + tmp912 * tmp929;
-        jacobian_anchors[(3, 0)] = -tmp456 * tmp930
-            + tmp465
-                * (-tmp452 * tmp922
-                    + tmp460
-                        * (tmp193
-                            * (-tmp47 * tmp924
-                                + tmp49 * tmp928
-                                + tmp51 * tmp924
-                                + tmp77 * (tmp751 - tmp925 - tmp926 - tmp927))
-                            - tmp462 * tmp922))
-            + tmp913 * tmp930;
-        jacobian_anchors[(0, 1)] = -tmp797 - tmp798 + tmp799 - tmp800;
-        jacobian_anchors[(1, 1)] = tmp429
-            * (-tmp283 * tmp932 + tmp428 * (tmp424 * (tmp150 * tmp942 + tmp151 * tmp938) - tmp426 * tmp932))
-            + tmp908 * tmp932
-            - tmp909 * tmp932;
-        jacobian_anchors[(2, 1)] = -tmp440 * tmp943
-            + tmp449
-                * (-tmp438 * tmp936
-                    + tmp448
-                        * (-tmp445 * tmp936
-                            + tmp446
-                                * (-tmp47 * (tmp872 + tmp939 + tmp940 + tmp941) - tmp58 * tmp938 - tmp60 * tmp942
-                                    + tmp77 * tmp938)))
-            + tmp912 * tmp943;
-        jacobian_anchors[(3, 1)] = -tmp456 * tmp944
-            + tmp465
-                * (-tmp452 * tmp934
-                    + tmp460
-                        * (tmp193
-                            * (-tmp47 * tmp942
-                                + tmp49 * tmp938
-                                + tmp51 * tmp942
-                                + tmp77 * (tmp776 - tmp933 - tmp935 - tmp937))
-                            - tmp462 * tmp934))
-            + tmp913 * tmp944;
+        jacobian_anchors[(0, 0)] = -tmp370;
+        jacobian_anchors[(1, 0)] = tmp248 * (tmp124 * tmp460 + tmp127 * tmp459) + tmp254 * tmp456;
+        jacobian_anchors[(2, 0)] = tmp259 * (tmp139 * tmp460 + tmp140 * tmp459) + tmp264 * tmp458;
+        jacobian_anchors[(3, 0)] = tmp272 * tmp457 + tmp275 * (tmp153 * tmp460 + tmp155 * tmp459);
+        jacobian_anchors[(0, 1)] = -tmp414;
+        jacobian_anchors[(1, 1)] = tmp248 * (tmp124 * tmp467 + tmp127 * tmp466) + tmp254 * tmp465;
+        jacobian_anchors[(2, 1)] = tmp259 * (tmp139 * tmp467 + tmp140 * tmp466) + tmp264 * tmp464;
+        jacobian_anchors[(3, 1)] = tmp272 * tmp463 + tmp275 * (tmp153 * tmp467 + tmp155 * tmp466);
         jacobian_anchors[(0, 2)] = 0.0;
         jacobian_anchors[(1, 2)] = 0.0;
         jacobian_anchors[(2, 2)] = 0.0;
         jacobian_anchors[(3, 2)] = 0.0;
         jacobian_anchors[(0, 3)] = 0.0;
-        jacobian_anchors[(1, 3)] = -tmp303 * tmp961
-            + tmp305 * tmp961
-            + tmp429 * (tmp428 * (tmp162 * tmp946 + tmp424 * (tmp150 * tmp954 + tmp151 * tmp960)) + tmp961)
-            - tmp774;
-        jacobian_anchors[(2, 3)] = tmp441 * tmp963 - tmp443 * tmp963
-            + tmp449
-                * (tmp448
-                    * (-tmp444 * tmp962
-                        + tmp446
-                            * (-tmp47 * (tmp767 - tmp947 + tmp949 - tmp950 - tmp951 + tmp953)
-                                - tmp58 * tmp960
-                                - tmp60 * tmp954
-                                + tmp77 * tmp960)
-                        + tmp447 * tmp946)
-                    + tmp963);
-        jacobian_anchors[(3, 3)] = tmp457 * tmp964 - tmp459 * tmp964
-            + tmp465
-                * (tmp460
-                    * (tmp193
-                        * (-tmp47 * tmp954
-                            + tmp49 * tmp960
-                            + tmp51 * tmp954
-                            + tmp77 * (tmp753 + tmp955 - tmp956 + tmp957 - tmp958 + tmp959))
-                        - tmp462 * tmp952
-                        + tmp464 * tmp946)
-                    + tmp964);
+        jacobian_anchors[(1, 3)] = tmp248 * (tmp124 * tmp478 + tmp127 * tmp477) + tmp254 * tmp473 - tmp402;
+        jacobian_anchors[(2, 3)] = tmp259 * (tmp139 * tmp478 + tmp140 * tmp477) + tmp264 * tmp476;
+        jacobian_anchors[(3, 3)] = tmp272 * tmp475 + tmp275 * (tmp153 * tmp478 + tmp155 * tmp477);
         jacobian_anchors[(0, 4)] = 0.0;
-        jacobian_anchors[(1, 4)] = -tmp303 * tmp981
-            + tmp305 * tmp981
-            + tmp429 * (tmp428 * (tmp162 * tmp966 + tmp424 * (tmp150 * tmp980 + tmp151 * tmp974)) + tmp981)
-            - tmp880;
-        jacobian_anchors[(2, 4)] = tmp441 * tmp982 - tmp443 * tmp982
-            + tmp449
-                * (tmp448
-                    * (-tmp445 * tmp970
-                        + tmp446
-                            * (-tmp47 * (tmp876 + tmp975 + tmp976 - tmp977 - tmp978 - tmp979)
-                                - tmp58 * tmp974
-                                - tmp60 * tmp980
-                                + tmp77 * tmp974)
-                        + tmp447 * tmp966)
-                    + tmp982);
-        jacobian_anchors[(3, 4)] = tmp457 * tmp983 - tmp459 * tmp983
-            + tmp465
-                * (tmp460
-                    * (tmp193
-                        * (-tmp47 * tmp980
-                            + tmp49 * tmp974
-                            + tmp51 * tmp980
-                            + tmp77 * (tmp779 + tmp967 + tmp968 + tmp969 - tmp971 - tmp973))
-                        - tmp462 * tmp972
-                        + tmp464 * tmp966)
-                    + tmp983);
+        jacobian_anchors[(1, 4)] = tmp248 * (tmp124 * tmp486 + tmp127 * tmp487) + tmp254 * tmp482 - tmp415;
+        jacobian_anchors[(2, 4)] = tmp259 * (tmp139 * tmp486 + tmp140 * tmp487) + tmp264 * tmp484;
+        jacobian_anchors[(3, 4)] = tmp272 * tmp485 + tmp275 * (tmp153 * tmp486 + tmp155 * tmp487);
         jacobian_anchors[(0, 5)] = 0.0;
         jacobian_anchors[(1, 5)] = 0.0;
         jacobian_anchors[(2, 5)] = 0.0;
         jacobian_anchors[(3, 5)] = 0.0;
         jacobian_anchors[(0, 6)] = 0.0;
-        jacobian_anchors[(1, 6)] = -tmp1004 * tmp303
-            + tmp1004 * tmp305
-            + tmp429
-                * (tmp1004
-                    + tmp428 * (tmp162 * tmp988 + tmp424 * (tmp1002 * tmp150 + tmp151 * tmp996) - tmp426 * tmp989));
-        jacobian_anchors[(2, 6)] = tmp1005 * tmp441 - tmp1005 * tmp443
-            + tmp449
-                * (tmp1005
-                    + tmp448
-                        * (tmp446
-                            * (-tmp1002 * tmp60
-                                - tmp47 * (-tmp1000 + tmp1001 + tmp768 - tmp997 + tmp998 - tmp999)
-                                - tmp58 * tmp996
-                                + tmp77 * tmp996)
-                            + tmp447 * tmp988))
-            - tmp775;
-        jacobian_anchors[(3, 6)] = tmp1006 * tmp457 - tmp1006 * tmp459
-            + tmp465
-                * (tmp1006
-                    + tmp460
-                        * (tmp193
-                            * (-tmp1002 * tmp47
-                                + tmp1002 * tmp51
-                                + tmp49 * tmp996
-                                + tmp77 * (tmp757 + tmp990 + tmp991 + tmp992 - tmp993 - tmp995))
-                            - tmp462 * tmp994
-                            + tmp464 * tmp988));
+        jacobian_anchors[(1, 6)] = tmp248 * (tmp124 * tmp497 + tmp127 * tmp498) + tmp254 * tmp493;
+        jacobian_anchors[(2, 6)] = tmp259 * (tmp139 * tmp497 + tmp140 * tmp498) + tmp264 * tmp494 - tmp412;
+        jacobian_anchors[(3, 6)] = tmp272 * tmp496 + tmp275 * (tmp153 * tmp497 + tmp155 * tmp498);
         jacobian_anchors[(0, 7)] = 0.0;
-        jacobian_anchors[(1, 7)] = -tmp1028 * tmp303
-            + tmp1028 * tmp305
-            + tmp429
-                * (tmp1028
-                    + tmp428 * (-tmp1011 * tmp426 + tmp1014 * tmp162 + tmp424 * (tmp1020 * tmp150 + tmp1026 * tmp151)));
-        jacobian_anchors[(2, 7)] = tmp1029 * tmp441 - tmp1029 * tmp443
-            + tmp449
-                * (tmp1029
-                    + tmp448
-                        * (tmp1014 * tmp447
-                            + tmp446
-                                * (-tmp1020 * tmp60 - tmp1026 * tmp58 + tmp1026 * tmp77
-                                    - tmp47 * (tmp1013 - tmp1016 - tmp1017 - tmp1018 + tmp1019 + tmp874))))
-            - tmp887;
-        jacobian_anchors[(3, 7)] = tmp1030 * tmp457 - tmp1030 * tmp459
-            + tmp465
-                * (tmp1030
-                    + tmp460
-                        * (-tmp1012 * tmp462
-                            + tmp1014 * tmp464
-                            + tmp193
-                                * (-tmp1020 * tmp47
-                                    + tmp1020 * tmp51
-                                    + tmp1026 * tmp49
-                                    + tmp77 * (-tmp1021 + tmp1022 + tmp1023 + tmp1024 - tmp1025 + tmp778))));
+        jacobian_anchors[(1, 7)] = tmp248 * (tmp124 * tmp507 + tmp127 * tmp506) + tmp254 * tmp503;
+        jacobian_anchors[(2, 7)] = tmp259 * (tmp139 * tmp507 + tmp140 * tmp506) + tmp264 * tmp504 - tmp442;
+        jacobian_anchors[(3, 7)] = tmp272 * tmp505 + tmp275 * (tmp153 * tmp507 + tmp155 * tmp506);
         jacobian_anchors[(0, 8)] = 0.0;
         jacobian_anchors[(1, 8)] = 0.0;
         jacobian_anchors[(2, 8)] = 0.0;
         jacobian_anchors[(3, 8)] = 0.0;
         jacobian_anchors[(0, 9)] = 0.0;
-        jacobian_anchors[(1, 9)] = -tmp1037 * tmp303
-            + tmp1037 * tmp305
-            + tmp429
-                * (tmp1037
-                    + tmp428 * (-tmp1035 * tmp426 + tmp1036 * tmp162 + tmp424 * (tmp1045 * tmp150 + tmp1051 * tmp151)));
-        jacobian_anchors[(2, 9)] = tmp1052 * tmp441 - tmp1052 * tmp443
-            + tmp449
-                * (tmp1052
-                    + tmp448
-                        * (tmp1036 * tmp447 - tmp1040 * tmp445
-                            + tmp446
-                                * (-tmp1045 * tmp60 - tmp1051 * tmp58 + tmp1051 * tmp77
-                                    - tmp47 * (-tmp1038 + tmp1039 + tmp1041 - tmp1043 - tmp1044 + tmp766))));
-        jacobian_anchors[(3, 9)] = tmp1053 * tmp457 - tmp1053 * tmp459
-            + tmp465
-                * (tmp1053
-                    + tmp460
-                        * (tmp1036 * tmp464
-                            + tmp193
-                                * (-tmp1045 * tmp47
-                                    + tmp1045 * tmp51
-                                    + tmp1051 * tmp49
-                                    + tmp77 * (tmp1046 - tmp1047 + tmp1048 - tmp1049 + tmp1050 + tmp755))))
-            - tmp795;
+        jacobian_anchors[(1, 9)] = tmp248 * (tmp124 * tmp515 + tmp127 * tmp516) + tmp254 * tmp512;
+        jacobian_anchors[(2, 9)] = tmp259 * (tmp139 * tmp515 + tmp140 * tmp516) + tmp264 * tmp514;
+        jacobian_anchors[(3, 9)] = tmp272 * tmp513 + tmp275 * (tmp153 * tmp515 + tmp155 * tmp516) - tmp413;
         jacobian_anchors[(0, 10)] = 0.0;
-        jacobian_anchors[(1, 10)] = -tmp1061 * tmp303
-            + tmp1061 * tmp305
-            + tmp429
-                * (tmp1061
-                    + tmp428 * (tmp1058 * tmp162 - tmp1060 * tmp425 + tmp424 * (tmp1068 * tmp150 + tmp1074 * tmp151)));
-        jacobian_anchors[(2, 10)] = tmp1075 * tmp441 - tmp1075 * tmp443
-            + tmp449
-                * (tmp1075
-                    + tmp448
-                        * (tmp1058 * tmp447 - tmp1065 * tmp445
-                            + tmp446
-                                * (-tmp1068 * tmp60 - tmp1074 * tmp58 + tmp1074 * tmp77
-                                    - tmp47 * (-tmp1062 - tmp1063 + tmp1064 + tmp1066 - tmp1067 + tmp878))));
-        jacobian_anchors[(3, 10)] = tmp1076 * tmp457 - tmp1076 * tmp459
-            + tmp465
-                * (tmp1076
-                    + tmp460
-                        * (tmp1058 * tmp464
-                            + tmp193
-                                * (-tmp1068 * tmp47
-                                    + tmp1068 * tmp51
-                                    + tmp1074 * tmp49
-                                    + tmp77 * (-tmp1069 + tmp1070 + tmp1071 + tmp1072 - tmp1073 + tmp777))))
-            - tmp888;
+        jacobian_anchors[(1, 10)] = tmp248 * (tmp124 * tmp524 + tmp127 * tmp523) + tmp254 * tmp522;
+        jacobian_anchors[(2, 10)] = tmp259 * (tmp139 * tmp524 + tmp140 * tmp523) + tmp264 * tmp521;
+        jacobian_anchors[(3, 10)] = tmp272 * tmp520 + tmp275 * (tmp153 * tmp524 + tmp155 * tmp523) - tmp443;
         jacobian_anchors[(0, 11)] = 0.0;
         jacobian_anchors[(1, 11)] = 0.0;
         jacobian_anchors[(2, 11)] = 0.0;
@@ -1963,9 +814,9 @@ pub fn catenary_length_residual(
         jacobian_length_offsets[(3, 3)] = 1.0_f64;
     }
     nalgebra::SVector::<f64, 4>::from([
-        tmp35 * tmp46 - encoder_lengths_m[0] + length_offsets_m[0],
-        tmp165 * tmp167 - encoder_lengths_m[1] + length_offsets_m[1],
-        tmp181 * tmp183 - encoder_lengths_m[2] + length_offsets_m[2],
-        tmp196 * tmp198 - encoder_lengths_m[3] + length_offsets_m[3],
+        tmp24 * tmp35 - encoder_lengths_m[0] + length_offsets_m[0],
+        tmp137 * tmp43 - encoder_lengths_m[1] + length_offsets_m[1],
+        tmp151 * tmp65 - encoder_lengths_m[2] + length_offsets_m[2],
+        tmp165 * tmp55 - encoder_lengths_m[3] + length_offsets_m[3],
     ])
 }

@@ -33,244 +33,186 @@ pub fn rigid_length_residual(
     jacobian_anchors: Option<&mut nalgebra::SMatrix<f64, 4, 12>>,
     jacobian_length_offsets: Option<&mut nalgebra::SMatrix<f64, 4, 4>>,
 ) -> nalgebra::SVector<f64, 4> {
-    // Total ops: 439
+    // Total ops: 356
 
-    // Intermediate terms (98)
-    let tmp0: f64 = 2.0_f64 * rotation_xyzw[0];
-    let tmp1: f64 = tmp0 * rotation_xyzw[3];
-    let tmp2: f64 = -tmp1;
-    let tmp3: f64 = 2.0_f64 * rotation_xyzw[1];
-    let tmp4: f64 = tmp3 * rotation_xyzw[2];
-    let tmp5: f64 = tmp2 + tmp4;
-    let tmp6: f64 = 2.0_f64 * rotation_xyzw[2] * rotation_xyzw[3];
-    let tmp7: f64 = tmp0 * rotation_xyzw[1];
-    let tmp8: f64 = tmp6 + tmp7;
-    let tmp9: f64 = rotation_xyzw[2] * rotation_xyzw[2];
-    let tmp10: f64 = -2.0_f64 * tmp9;
-    let tmp11: f64 = rotation_xyzw[0] * rotation_xyzw[0];
-    let tmp12: f64 = -2.0_f64 * tmp11;
-    let tmp13: f64 = tmp10 + tmp12 + 1.0_f64;
-    let tmp14: f64 = -tmp13 * attachments_m[(1, 0)] - tmp5 * attachments_m[(2, 0)] - tmp8 * attachments_m[(0, 0)]
+    // Intermediate terms (52)
+    let tmp0: f64 = 2.0_f64 * rotation_xyzw[3];
+    let tmp1: f64 = tmp0 * rotation_xyzw[0];
+    let tmp2: f64 = 2.0_f64 * rotation_xyzw[2];
+    let tmp3: f64 = tmp2 * rotation_xyzw[1];
+    let tmp4: f64 = -tmp1 + tmp3;
+    let tmp5: f64 = tmp2 * rotation_xyzw[3];
+    let tmp6: f64 = 2.0_f64 * rotation_xyzw[0] * rotation_xyzw[1];
+    let tmp7: f64 = tmp5 + tmp6;
+    let tmp8: f64 = -2.0_f64 * (rotation_xyzw[2] * rotation_xyzw[2]);
+    let tmp9: f64 = -2.0_f64 * (rotation_xyzw[0] * rotation_xyzw[0]);
+    let tmp10: f64 = tmp8 + tmp9 + 1.0_f64;
+    let tmp11: f64 = -tmp10 * attachments_m[(1, 0)] - tmp4 * attachments_m[(2, 0)] - tmp7 * attachments_m[(0, 0)]
         + anchors_m[(1, 0)]
         - position_m[1];
-    let tmp15: f64 = tmp3 * rotation_xyzw[3];
-    let tmp16: f64 = tmp0 * rotation_xyzw[2];
-    let tmp17: f64 = tmp15 + tmp16;
-    let tmp18: f64 = -tmp6;
-    let tmp19: f64 = tmp18 + tmp7;
-    let tmp20: f64 = rotation_xyzw[1] * rotation_xyzw[1];
-    let tmp21: f64 = 1.0_f64 - 2.0_f64 * tmp20;
-    let tmp22: f64 = tmp10 + tmp21;
-    let tmp23: f64 = -tmp17 * attachments_m[(2, 0)] - tmp19 * attachments_m[(1, 0)] - tmp22 * attachments_m[(0, 0)]
+    let tmp12: f64 = tmp0 * rotation_xyzw[1];
+    let tmp13: f64 = tmp2 * rotation_xyzw[0];
+    let tmp14: f64 = tmp12 + tmp13;
+    let tmp15: f64 = -tmp5 + tmp6;
+    let tmp16: f64 = 1.0_f64 - 2.0_f64 * (rotation_xyzw[1] * rotation_xyzw[1]);
+    let tmp17: f64 = tmp16 + tmp8;
+    let tmp18: f64 = -tmp14 * attachments_m[(2, 0)] - tmp15 * attachments_m[(1, 0)] - tmp17 * attachments_m[(0, 0)]
         + anchors_m[(0, 0)]
         - position_m[0];
-    let tmp24: f64 = tmp1 + tmp4;
-    let tmp25: f64 = -tmp15;
-    let tmp26: f64 = tmp16 + tmp25;
-    let tmp27: f64 = tmp12 + tmp21;
-    let tmp28: f64 = -tmp24 * attachments_m[(1, 0)] - tmp26 * attachments_m[(0, 0)] - tmp27 * attachments_m[(2, 0)]
+    let tmp19: f64 = tmp1 + tmp3;
+    let tmp20: f64 = -tmp12 + tmp13;
+    let tmp21: f64 = tmp16 + tmp9;
+    let tmp22: f64 = -tmp19 * attachments_m[(1, 0)] - tmp20 * attachments_m[(0, 0)] - tmp21 * attachments_m[(2, 0)]
         + anchors_m[(2, 0)]
         - position_m[2];
-    let tmp29: f64 = ((tmp14 * tmp14) + (tmp23 * tmp23) + (tmp28 * tmp28) + epsilon).sqrt();
-    let tmp30: f64 = -tmp13 * attachments_m[(1, 1)] - tmp5 * attachments_m[(2, 1)] - tmp8 * attachments_m[(0, 1)]
+    let tmp23: f64 = ((tmp11 * tmp11) + (tmp18 * tmp18) + (tmp22 * tmp22) + epsilon).sqrt();
+    let tmp24: f64 = -tmp10 * attachments_m[(1, 1)] - tmp4 * attachments_m[(2, 1)] - tmp7 * attachments_m[(0, 1)]
         + anchors_m[(1, 1)]
         - position_m[1];
-    let tmp31: f64 = -tmp17 * attachments_m[(2, 1)] - tmp19 * attachments_m[(1, 1)] - tmp22 * attachments_m[(0, 1)]
+    let tmp25: f64 = -tmp14 * attachments_m[(2, 1)] - tmp15 * attachments_m[(1, 1)] - tmp17 * attachments_m[(0, 1)]
         + anchors_m[(0, 1)]
         - position_m[0];
-    let tmp32: f64 = -tmp24 * attachments_m[(1, 1)] - tmp26 * attachments_m[(0, 1)] - tmp27 * attachments_m[(2, 1)]
+    let tmp26: f64 = -tmp19 * attachments_m[(1, 1)] - tmp20 * attachments_m[(0, 1)] - tmp21 * attachments_m[(2, 1)]
         + anchors_m[(2, 1)]
         - position_m[2];
-    let tmp33: f64 = ((tmp30 * tmp30) + (tmp31 * tmp31) + (tmp32 * tmp32) + epsilon).sqrt();
-    let tmp34: f64 = -tmp13 * attachments_m[(1, 2)] - tmp5 * attachments_m[(2, 2)] - tmp8 * attachments_m[(0, 2)]
+    let tmp27: f64 = ((tmp24 * tmp24) + (tmp25 * tmp25) + (tmp26 * tmp26) + epsilon).sqrt();
+    let tmp28: f64 = -tmp10 * attachments_m[(1, 2)] - tmp4 * attachments_m[(2, 2)] - tmp7 * attachments_m[(0, 2)]
         + anchors_m[(1, 2)]
         - position_m[1];
-    let tmp35: f64 = -tmp17 * attachments_m[(2, 2)] - tmp19 * attachments_m[(1, 2)] - tmp22 * attachments_m[(0, 2)]
+    let tmp29: f64 = -tmp14 * attachments_m[(2, 2)] - tmp15 * attachments_m[(1, 2)] - tmp17 * attachments_m[(0, 2)]
         + anchors_m[(0, 2)]
         - position_m[0];
-    let tmp36: f64 = -tmp24 * attachments_m[(1, 2)] - tmp26 * attachments_m[(0, 2)] - tmp27 * attachments_m[(2, 2)]
+    let tmp30: f64 = -tmp19 * attachments_m[(1, 2)] - tmp20 * attachments_m[(0, 2)] - tmp21 * attachments_m[(2, 2)]
         + anchors_m[(2, 2)]
         - position_m[2];
-    let tmp37: f64 = ((tmp34 * tmp34) + (tmp35 * tmp35) + (tmp36 * tmp36) + epsilon).sqrt();
-    let tmp38: f64 = -tmp13 * attachments_m[(1, 3)] - tmp5 * attachments_m[(2, 3)] - tmp8 * attachments_m[(0, 3)]
+    let tmp31: f64 = ((tmp28 * tmp28) + (tmp29 * tmp29) + (tmp30 * tmp30) + epsilon).sqrt();
+    let tmp32: f64 = -tmp10 * attachments_m[(1, 3)] - tmp4 * attachments_m[(2, 3)] - tmp7 * attachments_m[(0, 3)]
         + anchors_m[(1, 3)]
         - position_m[1];
-    let tmp39: f64 = -tmp17 * attachments_m[(2, 3)] - tmp19 * attachments_m[(1, 3)] - tmp22 * attachments_m[(0, 3)]
+    let tmp33: f64 = -tmp14 * attachments_m[(2, 3)] - tmp15 * attachments_m[(1, 3)] - tmp17 * attachments_m[(0, 3)]
         + anchors_m[(0, 3)]
         - position_m[0];
-    let tmp40: f64 = -tmp24 * attachments_m[(1, 3)] - tmp26 * attachments_m[(0, 3)] - tmp27 * attachments_m[(2, 3)]
+    let tmp34: f64 = -tmp19 * attachments_m[(1, 3)] - tmp20 * attachments_m[(0, 3)] - tmp21 * attachments_m[(2, 3)]
         + anchors_m[(2, 3)]
         - position_m[2];
-    let tmp41: f64 = ((tmp38 * tmp38) + (tmp39 * tmp39) + (tmp40 * tmp40) + epsilon).sqrt();
-    let tmp42: f64 = -tmp4;
-    let tmp43: f64 = tmp2 + tmp42;
-    let tmp44: f64 = -tmp20;
-    let tmp45: f64 = tmp44 + tmp9;
-    let tmp46: f64 = rotation_xyzw[3] * rotation_xyzw[3];
-    let tmp47: f64 = -tmp11;
-    let tmp48: f64 = tmp46 + tmp47;
-    let tmp49: f64 = tmp45 + tmp48;
-    let tmp50: f64 = 2.0_f64 * tmp28;
-    let tmp51: f64 = -tmp46;
-    let tmp52: f64 = tmp11 + tmp51;
-    let tmp53: f64 = tmp45 + tmp52;
-    let tmp54: f64 = 2.0_f64 * tmp14;
-    let tmp55: f64 = -tmp7;
-    let tmp56: f64 = tmp55 + tmp6;
-    let tmp57: f64 = 2.0_f64 * tmp23;
-    let tmp58: f64 = 1.0_f64 / tmp29;
-    let tmp59: f64 = 0.5_f64 * tmp58;
-    let tmp60: f64 = 2.0_f64 * tmp32;
-    let tmp61: f64 = 2.0_f64 * tmp30;
-    let tmp62: f64 = 2.0_f64 * tmp31;
-    let tmp63: f64 = 1.0_f64 / tmp33;
-    let tmp64: f64 = 0.5_f64 * tmp63;
-    let tmp65: f64 = 2.0_f64 * tmp36;
-    let tmp66: f64 = 2.0_f64 * tmp34;
-    let tmp67: f64 = 2.0_f64 * tmp35;
-    let tmp68: f64 = 1.0_f64 / tmp37;
-    let tmp69: f64 = 0.5_f64 * tmp68;
-    let tmp70: f64 = 2.0_f64 * tmp40;
-    let tmp71: f64 = 2.0_f64 * tmp38;
-    let tmp72: f64 = 2.0_f64 * tmp39;
-    let tmp73: f64 = 1.0_f64 / tmp41;
-    let tmp74: f64 = 0.5_f64 * tmp73;
-    let tmp75: f64 = -tmp9;
-    let tmp76: f64 = tmp20 + tmp75;
-    let tmp77: f64 = tmp52 + tmp76;
-    let tmp78: f64 = -tmp16;
-    let tmp79: f64 = tmp25 + tmp78;
-    let tmp80: f64 = tmp11 + tmp44 + tmp46 + tmp75;
-    let tmp81: f64 = tmp1 + tmp42;
-    let tmp82: f64 = tmp18 + tmp55;
-    let tmp83: f64 = tmp48 + tmp76;
-    let tmp84: f64 = tmp20 + tmp47 + tmp51 + tmp9;
-    let tmp85: f64 = tmp15 + tmp78;
-    let tmp86: f64 = tmp23 * tmp58;
-    let tmp87: f64 = tmp31 * tmp63;
-    let tmp88: f64 = tmp35 * tmp68;
-    let tmp89: f64 = tmp39 * tmp73;
-    let tmp90: f64 = tmp14 * tmp58;
-    let tmp91: f64 = tmp30 * tmp63;
-    let tmp92: f64 = tmp34 * tmp68;
-    let tmp93: f64 = tmp38 * tmp73;
-    let tmp94: f64 = tmp28 * tmp58;
-    let tmp95: f64 = tmp32 * tmp63;
-    let tmp96: f64 = tmp36 * tmp68;
-    let tmp97: f64 = tmp40 * tmp73;
+    let tmp35: f64 = ((tmp32 * tmp32) + (tmp33 * tmp33) + (tmp34 * tmp34) + epsilon).sqrt();
+    let tmp36: f64 = 1.0_f64 / tmp23;
+    let tmp37: f64 = tmp22 * tmp36;
+    let tmp38: f64 = tmp18 * tmp36;
+    let tmp39: f64 = tmp11 * tmp36;
+    let tmp40: f64 = 1.0_f64 / tmp27;
+    let tmp41: f64 = tmp24 * tmp40;
+    let tmp42: f64 = tmp26 * tmp40;
+    let tmp43: f64 = tmp25 * tmp40;
+    let tmp44: f64 = 1.0_f64 / tmp31;
+    let tmp45: f64 = tmp28 * tmp44;
+    let tmp46: f64 = tmp29 * tmp44;
+    let tmp47: f64 = tmp30 * tmp44;
+    let tmp48: f64 = 1.0_f64 / tmp35;
+    let tmp49: f64 = tmp34 * tmp48;
+    let tmp50: f64 = tmp33 * tmp48;
+    let tmp51: f64 = tmp32 * tmp48;
 
     // Output terms (4)
     if let Some(jacobian_pose) = jacobian_pose {
-        jacobian_pose[(0, 0)] = tmp59
-            * (tmp50 * (-tmp43 * attachments_m[(2, 0)] - tmp49 * attachments_m[(1, 0)])
-                + tmp54 * (-tmp5 * attachments_m[(1, 0)] - tmp53 * attachments_m[(2, 0)])
-                + tmp57 * (-tmp17 * attachments_m[(1, 0)] - tmp56 * attachments_m[(2, 0)]));
-        jacobian_pose[(1, 0)] = tmp64
-            * (tmp60 * (-tmp43 * attachments_m[(2, 1)] - tmp49 * attachments_m[(1, 1)])
-                + tmp61 * (-tmp5 * attachments_m[(1, 1)] - tmp53 * attachments_m[(2, 1)])
-                + tmp62 * (-tmp17 * attachments_m[(1, 1)] - tmp56 * attachments_m[(2, 1)]));
-        jacobian_pose[(2, 0)] = tmp69
-            * (tmp65 * (-tmp43 * attachments_m[(2, 2)] - tmp49 * attachments_m[(1, 2)])
-                + tmp66 * (-tmp5 * attachments_m[(1, 2)] - tmp53 * attachments_m[(2, 2)])
-                + tmp67 * (-tmp17 * attachments_m[(1, 2)] - tmp56 * attachments_m[(2, 2)]));
-        jacobian_pose[(3, 0)] = tmp74
-            * (tmp70 * (-tmp43 * attachments_m[(2, 3)] - tmp49 * attachments_m[(1, 3)])
-                + tmp71 * (-tmp5 * attachments_m[(1, 3)] - tmp53 * attachments_m[(2, 3)])
-                + tmp72 * (-tmp17 * attachments_m[(1, 3)] - tmp56 * attachments_m[(2, 3)]));
-        jacobian_pose[(0, 1)] = tmp59
-            * (tmp50 * (-tmp26 * attachments_m[(2, 0)] - tmp77 * attachments_m[(0, 0)])
-                + tmp54 * (-tmp8 * attachments_m[(2, 0)] - tmp81 * attachments_m[(0, 0)])
-                + tmp57 * (-tmp79 * attachments_m[(0, 0)] - tmp80 * attachments_m[(2, 0)]));
-        jacobian_pose[(1, 1)] = tmp64
-            * (tmp60 * (-tmp26 * attachments_m[(2, 1)] - tmp77 * attachments_m[(0, 1)])
-                + tmp61 * (-tmp8 * attachments_m[(2, 1)] - tmp81 * attachments_m[(0, 1)])
-                + tmp62 * (-tmp79 * attachments_m[(0, 1)] - tmp80 * attachments_m[(2, 1)]));
-        jacobian_pose[(2, 1)] = tmp69
-            * (tmp65 * (-tmp26 * attachments_m[(2, 2)] - tmp77 * attachments_m[(0, 2)])
-                + tmp66 * (-tmp8 * attachments_m[(2, 2)] - tmp81 * attachments_m[(0, 2)])
-                + tmp67 * (-tmp79 * attachments_m[(0, 2)] - tmp80 * attachments_m[(2, 2)]));
-        jacobian_pose[(3, 1)] = tmp74
-            * (tmp70 * (-tmp26 * attachments_m[(2, 3)] - tmp77 * attachments_m[(0, 3)])
-                + tmp71 * (-tmp8 * attachments_m[(2, 3)] - tmp81 * attachments_m[(0, 3)])
-                + tmp72 * (-tmp79 * attachments_m[(0, 3)] - tmp80 * attachments_m[(2, 3)]));
-        jacobian_pose[(0, 2)] = tmp59
-            * (tmp50 * (-tmp24 * attachments_m[(0, 0)] - tmp85 * attachments_m[(1, 0)])
-                + tmp54 * (-tmp82 * attachments_m[(1, 0)] - tmp83 * attachments_m[(0, 0)])
-                + tmp57 * (-tmp19 * attachments_m[(0, 0)] - tmp84 * attachments_m[(1, 0)]));
-        jacobian_pose[(1, 2)] = tmp64
-            * (tmp60 * (-tmp24 * attachments_m[(0, 1)] - tmp85 * attachments_m[(1, 1)])
-                + tmp61 * (-tmp82 * attachments_m[(1, 1)] - tmp83 * attachments_m[(0, 1)])
-                + tmp62 * (-tmp19 * attachments_m[(0, 1)] - tmp84 * attachments_m[(1, 1)]));
-        jacobian_pose[(2, 2)] = tmp69
-            * (tmp65 * (-tmp24 * attachments_m[(0, 2)] - tmp85 * attachments_m[(1, 2)])
-                + tmp66 * (-tmp82 * attachments_m[(1, 2)] - tmp83 * attachments_m[(0, 2)])
-                + tmp67 * (-tmp19 * attachments_m[(0, 2)] - tmp84 * attachments_m[(1, 2)]));
-        jacobian_pose[(3, 2)] = tmp74
-            * (tmp70 * (-tmp24 * attachments_m[(0, 3)] - tmp85 * attachments_m[(1, 3)])
-                + tmp71 * (-tmp82 * attachments_m[(1, 3)] - tmp83 * attachments_m[(0, 3)])
-                + tmp72 * (-tmp19 * attachments_m[(0, 3)] - tmp84 * attachments_m[(1, 3)]));
-        jacobian_pose[(0, 3)] = -tmp86;
-        jacobian_pose[(1, 3)] = -tmp87;
-        jacobian_pose[(2, 3)] = -tmp88;
-        jacobian_pose[(3, 3)] = -tmp89;
-        jacobian_pose[(0, 4)] = -tmp90;
-        jacobian_pose[(1, 4)] = -tmp91;
-        jacobian_pose[(2, 4)] = -tmp92;
-        jacobian_pose[(3, 4)] = -tmp93;
-        jacobian_pose[(0, 5)] = -tmp94;
-        jacobian_pose[(1, 5)] = -tmp95;
-        jacobian_pose[(2, 5)] = -tmp96;
-        jacobian_pose[(3, 5)] = -tmp97;
+        jacobian_pose[(0, 0)] = -tmp37 * (-tmp19 * attachments_m[(2, 0)] + tmp21 * attachments_m[(1, 0)])
+            - tmp38 * (tmp14 * attachments_m[(1, 0)] - tmp15 * attachments_m[(2, 0)])
+            - tmp39 * (-tmp10 * attachments_m[(2, 0)] + tmp4 * attachments_m[(1, 0)]);
+        jacobian_pose[(1, 0)] = -tmp41 * (-tmp10 * attachments_m[(2, 1)] + tmp4 * attachments_m[(1, 1)])
+            - tmp42 * (-tmp19 * attachments_m[(2, 1)] + tmp21 * attachments_m[(1, 1)])
+            - tmp43 * (tmp14 * attachments_m[(1, 1)] - tmp15 * attachments_m[(2, 1)]);
+        jacobian_pose[(2, 0)] = -tmp45 * (-tmp10 * attachments_m[(2, 2)] + tmp4 * attachments_m[(1, 2)])
+            - tmp46 * (tmp14 * attachments_m[(1, 2)] - tmp15 * attachments_m[(2, 2)])
+            - tmp47 * (-tmp19 * attachments_m[(2, 2)] + tmp21 * attachments_m[(1, 2)]);
+        jacobian_pose[(3, 0)] = -tmp49 * (-tmp19 * attachments_m[(2, 3)] + tmp21 * attachments_m[(1, 3)])
+            - tmp50 * (tmp14 * attachments_m[(1, 3)] - tmp15 * attachments_m[(2, 3)])
+            - tmp51 * (-tmp10 * attachments_m[(2, 3)] + tmp4 * attachments_m[(1, 3)]);
+        jacobian_pose[(0, 1)] = -tmp37 * (tmp20 * attachments_m[(2, 0)] - tmp21 * attachments_m[(0, 0)])
+            - tmp38 * (-tmp14 * attachments_m[(0, 0)] + tmp17 * attachments_m[(2, 0)])
+            - tmp39 * (-tmp4 * attachments_m[(0, 0)] + tmp7 * attachments_m[(2, 0)]);
+        jacobian_pose[(1, 1)] = -tmp41 * (-tmp4 * attachments_m[(0, 1)] + tmp7 * attachments_m[(2, 1)])
+            - tmp42 * (tmp20 * attachments_m[(2, 1)] - tmp21 * attachments_m[(0, 1)])
+            - tmp43 * (-tmp14 * attachments_m[(0, 1)] + tmp17 * attachments_m[(2, 1)]);
+        jacobian_pose[(2, 1)] = -tmp45 * (-tmp4 * attachments_m[(0, 2)] + tmp7 * attachments_m[(2, 2)])
+            - tmp46 * (-tmp14 * attachments_m[(0, 2)] + tmp17 * attachments_m[(2, 2)])
+            - tmp47 * (tmp20 * attachments_m[(2, 2)] - tmp21 * attachments_m[(0, 2)]);
+        jacobian_pose[(3, 1)] = -tmp49 * (tmp20 * attachments_m[(2, 3)] - tmp21 * attachments_m[(0, 3)])
+            - tmp50 * (-tmp14 * attachments_m[(0, 3)] + tmp17 * attachments_m[(2, 3)])
+            - tmp51 * (-tmp4 * attachments_m[(0, 3)] + tmp7 * attachments_m[(2, 3)]);
+        jacobian_pose[(0, 2)] = -tmp37 * (tmp19 * attachments_m[(0, 0)] - tmp20 * attachments_m[(1, 0)])
+            - tmp38 * (tmp15 * attachments_m[(0, 0)] - tmp17 * attachments_m[(1, 0)])
+            - tmp39 * (tmp10 * attachments_m[(0, 0)] - tmp7 * attachments_m[(1, 0)]);
+        jacobian_pose[(1, 2)] = -tmp41 * (tmp10 * attachments_m[(0, 1)] - tmp7 * attachments_m[(1, 1)])
+            - tmp42 * (tmp19 * attachments_m[(0, 1)] - tmp20 * attachments_m[(1, 1)])
+            - tmp43 * (tmp15 * attachments_m[(0, 1)] - tmp17 * attachments_m[(1, 1)]);
+        jacobian_pose[(2, 2)] = -tmp45 * (tmp10 * attachments_m[(0, 2)] - tmp7 * attachments_m[(1, 2)])
+            - tmp46 * (tmp15 * attachments_m[(0, 2)] - tmp17 * attachments_m[(1, 2)])
+            - tmp47 * (tmp19 * attachments_m[(0, 2)] - tmp20 * attachments_m[(1, 2)]);
+        jacobian_pose[(3, 2)] = -tmp49 * (tmp19 * attachments_m[(0, 3)] - tmp20 * attachments_m[(1, 3)])
+            - tmp50 * (tmp15 * attachments_m[(0, 3)] - tmp17 * attachments_m[(1, 3)])
+            - tmp51 * (tmp10 * attachments_m[(0, 3)] - tmp7 * attachments_m[(1, 3)]);
+        jacobian_pose[(0, 3)] = -tmp38;
+        jacobian_pose[(1, 3)] = -tmp43;
+        jacobian_pose[(2, 3)] = -tmp46;
+        jacobian_pose[(3, 3)] = -tmp50;
+        jacobian_pose[(0, 4)] = -tmp39;
+        jacobian_pose[(1, 4)] = -tmp41;
+        jacobian_pose[(2, 4)] = -tmp45;
+        jacobian_pose[(3, 4)] = -tmp51;
+        jacobian_pose[(0, 5)] = -tmp37;
+        jacobian_pose[(1, 5)] = -tmp42;
+        jacobian_pose[(2, 5)] = -tmp47;
+        jacobian_pose[(3, 5)] = -tmp49;
     }
     if let Some(jacobian_anchors) = jacobian_anchors {
-        jacobian_anchors[(0, 0)] = tmp86;
+        jacobian_anchors[(0, 0)] = tmp38;
         jacobian_anchors[(1, 0)] = 0.0;
         jacobian_anchors[(2, 0)] = 0.0;
         jacobian_anchors[(3, 0)] = 0.0;
-        jacobian_anchors[(0, 1)] = tmp90;
+        jacobian_anchors[(0, 1)] = tmp39;
         jacobian_anchors[(1, 1)] = 0.0;
         jacobian_anchors[(2, 1)] = 0.0;
         jacobian_anchors[(3, 1)] = 0.0;
-        jacobian_anchors[(0, 2)] = tmp94;
+        jacobian_anchors[(0, 2)] = tmp37;
         jacobian_anchors[(1, 2)] = 0.0;
         jacobian_anchors[(2, 2)] = 0.0;
         jacobian_anchors[(3, 2)] = 0.0;
         jacobian_anchors[(0, 3)] = 0.0;
-        jacobian_anchors[(1, 3)] = tmp87;
+        jacobian_anchors[(1, 3)] = tmp43;
         jacobian_anchors[(2, 3)] = 0.0;
         jacobian_anchors[(3, 3)] = 0.0;
         jacobian_anchors[(0, 4)] = 0.0;
-        jacobian_anchors[(1, 4)] = tmp91;
+        jacobian_anchors[(1, 4)] = tmp41;
         jacobian_anchors[(2, 4)] = 0.0;
         jacobian_anchors[(3, 4)] = 0.0;
         jacobian_anchors[(0, 5)] = 0.0;
-        jacobian_anchors[(1, 5)] = tmp95;
+        jacobian_anchors[(1, 5)] = tmp42;
         jacobian_anchors[(2, 5)] = 0.0;
         jacobian_anchors[(3, 5)] = 0.0;
         jacobian_anchors[(0, 6)] = 0.0;
         jacobian_anchors[(1, 6)] = 0.0;
-        jacobian_anchors[(2, 6)] = tmp88;
+        jacobian_anchors[(2, 6)] = tmp46;
         jacobian_anchors[(3, 6)] = 0.0;
         jacobian_anchors[(0, 7)] = 0.0;
         jacobian_anchors[(1, 7)] = 0.0;
-        jacobian_anchors[(2, 7)] = tmp92;
+        jacobian_anchors[(2, 7)] = tmp45;
         jacobian_anchors[(3, 7)] = 0.0;
         jacobian_anchors[(0, 8)] = 0.0;
         jacobian_anchors[(1, 8)] = 0.0;
-        jacobian_anchors[(2, 8)] = tmp96;
+        jacobian_anchors[(2, 8)] = tmp47;
         jacobian_anchors[(3, 8)] = 0.0;
         jacobian_anchors[(0, 9)] = 0.0;
         jacobian_anchors[(1, 9)] = 0.0;
         jacobian_anchors[(2, 9)] = 0.0;
-        jacobian_anchors[(3, 9)] = tmp89;
+        jacobian_anchors[(3, 9)] = tmp50;
         jacobian_anchors[(0, 10)] = 0.0;
         jacobian_anchors[(1, 10)] = 0.0;
         jacobian_anchors[(2, 10)] = 0.0;
-        jacobian_anchors[(3, 10)] = tmp93;
+        jacobian_anchors[(3, 10)] = tmp51;
         jacobian_anchors[(0, 11)] = 0.0;
         jacobian_anchors[(1, 11)] = 0.0;
         jacobian_anchors[(2, 11)] = 0.0;
-        jacobian_anchors[(3, 11)] = tmp97;
+        jacobian_anchors[(3, 11)] = tmp49;
     }
     if let Some(jacobian_length_offsets) = jacobian_length_offsets {
         jacobian_length_offsets[(0, 0)] = 1.0_f64;
@@ -291,9 +233,9 @@ pub fn rigid_length_residual(
         jacobian_length_offsets[(3, 3)] = 1.0_f64;
     }
     nalgebra::SVector::<f64, 4>::from([
-        tmp29 - encoder_lengths_m[0] + length_offsets_m[0],
-        tmp33 - encoder_lengths_m[1] + length_offsets_m[1],
-        tmp37 - encoder_lengths_m[2] + length_offsets_m[2],
-        tmp41 - encoder_lengths_m[3] + length_offsets_m[3],
+        tmp23 - encoder_lengths_m[0] + length_offsets_m[0],
+        tmp27 - encoder_lengths_m[1] + length_offsets_m[1],
+        tmp31 - encoder_lengths_m[2] + length_offsets_m[2],
+        tmp35 - encoder_lengths_m[3] + length_offsets_m[3],
     ])
 }
