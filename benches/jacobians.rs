@@ -15,10 +15,17 @@
 //! between the two Jacobians, `max |a - n| / max(1, max |n|)` per block and the maximum over the
 //! blocks, is printed beside the function's name.
 //!
+//! After the groups the bench prints a summary table: per function criterion's median times of
+//! this run (read back from criterion's `estimates.json`), their ratio, the Jacobian difference and
+//! whether the targets (at least 10x faster, within 1e-6 relative) are met. `BENCHMARKS.md` quotes it.
+//!
 //! Run with `cargo bench --bench jacobians` (`make bench` runs every bench); add a filter such
 //! as `-- catenary_length_residual` for one group.
 
 use std::hint::black_box;
+use std::path::PathBuf;
+use std::sync::Mutex;
+use std::time::SystemTime;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, SVector, Vector2, Vector3, Vector4, Vector6};
@@ -276,6 +283,61 @@ fn load_cell(p: &Point, j: Option<&mut (M<1, 2>, M<1, 1>, M<1, 1>)>) -> SVector<
     )
 }
 
+/// Per group, the largest relative Jacobian difference, for the summary.
+static DIFFERENCES: Mutex<Vec<(String, f64)>> = Mutex::new(Vec::new());
+
+/// Criterion's output folder, found as criterion finds it: `$CRITERION_HOME`, else
+/// `$CARGO_TARGET_DIR/criterion`, else this package's `target/criterion`.
+fn criterion_home() -> PathBuf {
+    if let Some(home) = std::env::var_os("CRITERION_HOME") {
+        return home.into();
+    }
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target"));
+    target.join("criterion")
+}
+
+/// The median time (ns) of `group/function/large` if criterion wrote it after `since`.
+fn median_ns(group: &str, function: &str, since: SystemTime) -> Option<f64> {
+    let path = criterion_home()
+        .join(group)
+        .join(function)
+        .join("large/new/estimates.json");
+    let modified = std::fs::metadata(&path).and_then(|m| m.modified()).ok()?;
+    if modified < since {
+        return None;
+    }
+    let estimates: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).ok()?).ok()?;
+    estimates["median"]["point_estimate"].as_f64()
+}
+
+/// The summary table of the groups that ran since `since` (a filter may skip some).
+fn print_summary(since: SystemTime) {
+    println!();
+    println!(
+        "Jacobian summary (criterion medians of this run; targets: numerical / analytic >= 10x, difference <= 1e-6):"
+    );
+    println!(
+        "| function | analytic ns | numerical ns | numerical / analytic | max rel. Jacobian difference | targets |"
+    );
+    println!("|---|---:|---:|---:|---:|---|");
+    for (name, difference) in DIFFERENCES.lock().expect("one bench thread").iter() {
+        let (Some(analytic), Some(numerical)) =
+            (median_ns(name, "analytic", since), median_ns(name, "numerical", since))
+        else {
+            continue;
+        };
+        let ratio = numerical / analytic;
+        let met = if ratio >= 10.0 && *difference <= 1e-6 {
+            "met"
+        } else {
+            "MISSED"
+        };
+        println!("| `{name}` | {analytic:.1} | {numerical:.1} | {ratio:.1}x | {difference:.1e} | {met} |");
+    }
+}
+
 fn dynamic<const R: usize, const C: usize>(m: &M<R, C>) -> DMatrix<f64> {
     DMatrix::from_column_slice(R, C, m.as_slice())
 }
@@ -349,6 +411,10 @@ fn group<J: Default, const R: usize>(
         .map(|(a, n)| (a - n).amax() / n.amax().max(1.0))
         .fold(0.0, f64::max);
     println!("{name}: max relative Jacobian difference {difference:.1e}");
+    DIFFERENCES
+        .lock()
+        .expect("one bench thread")
+        .push((name.to_string(), difference));
 
     let mut group = c.benchmark_group(name);
     // The Jacobians are written into one buffer, as the solver does (`graph::LinearizationBuffers`).
@@ -368,6 +434,8 @@ fn group<J: Default, const R: usize>(
 
 fn jacobians(c: &mut Criterion) {
     use Block::{Additive, Pose};
+    // Criterion's files are compared with this (minus a second of file-time granularity).
+    let start = SystemTime::now() - std::time::Duration::from_secs(1);
     let p = point();
     let reference = Additive(|q| q.reference_tension_n.as_mut_slice());
     let anchors = Additive(|q| q.anchors_m.as_mut_slice());
@@ -431,6 +499,7 @@ fn jacobians(c: &mut Criterion) {
     group(c, "load_cell_residual", &p, &load_cell_blocks, load_cell, |j| {
         vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)]
     });
+    print_summary(start);
 }
 
 criterion_group!(benches, jacobians);

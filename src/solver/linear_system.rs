@@ -412,7 +412,7 @@ impl LinearSystem {
 
 /// `a . b` for two columns of `R` entries (`R = 0`: of equal length).
 #[inline(always)]
-fn dot<const R: usize>(a: &[f64], b: &[f64]) -> f64 {
+pub(super) fn dot<const R: usize>(a: &[f64], b: &[f64]) -> f64 {
     if R == 0 {
         return a.iter().zip(b).map(|(x, y)| x * y).sum();
     }

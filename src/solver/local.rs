@@ -14,6 +14,7 @@
 //! nonlinear elimination (Lanzkron, Rose & Wilkes, 1996). At a minimum of the
 //! full problem the refinement changes nothing.
 
+use super::linear_system::dot;
 use super::schur::{backward_substitute, cholesky_in_place, forward_substitute};
 use crate::graph::{FactorGraph, LinearizationBuffers, Values, VariableId};
 
@@ -145,7 +146,7 @@ fn linearize_group(graph: &FactorGraph, group: &Group, values: &Values, work: &m
         for &(slot_a, offset_a) in slots {
             let ja = linearized.jacobians[slot_a].as_slice();
             for (c, column) in ja.chunks_exact(rows).enumerate() {
-                work.gradient[offset_a + c] += dot(column, &linearized.residual);
+                work.gradient[offset_a + c] += dot::<0>(column, &linearized.residual);
             }
             for &(slot_b, offset_b) in slots {
                 if offset_a < offset_b {
@@ -156,7 +157,7 @@ fn linearize_group(graph: &FactorGraph, group: &Group, values: &Values, work: &m
                     for (j, column_b) in jb.chunks_exact(rows).enumerate() {
                         let (row, col) = (offset_a + i, offset_b + j);
                         if row >= col {
-                            work.hessian[row + col * dim] += dot(column_a, column_b);
+                            work.hessian[row + col * dim] += dot::<0>(column_a, column_b);
                         }
                     }
                 }
@@ -168,10 +169,6 @@ fn linearize_group(graph: &FactorGraph, group: &Group, values: &Values, work: &m
         .chain(&work.gradient)
         .all(|v| v.is_finite())
         .then_some(cost)
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &mut Workspace) {
