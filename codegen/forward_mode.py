@@ -7,8 +7,9 @@ subexpression elimination cannot fold the products back. The generated
 Jacobians then cost about 11 times the value.
 
 Here the model marks its intermediate quantities with :func:`checkpoint`
-(attachment arms, spans and directions, the solutions of eq. 11, the catenary's
-``u`` and ``lambda``). While a :class:`Tape` records, each marked quantity is
+(attachment points and arms, spans and horizontal directions, the solutions of
+eq. 11; marking the catenary's ``u`` and ``lambda`` too was tried and made
+the code longer). While a :class:`Tape` records, each marked quantity is
 replaced by a fresh symbol and its defining expression is kept. The Jacobian of
 an output with respect to a block of inputs is then the chain rule, applied
 quantity by quantity (forward-mode automatic differentiation with symbolic
