@@ -19,6 +19,9 @@
 //! this run (read back from criterion's `estimates.json`), their ratio, the Jacobian difference and
 //! whether the targets (at least 10x faster, within 1e-6 relative) are met. `BENCHMARKS.md` quotes it.
 //!
+//! The point and the calls of the generated functions are `tests/common/generated_calls.rs`, shared
+//! with the finite-difference tests (`tests/generated_jacobians.rs`).
+//!
 //! Run with `cargo bench --bench jacobians` (`make bench` runs every bench); add a filter such
 //! as `-- catenary_length_residual` for one group.
 
@@ -28,36 +31,17 @@ use std::sync::Mutex;
 use std::time::SystemTime;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, SVector, Vector2, Vector3, Vector4, Vector6};
-use sagcal::calib::factors::{SlotOrder, EPSILON};
-use sagcal::generated;
+use nalgebra::{DMatrix, DVector, Matrix3x4, SVector, Vector2, Vector3, Vector4, Vector6};
+use sagcal::calib::factors::SlotOrder;
 use sagcal::model::{PlatformPose, Robot};
 
-type M<const R: usize, const C: usize> = SMatrix<f64, R, C>;
+#[path = "../tests/common/generated_calls.rs"]
+mod generated_calls;
 
-/// All arguments of the generated functions.
-#[derive(Clone)]
-struct Point {
-    pose: PlatformPose,
-    reference_tension_n: Vector2<f64>,
-    anchors_m: Matrix3x4<f64>,
-    attachments_m: Matrix3x4<f64>,
-    com_offset_m: Vector3<f64>,
-    platform_weight_n: f64,
-    cable_weight_n_per_m: f64,
-    length_offsets_m: Vector4<f64>,
-    encoder_lengths_m: Vector4<f64>,
-    prior: PlatformPose,
-    measured_tension_n: f64,
-    /// Per slot `extended_cable`'s span (m), `f_h` and `f_v` (N), from `cable_geometry`.
-    spans_m: Vector4<f64>,
-    horizontal_tensions_n: Vector4<f64>,
-    vertical_tensions_n: Vector4<f64>,
-    axial_compliance_per_mn: f64,
-    pulley_radius_m: f64,
-    load_cell_bias_n: f64,
-    load_cell_gain_error: f64,
-}
+use generated_calls::{
+    attachment_height, catenary_length, dynamic, extended, extended_blocks, geometry, load_cell, pose_prior,
+    reference_tension, rigid_length, tensions, Point,
+};
 
 /// A large-robot operating point where all four cables pull.
 fn point() -> Point {
@@ -77,210 +61,23 @@ fn point() -> Point {
         encoder_lengths_m: Vector4::new(170.0, 180.0, 160.0, 175.0),
         prior: pose.retract(&Vector6::new(0.01, -0.02, 0.015, 0.05, -0.03, 0.02)),
         measured_tension_n: reference_tension_n.norm() + 2.0,
-        spans_m: Vector4::zeros(),
-        horizontal_tensions_n: Vector4::zeros(),
-        vertical_tensions_n: Vector4::zeros(),
+        cable_spans_m: Vector4::zeros(),
+        cable_horizontal_tensions_n: Vector4::zeros(),
+        cable_vertical_tensions_n: Vector4::zeros(),
         axial_compliance_per_mn: 0.5,
         pulley_radius_m: 0.2,
         load_cell_bias_n: 3.0,
         load_cell_gain_error: 0.01,
     };
     let g = geometry(&p, None);
-    p.spans_m = Vector4::from_fn(|j, _| g[4 * j]);
-    p.horizontal_tensions_n = Vector4::from_fn(|j, _| g[4 * j + 1]);
-    p.vertical_tensions_n = Vector4::from_fn(|j, _| g[4 * j + 2]);
+    p.cable_spans_m = Vector4::from_fn(|j, _| g[4 * j]);
+    p.cable_horizontal_tensions_n = Vector4::from_fn(|j, _| g[4 * j + 1]);
+    p.cable_vertical_tensions_n = Vector4::from_fn(|j, _| g[4 * j + 2]);
     assert!(
-        p.horizontal_tensions_n.min() > 0.0 && p.vertical_tensions_n.min() > 0.0,
+        p.cable_horizontal_tensions_n.min() > 0.0 && p.cable_vertical_tensions_n.min() > 0.0,
         "a slack or pushing cable: {g}"
     );
     p
-}
-
-// Each generated function at a point, with all its Jacobians (`Some`) or none.
-
-fn tensions(p: &Point, j: Option<&mut (M<8, 6>, M<8, 2>, M<8, 12>)>) -> SVector<f64, 8> {
-    let (pose, reference, anchors) = match j {
-        Some((a, b, c)) => (Some(a), Some(b), Some(c)),
-        None => (None, None, None),
-    };
-    generated::cable_tensions_from_reference(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.reference_tension_n,
-        &p.anchors_m,
-        &p.attachments_m,
-        &p.com_offset_m,
-        p.platform_weight_n,
-        EPSILON,
-        pose,
-        reference,
-        anchors,
-    )
-}
-
-fn catenary_length(p: &Point, j: Option<&mut (M<4, 6>, M<4, 2>, M<4, 12>, M<4, 4>)>) -> SVector<f64, 4> {
-    let (pose, reference, anchors, offsets) = match j {
-        Some((a, b, c, d)) => (Some(a), Some(b), Some(c), Some(d)),
-        None => (None, None, None, None),
-    };
-    generated::catenary_length_residual(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.reference_tension_n,
-        &p.anchors_m,
-        &p.attachments_m,
-        &p.com_offset_m,
-        p.platform_weight_n,
-        p.cable_weight_n_per_m,
-        &p.length_offsets_m,
-        &p.encoder_lengths_m,
-        EPSILON,
-        pose,
-        reference,
-        anchors,
-        offsets,
-    )
-}
-
-fn attachment_height(p: &Point, j: Option<&mut (M<4, 6>, M<4, 2>, M<4, 12>)>) -> SVector<f64, 4> {
-    let (pose, reference, anchors) = match j {
-        Some((a, b, c)) => (Some(a), Some(b), Some(c)),
-        None => (None, None, None),
-    };
-    generated::attachment_height_residual(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.reference_tension_n,
-        &p.anchors_m,
-        &p.attachments_m,
-        &p.com_offset_m,
-        p.platform_weight_n,
-        p.cable_weight_n_per_m,
-        EPSILON,
-        pose,
-        reference,
-        anchors,
-    )
-}
-
-fn reference_tension(p: &Point, j: Option<&mut M<1, 2>>) -> SVector<f64, 1> {
-    generated::reference_tension_residual(&p.reference_tension_n, p.measured_tension_n, EPSILON, j)
-}
-
-fn pose_prior(p: &Point, j: Option<&mut M<6, 6>>) -> SVector<f64, 6> {
-    generated::pose_prior_residual(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.prior.position_m,
-        &p.prior.rotation_xyzw(),
-        EPSILON,
-        j,
-    )
-}
-
-fn rigid_length(p: &Point, j: Option<&mut (M<4, 6>, M<4, 12>, M<4, 4>)>) -> SVector<f64, 4> {
-    let (pose, anchors, offsets) = match j {
-        Some((a, b, c)) => (Some(a), Some(b), Some(c)),
-        None => (None, None, None),
-    };
-    generated::rigid_length_residual(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.anchors_m,
-        &p.attachments_m,
-        &p.length_offsets_m,
-        &p.encoder_lengths_m,
-        EPSILON,
-        pose,
-        anchors,
-        offsets,
-    )
-}
-
-fn geometry(p: &Point, j: Option<&mut (M<16, 6>, M<16, 2>, M<16, 12>, M<16, 3>)>) -> SVector<f64, 16> {
-    let (pose, reference, anchors, com) = match j {
-        Some((a, b, c, d)) => (Some(a), Some(b), Some(c), Some(d)),
-        None => (None, None, None, None),
-    };
-    generated::cable_geometry(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.reference_tension_n,
-        &p.anchors_m,
-        &p.attachments_m,
-        &p.com_offset_m,
-        p.platform_weight_n,
-        EPSILON,
-        pose,
-        reference,
-        anchors,
-        com,
-    )
-}
-
-/// Per slot the 2x1 Jacobians of `extended_cable`: span, `f_h`, `f_v`, compliance, radius.
-type ExtendedJacobians = [(M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>); 4];
-
-/// `extended_cable` of the four slots stacked: `[paid_out_0, drop_0, paid_out_1, ...]`.
-fn extended(p: &Point, mut j: Option<&mut ExtendedJacobians>) -> SVector<f64, 8> {
-    let mut value = SVector::<f64, 8>::zeros();
-    for s in 0..4 {
-        let (span, horizontal, vertical, compliance, radius) = match j.as_deref_mut() {
-            Some(j) => {
-                let (a, b, c, d, e) = &mut j[s];
-                (Some(a), Some(b), Some(c), Some(d), Some(e))
-            }
-            None => (None, None, None, None, None),
-        };
-        let cable = generated::extended_cable(
-            p.spans_m[s],
-            p.horizontal_tensions_n[s],
-            p.vertical_tensions_n[s],
-            p.cable_weight_n_per_m,
-            p.axial_compliance_per_mn,
-            p.pulley_radius_m,
-            EPSILON,
-            span,
-            horizontal,
-            vertical,
-            compliance,
-            radius,
-        );
-        value.fixed_rows_mut::<2>(2 * s).copy_from(&cable);
-    }
-    value
-}
-
-/// The per-slot Jacobians of [`extended`] as blocks of the stacked value: span, `f_h` and `f_v`
-/// (8x4, block diagonal), compliance and radius (8x1).
-fn extended_blocks(j: &ExtendedJacobians) -> Vec<DMatrix<f64>> {
-    let mut blocks = vec![DMatrix::zeros(8, 4), DMatrix::zeros(8, 4), DMatrix::zeros(8, 4)];
-    blocks.extend([DMatrix::zeros(8, 1), DMatrix::zeros(8, 1)]);
-    for (s, (span, horizontal, vertical, compliance, radius)) in j.iter().enumerate() {
-        for (b, d) in [span, horizontal, vertical].into_iter().enumerate() {
-            blocks[b].view_mut((2 * s, s), (2, 1)).copy_from(d);
-        }
-        blocks[3].view_mut((2 * s, 0), (2, 1)).copy_from(compliance);
-        blocks[4].view_mut((2 * s, 0), (2, 1)).copy_from(radius);
-    }
-    blocks
-}
-
-fn load_cell(p: &Point, j: Option<&mut (M<1, 2>, M<1, 1>, M<1, 1>)>) -> SVector<f64, 1> {
-    let (reference, bias, gain) = match j {
-        Some((a, b, c)) => (Some(a), Some(b), Some(c)),
-        None => (None, None, None),
-    };
-    generated::load_cell_residual(
-        &p.reference_tension_n,
-        p.load_cell_bias_n,
-        p.load_cell_gain_error,
-        p.measured_tension_n,
-        EPSILON,
-        reference,
-        bias,
-        gain,
-    )
 }
 
 /// Per group, the largest relative Jacobian difference, for the summary.
@@ -336,10 +133,6 @@ fn print_summary(since: SystemTime) {
         };
         println!("| `{name}` | {analytic:.1} | {numerical:.1} | {ratio:.1}x | {difference:.1e} | {met} |");
     }
-}
-
-fn dynamic<const R: usize, const C: usize>(m: &M<R, C>) -> DMatrix<f64> {
-    DMatrix::from_column_slice(R, C, m.as_slice())
 }
 
 /// A differentiated argument block, in the column order of the generated Jacobians.
@@ -484,9 +277,9 @@ fn jacobians(c: &mut Criterion) {
         |j| vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2), dynamic(&j.3)],
     );
     let per_cable: [Block; 5] = [
-        Additive(|q| q.spans_m.as_mut_slice()),
-        Additive(|q| q.horizontal_tensions_n.as_mut_slice()),
-        Additive(|q| q.vertical_tensions_n.as_mut_slice()),
+        Additive(|q| q.cable_spans_m.as_mut_slice()),
+        Additive(|q| q.cable_horizontal_tensions_n.as_mut_slice()),
+        Additive(|q| q.cable_vertical_tensions_n.as_mut_slice()),
         Additive(|q| std::slice::from_mut(&mut q.axial_compliance_per_mn)),
         Additive(|q| std::slice::from_mut(&mut q.pulley_radius_m)),
     ];

@@ -16,11 +16,16 @@
 //!   a massless cable's pulley exit in closed form.
 //! * The massless limit `g_c = 0`.
 
-use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, UnitQuaternion, Vector2, Vector3, Vector4, Vector6};
+use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, SVector, UnitQuaternion, Vector2, Vector3, Vector4, Vector6};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sagcal::generated;
 use sagcal::model::{Catenary, PlatformPose, Robot};
+
+#[path = "common/generated_calls.rs"]
+mod calls;
+
+use calls::{dynamic, extended_blocks, Point, M};
 
 /// SymForce's default epsilon (`sym::kDefaultEpsilon`).
 const EPSILON: f64 = 10.0 * f64::EPSILON;
@@ -82,33 +87,6 @@ fn slot_order(robot: &Robot) -> [usize; 4] {
         }
     }
     order
-}
-
-/// All arguments of the generated functions.
-#[derive(Clone, Debug)]
-struct Point {
-    pose: PlatformPose,
-    reference_tension_n: Vector2<f64>,
-    anchors_m: Matrix3x4<f64>,
-    attachments_m: Matrix3x4<f64>,
-    com_offset_m: Vector3<f64>,
-    platform_weight_n: f64,
-    cable_weight_n_per_m: f64,
-    length_offsets_m: Vector4<f64>,
-    encoder_lengths_m: Vector4<f64>,
-    prior: PlatformPose,
-    measured_tension_n: f64,
-    /// Per slot the scalar arguments of `extended_cable`: span (m), `f_h`, `f_v` (N); taken
-    /// from `cable_geometry` at this point by [`physical_points`].
-    cable_spans_m: Vector4<f64>,
-    cable_horizontal_tensions_n: Vector4<f64>,
-    cable_vertical_tensions_n: Vector4<f64>,
-    /// `1e6 / EA`, 1/MN, shared by the four cables.
-    axial_compliance_per_mn: f64,
-    /// Pulley radius, metres, shared by the four pulleys.
-    pulley_radius_m: f64,
-    load_cell_bias_n: f64,
-    load_cell_gain_error: f64,
 }
 
 fn random_rotation(rng: &mut ChaCha8Rng, max_angle_deg: f64) -> UnitQuaternion<f64> {
@@ -279,149 +257,60 @@ struct Function {
     evaluate: fn(&Point) -> Evaluation,
 }
 
-fn dynamic<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> DMatrix<f64> {
-    DMatrix::from_column_slice(R, C, m.as_slice())
-}
-
 /// Every Jacobian starts as NaN: the generated code must overwrite every entry.
-fn nan<const R: usize, const C: usize>() -> SMatrix<f64, R, C> {
+fn nan<const R: usize, const C: usize>() -> M<R, C> {
     SMatrix::from_element(f64::NAN)
 }
 
+fn column<const R: usize>(value: SVector<f64, R>) -> DVector<f64> {
+    DVector::from_column_slice(value.as_slice())
+}
+
 fn tensions(p: &Point) -> Evaluation {
-    let (mut pose, mut reference, mut anchors) = (nan::<8, 6>(), nan::<8, 2>(), nan::<8, 12>());
-    let value = generated::cable_tensions_from_reference(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.reference_tension_n,
-        &p.anchors_m,
-        &p.attachments_m,
-        &p.com_offset_m,
-        p.platform_weight_n,
-        EPSILON,
-        Some(&mut pose),
-        Some(&mut reference),
-        Some(&mut anchors),
-    );
-    let value = DVector::from_column_slice(value.as_slice());
-    (value, vec![dynamic(&pose), dynamic(&reference), dynamic(&anchors)])
+    let mut j = (nan(), nan(), nan());
+    let value = calls::tensions(p, Some(&mut j));
+    (column(value), vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)])
 }
 
 fn catenary_length(p: &Point) -> Evaluation {
-    let (mut pose, mut reference, mut anchors, mut offsets) =
-        (nan::<4, 6>(), nan::<4, 2>(), nan::<4, 12>(), nan::<4, 4>());
-    let value = generated::catenary_length_residual(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.reference_tension_n,
-        &p.anchors_m,
-        &p.attachments_m,
-        &p.com_offset_m,
-        p.platform_weight_n,
-        p.cable_weight_n_per_m,
-        &p.length_offsets_m,
-        &p.encoder_lengths_m,
-        EPSILON,
-        Some(&mut pose),
-        Some(&mut reference),
-        Some(&mut anchors),
-        Some(&mut offsets),
-    );
-    let value = DVector::from_column_slice(value.as_slice());
+    let mut j = (nan(), nan(), nan(), nan());
+    let value = calls::catenary_length(p, Some(&mut j));
     (
-        value,
-        vec![
-            dynamic(&pose),
-            dynamic(&reference),
-            dynamic(&anchors),
-            dynamic(&offsets),
-        ],
+        column(value),
+        vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2), dynamic(&j.3)],
     )
 }
 
 fn attachment_height(p: &Point) -> Evaluation {
-    let (mut pose, mut reference, mut anchors) = (nan::<4, 6>(), nan::<4, 2>(), nan::<4, 12>());
-    let value = generated::attachment_height_residual(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.reference_tension_n,
-        &p.anchors_m,
-        &p.attachments_m,
-        &p.com_offset_m,
-        p.platform_weight_n,
-        p.cable_weight_n_per_m,
-        EPSILON,
-        Some(&mut pose),
-        Some(&mut reference),
-        Some(&mut anchors),
-    );
-    let value = DVector::from_column_slice(value.as_slice());
-    (value, vec![dynamic(&pose), dynamic(&reference), dynamic(&anchors)])
+    let mut j = (nan(), nan(), nan());
+    let value = calls::attachment_height(p, Some(&mut j));
+    (column(value), vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)])
 }
 
 fn reference_tension(p: &Point) -> Evaluation {
-    let mut reference = nan::<1, 2>();
-    let value = generated::reference_tension_residual(
-        &p.reference_tension_n,
-        p.measured_tension_n,
-        EPSILON,
-        Some(&mut reference),
-    );
-    (DVector::from_column_slice(value.as_slice()), vec![dynamic(&reference)])
+    let mut j = nan();
+    let value = calls::reference_tension(p, Some(&mut j));
+    (column(value), vec![dynamic(&j)])
 }
 
 fn pose_prior(p: &Point) -> Evaluation {
-    let mut pose = nan::<6, 6>();
-    let value = generated::pose_prior_residual(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.prior.position_m,
-        &p.prior.rotation_xyzw(),
-        EPSILON,
-        Some(&mut pose),
-    );
-    (DVector::from_column_slice(value.as_slice()), vec![dynamic(&pose)])
+    let mut j = nan();
+    let value = calls::pose_prior(p, Some(&mut j));
+    (column(value), vec![dynamic(&j)])
 }
 
 fn rigid_length(p: &Point) -> Evaluation {
-    let (mut pose, mut anchors, mut offsets) = (nan::<4, 6>(), nan::<4, 12>(), nan::<4, 4>());
-    let value = generated::rigid_length_residual(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.anchors_m,
-        &p.attachments_m,
-        &p.length_offsets_m,
-        &p.encoder_lengths_m,
-        EPSILON,
-        Some(&mut pose),
-        Some(&mut anchors),
-        Some(&mut offsets),
-    );
-    let value = DVector::from_column_slice(value.as_slice());
-    (value, vec![dynamic(&pose), dynamic(&anchors), dynamic(&offsets)])
+    let mut j = (nan(), nan(), nan());
+    let value = calls::rigid_length(p, Some(&mut j));
+    (column(value), vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)])
 }
 
 fn geometry(p: &Point) -> Evaluation {
-    let (mut pose, mut reference, mut anchors, mut com) =
-        (nan::<16, 6>(), nan::<16, 2>(), nan::<16, 12>(), nan::<16, 3>());
-    let value = generated::cable_geometry(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.reference_tension_n,
-        &p.anchors_m,
-        &p.attachments_m,
-        &p.com_offset_m,
-        p.platform_weight_n,
-        EPSILON,
-        Some(&mut pose),
-        Some(&mut reference),
-        Some(&mut anchors),
-        Some(&mut com),
-    );
-    let value = DVector::from_column_slice(value.as_slice());
+    let mut j = (nan(), nan(), nan(), nan());
+    let value = calls::geometry(p, Some(&mut j));
     (
-        value,
-        vec![dynamic(&pose), dynamic(&reference), dynamic(&anchors), dynamic(&com)],
+        column(value),
+        vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2), dynamic(&j.3)],
     )
 }
 
@@ -430,62 +319,15 @@ fn geometry(p: &Point) -> Evaluation {
 /// The per-cable blocks (span, `f_h`, `f_v`) are block diagonal, 8x4, from the 2x1 Jacobians of
 /// each slot; the compliance and radius are shared, 8x1.
 fn extended(p: &Point) -> Evaluation {
-    let mut value = DVector::zeros(8);
-    let mut jacobians = vec![
-        DMatrix::zeros(8, 4),
-        DMatrix::zeros(8, 4),
-        DMatrix::zeros(8, 4),
-        DMatrix::zeros(8, 1),
-        DMatrix::zeros(8, 1),
-    ];
-    for j in 0..4 {
-        let (mut span, mut horizontal, mut vertical, mut compliance, mut radius) = (
-            nan::<2, 1>(),
-            nan::<2, 1>(),
-            nan::<2, 1>(),
-            nan::<2, 1>(),
-            nan::<2, 1>(),
-        );
-        let cable = generated::extended_cable(
-            p.cable_spans_m[j],
-            p.cable_horizontal_tensions_n[j],
-            p.cable_vertical_tensions_n[j],
-            p.cable_weight_n_per_m,
-            p.axial_compliance_per_mn,
-            p.pulley_radius_m,
-            EPSILON,
-            Some(&mut span),
-            Some(&mut horizontal),
-            Some(&mut vertical),
-            Some(&mut compliance),
-            Some(&mut radius),
-        );
-        value.rows_mut(2 * j, 2).copy_from(&cable);
-        for (b, derivative) in [span, horizontal, vertical].iter().enumerate() {
-            jacobians[b].view_mut((2 * j, j), (2, 1)).copy_from(derivative);
-        }
-        jacobians[3].view_mut((2 * j, 0), (2, 1)).copy_from(&compliance);
-        jacobians[4].view_mut((2 * j, 0), (2, 1)).copy_from(&radius);
-    }
-    (value, jacobians)
+    let mut j = [(); 4].map(|_| (nan(), nan(), nan(), nan(), nan()));
+    let value = calls::extended(p, Some(&mut j));
+    (column(value), extended_blocks(&j))
 }
 
 fn load_cell(p: &Point) -> Evaluation {
-    let (mut reference, mut bias, mut gain) = (nan::<1, 2>(), nan::<1, 1>(), nan::<1, 1>());
-    let value = generated::load_cell_residual(
-        &p.reference_tension_n,
-        p.load_cell_bias_n,
-        p.load_cell_gain_error,
-        p.measured_tension_n,
-        EPSILON,
-        Some(&mut reference),
-        Some(&mut bias),
-        Some(&mut gain),
-    );
-    (
-        DVector::from_column_slice(value.as_slice()),
-        vec![dynamic(&reference), dynamic(&bias), dynamic(&gain)],
-    )
+    let mut j = (nan(), nan(), nan());
+    let value = calls::load_cell(p, Some(&mut j));
+    (column(value), vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)])
 }
 
 const FUNCTIONS: [Function; 9] = [
@@ -1103,23 +945,7 @@ fn catenary_residual_of_a_heavy_cable_is_longer_than_rigid() {
 #[test]
 fn outputs_do_not_depend_on_the_requested_jacobians() {
     let p = physical_points(&large(), 61, 1).remove(0);
-    let without = generated::catenary_length_residual(
-        &p.pose.position_m,
-        &p.pose.rotation_xyzw(),
-        &p.reference_tension_n,
-        &p.anchors_m,
-        &p.attachments_m,
-        &p.com_offset_m,
-        p.platform_weight_n,
-        p.cable_weight_n_per_m,
-        &p.length_offsets_m,
-        &p.encoder_lengths_m,
-        EPSILON,
-        None,
-        None,
-        None,
-        None,
-    );
+    let without = calls::catenary_length(&p, None);
     assert_eq!(DVector::from_column_slice(without.as_slice()), catenary_length(&p).0);
 }
 
