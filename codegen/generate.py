@@ -455,16 +455,28 @@ def printed_expressions(codegen: Codegen) -> list[str]:
     return codes
 
 
-def operation_count_table(codegens: dict[str, Codegen]) -> str:
-    """Markdown table: SymForce's op count and the printed operations before -> after the rewrite."""
-    header = "| function | SymForce ops | " + " | ".join(OPERATION_COLUMNS) + " |"
-    rule = "| --- | ---: | " + " | ".join("---:" for _ in OPERATION_COLUMNS) + " |"
+def value_operation_count(spec: FunctionSpec) -> int:
+    """SymForce's op count of the function's value alone (no Jacobians), for the ratio to the full count."""
+    inputs = symbolic_inputs(spec)
+    outputs = Values()
+    with forward_mode.recording() as tape:
+        outputs[spec.output_name] = tape.expand(spec.symbolic(*inputs.values()))  # type: ignore[operator]
+    return Codegen(inputs=inputs, outputs=outputs, config=SagcalRustConfig(), name=spec.name).total_ops()
+
+
+def operation_count_table(codegens: dict[str, Codegen], value_ops: dict[str, int]) -> str:
+    """Markdown table: SymForce's op counts (value and Jacobians; value alone) and the printed operations.
+
+    The printed operations are counted before -> after sagcal's printer rewrite.
+    """
+    header = "| function | SymForce ops | value alone | " + " | ".join(OPERATION_COLUMNS) + " |"
+    rule = "| --- | ---: | ---: | " + " | ".join("---:" for _ in OPERATION_COLUMNS) + " |"
     rows = [header, rule]
     for name, codegen in codegens.items():
         new = count_operations(printed_expressions(codegen))
         old = count_operations(codegen.config.stock_printed)
         cells = [f"{old[k]} -> {new[k]}" if old[k] != new[k] else f"{new[k]}" for k in OPERATION_COLUMNS]
-        rows.append(f"| `{name}` | {codegen.total_ops()} | " + " | ".join(cells) + " |")
+        rows.append(f"| `{name}` | {codegen.total_ops()} | {value_ops[name]} | " + " | ".join(cells) + " |")
     return "\n".join(rows) + "\n"
 
 
@@ -537,7 +549,8 @@ def generate_all() -> tuple[dict[str, str], str]:
     codegens = {spec.name: build_codegen(spec) for spec in FUNCTIONS}
     files = {f"{name}.rs": render_function(codegen) for name, codegen in codegens.items()}
     files["mod.rs"] = render_mod(list(codegens))
-    return files, render_readme(operation_count_table(codegens))
+    value_ops = {spec.name: value_operation_count(spec) for spec in FUNCTIONS}
+    return files, render_readme(operation_count_table(codegens, value_ops))
 
 
 # --------------------------------------------------------------------------------------------------
