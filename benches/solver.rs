@@ -1,5 +1,5 @@
 //! Solver scaling: the full catenary calibration solve of
-//! [`sagcal::benchmark::BenchmarkProblem`] (same data seed, same kind of
+//! [`sagcal::experiments::benchmark::BenchmarkProblem`] (same data seed, same kind of
 //! initial guess, the stopping rule of `BenchmarkProblem::stopping`) at 9,
 //! 35, 1 000 and 10 000 poses, on one thread.
 //!
@@ -16,7 +16,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion};
-use sagcal::benchmark::BenchmarkProblem;
+use sagcal::experiments::benchmark::BenchmarkProblem;
 use sagcal::solver::optimize;
 
 /// Pose counts of the issue.

@@ -25,22 +25,19 @@
 
 #![warn(missing_docs)]
 
-pub mod benchmark;
 pub mod calib;
 pub mod diagnose;
 pub mod error;
-pub mod experiment;
+pub mod experiments;
 #[path = "../generated/mod.rs"]
 #[allow(missing_docs, clippy::all)]
 pub mod generated;
 pub mod graph;
-pub mod hidden_effects;
 pub mod io;
 pub mod model;
 pub mod plot;
-pub mod plot_residuals;
 pub mod sim;
 pub mod solver;
-pub mod verify;
+pub mod stats;
 
 pub use error::{Error, Result};

@@ -104,7 +104,7 @@ fn paper_noise_from_the_paper_perturbation() {
 fn chi_square_quantile_matches_tables() {
     // 99.9 % points of chi-square (Abramowitz & Stegun, Table 26.8).
     for (k, table) in [(10, 29.588), (30, 59.703), (100, 149.449)] {
-        let q = sagcal::calib::chi_square_quantile_999(k);
+        let q = sagcal::stats::chi_square_quantile_999(k);
         assert!((q - table).abs() / table < 0.01, "k = {k}: {q} vs {table}");
     }
 }

@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use sagcal::hidden_effects::{case_seed, identifiability, run_case, HiddenEffectOptions};
+use sagcal::experiments::hidden_effects::{case_seed, identifiability, run_case, HiddenEffectOptions};
 use sagcal::model::effects::{EffectKind, Effects};
 use sagcal::model::Robot;
 

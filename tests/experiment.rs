@@ -3,7 +3,7 @@
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sagcal::calib::CableModel;
-use sagcal::experiment::{pose_pool, run_protocol, Protocol, Source};
+use sagcal::experiments::table2::{pose_pool, run_protocol, Protocol, Source};
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};

@@ -1,5 +1,5 @@
 //! The apex-solver peer (issue 5): apex-solver 1.5's sparse Levenberg-Marquardt
-//! on the benchmark problem of [`sagcal::benchmark`].
+//! on the benchmark problem of [`sagcal::experiments::benchmark`].
 //!
 //! **Problem.** Built from [`BenchmarkProblem::graph`], factor by factor: its
 //! factor list, variable connectivity and per-row sigmas are read from the
@@ -81,7 +81,7 @@ use apex_solver::{ManifoldType, NoiseModel};
 use faer::mat::MatMut;
 use nalgebra::{Quaternion, SMatrix, UnitQuaternion, Vector2, Vector3, Vector4};
 
-use sagcal::benchmark::BenchmarkProblem;
+use sagcal::experiments::benchmark::BenchmarkProblem;
 use sagcal::calib::factors::{SlotOrder, EPSILON};
 use sagcal::calib::CalibrationGraph;
 use sagcal::generated;

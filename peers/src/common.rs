@@ -1,7 +1,7 @@
 //! What every peer returns, and the shared stopping rule.
 
 use nalgebra::DVector;
-use sagcal::benchmark::BenchmarkProblem;
+use sagcal::experiments::benchmark::BenchmarkProblem;
 use sagcal::calib::CalibrationGraph;
 use sagcal::graph::{Values, VariableValue};
 use sagcal::model::pose::PlatformPose;

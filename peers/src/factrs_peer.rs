@@ -1,4 +1,4 @@
-//! The factrs peer (issue 5): the benchmark problem of [`sagcal::benchmark`]
+//! The factrs peer (issue 5): the benchmark problem of [`sagcal::experiments::benchmark`]
 //! solved by factrs 0.3 (<https://github.com/rpl-cmu/factrs>), whose
 //! Jacobians come from forward-mode dual numbers (`num_dual::DualVec`)
 //! instead of sagcal's SymForce-generated analytic derivatives.
@@ -102,7 +102,7 @@ use factrs::optimizers::{BaseOptParams, LevenMarquardt, LevenParams, OptError, O
 use factrs::residuals::{Residual1, Residual2, Residual4, Residual5};
 use factrs::variables::{VectorVar, VectorVar2, VectorVar3, VectorVar4, SO3};
 
-use sagcal::benchmark::BenchmarkProblem;
+use sagcal::experiments::benchmark::BenchmarkProblem;
 use sagcal::calib::{CableModel, OrientationPrior};
 use sagcal::graph::RobustKernel;
 use sagcal::io::measurements::PoseMeasurement;

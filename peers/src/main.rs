@@ -23,7 +23,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Parser;
-use sagcal::benchmark::BenchmarkProblem;
+use sagcal::experiments::benchmark::BenchmarkProblem;
 use sagcal::solver::optimize;
 use serde::Serialize;
 

@@ -48,13 +48,14 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::graph::{whitened_squared_norm, FactorGraph, RobustKernel, Values, VariableId, VariableValue};
-use crate::io::measurements::PoseMeasurement;
 use crate::model::effects::{EffectKind, Effects};
+use crate::model::measurement::PoseMeasurement;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::SensorNoise;
 use crate::model::statics::{self, CableTension, Equilibrium, StaticsOptions};
 use crate::solver::{marginal_covariance, optimize, Covariance, LmParams, SolveSummary, UnobservableDirection};
+use crate::stats::chi_square_quantile_999;
 
 use effect_factors::{EffectVariables, ExtendedHeightFactor, ExtendedLengthFactor, LoadCellFactor};
 use factors::{
@@ -739,23 +740,6 @@ fn orientation_check(result: &CalibrationResult, measurements: &[PoseMeasurement
         limit: chi_square_quantile_999(components),
         mean_angle_deg: angles.iter().sum::<f64>() / angles.len().max(1) as f64 * 180.0 / std::f64::consts::PI,
     }
-}
-
-/// The 99.9 % quantile of chi-square with `k` degrees of freedom by the
-/// Wilson-Hilferty cube-root normal approximation
-/// `k (1 - 2/(9k) + z sqrt(2/(9k)))^3`, `z = 3.0902` (relative error below
-/// 1 % for k >= 3; Johnson, Kotz & Balakrishnan, *Continuous Univariate
-/// Distributions*, vol. 1, 1994, eq. 18.24).
-pub fn chi_square_quantile_999(k: usize) -> f64 {
-    chi_square_quantile(k, 3.0902)
-}
-
-/// The quantile of chi-square with `k` degrees of freedom at the standard
-/// normal quantile `z` (Wilson-Hilferty, see [`chi_square_quantile_999`]).
-pub fn chi_square_quantile(k: usize, z: f64) -> f64 {
-    let k = k.max(1) as f64;
-    let c = 2.0 / (9.0 * k);
-    k * (1.0 - c + z * c.sqrt()).max(0.0).powi(3)
 }
 
 impl CalibrationOptions {

@@ -7,7 +7,7 @@ use sagcal::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::model::effects::EffectKind;
 use sagcal::model::Robot;
-use sagcal::plot_residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
+use sagcal::plot::residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
 
 use super::output::{print_json, Table};
 use super::DiagnoseArgs;

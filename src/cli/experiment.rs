@@ -2,7 +2,7 @@
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sagcal::calib::{CableModel, OrientationPrior};
-use sagcal::experiment::{pose_pool, run_protocol, PoseCountResult, Protocol, Source};
+use sagcal::experiments::table2::{pose_pool, run_protocol, PoseCountResult, Protocol, Source};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;

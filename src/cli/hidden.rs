@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use sagcal::hidden_effects::{
+use sagcal::experiments::hidden_effects::{
     effect_ranges, identifiability, mean_reference_tension_n, mid_range_effects, run_sweep, smallest_effects,
     EffectRange, HiddenCase, HiddenEffectOptions, Identifiability,
 };

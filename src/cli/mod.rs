@@ -82,10 +82,10 @@ fn parse_pose_counts(text: &str) -> Result<Vec<usize>, String> {
         .collect()
 }
 
-fn parse_source(text: &str) -> Result<sagcal::experiment::Source, String> {
+fn parse_source(text: &str) -> Result<sagcal::experiments::table2::Source, String> {
     match text {
-        "log" => Ok(sagcal::experiment::Source::Log),
-        "model" => Ok(sagcal::experiment::Source::Model),
+        "log" => Ok(sagcal::experiments::table2::Source::Log),
+        "model" => Ok(sagcal::experiments::table2::Source::Model),
         other => Err(format!("unknown source `{other}` (log, model)")),
     }
 }
@@ -115,7 +115,7 @@ struct Table2Args {
     noise: sagcal::model::sensors::NoisePreset,
     /// `log`: the log's own lengths and tensions; `model`: the model's equilibria at the logged poses.
     #[arg(long, default_value = "log", value_parser = parse_source)]
-    source: sagcal::experiment::Source,
+    source: sagcal::experiments::table2::Source,
     /// Anchor perturbation of the initial guess, m (default 10, 1 for light robots).
     #[arg(long)]
     anchor_perturbation_m: Option<f64>,

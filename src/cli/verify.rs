@@ -1,9 +1,9 @@
 //! `sagcal verify`: the model against measured data.
 
+use sagcal::diagnose::verify::{verify, Closure, VerifyReport};
 use sagcal::io::recurdyn::{read_recurdyn, LoadOptions};
 use sagcal::model::statics::StaticsOptions;
 use sagcal::model::Robot;
-use sagcal::verify::{verify, Closure, VerifyReport};
 
 use super::output::{print_json, Table};
 use super::{ClosureArg, VerifyArgs};

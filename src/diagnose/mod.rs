@@ -28,6 +28,8 @@
 //! cell, localiser) are collected. `cv_rms` is their root mean square (about 1
 //! when the model and the stated noise are right).
 
+pub mod verify;
+
 use nalgebra::Vector3;
 use serde::Serialize;
 
@@ -37,11 +39,12 @@ use crate::calib::{
 };
 use crate::error::{Error, Result};
 use crate::graph::{whitened_squared_norm, FactorGraph, VariableValue};
-use crate::io::measurements::PoseMeasurement;
 use crate::model::effects::EffectKind;
+use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::statics::{self, CableTension};
 use crate::solver::optimize;
+use crate::stats::{self, chi_square_quantile_001, chi_square_quantile_999, correlation};
 
 /// The factor types that are measurements (the others are model constraints).
 pub const MEASUREMENT_KINDS: [&str; 3] = ["catenary_length", "reference_tension", "pose_prior"];
@@ -264,12 +267,6 @@ struct PoseSample {
 
 const CABLE_DRIVER_COUNT: usize = 7;
 
-/// The 0.1 % quantile of chi-square with `k` degrees of freedom (Wilson-Hilferty,
-/// as [`crate::calib::chi_square_quantile_999`]).
-pub fn chi_square_quantile_001(k: usize) -> f64 {
-    crate::calib::chi_square_quantile(k, -3.0902)
-}
-
 /// The per-cable drivers, with units.
 pub const DRIVERS: [&str; CABLE_DRIVER_COUNT] = [
     "tension at the pulley (N)",
@@ -351,7 +348,7 @@ pub fn diagnose(
     } else {
         1.0
     };
-    let bic = |chi: f64, added: usize| chi / variance_factor + (unknowns + added) as f64 * (n as f64).ln();
+    let bic = |chi: f64, added: usize| stats::bic(chi, variance_factor, unknowns + added, n);
     let baseline_bic = bic(base_chi, 0);
     let factor_tests = factor_tests(&base_graph.graph, n, dof);
     let base_samples = samples(&baseline, &used, &base_graph)?;
@@ -504,7 +501,7 @@ pub fn diagnose(
         measurement_components: n,
         baseline_chi_square: base_chi,
         baseline_dof: dof,
-        baseline_consistent: base_chi <= crate::calib::chi_square_quantile_999(dof),
+        baseline_consistent: base_chi <= chi_square_quantile_999(dof),
         variance_factor,
         factor_tests,
         drivers,
@@ -604,7 +601,7 @@ fn factor_tests(graph: &FactorGraph, components: usize, dof: usize) -> Vec<Facto
                 }
             }
             let expected = count as f64 * dof as f64 / components.max(1) as f64;
-            let limit = crate::calib::chi_square_quantile_999(expected.round().max(1.0) as usize);
+            let limit = chi_square_quantile_999(expected.round().max(1.0) as usize);
             FactorTest {
                 kind: kind.to_string(),
                 components: count,
@@ -714,29 +711,6 @@ fn series_of(samples: &[PoseSample], residual: &str, driver: &str) -> Vec<(f64, 
         }
     }
     points
-}
-
-/// Pearson correlation and its t statistic.
-fn correlation(points: &[(f64, f64)]) -> (f64, f64) {
-    let points: Vec<&(f64, f64)> = points.iter().filter(|(x, y)| x.is_finite() && y.is_finite()).collect();
-    let n = points.len() as f64;
-    if n < 3.0 {
-        return (f64::NAN, f64::NAN);
-    }
-    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
-    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
-    for (x, y) in points.iter().map(|p| (p.0 - mx, p.1 - my)) {
-        sxy += x * y;
-        sxx += x * x;
-        syy += y * y;
-    }
-    if sxx <= 0.0 || syy <= 0.0 {
-        return (0.0, 0.0);
-    }
-    let r = (sxy / (sxx * syy).sqrt()).clamp(-1.0, 1.0);
-    let t = r * ((n - 2.0) / (1.0 - r * r).max(1e-300)).sqrt();
-    (r, t)
 }
 
 fn driver_tests(samples: &[PoseSample]) -> Vec<DriverTest> {
@@ -860,26 +834,4 @@ fn global_ids(built: &CalibrationGraph) -> Vec<crate::graph::VariableId> {
         ids.extend(EffectKind::ALL.map(|k| e.of(k)));
     }
     ids
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn correlation_matches_a_closed_form() {
-        // y = 2x + 1 exactly: r = 1; y = x^2 on a symmetric grid: r = 0.
-        let line: Vec<(f64, f64)> = (0..10).map(|k| (k as f64, 2.0 * k as f64 + 1.0)).collect();
-        let (r, _) = correlation(&line);
-        assert!((r - 1.0).abs() < 1e-12);
-        let parabola: Vec<(f64, f64)> = (-5..=5).map(|k| (k as f64, (k * k) as f64)).collect();
-        assert!(correlation(&parabola).0.abs() < 1e-12);
-        // Deviations (-1.5, -0.5, 0.5, 1.5) and (-1.5, 0.5, -0.5, 1.5): sxy = 4, sxx = syy = 5, r = 0.8.
-        let x = [1.0, 2.0, 3.0, 4.0];
-        let y = [1.0, 3.0, 2.0, 4.0];
-        let points: Vec<(f64, f64)> = x.iter().zip(y).map(|(a, b)| (*a, b)).collect();
-        let (r, t) = correlation(&points);
-        assert!((r - 0.8).abs() < 1e-12, "{r}");
-        assert!((t - 0.8 * (2.0f64 / 0.36).sqrt()).abs() < 1e-12);
-    }
 }

@@ -55,11 +55,12 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::io::atomic::write_atomically;
 use crate::io::recurdyn::{looks_like_recurdyn, read_recurdyn, LoadOptions, RecurDynRow, RejectedRow};
+pub use crate::model::measurement::PoseMeasurement;
 
 /// The header of a sagcal measurement file, in column order.
 pub const MEASUREMENT_HEADER: [&str; 11] = [
@@ -86,27 +87,6 @@ const N_CABLES: usize = 4;
 const RECURDYN_HEADER: &str = "x,y,z,pitch,roll,yaw,L1,L2,L3,L4,fc1,fz1,fh1,fc2,fz2,fh2,fc3,fz3,fh3,fc4,fz4,fh4,";
 /// At most this many rejection reasons are quoted when every row is rejected.
 const MAX_QUOTED_REASONS: usize = 3;
-
-/// One static pose: localiser pose, encoder readings and load-cell tension.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct PoseMeasurement {
-    /// 1-based line in the file it was read from (comments and blank lines
-    /// counted, the header of a comment-free file is line 1); 0 for in-memory data.
-    pub line: usize,
-    /// Localiser position of the platform frame origin in the world frame, metres.
-    pub position_m: [f64; 3],
-    /// Roll angle (rotation about x, applied first), degrees.
-    pub roll_deg: f64,
-    /// Pitch angle (rotation about y), degrees.
-    pub pitch_deg: f64,
-    /// Yaw angle (rotation about z, applied last), degrees: `R = Rz(yaw) Ry(pitch) Rx(roll)`.
-    pub yaw_deg: f64,
-    /// Encoder readings of cables 1..4, metres: true cable length plus an
-    /// unknown per-cable offset (any finite value).
-    pub encoder_lengths_m: [f64; 4],
-    /// Load-cell tension of the reference cable at the platform attachment, newtons (positive).
-    pub reference_tension_n: f64,
-}
 
 /// The format a measurement file was read from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]

@@ -2,6 +2,7 @@
 
 pub mod catenary;
 pub mod effects;
+pub mod measurement;
 pub mod pose;
 pub mod robot;
 pub mod sensors;
@@ -9,5 +10,6 @@ pub mod statics;
 
 pub use catenary::Catenary;
 pub use effects::Effects;
+pub use measurement::PoseMeasurement;
 pub use pose::PlatformPose;
 pub use robot::{Robot, CABLE_COUNT};

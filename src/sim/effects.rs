@@ -16,8 +16,8 @@ use nalgebra::Vector3;
 use rand::Rng;
 
 use crate::error::{Error, Result};
-use crate::io::measurements::PoseMeasurement;
 use crate::model::effects::Effects;
+use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::Robot;
 use crate::model::sensors::SensorNoise;
 use crate::model::statics::Equilibrium;

@@ -20,7 +20,7 @@ use rand_distr::{Distribution, StandardNormal};
 
 use crate::calib::{build_graph, warm_start, CableModel, CalibrationGraph, CalibrationOptions, OrientationPrior};
 use crate::error::{Error, Result};
-use crate::io::measurements::PoseMeasurement;
+use crate::model::measurement::PoseMeasurement;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::NoisePreset;

@@ -32,7 +32,7 @@
 //! is undefined (fewer than two finite points, or all driver values equal).
 //!
 //! ```
-//! use sagcal::plot_residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
+//! use sagcal::plot::residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
 //! let before: Vec<(f64, f64)> = (0..50).map(|i| (i as f64, 0.1 * i as f64 - 2.5)).collect();
 //! let after: Vec<(f64, f64)> = (0..50).map(|i| (i as f64, 0.0)).collect();
 //! let plot = ResidualPlot {
@@ -49,7 +49,7 @@
 //! assert_eq!(svg.matches(r#"class="after""#).count(), 50);
 //! ```
 
-use crate::plot::{esc, halo_text, n2, shorten, text_w};
+use super::svg::{esc, halo_text, n2, shorten, text_w, C_FRAME, C_GRID, C_MUTED, C_TEXT, FONT};
 use std::fmt::Write as _;
 
 /// One series of points: `(driver value, residual)` pairs and a name.
@@ -94,12 +94,7 @@ const BELOW_PANEL: f64 = 50.0;
 const CAPTION_H: f64 = 30.0;
 const BINS: usize = 10;
 
-const FONT: &str = "DejaVu Sans, Helvetica, Arial, sans-serif";
-const C_TEXT: &str = "#222222";
-const C_MUTED: &str = "#666666";
-const C_GRID: &str = "#e6e6e6";
 const C_ZERO: &str = "#8c8c8c";
-const C_FRAME: &str = "#9a9a9a";
 const C_BEFORE: &str = "#d62728";
 const C_BEFORE_DARK: &str = "#8e1616";
 const C_AFTER: &str = "#1f5fbf";
@@ -663,7 +658,7 @@ fn render_panel(s: &mut String, plot: &ResidualPlot, p: &Prepared<'_>, xa: &Axis
 }
 
 // ---------------------------------------------------------------------------
-// Text helpers (copied from `crate::plot`, where they are private).
+// Text helpers.
 
 /// `x` with `sig` significant digits (no exponent for moderate values), or `n/a`.
 fn fmt_sig(x: f64, sig: i32) -> String {

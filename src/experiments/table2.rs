@@ -28,7 +28,7 @@ use crate::calib::{
     ParameterUncertainty,
 };
 use crate::error::{Error, Result};
-use crate::io::measurements::PoseMeasurement;
+use crate::model::measurement::PoseMeasurement;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::{NoisePreset, SensorNoise};

@@ -25,7 +25,7 @@
 //! `data-view` (`xy` or `xz`), `data-anchor` and `data-scale-px-per-m`.
 //!
 //! ```
-//! use sagcal::plot::{anchor_plot_svg, AnchorPlot, AnchorPlotEntry};
+//! use sagcal::plot::anchors::{anchor_plot_svg, AnchorPlot, AnchorPlotEntry};
 //! let plot = AnchorPlot {
 //!     title: "Anchor calibration".into(),
 //!     caption: "sagcal calibrate --seed 1".into(),
@@ -44,7 +44,8 @@
 //! ```
 
 use std::fmt::Write as _;
-use std::path::Path;
+
+use super::svg::{esc, halo_text, n2, shorten, text_w, C_FRAME, C_GRID, C_MUTED, C_TEXT, FONT};
 
 /// One anchor (pulley) to draw: its nominal, initial, estimated and true position.
 #[derive(Debug, Clone, PartialEq)]
@@ -97,12 +98,7 @@ const CAPTION_H: f64 = 30.0;
 const MAX_PLATFORM_DOTS: usize = 3000;
 const LINE_H: f64 = 14.0;
 
-const FONT: &str = "DejaVu Sans, Helvetica, Arial, sans-serif";
-const C_TEXT: &str = "#222222";
-const C_MUTED: &str = "#666666";
-const C_GRID: &str = "#e6e6e6";
 const C_AXIS: &str = "#c4c4c4";
-const C_FRAME: &str = "#9a9a9a";
 const C_INITIAL: &str = "#d62728";
 const C_ESTIMATE: &str = "#1f5fbf";
 const C_TRUTH: &str = "#1a9a2a";
@@ -171,14 +167,6 @@ pub fn anchor_plot_svg(plot: &AnchorPlot) -> String {
     );
     s.push_str("</svg>\n");
     s
-}
-
-/// Write `svg` to `path` atomically: the text goes to a temporary file in the
-/// same directory, which is then renamed over `path`.
-///
-/// Errors are [`crate::Error::Io`] naming `path`; on error no file is left behind.
-pub fn write_svg(path: &Path, svg: &str) -> crate::Result<()> {
-    crate::io::write_atomically(path, svg.as_bytes())
 }
 
 // ---------------------------------------------------------------------------
@@ -314,49 +302,6 @@ fn fmt_sig(x: f64, sig: i32) -> String {
     format!("{x:.dec$}")
 }
 
-/// A pixel coordinate for an attribute (always a finite number).
-pub(crate) fn n2(x: f64) -> String {
-    if x.is_finite() {
-        format!("{:.2}", x + 0.0)
-    } else {
-        "0".to_owned()
-    }
-}
-
-/// Escape text for XML content and attribute values; control characters become spaces.
-pub(crate) fn esc(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c if (c as u32) < 0x20 || c == '\u{7f}' => out.push(' '),
-            '\u{FFFE}' | '\u{FFFF}' => out.push('\u{FFFD}'),
-            c => out.push(c),
-        }
-    }
-    out
-}
-
-/// `s` cut to at most `max` characters (with an ellipsis).
-pub(crate) fn shorten(s: &str, max: usize) -> String {
-    if s.chars().count() <= max {
-        s.to_owned()
-    } else {
-        let mut t: String = s.chars().take(max.saturating_sub(1)).collect();
-        t.push('\u{2026}');
-        t
-    }
-}
-
-/// Rough width of `s` in pixels at `font` px (sans-serif average).
-pub(crate) fn text_w(s: &str, font: f64) -> f64 {
-    s.chars().count() as f64 * font * 0.6
-}
-
 // ---------------------------------------------------------------------------
 // Markers.
 
@@ -430,17 +375,6 @@ fn arrow(s: &mut String, x0: f64, y0: f64, x1: f64, y1: f64, color: &str) {
         n2(by + 4.5 * ny),
         n2(bx - 4.5 * nx),
         n2(by - 4.5 * ny)
-    );
-}
-
-/// Text with a white halo so it stays readable over grid and ellipses.
-pub(crate) fn halo_text(s: &mut String, x: f64, y: f64, anchor: &str, fill: &str, text: &str) {
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="{}" text-anchor="{anchor}" fill="{fill}" stroke="white" stroke-width="3" stroke-linejoin="round" paint-order="stroke">{}</text>"#,
-        n2(x),
-        n2(y),
-        esc(text)
     );
 }
 

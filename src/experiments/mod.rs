@@ -1,0 +1,13 @@
+//! Experiments that exercise the jobs end to end on simulated or logged data,
+//! each reproducible from a seed.
+//!
+//! - [`table2`]: the paper's Table II protocol with its Cramer-Rao bound
+//!   (`sagcal experiment table2`);
+//! - [`hidden_effects`]: effects hidden in simulated data, diagnosed blind and
+//!   scored (`sagcal experiment hidden-effects`);
+//! - [`benchmark`]: the reproducible calibration graph the solver benches and
+//!   the peer comparison share.
+
+pub mod benchmark;
+pub mod hidden_effects;
+pub mod table2;

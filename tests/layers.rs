@@ -1,0 +1,140 @@
+//! The crate's layering, checked on its source: data flows one way,
+//! io -> model -> graph -> solver -> calib / diagnose / localize / plan ->
+//! experiments -> cli, and no module imports a module above it.
+//!
+//! `io` converts files into `model` types, so `io` may name `model`; `model`
+//! names no file type and nothing above itself. Doc comments may link
+//! anywhere: only code lines are checked.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+/// Each top-level module of `src/` and the crate modules its code may name.
+const ALLOWED: &[(&str, &[&str])] = &[
+    ("error", &[]),
+    ("stats", &["error"]),
+    ("model", &["error", "stats", "generated"]),
+    ("io", &["error", "model"]),
+    ("sim", &["error", "stats", "generated", "model"]),
+    ("graph", &["error", "stats", "generated", "model"]),
+    ("solver", &["error", "stats", "model", "graph"]),
+    ("calib", &["error", "stats", "generated", "model", "graph", "solver"]),
+    (
+        "diagnose",
+        &["error", "stats", "generated", "model", "io", "graph", "solver", "calib"],
+    ),
+    (
+        "localize",
+        &["error", "stats", "generated", "model", "graph", "solver", "calib"],
+    ),
+    (
+        "plan",
+        &["error", "stats", "generated", "model", "graph", "solver", "calib"],
+    ),
+    (
+        "experiments",
+        &[
+            "error",
+            "stats",
+            "generated",
+            "model",
+            "io",
+            "sim",
+            "graph",
+            "solver",
+            "calib",
+            "diagnose",
+            "localize",
+            "plan",
+        ],
+    ),
+    ("plot", &["error", "io"]),
+];
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The crate modules named by `crate::<module>` in the code (not the comments) of `text`.
+fn named_modules(text: &str) -> BTreeSet<String> {
+    let mut named = BTreeSet::new();
+    for line in text.lines() {
+        let code = line.split("//").next().unwrap_or("");
+        let mut rest = code;
+        while let Some(at) = rest.find("crate::") {
+            let after = &rest[at + "crate::".len()..];
+            let name: String = after
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            // `crate::Error` and `crate::Result` are the error module's re-exports.
+            let name = if name == "Error" || name == "Result" {
+                "error".to_string()
+            } else {
+                name
+            };
+            if !name.is_empty() {
+                named.insert(name);
+            }
+            rest = after;
+        }
+    }
+    named
+}
+
+#[test]
+fn no_module_imports_a_higher_layer() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut violations = Vec::new();
+    let mut checked = 0;
+    for (module, allowed) in ALLOWED {
+        let mut files = Vec::new();
+        let dir = src.join(module);
+        if dir.is_dir() {
+            rust_files(&dir, &mut files);
+        }
+        let file = src.join(format!("{module}.rs"));
+        if file.is_file() {
+            files.push(file);
+        }
+        for file in files {
+            checked += 1;
+            let text = std::fs::read_to_string(&file).unwrap();
+            for name in named_modules(&text) {
+                if name != *module && !allowed.contains(&name.as_str()) {
+                    violations.push(format!("{} names crate::{name}", file.display()));
+                }
+            }
+        }
+    }
+    assert!(checked > 40, "only {checked} files found under {}", src.display());
+    assert!(violations.is_empty(), "layer violations:\n{}", violations.join("\n"));
+}
+
+#[test]
+fn every_top_level_module_has_a_layer() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let known: BTreeSet<&str> = ALLOWED.iter().map(|(m, _)| *m).chain(["cli", "lib", "main"]).collect();
+    for entry in std::fs::read_dir(&src).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        assert!(
+            known.contains(name.as_str()),
+            "src/{name} has no layer in tests/layers.rs: place it in ALLOWED"
+        );
+    }
+}
+
+#[test]
+fn the_checker_sees_an_upward_import() {
+    let text = "use crate::calib::calibrate; // crate::cli in a comment\n/// [`crate::plot`]\n";
+    let named = named_modules(text);
+    assert_eq!(named.into_iter().collect::<Vec<_>>(), vec!["calib".to_string()]);
+}
