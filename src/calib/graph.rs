@@ -1,0 +1,276 @@
+//! The variables and factors of one calibration problem, and the checks the
+//! measurements pass before a problem is built.
+
+use std::sync::Arc;
+
+use nalgebra::{DVector, Vector3};
+
+use super::effect_factors::{EffectVariables, ExtendedHeightFactor, ExtendedLengthFactor, LoadCellFactor};
+use super::factors::{
+    AttachmentHeightFactor, CalibrationVariables, CatenaryLengthFactor, PosePriorFactor, PoseVariables,
+    ReferenceTensionFactor, RigidLengthFactor, SlotOrder, TensionGuardFactor,
+};
+use super::options::{CableModel, CalibrationOptions, OrientationPrior};
+use crate::error::{Error, Result};
+use crate::graph::{FactorGraph, Values, VariableValue};
+use crate::model::effects::{EffectKind, Effects};
+use crate::model::measurement::PoseMeasurement;
+use crate::model::pose::PlatformPose;
+use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::statics::CableTension;
+
+/// The minimum number of poses: each adds 8 unknowns (pose, reference tension)
+/// and 12 equations (4 encoders, 1 load cell, 3 position priors, 4 heights),
+/// so `4 N >= 16` global unknowns.
+pub const MIN_POSES: usize = 4;
+
+/// Check the measurements before building a problem.
+pub fn validate_measurements(measurements: &[PoseMeasurement]) -> Result<()> {
+    if measurements.len() < MIN_POSES {
+        return Err(Error::InvalidInput(format!(
+            "{} poses cannot determine 12 anchor coordinates and 4 offsets: each pose adds 4 independent equations, so at least {MIN_POSES} distinct poses are needed (the paper uses 9 to 35)",
+            measurements.len()
+        )));
+    }
+    let first = Vector3::from(measurements[0].position_m);
+    let spread = measurements
+        .iter()
+        .map(|m| (Vector3::from(m.position_m) - first).norm())
+        .fold(0.0, f64::max);
+    if spread < 1e-3 {
+        return Err(Error::InvalidInput(format!(
+            "all {} poses are at the same position ({:?}): the anchors are not observable from one place; move the platform across the workspace",
+            measurements.len(),
+            measurements[0].position_m
+        )));
+    }
+    for m in measurements {
+        let fields = m
+            .position_m
+            .iter()
+            .chain(&m.encoder_lengths_m)
+            .chain([&m.roll_deg, &m.pitch_deg, &m.yaw_deg]);
+        if fields.into_iter().any(|v| !v.is_finite())
+            || !(m.reference_tension_n.is_finite() && m.reference_tension_n > 0.0)
+        {
+            return Err(Error::InvalidInput(format!(
+                "pose at line {}: values must be finite and the tension positive",
+                m.line
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The localiser's pose of a measurement.
+pub(super) fn measured_pose(m: &PoseMeasurement) -> PlatformPose {
+    PlatformPose::from_roll_pitch_yaw_deg(Vector3::from(m.position_m), m.roll_deg, m.pitch_deg, m.yaw_deg)
+}
+
+/// The graph and its variable ids.
+pub struct CalibrationGraph {
+    /// The graph.
+    pub graph: FactorGraph,
+    /// Anchors and offsets.
+    pub globals: CalibrationVariables,
+    /// Per pose.
+    pub poses: Vec<PoseVariables>,
+    /// The effect parameters, when the graph uses the extended model (the
+    /// robot has `[effects]`, or one is estimated); `None`: the baseline factors.
+    pub effects: Option<EffectVariables>,
+}
+
+/// Build the graph for `model` with initial values: anchors/offsets from
+/// `robot`, poses from `poses`, reference tensions from `tensions`.
+pub fn build_graph(
+    robot: &Robot,
+    measurements: &[PoseMeasurement],
+    poses: &[PlatformPose],
+    tensions: &[CableTension],
+    model: CableModel,
+    options: &CalibrationOptions,
+) -> CalibrationGraph {
+    let mut graph = FactorGraph::new();
+    let anchors = std::array::from_fn(|i| {
+        graph.values.insert(
+            format!("anchor {}", i + 1),
+            VariableValue::Vector(DVector::from_column_slice(robot.anchors_m[i].as_slice())),
+        )
+    });
+    let length_offsets = std::array::from_fn(|i| {
+        graph.values.insert(
+            format!("length offset {}", i + 1),
+            VariableValue::Vector(DVector::from_element(1, robot.length_offsets_m[i])),
+        )
+    });
+    let globals = CalibrationVariables {
+        anchors,
+        length_offsets,
+    };
+    let extended = model == CableModel::Catenary && (!robot.effects.is_none() || options.free_effect.is_some());
+    let effect_variables = extended.then(|| insert_effect_variables(&mut graph.values, robot, options.free_effect));
+    let mut slot_order = SlotOrder::new(robot);
+    if extended {
+        // The vertical centre-of-mass shift is a known input (see `EffectVariables::com_shift`).
+        slot_order.com_offset_m.z += robot.effects.com_shift_m[2];
+    }
+    let slots = Arc::new(slot_order);
+    let noise = &options.noise;
+    let mut pose_variables = Vec::with_capacity(measurements.len());
+    for (k, m) in measurements.iter().enumerate() {
+        let pose = graph
+            .values
+            .insert(format!("pose {}", k + 1), VariableValue::Pose(poses[k]));
+        let reference_tension = graph.values.insert(
+            format!("reference tension {}", k + 1),
+            VariableValue::Vector(DVector::from_row_slice(&[
+                tensions[k].horizontal_n,
+                tensions[k].vertical_n,
+            ])),
+        );
+        let vars = PoseVariables {
+            pose,
+            reference_tension,
+        };
+        let orientation_sigma = (options.orientation_prior == OrientationPrior::On || model == CableModel::Rigid)
+            .then_some(noise.orientation_sigma_rad);
+        graph.add(PosePriorFactor::new(
+            pose,
+            &measured_pose(m),
+            noise.position_sigma_m,
+            orientation_sigma,
+            options.robust.pose_prior,
+        ));
+        match model {
+            CableModel::Rigid => {
+                graph.values.set_fixed(reference_tension, true);
+                graph.add(RigidLengthFactor::new(
+                    slots.clone(),
+                    globals,
+                    vars,
+                    &m.encoder_lengths_m,
+                    noise.encoder_sigma_m,
+                    options.robust.encoder,
+                ));
+            }
+            CableModel::Catenary => {
+                if let Some(effects) = effect_variables {
+                    graph.add(ExtendedLengthFactor::new(
+                        slots.clone(),
+                        globals,
+                        effects,
+                        vars,
+                        &m.encoder_lengths_m,
+                        noise.encoder_sigma_m,
+                        options.robust.encoder,
+                    ));
+                    graph.add(ExtendedHeightFactor::new(
+                        slots.clone(),
+                        globals,
+                        effects,
+                        vars,
+                        options.height_sigma_m,
+                    ));
+                    graph.add(LoadCellFactor::new(
+                        reference_tension,
+                        effects.load_cell,
+                        m.reference_tension_n,
+                        noise.load_cell_sigma_n,
+                        options.robust.load_cell,
+                    ));
+                } else {
+                    graph.add(CatenaryLengthFactor::new(
+                        slots.clone(),
+                        globals,
+                        vars,
+                        &m.encoder_lengths_m,
+                        noise.encoder_sigma_m,
+                        options.robust.encoder,
+                    ));
+                    graph.add(AttachmentHeightFactor::new(
+                        slots.clone(),
+                        globals,
+                        vars,
+                        options.height_sigma_m,
+                    ));
+                    graph.add(ReferenceTensionFactor::new(
+                        reference_tension,
+                        m.reference_tension_n,
+                        noise.load_cell_sigma_n,
+                        options.robust.load_cell,
+                    ));
+                }
+                graph.add(TensionGuardFactor::new(
+                    slots.clone(),
+                    globals,
+                    vars,
+                    0.01 * robot.platform_weight_n / CABLE_COUNT as f64,
+                    0.01 * robot.platform_weight_n / CABLE_COUNT as f64,
+                ));
+            }
+        }
+        pose_variables.push(vars);
+        graph.local_groups.push(vec![vars.pose, vars.reference_tension]);
+    }
+    CalibrationGraph {
+        graph,
+        globals,
+        poses: pose_variables,
+        effects: effect_variables,
+    }
+}
+
+/// The effect-parameter variables with the values of `robot.effects`, all
+/// fixed except those of `free`.
+fn insert_effect_variables(values: &mut Values, robot: &Robot, free: Option<EffectKind>) -> EffectVariables {
+    let e = &robot.effects;
+    let mut vector =
+        |name: &str, data: &[f64]| values.insert(name, VariableValue::Vector(DVector::from_column_slice(data)));
+    let variables = EffectVariables {
+        axial_compliance: vector("axial compliance (1/MN)", &[e.axial_compliance_per_mn()]),
+        pulley_radius: vector("pulley radius", &[e.pulley_radius_m]),
+        encoder_gain_errors: vector("encoder gain errors", &e.encoder_gain.map(|g| g - 1.0)),
+        load_cell: vector(
+            "load cell bias and gain error",
+            &[e.load_cell_bias_n, e.load_cell_gain - 1.0],
+        ),
+        com_shift: vector("centre of mass shift", &e.com_shift_m[..2]),
+    };
+    for kind in EffectKind::ALL {
+        values.set_fixed(variables.of(kind), Some(kind) != free);
+    }
+    variables
+}
+
+/// The effects held in the graph's effect variables (the inverse of
+/// [`insert_effect_variables`]); a compliance `<= 0` reads as an inextensible cable.
+pub fn effects_from_graph(template: &Robot, built: &CalibrationGraph) -> Option<Effects> {
+    let vars = built.effects?;
+    let values = &built.graph.values;
+    let compliance = values.vector(vars.axial_compliance)[0];
+    let gains = values.vector(vars.encoder_gain_errors);
+    let cell = values.vector(vars.load_cell);
+    let com = values.vector(vars.com_shift);
+    Some(Effects {
+        axial_stiffness_n: (compliance > 0.0).then(|| 1e6 / compliance),
+        pulley_radius_m: values.vector(vars.pulley_radius)[0],
+        encoder_gain: std::array::from_fn(|i| 1.0 + gains[i]),
+        load_cell_bias_n: cell[0],
+        load_cell_gain: 1.0 + cell[1],
+        com_shift_m: [com[0], com[1], template.effects.com_shift_m[2]],
+    })
+}
+
+/// The robot with the graph's current anchors and offsets.
+pub fn robot_from_graph(template: &Robot, built: &CalibrationGraph) -> Robot {
+    let mut robot = template.clone();
+    for i in 0..CABLE_COUNT {
+        let a = built.graph.values.vector(built.globals.anchors[i]);
+        robot.anchors_m[i] = Vector3::new(a[0], a[1], a[2]);
+        robot.length_offsets_m[i] = built.graph.values.vector(built.globals.length_offsets[i])[0];
+    }
+    if let Some(effects) = effects_from_graph(template, built) {
+        robot.effects = effects;
+    }
+    robot
+}

@@ -1,0 +1,288 @@
+//! Where the solver starts (module docs of [`crate::calib`]): the rigid
+//! stage's start, the per-pose warm-up on the statics, and the length offsets
+//! in closed form.
+
+use super::graph::{build_graph, measured_pose, CalibrationGraph, MIN_POSES};
+use super::options::{CableModel, CalibrationOptions};
+use crate::error::{Error, Result};
+use crate::model::measurement::PoseMeasurement;
+use crate::model::pose::PlatformPose;
+use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::statics::{self, CableTension, Equilibrium, StaticsOptions};
+
+/// Eq. (17)-(18): `f_v = m_e g / 4`, `f_h = f_v / tan(alpha)`, alpha the angle
+/// between the reference cable's chord and the horizontal. Only a fallback.
+fn paper_initial_tension(robot: &Robot, pose: &PlatformPose) -> CableTension {
+    let geometry = statics::cable_geometry(robot, pose)[robot.reference_cable];
+    let vertical = robot.platform_weight_n / CABLE_COUNT as f64;
+    let alpha = geometry.height_difference_m.atan2(geometry.span_m).max(1e-3);
+    CableTension {
+        horizontal_n: vertical / alpha.tan(),
+        vertical_n: vertical,
+    }
+}
+
+/// Step (2) of the initialisation for a given robot: every pose's static
+/// equilibrium at its measured position and load-cell tension (the poses and
+/// reference tensions `(f_h, f_v)` to start the catenary graph from). Poses
+/// without an equilibrium start from the measured pose and eq. (17)-(18);
+/// their indices are the third element.
+pub fn warm_start(
+    robot: &Robot,
+    measurements: &[PoseMeasurement],
+) -> (Vec<PlatformPose>, Vec<CableTension>, Vec<usize>) {
+    let warm = warm_up(robot, measurements);
+    (warm.poses, warm.tensions, warm.failures)
+}
+
+/// The per-pose warm-up: a start for every pose.
+struct WarmUp {
+    poses: Vec<PlatformPose>,
+    tensions: Vec<CableTension>,
+    /// Poses without an equilibrium (their start is the measured pose and eq. 17-18).
+    failures: Vec<usize>,
+    equilibria: Vec<Option<Equilibrium>>,
+}
+
+/// Per-pose warm-up: the static equilibrium at each measured position and
+/// load-cell tension for `robot`'s current anchors (or, where that tension has
+/// none, the nearest tension that has one). Poses without any start from the
+/// measured pose and eq. (17)-(18) and are listed as failures.
+fn warm_up(robot: &Robot, measurements: &[PoseMeasurement]) -> WarmUp {
+    let options = StaticsOptions::default();
+    let mut warm = WarmUp {
+        poses: Vec::with_capacity(measurements.len()),
+        tensions: Vec::with_capacity(measurements.len()),
+        failures: Vec::new(),
+        equilibria: Vec::with_capacity(measurements.len()),
+    };
+    for (k, m) in measurements.iter().enumerate() {
+        let measured = measured_pose(m);
+        let solved = statics::solve_with_reference_tension(
+            robot,
+            measured.position_m,
+            m.reference_tension_n,
+            Some(measured.rotation),
+            &options,
+        )
+        .or_else(|_| {
+            statics::feasible_start(robot, measured.position_m, Some(measured.rotation), &options).map(|(_, eq)| eq)
+        });
+        match solved {
+            Ok(eq) => {
+                warm.poses.push(eq.pose);
+                warm.tensions.push(eq.tensions[robot.reference_cable]);
+                warm.equilibria.push(Some(eq));
+            }
+            Err(_) => {
+                warm.failures.push(k);
+                warm.poses.push(measured);
+                warm.tensions.push(paper_initial_tension(robot, &measured));
+                warm.equilibria.push(None);
+            }
+        }
+    }
+    warm
+}
+
+/// Closed-form length offsets for fixed geometry: the offsets enter the
+/// encoder factors linearly, so the least-squares value is the mean of
+/// `encoder - catenary length` over the poses.
+fn offsets_in_closed_form(
+    robot: &Robot,
+    measurements: &[PoseMeasurement],
+    equilibria: &[Option<Equilibrium>],
+) -> [f64; CABLE_COUNT] {
+    std::array::from_fn(|i| {
+        let differences: Vec<f64> = measurements
+            .iter()
+            .zip(equilibria)
+            .filter_map(|(m, eq)| eq.as_ref().map(|eq| m.encoder_lengths_m[i] - eq.cable_lengths_m[i]))
+            .collect();
+        if differences.is_empty() {
+            robot.length_offsets_m[i]
+        } else {
+            differences.iter().sum::<f64>() / differences.len() as f64
+        }
+    })
+}
+
+/// Closed-form offsets for the straight-cable model: mean of `encoder - chord`.
+fn rigid_offsets_in_closed_form(
+    robot: &Robot,
+    measurements: &[PoseMeasurement],
+    poses: &[PlatformPose],
+) -> [f64; CABLE_COUNT] {
+    std::array::from_fn(|i| {
+        measurements
+            .iter()
+            .zip(poses)
+            .map(|(m, p)| {
+                let attachment = p.position_m + p.rotation_matrix() * robot.attachments_m[i];
+                m.encoder_lengths_m[i] - (robot.anchors_m[i] - attachment).norm()
+            })
+            .sum::<f64>()
+            / measurements.len() as f64
+    })
+}
+
+/// The rigid stage's start: `initial` with the straight-cable offsets in
+/// closed form, the measured poses, and eq. (17)-(18)'s reference tensions
+/// (held fixed by the rigid model).
+pub(super) fn rigid_start(
+    initial: &Robot,
+    measurements: &[PoseMeasurement],
+) -> (Robot, Vec<PlatformPose>, Vec<CableTension>) {
+    let measured: Vec<PlatformPose> = measurements.iter().map(measured_pose).collect();
+    let placeholder: Vec<CableTension> = measured.iter().map(|p| paper_initial_tension(initial, p)).collect();
+    let mut start = initial.clone();
+    start.length_offsets_m = rigid_offsets_in_closed_form(initial, measurements, &measured);
+    (start, measured, placeholder)
+}
+
+/// The options of the relaxed-statics stage: the attachment-height sigma
+/// raised to the encoder sigma (see [`super::calibrate_once`]).
+pub(super) fn relaxed_statics(options: &CalibrationOptions) -> CalibrationOptions {
+    CalibrationOptions {
+        height_sigma_m: options.height_sigma_m.max(options.noise.encoder_sigma_m),
+        ..*options
+    }
+}
+
+/// A warmed-up start of the catenary stages.
+pub(super) struct CatenaryStart {
+    /// Anchors of the candidate, offsets in closed form.
+    pub robot: Robot,
+    /// Per measurement: the warmed-up pose and reference tension.
+    pub poses: Vec<PlatformPose>,
+    /// Per measurement: the warmed-up reference tension.
+    pub tensions: Vec<CableTension>,
+    /// The measurements with an equilibrium at the candidate's anchors.
+    pub feasible: Vec<usize>,
+}
+
+impl CatenaryStart {
+    /// The feasible poses' measurements, poses and reference tensions.
+    pub fn feasible_subset(
+        &self,
+        measurements: &[PoseMeasurement],
+    ) -> (Vec<PoseMeasurement>, Vec<PlatformPose>, Vec<CableTension>) {
+        (
+            self.feasible.iter().map(|&k| measurements[k]).collect(),
+            self.feasible.iter().map(|&k| self.poses[k]).collect(),
+            self.feasible.iter().map(|&k| self.tensions[k]).collect(),
+        )
+    }
+}
+
+/// The better of the `candidates` (the initial guess, and a rigid-cable
+/// calibration from it: close on robots whose cables barely sag, biased where
+/// they sag a lot). Each is warmed up (per-pose statics, closed-form offsets);
+/// the one with the lower relaxed catenary cost per feasible pose wins.
+/// `None` if no candidate has [`MIN_POSES`] poses with an equilibrium.
+pub(super) fn choose_start(
+    candidates: [Robot; 2],
+    measurements: &[PoseMeasurement],
+    relaxed_options: &CalibrationOptions,
+) -> Option<CatenaryStart> {
+    let mut best: Option<(f64, CatenaryStart)> = None;
+    for candidate in candidates {
+        let warm = warm_up(&candidate, measurements);
+        let mut start = candidate;
+        start.length_offsets_m = offsets_in_closed_form(&start, measurements, &warm.equilibria);
+        let feasible: Vec<usize> = (0..measurements.len())
+            .filter(|k| warm.equilibria[*k].is_some())
+            .collect();
+        if feasible.len() < MIN_POSES {
+            continue;
+        }
+        let chosen: Vec<PoseMeasurement> = feasible.iter().map(|&k| measurements[k]).collect();
+        let poses: Vec<PlatformPose> = feasible.iter().map(|&k| warm.poses[k]).collect();
+        let tensions: Vec<CableTension> = feasible.iter().map(|&k| warm.tensions[k]).collect();
+        let graph = build_graph(
+            &start,
+            &chosen,
+            &poses,
+            &tensions,
+            CableModel::Catenary,
+            relaxed_options,
+        );
+        // Compare per pose, so that a start with more feasible poses is not penalised.
+        let Some(cost) = graph.graph.cost(&graph.graph.values) else {
+            continue;
+        };
+        let score = cost / feasible.len() as f64 * (1.0 + (measurements.len() - feasible.len()) as f64);
+        if best.as_ref().is_none_or(|(b, _)| score < *b) {
+            let start = CatenaryStart {
+                robot: start,
+                poses: warm.poses,
+                tensions: warm.tensions,
+                feasible,
+            };
+            best = Some((score, start));
+        }
+    }
+    best.map(|(_, start)| start)
+}
+
+/// The start of the final stage: every measurement, the feasible ones at the
+/// relaxed stage's solution, those that sat out warmed up again at its
+/// anchors `relaxed_robot`, and those still without an equilibrium excluded.
+pub(super) struct FinalStart {
+    /// The measurements in the final stage.
+    pub measurements: Vec<PoseMeasurement>,
+    /// Their start poses.
+    pub poses: Vec<PlatformPose>,
+    /// Their start reference tensions.
+    pub tensions: Vec<CableTension>,
+    /// Indices of the measurements left out.
+    pub excluded: Vec<usize>,
+}
+
+/// The final stage's start after the relaxed stage (see [`FinalStart`]);
+/// an error if fewer than [`MIN_POSES`] poses remain.
+pub(super) fn final_start(
+    relaxed: &CalibrationGraph,
+    relaxed_robot: &Robot,
+    measurements: &[PoseMeasurement],
+    feasible: &[usize],
+) -> Result<FinalStart> {
+    let WarmUp {
+        poses: rewarmed_poses,
+        tensions: rewarmed_tensions,
+        failures: still_failing,
+        ..
+    } = warm_up(relaxed_robot, measurements);
+    let mut start = FinalStart {
+        measurements: Vec::new(),
+        poses: Vec::new(),
+        tensions: Vec::new(),
+        excluded: Vec::new(),
+    };
+    for k in 0..measurements.len() {
+        if let Some(slot) = feasible.iter().position(|&f| f == k) {
+            let vars = relaxed.poses[slot];
+            let t = relaxed.graph.values.vector(vars.reference_tension);
+            start.poses.push(*relaxed.graph.values.pose(vars.pose));
+            start.tensions.push(CableTension {
+                horizontal_n: t[0],
+                vertical_n: t[1],
+            });
+        } else if still_failing.contains(&k) {
+            start.excluded.push(k);
+            continue;
+        } else {
+            start.poses.push(rewarmed_poses[k]);
+            start.tensions.push(rewarmed_tensions[k]);
+        }
+        start.measurements.push(measurements[k]);
+    }
+    if start.measurements.len() < MIN_POSES {
+        return Err(Error::NoEquilibrium(format!(
+            "only {} of {} poses have a positive-tension equilibrium at the calibrated anchors",
+            start.measurements.len(),
+            measurements.len()
+        )));
+    }
+    Ok(start)
+}

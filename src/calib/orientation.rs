@@ -1,0 +1,100 @@
+//! The localiser's orientation: used as a prior, or dropped when a
+//! chi-square test finds it inconsistent with the fitted statics
+//! ([`OrientationPrior::Auto`], module docs of [`crate::calib`]).
+
+use serde::Serialize;
+
+use super::calibrate_once;
+use super::graph::measured_pose;
+use super::options::{CalibrationOptions, OrientationPrior};
+use super::result::CalibrationResult;
+use crate::error::Result;
+use crate::model::measurement::PoseMeasurement;
+use crate::model::robot::Robot;
+use crate::stats::chi_square_quantile_999;
+
+/// The consistency test of the localiser's orientations with the fitted
+/// statics, and what the calibration did with it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct OrientationCheck {
+    /// Whether the final calibration used the orientation prior.
+    pub prior_used: bool,
+    /// `sum |log(R_measured^T R_fitted)|^2 / sigma^2` over the poses, with the prior on.
+    pub chi_square: f64,
+    /// Number of orientation residual components (3 per pose).
+    pub components: usize,
+    /// The 99.9 % quantile of chi-square with `components` degrees of freedom
+    /// (Wilson-Hilferty); above it the orientations are declared inconsistent.
+    pub limit: f64,
+    /// Mean angle between measured and fitted orientations, degrees.
+    pub mean_angle_deg: f64,
+}
+
+/// Chi-square of the localiser's orientations against the fitted poses of a
+/// calibration made with the orientation prior. Conservative: the fitted
+/// orientation is pulled towards the measured one, so consistent data give
+/// less than the `3 N` degrees of freedom tested against.
+fn orientation_check(result: &CalibrationResult, measurements: &[PoseMeasurement], sigma_rad: f64) -> OrientationCheck {
+    let used = (0..measurements.len()).filter(|k| !result.excluded_poses.contains(k));
+    let angles: Vec<f64> = used
+        .zip(&result.poses)
+        .map(|(k, fitted)| measured_pose(&measurements[k]).rotation.angle_to(&fitted.rotation))
+        .collect();
+    let chi_square = angles.iter().map(|a| (a / sigma_rad).powi(2)).sum();
+    let components = 3 * angles.len();
+    OrientationCheck {
+        prior_used: true,
+        chi_square,
+        components,
+        limit: chi_square_quantile_999(components),
+        mean_angle_deg: angles.iter().sum::<f64>() / angles.len().max(1) as f64 * 180.0 / std::f64::consts::PI,
+    }
+}
+
+impl CalibrationOptions {
+    /// These options with [`OrientationPrior::Auto`] resolved to what `result`
+    /// used (`On` if it kept the prior, else `Off`): the options under which
+    /// to compare `result` with its Cramer-Rao bound.
+    pub fn as_used_by(&self, result: &CalibrationResult) -> CalibrationOptions {
+        let orientation_prior = match (self.orientation_prior, result.orientation_check) {
+            (OrientationPrior::Auto, Some(check)) if check.prior_used => OrientationPrior::On,
+            (OrientationPrior::Auto, _) => OrientationPrior::Off,
+            (other, _) => other,
+        };
+        CalibrationOptions {
+            orientation_prior,
+            ..*self
+        }
+    }
+}
+
+/// [`OrientationPrior::Auto`]: calibrate with the orientation prior, test the
+/// localiser's orientations against the fitted statics ([`orientation_check`]),
+/// and calibrate again without the prior if they are inconsistent (or if the
+/// calibration with it fails). The test is recorded in the result.
+pub(super) fn calibrate_testing_orientation(
+    initial: &Robot,
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+) -> Result<CalibrationResult> {
+    let with_prior = CalibrationOptions {
+        orientation_prior: OrientationPrior::On,
+        ..*options
+    };
+    let without_prior = CalibrationOptions {
+        orientation_prior: OrientationPrior::Off,
+        ..*options
+    };
+    let Ok(mut result) = calibrate_once(initial, measurements, &with_prior) else {
+        return calibrate_once(initial, measurements, &without_prior);
+    };
+    let mut check = orientation_check(&result, measurements, options.noise.orientation_sigma_rad);
+    if check.chi_square <= check.limit {
+        result.orientation_check = Some(check);
+        return Ok(result);
+    }
+    let mut result = calibrate_once(initial, measurements, &without_prior)?;
+    check.prior_used = false;
+    result.orientation_check = Some(check);
+    Ok(result)
+}
