@@ -4,11 +4,30 @@
 //! after Dindarloo et al., *A Graph-Based Self-Calibration Technique for
 //! Cable-Driven Robots with Sagging Cable*.
 //!
-//! Layers, data flowing one way: [`io`] (files) -> [`model`] (catenary,
-//! robot, kineto-statics) -> graph / solver / calib (factor graph and sparse
-//! Levenberg-Marquardt) -> the `sagcal` command line. The residuals and their
-//! analytic Jacobians are derived with SymForce in `codegen/` and emitted into
-//! [`generated`].
+//! sagcal does four jobs for an operator, in the order they meet them:
+//! **plan** the poses worth visiting (`plan`, to come), **calibrate** the
+//! anchors and encoder offsets ([`calib`]), **diagnose** what the model gets
+//! wrong ([`diagnose`]), and **localise** the calibrated robot from its cable
+//! readings (`localize`, to come).
+//!
+//! The layers, data flowing one way (no module names one above it; the
+//! test `tests/layout.rs` checks it):
+//!
+//! | layer | purpose |
+//! |---|---|
+//! | [`error`], [`stats`] | the error type; chi-square quantiles, correlation, BIC |
+//! | [`model`] | cable physics (catenary, elastic, pulley), robot, statics, effects, measurements |
+//! | [`io`] | files -> plain serde structs -> `model` types (`model` never sees a file) |
+//! | [`sim`] | closed-form and discretised simulators (the truth of the experiments) |
+//! | [`graph`] | variables, the factor trait, noise, robust kernels ([`calib`]'s factors wrap [`generated`]) |
+//! | [`solver`] | sparse Levenberg-Marquardt: pattern, Schur / Cholesky, covariance |
+//! | [`calib`], [`diagnose`] | the jobs: staged calibration; residual tests, candidate effects, verdict |
+//! | [`experiments`] | Table II protocol, hidden effects, the benchmark problem |
+//! | [`plot`] | figures (SVG) |
+//! | the `sagcal` binary | a thin clap layer, one file per command |
+//!
+//! The residuals and their analytic Jacobians are derived with SymForce in
+//! `codegen/` and emitted into [`generated`].
 //!
 //! ```
 //! use sagcal::model::{Catenary, Robot};

@@ -91,22 +91,7 @@ pub fn build_graph(
     options: &CalibrationOptions,
 ) -> CalibrationGraph {
     let mut graph = FactorGraph::new();
-    let anchors = std::array::from_fn(|i| {
-        graph.values.insert(
-            format!("anchor {}", i + 1),
-            VariableValue::Vector(DVector::from_column_slice(robot.anchors_m[i].as_slice())),
-        )
-    });
-    let length_offsets = std::array::from_fn(|i| {
-        graph.values.insert(
-            format!("length offset {}", i + 1),
-            VariableValue::Vector(DVector::from_element(1, robot.length_offsets_m[i])),
-        )
-    });
-    let globals = CalibrationVariables {
-        anchors,
-        length_offsets,
-    };
+    let globals = insert_anchors_and_offsets(&mut graph.values, robot);
     let extended = model == CableModel::Catenary && (!robot.effects.is_none() || options.free_effect.is_some());
     let effect_variables = extended.then(|| insert_effect_variables(&mut graph.values, robot, options.free_effect));
     let mut slot_order = SlotOrder::new(robot);
@@ -114,8 +99,14 @@ pub fn build_graph(
         // The vertical centre-of-mass shift is a known input (see `EffectVariables::com_shift`).
         slot_order.com_offset_m.z += robot.effects.com_shift_m[2];
     }
-    let slots = Arc::new(slot_order);
-    let noise = &options.noise;
+    let factors = PoseFactors {
+        slots: Arc::new(slot_order),
+        globals,
+        effects: effect_variables,
+        model,
+        options,
+        tension_floor_n: 0.01 * robot.platform_weight_n / CABLE_COUNT as f64,
+    };
     let mut pose_variables = Vec::with_capacity(measurements.len());
     for (k, m) in measurements.iter().enumerate() {
         let pose = graph
@@ -132,83 +123,7 @@ pub fn build_graph(
             pose,
             reference_tension,
         };
-        let orientation_sigma = (options.orientation_prior == OrientationPrior::On || model == CableModel::Rigid)
-            .then_some(noise.orientation_sigma_rad);
-        graph.add(PosePriorFactor::new(
-            pose,
-            &measured_pose(m),
-            noise.position_sigma_m,
-            orientation_sigma,
-            options.robust.pose_prior,
-        ));
-        match model {
-            CableModel::Rigid => {
-                graph.values.set_fixed(reference_tension, true);
-                graph.add(RigidLengthFactor::new(
-                    slots.clone(),
-                    globals,
-                    vars,
-                    &m.encoder_lengths_m,
-                    noise.encoder_sigma_m,
-                    options.robust.encoder,
-                ));
-            }
-            CableModel::Catenary => {
-                if let Some(effects) = effect_variables {
-                    graph.add(ExtendedLengthFactor::new(
-                        slots.clone(),
-                        globals,
-                        effects,
-                        vars,
-                        &m.encoder_lengths_m,
-                        noise.encoder_sigma_m,
-                        options.robust.encoder,
-                    ));
-                    graph.add(ExtendedHeightFactor::new(
-                        slots.clone(),
-                        globals,
-                        effects,
-                        vars,
-                        options.height_sigma_m,
-                    ));
-                    graph.add(LoadCellFactor::new(
-                        reference_tension,
-                        effects.load_cell,
-                        m.reference_tension_n,
-                        noise.load_cell_sigma_n,
-                        options.robust.load_cell,
-                    ));
-                } else {
-                    graph.add(CatenaryLengthFactor::new(
-                        slots.clone(),
-                        globals,
-                        vars,
-                        &m.encoder_lengths_m,
-                        noise.encoder_sigma_m,
-                        options.robust.encoder,
-                    ));
-                    graph.add(AttachmentHeightFactor::new(
-                        slots.clone(),
-                        globals,
-                        vars,
-                        options.height_sigma_m,
-                    ));
-                    graph.add(ReferenceTensionFactor::new(
-                        reference_tension,
-                        m.reference_tension_n,
-                        noise.load_cell_sigma_n,
-                        options.robust.load_cell,
-                    ));
-                }
-                graph.add(TensionGuardFactor::new(
-                    slots.clone(),
-                    globals,
-                    vars,
-                    0.01 * robot.platform_weight_n / CABLE_COUNT as f64,
-                    0.01 * robot.platform_weight_n / CABLE_COUNT as f64,
-                ));
-            }
-        }
+        factors.add(&mut graph, vars, m);
         pose_variables.push(vars);
         graph.local_groups.push(vec![vars.pose, vars.reference_tension]);
     }
@@ -217,6 +132,152 @@ pub fn build_graph(
         globals,
         poses: pose_variables,
         effects: effect_variables,
+    }
+}
+
+/// The anchor and length-offset variables with `robot`'s values.
+fn insert_anchors_and_offsets(values: &mut Values, robot: &Robot) -> CalibrationVariables {
+    let anchors = std::array::from_fn(|i| {
+        values.insert(
+            format!("anchor {}", i + 1),
+            VariableValue::Vector(DVector::from_column_slice(robot.anchors_m[i].as_slice())),
+        )
+    });
+    let length_offsets = std::array::from_fn(|i| {
+        values.insert(
+            format!("length offset {}", i + 1),
+            VariableValue::Vector(DVector::from_element(1, robot.length_offsets_m[i])),
+        )
+    });
+    CalibrationVariables {
+        anchors,
+        length_offsets,
+    }
+}
+
+/// What every pose's factors share: the robot's slot order, the global and
+/// effect variables, the cable model and the options.
+struct PoseFactors<'a> {
+    slots: Arc<SlotOrder>,
+    globals: CalibrationVariables,
+    effects: Option<EffectVariables>,
+    model: CableModel,
+    options: &'a CalibrationOptions,
+    /// The positivity guard's minimum horizontal tension, and its sigma: 1 %
+    /// of the platform's weight share per cable, newtons.
+    tension_floor_n: f64,
+}
+
+impl PoseFactors<'_> {
+    /// One pose's factors: the pose prior, then the cable model's factors.
+    fn add(&self, graph: &mut FactorGraph, vars: PoseVariables, m: &PoseMeasurement) {
+        let noise = &self.options.noise;
+        let orientation_sigma = (self.options.orientation_prior == OrientationPrior::On
+            || self.model == CableModel::Rigid)
+            .then_some(noise.orientation_sigma_rad);
+        graph.add(PosePriorFactor::new(
+            vars.pose,
+            &measured_pose(m),
+            noise.position_sigma_m,
+            orientation_sigma,
+            self.options.robust.pose_prior,
+        ));
+        match (self.model, self.effects) {
+            (CableModel::Rigid, _) => self.add_rigid(graph, vars, m),
+            (CableModel::Catenary, Some(effects)) => {
+                self.add_extended(graph, vars, m, effects);
+                self.add_tension_guard(graph, vars);
+            }
+            (CableModel::Catenary, None) => {
+                self.add_catenary(graph, vars, m);
+                self.add_tension_guard(graph, vars);
+            }
+        }
+    }
+
+    /// The straight-cable length factor; the reference tension is held fixed.
+    fn add_rigid(&self, graph: &mut FactorGraph, vars: PoseVariables, m: &PoseMeasurement) {
+        graph.values.set_fixed(vars.reference_tension, true);
+        graph.add(RigidLengthFactor::new(
+            self.slots.clone(),
+            self.globals,
+            vars,
+            &m.encoder_lengths_m,
+            self.options.noise.encoder_sigma_m,
+            self.options.robust.encoder,
+        ));
+    }
+
+    /// The paper's factors: catenary length (eq. 14), attachment height
+    /// (eq. 15), reference tension (eq. 16).
+    fn add_catenary(&self, graph: &mut FactorGraph, vars: PoseVariables, m: &PoseMeasurement) {
+        let noise = &self.options.noise;
+        graph.add(CatenaryLengthFactor::new(
+            self.slots.clone(),
+            self.globals,
+            vars,
+            &m.encoder_lengths_m,
+            noise.encoder_sigma_m,
+            self.options.robust.encoder,
+        ));
+        graph.add(AttachmentHeightFactor::new(
+            self.slots.clone(),
+            self.globals,
+            vars,
+            self.options.height_sigma_m,
+        ));
+        graph.add(ReferenceTensionFactor::new(
+            vars.reference_tension,
+            m.reference_tension_n,
+            noise.load_cell_sigma_n,
+            self.options.robust.load_cell,
+        ));
+    }
+
+    /// The extended model's factors: length and height with the effect
+    /// parameters, and the load cell with bias and gain.
+    fn add_extended(
+        &self,
+        graph: &mut FactorGraph,
+        vars: PoseVariables,
+        m: &PoseMeasurement,
+        effects: EffectVariables,
+    ) {
+        let noise = &self.options.noise;
+        graph.add(ExtendedLengthFactor::new(
+            self.slots.clone(),
+            self.globals,
+            effects,
+            vars,
+            &m.encoder_lengths_m,
+            noise.encoder_sigma_m,
+            self.options.robust.encoder,
+        ));
+        graph.add(ExtendedHeightFactor::new(
+            self.slots.clone(),
+            self.globals,
+            effects,
+            vars,
+            self.options.height_sigma_m,
+        ));
+        graph.add(LoadCellFactor::new(
+            vars.reference_tension,
+            effects.load_cell,
+            m.reference_tension_n,
+            noise.load_cell_sigma_n,
+            self.options.robust.load_cell,
+        ));
+    }
+
+    /// Every cable's tension kept positive (inactive at the optimum).
+    fn add_tension_guard(&self, graph: &mut FactorGraph, vars: PoseVariables) {
+        graph.add(TensionGuardFactor::new(
+            self.slots.clone(),
+            self.globals,
+            vars,
+            self.tension_floor_n,
+            self.tension_floor_n,
+        ));
     }
 }
 
@@ -243,7 +304,7 @@ fn insert_effect_variables(values: &mut Values, robot: &Robot, free: Option<Effe
 }
 
 /// The effects held in the graph's effect variables (the inverse of
-/// [`insert_effect_variables`]); a compliance `<= 0` reads as an inextensible cable.
+/// `insert_effect_variables`); a compliance `<= 0` reads as an inextensible cable.
 pub fn effects_from_graph(template: &Robot, built: &CalibrationGraph) -> Option<Effects> {
     let vars = built.effects?;
     let values = &built.graph.values;

@@ -96,7 +96,7 @@ pub struct CalibrationOptions {
     /// Solver settings.
     pub lm: LmParams,
     /// An effect of the catalogue whose parameters are estimated too (the
-    /// extended model, [`effect_factors`]); `None`: the effects of the robot
+    /// extended model, [`crate::calib::effect_factors`]); `None`: the effects of the robot
     /// file (`[effects]`, default none) are known inputs, held fixed.
     pub free_effect: Option<EffectKind>,
 }

@@ -76,9 +76,9 @@ pub struct CalibrationResult {
     /// no positive-tension equilibrium near them with the calibrated anchors.
     pub excluded_poses: Vec<usize>,
     /// The orientation consistency test (catenary model with
-    /// [`OrientationPrior::Auto`]; `None` otherwise).
+    /// [`crate::calib::OrientationPrior::Auto`]; `None` otherwise).
     pub orientation_check: Option<OrientationCheck>,
-    /// The estimated effect ([`CalibrationOptions::free_effect`]), with 1-sigma.
+    /// The estimated effect ([`crate::calib::CalibrationOptions::free_effect`]), with 1-sigma.
     pub effect_estimate: Option<EffectEstimate>,
 }
 

@@ -36,7 +36,7 @@
 //!
 //! A case is right when the verdict names the hidden effect (`none` for none).
 //! `pulley` is reported but left out of the detection score: a pulley radius
-//! is almost entirely absorbed by the anchors ([`pulley_identifiability`]),
+//! is almost entirely absorbed by the anchors ([`identifiability`]),
 //! so it is supported as a known geometry input instead (the robot file's
 //! `[effects] pulley_radius_m`), and each pulley case also reports the anchor
 //! error of a calibration that is given the radius.

@@ -1050,6 +1050,47 @@ pub fn solve_forward(
     check_options(options)?;
     check_robot(robot)?;
     check_lengths(paid_out_lengths_m)?;
+    check_guess(guess)?;
+    let problem = problem(robot, options, paid_out_lengths_m);
+    // Free lengths start at the paid-out length minus a quarter turn of wrap.
+    let lengths: [f64; CABLE_COUNT] = std::array::from_fn(|i| {
+        let wrapped = 0.5 * PI * options.pulley_radius_m;
+        if paid_out_lengths_m[i] > 2.0 * wrapped {
+            paid_out_lengths_m[i] - wrapped
+        } else {
+            paid_out_lengths_m[i]
+        }
+    });
+    let (solution, iterations) = newton_from_starts(robot, options, &problem, guess, lengths);
+    let state = solution.ok_or_else(|| {
+        Error::NoEquilibrium(format!(
+            "discretised robot ({} segments, EA {} N, pulley radius {} m): Newton did not converge from the pose at {:?} for paid-out lengths {:?} m",
+            options.segments,
+            options.axial_stiffness_n,
+            options.pulley_radius_m,
+            guess.pose.position_m.as_slice(),
+            paid_out_lengths_m
+        ))
+    })?;
+    let mut equilibrium = DiscretisedEquilibrium {
+        pose: state.pose,
+        cables: assemble_cables(robot, &problem, &state)?,
+        paid_out_lengths_m: *paid_out_lengths_m,
+        iterations,
+        max_residual_n: 0.0,
+    };
+    let residual = equilibrium_residual_n(robot, options, &equilibrium);
+    equilibrium.max_residual_n = residual.max_n();
+    if !(equilibrium.max_residual_n.is_finite() && residual.max_m().is_finite()) {
+        return Err(Error::NoEquilibrium(
+            "discretised robot: non-finite residual at the solution".into(),
+        ));
+    }
+    Ok(equilibrium)
+}
+
+/// The initial guess must be finite.
+fn check_guess(guess: &InitialGuess) -> Result<()> {
     let pose_finite =
         guess.pose.position_m.iter().all(|x| x.is_finite()) && guess.pose.rotation.coords.iter().all(|x| x.is_finite());
     if !pose_finite {
@@ -1064,25 +1105,27 @@ pub fn solve_forward(
             ));
         }
     }
-    let problem = problem(robot, options, paid_out_lengths_m);
-    // Free lengths start at the paid-out length minus a quarter turn of wrap.
-    let lengths: [f64; CABLE_COUNT] = std::array::from_fn(|i| {
-        let wrapped = 0.5 * PI * options.pulley_radius_m;
-        if paid_out_lengths_m[i] > 2.0 * wrapped {
-            paid_out_lengths_m[i] - wrapped
-        } else {
-            paid_out_lengths_m[i]
-        }
-    });
+    Ok(())
+}
+
+/// Damped Newton from each start in turn, then the Newton homotopy from
+/// each (see [`solve_forward`]); the solution, if any, and the iterations
+/// spent. Starts are computed only when the previous ones fail: the guess's
+/// forces, then each cable solved alone between the guessed attachment and
+/// its pulley (forces and free lengths), then the straight-cable statics.
+fn newton_from_starts(
+    robot: &Robot,
+    options: &DiscretisedOptions,
+    problem: &Problem,
+    guess: &InitialGuess,
+    lengths: [f64; CABLE_COUNT],
+) -> (Option<State>, usize) {
     let mut iterations = 0;
     let state = |(forces, lengths): ([Vector3<f64>; CABLE_COUNT], [f64; CABLE_COUNT])| State {
         pose: guess.pose,
         forces,
         lengths,
     };
-    // Starts, each computed only when the previous ones fail: the guess's
-    // forces, then each cable solved alone between the guessed attachment and
-    // its pulley (forces and free lengths), then the straight-cable statics.
     let rotation = guess.pose.rotation_matrix();
     let single_cables = |iterations: &mut usize| {
         let mut forces = [Vector3::zeros(); CABLE_COUNT];
@@ -1099,48 +1142,32 @@ pub fn solve_forward(
         Some((forces, free_lengths))
     };
     let mut tried = Vec::new();
-    let mut solution = None;
     // Damped Newton from each start in turn ...
     for strategy in 0..3 {
         let start = match strategy {
             0 => guess.platform_forces_n.map(|forces| (forces, lengths)),
             1 => single_cables(&mut iterations),
-            _ => Some((straight_forces(robot, &problem, &guess.pose), lengths)),
+            _ => Some((straight_forces(robot, problem, &guess.pose), lengths)),
         };
         let Some(start) = start else { continue };
         tried.push(start);
         match problem.newton(state(start), options.max_iterations) {
-            Ok((found, used)) => {
-                iterations += used;
-                solution = Some(found);
-                break;
-            }
+            Ok((found, used)) => return (Some(found), iterations + used),
             Err(used) => iterations += used,
         }
     }
     // ... then the Newton homotopy from each.
-    if solution.is_none() {
-        for start in tried {
-            match problem.continuation(state(start), options.max_iterations) {
-                Ok((found, used)) => {
-                    iterations += used;
-                    solution = Some(found);
-                    break;
-                }
-                Err(used) => iterations += used,
-            }
+    for start in tried {
+        match problem.continuation(state(start), options.max_iterations) {
+            Ok((found, used)) => return (Some(found), iterations + used),
+            Err(used) => iterations += used,
         }
     }
-    let state = solution.ok_or_else(|| {
-        Error::NoEquilibrium(format!(
-            "discretised robot ({} segments, EA {} N, pulley radius {} m): Newton did not converge from the pose at {:?} for paid-out lengths {:?} m",
-            options.segments,
-            options.axial_stiffness_n,
-            options.pulley_radius_m,
-            guess.pose.position_m.as_slice(),
-            paid_out_lengths_m
-        ))
-    })?;
+    (None, iterations)
+}
+
+/// The four chains of a solved state, node by node.
+fn assemble_cables(robot: &Robot, problem: &Problem, state: &State) -> Result<[DiscretisedCable; CABLE_COUNT]> {
     let rotation = state.pose.rotation_matrix();
     let mut cables = Vec::with_capacity(CABLE_COUNT);
     for i in 0..CABLE_COUNT {
@@ -1149,24 +1176,9 @@ pub fn solve_forward(
             .ok_or_else(|| Error::NoEquilibrium("discretised robot: degenerate chain at the solution".into()))?;
         cables.push(cable);
     }
-    let cables: [DiscretisedCable; CABLE_COUNT] = cables
+    cables
         .try_into()
-        .map_err(|_| Error::NoEquilibrium("discretised robot: cable count".into()))?;
-    let mut equilibrium = DiscretisedEquilibrium {
-        pose: state.pose,
-        cables,
-        paid_out_lengths_m: *paid_out_lengths_m,
-        iterations,
-        max_residual_n: 0.0,
-    };
-    let residual = equilibrium_residual_n(robot, options, &equilibrium);
-    equilibrium.max_residual_n = residual.max_n();
-    if !(equilibrium.max_residual_n.is_finite() && residual.max_m().is_finite()) {
-        return Err(Error::NoEquilibrium(
-            "discretised robot: non-finite residual at the solution".into(),
-        ));
-    }
-    Ok(equilibrium)
+        .map_err(|_| Error::NoEquilibrium("discretised robot: cable count".into()))
 }
 
 /// An independent check of an equilibrium from its node positions.
@@ -1255,25 +1267,7 @@ pub fn equilibrium_residual_n(
         let anchor = robot.anchors_m[i];
         worst(&mut result.closure_m, (cable.nodes_m[n] - exit).norm());
         let pulley_pull = segment(n - 1) + Vector3::z() * (0.5 * node_weight);
-        let wrapped_length = if radius > 0.0 {
-            let from_anchor = exit - anchor;
-            let u = horizontal_unit(&from_anchor)
-                .or_else(|| horizontal_unit(&(cable.nodes_m[0] - anchor)))
-                .unwrap_or_else(Vector3::x);
-            let centre = anchor + u * radius;
-            let radial = exit - centre;
-            worst(&mut result.groove_m, radial.norm() - radius);
-            let normal = u.cross(&Vector3::z());
-            let radial_unit = radial / radial.norm();
-            worst(&mut result.pulley_force_n, pulley_pull.dot(&radial_unit));
-            worst(&mut result.pulley_force_n, pulley_pull.dot(&normal));
-            // Polar angle of the exit point in the pulley plane; the wrap runs from pi down to it.
-            let wrap = PI - radial.z.atan2(radial.dot(&u));
-            radius * wrap / (1.0 + pulley_pull.norm() * compliance)
-        } else {
-            worst(&mut result.groove_m, (exit - anchor).norm());
-            0.0
-        };
+        let wrapped_length = pulley_end(&mut result, cable, &anchor, radius, compliance, &pulley_pull);
         worst(
             &mut result.paid_out_m,
             cable.free_length_m + wrapped_length - equilibrium.paid_out_lengths_m[i],
@@ -1282,6 +1276,41 @@ pub fn equilibrium_residual_n(
     result.platform_force_n = nan_max(0.0, force_sum.norm());
     result.platform_moment_n_m = nan_max(0.0, moment_sum.norm());
     result
+}
+
+/// The pulley end of `cable` in [`equilibrium_residual_n`]: the exit point on
+/// the groove, the pulley's pull `pulley_pull` in the pulley plane and along
+/// the groove's tangent (worst values into `result`); returns the wrapped
+/// length `r wrap / (1 + T c)` (zero without a pulley).
+fn pulley_end(
+    result: &mut EquilibriumResidual,
+    cable: &DiscretisedCable,
+    anchor: &Vector3<f64>,
+    radius: f64,
+    compliance: f64,
+    pulley_pull: &Vector3<f64>,
+) -> f64 {
+    let worst = |slot: &mut f64, value: f64| *slot = nan_max(*slot, value);
+    let exit = cable.exit_point_m;
+    if radius > 0.0 {
+        let from_anchor = exit - anchor;
+        let u = horizontal_unit(&from_anchor)
+            .or_else(|| horizontal_unit(&(cable.nodes_m[0] - anchor)))
+            .unwrap_or_else(Vector3::x);
+        let centre = anchor + u * radius;
+        let radial = exit - centre;
+        worst(&mut result.groove_m, radial.norm() - radius);
+        let normal = u.cross(&Vector3::z());
+        let radial_unit = radial / radial.norm();
+        worst(&mut result.pulley_force_n, pulley_pull.dot(&radial_unit));
+        worst(&mut result.pulley_force_n, pulley_pull.dot(&normal));
+        // Polar angle of the exit point in the pulley plane; the wrap runs from pi down to it.
+        let wrap = PI - radial.z.atan2(radial.dot(&u));
+        radius * wrap / (1.0 + pulley_pull.norm() * compliance)
+    } else {
+        worst(&mut result.groove_m, (exit - anchor).norm());
+        0.0
+    }
 }
 
 #[cfg(test)]

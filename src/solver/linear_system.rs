@@ -144,19 +144,21 @@ impl Hasher for IndexHasher {
     }
 }
 
-/// A block of `H` between variables `row_var` (larger offset) and `col_var`.
-struct BlockLayout {
-    start: usize,
+/// Where each free variable's tangent block sits in the step vector: the
+/// global variables first, then each local group's free variables together.
+struct TangentLayout {
+    /// Per variable index, its offset (`None`: fixed).
+    offsets: Vec<Option<usize>>,
+    /// Length of the step vector.
+    dim: usize,
+    /// Length of the global part (before the first group).
+    globals: usize,
+    /// Per group with a free variable, `(start, length)` in the step vector.
+    group_ranges: Vec<(usize, usize)>,
 }
 
-impl LinearSystem {
-    /// Analyse the pattern of `H` for these factors and free variables.
-    ///
-    /// `local_groups` (see [`crate::graph::FactorGraph::local_groups`]): when
-    /// every factor touches at most one group, the groups are eliminated
-    /// block by block ([`schur`](super::schur)); otherwise, or without groups,
-    /// `H` is factored by faer's supernodal sparse Cholesky.
-    pub fn new(values: &Values, factors: &[Box<dyn Factor>], local_groups: &[Vec<VariableId>]) -> Result<Self, String> {
+impl TangentLayout {
+    fn new(values: &Values, local_groups: &[Vec<VariableId>]) -> Self {
         let mut offsets = vec![None; values.len()];
         let mut in_group = vec![false; values.len()];
         for id in local_groups.iter().flatten() {
@@ -184,33 +186,40 @@ impl LinearSystem {
                 group_ranges.push((start, dim - start));
             }
         }
-        if dim == 0 {
-            return Err("every variable is fixed: nothing to solve".into());
+        Self {
+            offsets,
+            dim,
+            globals,
+            group_ranges,
         }
-        let tangent = |id: VariableId| values.tangent_dim(id);
-        let mut blocks: BlockMap = BlockMap::default();
-        let mut block_order: Vec<(VariableId, VariableId)> = Vec::new();
-        let mut entry_count = 0;
-        let mut factor_blocks = Vec::with_capacity(factors.len());
-        let mut block_for = |a: VariableId, b: VariableId, blocks: &mut BlockMap| -> usize {
-            let layout = blocks.entry((a.0, b.0)).or_insert_with(|| {
-                let size = if a == b {
-                    tangent(a) * (tangent(a) + 1) / 2
-                } else {
-                    tangent(a) * tangent(b)
-                };
-                let start = entry_count;
-                entry_count += size;
-                block_order.push((a, b));
-                BlockLayout { start }
-            });
-            layout.start
+    }
+}
+
+/// The stored blocks of the lower triangle of `H`, in storage order, and
+/// where each factor's slot pairs accumulate.
+struct BlockPattern {
+    blocks: BlockMap,
+    /// `(row variable, column variable)` of each block, in storage order.
+    block_order: Vec<(VariableId, VariableId)>,
+    /// Number of stored scalars.
+    entry_count: usize,
+    /// Per factor: `(slot a, slot b, block start)` of each block it touches.
+    factor_blocks: Vec<Vec<(usize, usize, usize)>>,
+}
+
+impl BlockPattern {
+    fn new(values: &Values, factors: &[Box<dyn Factor>], offsets: &[Option<usize>]) -> Self {
+        let mut pattern = Self {
+            blocks: BlockMap::default(),
+            block_order: Vec::new(),
+            entry_count: 0,
+            factor_blocks: Vec::with_capacity(factors.len()),
         };
         // Every free variable gets its diagonal block, even if no factor touches it
         // (then H is singular and the solver reports it instead of crashing).
         for (id, _) in values.iter() {
             if offsets[id.0].is_some() {
-                block_for(id, id, &mut blocks);
+                pattern.block_for(values, id, id);
             }
         }
         for factor in factors {
@@ -224,16 +233,47 @@ impl LinearSystem {
                     if oa < ob || (a == b && slot_a != slot_b) {
                         continue;
                     }
-                    list.push((slot_a, slot_b, block_for(a, b, &mut blocks)));
+                    list.push((slot_a, slot_b, pattern.block_for(values, a, b)));
                 }
             }
-            factor_blocks.push(list);
+            pattern.factor_blocks.push(list);
         }
-        // Scalar (row, col) of every stored entry, in storage order.
-        let mut indices = vec![(0usize, 0usize); entry_count];
+        pattern
+    }
+
+    /// The start of block `(a, b)`, stored after the others if new (a
+    /// diagonal block keeps its lower triangle only).
+    fn block_for(&mut self, values: &Values, a: VariableId, b: VariableId) -> usize {
+        let tangent = |id: VariableId| values.tangent_dim(id);
+        let entry_count = &mut self.entry_count;
+        let block_order = &mut self.block_order;
+        let layout = self.blocks.entry((a.0, b.0)).or_insert_with(|| {
+            let size = if a == b {
+                tangent(a) * (tangent(a) + 1) / 2
+            } else {
+                tangent(a) * tangent(b)
+            };
+            let start = *entry_count;
+            *entry_count += size;
+            block_order.push((a, b));
+            BlockLayout { start }
+        });
+        layout.start
+    }
+
+    /// Scalar `(row, col)` of every stored entry, in storage order, and the
+    /// storage slot of each diagonal entry.
+    fn entry_indices(
+        &self,
+        values: &Values,
+        offsets: &[Option<usize>],
+        dim: usize,
+    ) -> (Vec<(usize, usize)>, Vec<usize>) {
+        let tangent = |id: VariableId| values.tangent_dim(id);
+        let mut indices = vec![(0usize, 0usize); self.entry_count];
         let mut diagonal_slots = vec![0; dim];
-        for &(a, b) in &block_order {
-            let start = blocks[&(a.0, b.0)].start;
+        for &(a, b) in &self.block_order {
+            let start = self.blocks[&(a.0, b.0)].start;
             let (oa, ob) = (offsets[a.0].unwrap_or(0), offsets[b.0].unwrap_or(0));
             let (da, db) = (tangent(a), tangent(b));
             let mut k = start;
@@ -250,20 +290,43 @@ impl LinearSystem {
                 }
             }
         }
+        (indices, diagonal_slots)
+    }
+}
+
+/// A block of `H` between variables `row_var` (larger offset) and `col_var`.
+struct BlockLayout {
+    start: usize,
+}
+
+impl LinearSystem {
+    /// Analyse the pattern of `H` for these factors and free variables.
+    ///
+    /// `local_groups` (see [`crate::graph::FactorGraph::local_groups`]): when
+    /// every factor touches at most one group, the groups are eliminated
+    /// block by block (`solver::schur`); otherwise, or without groups,
+    /// `H` is factored by faer's supernodal sparse Cholesky.
+    pub fn new(values: &Values, factors: &[Box<dyn Factor>], local_groups: &[Vec<VariableId>]) -> Result<Self, String> {
+        let layout = TangentLayout::new(values, local_groups);
+        if layout.dim == 0 {
+            return Err("every variable is fixed: nothing to solve".into());
+        }
+        let pattern = BlockPattern::new(values, factors, &layout.offsets);
+        let (indices, diagonal_slots) = pattern.entry_indices(values, &layout.offsets, layout.dim);
         // The reduced system of the elimination is dense: worth it while it is small.
-        let schur = (!group_ranges.is_empty() && globals <= MAX_SCHUR_GLOBALS)
-            .then(|| SchurLayout::new(&indices, globals, group_ranges))
+        let schur = (!layout.group_ranges.is_empty() && layout.globals <= MAX_SCHUR_GLOBALS)
+            .then(|| SchurLayout::new(&indices, layout.globals, layout.group_ranges))
             .flatten();
         let factorization = match schur {
-            Some(layout) => Factorization::Schur(layout),
-            None => Factorization::Sparse(Box::new(SparseCholesky::new(&indices, dim)?)),
+            Some(schur) => Factorization::Schur(schur),
+            None => Factorization::Sparse(Box::new(SparseCholesky::new(&indices, layout.dim)?)),
         };
         Ok(Self {
-            offsets,
-            dim,
-            factor_blocks,
+            offsets: layout.offsets,
+            dim: layout.dim,
+            factor_blocks: pattern.factor_blocks,
             diagonal_slots,
-            entry_count,
+            entry_count: pattern.entry_count,
             indices,
             factorization,
         })

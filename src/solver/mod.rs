@@ -221,8 +221,10 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
         });
     };
     let initial_cost = linearization.cost;
-    let mut damping = params.initial_damping;
-    let mut nu = 2.0;
+    let mut damping = Damping {
+        value: params.initial_damping,
+        nu: 2.0,
+    };
     let mut history = Vec::new();
     let mut termination = Termination::MaxIterations;
     for iteration in 1..=params.max_iterations {
@@ -232,57 +234,28 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
             termination = Termination::GradientConverged;
             break;
         }
-        let diagonal: Vec<f64> = system
-            .diagonal(&linearization.hessian)
-            .iter()
-            .map(|d| d.clamp(1e-6, 1e32))
-            .collect();
-        let rhs: Vec<f64> = gradient.iter().map(|g| -g).collect();
-        let mut trials = 0;
-        let mut accepted = None;
-        while damping <= params.max_damping {
-            trials += 1;
-            let damp: Vec<f64> = diagonal.iter().map(|d| damping * d).collect();
-            let Some(step) = system.solve(&linearization.hessian, &damp, &rhs) else {
-                damping *= nu;
-                nu *= 2.0;
-                continue;
-            };
-            // Predicted decrease of 1/2|r + J dx|^2: -g.dx - 1/2 dx.H dx = 1/2 dx.(lambda D dx - g).
-            let predicted: f64 = 0.5
-                * step
-                    .iter()
-                    .zip(&damp)
-                    .zip(gradient)
-                    .map(|((dx, d), g)| dx * (d * dx - g))
-                    .sum::<f64>();
-            let mut candidate = retract_all(&values, &system, &step);
-            if !groups.is_empty() {
-                groups.refine(graph, &mut candidate);
-            }
-            let new_cost = graph.cost(&candidate);
-            match new_cost {
-                Some(new_cost) if new_cost < cost && predicted > 0.0 => {
-                    let gain_ratio = (cost - new_cost) / predicted;
-                    damping *= (1.0 / 3.0f64).max(1.0 - (2.0 * gain_ratio - 1.0).powi(3));
-                    damping = damping.max(1e-15);
-                    nu = 2.0;
-                    accepted = Some((step, candidate, new_cost, gain_ratio));
-                    break;
-                }
-                _ => {
-                    damping *= nu;
-                    nu *= 2.0;
-                }
-            }
-        }
-        let Some((step, candidate, new_cost, gain_ratio)) = accepted else {
+        let (accepted, trials) = damped_step(
+            graph,
+            &groups,
+            &mut system,
+            &values,
+            &linearization,
+            &mut damping,
+            params,
+        );
+        let Some(Accepted {
+            step,
+            candidate,
+            cost: new_cost,
+            gain_ratio,
+        }) = accepted
+        else {
             termination = Termination::DampingExhausted;
             history.push(IterationSummary {
                 iteration,
                 cost,
                 gain_ratio: f64::NAN,
-                damping,
+                damping: damping.value,
                 step_norm: 0.0,
                 trials,
             });
@@ -295,7 +268,7 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
             iteration,
             cost: new_cost,
             gain_ratio,
-            damping,
+            damping: damping.value,
             step_norm,
             trials,
         });
@@ -324,6 +297,95 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
         termination,
         history,
     })
+}
+
+/// Nielsen's damping (Madsen, Nielsen & Tingleff, *Methods for Non-Linear
+/// Least Squares Problems*, 2004, eq. 2.21): `lambda`, and the factor `nu` it
+/// grows by after each rejected step.
+struct Damping {
+    value: f64,
+    nu: f64,
+}
+
+impl Damping {
+    /// A rejected step: `lambda *= nu`, `nu *= 2`.
+    fn reject(&mut self) {
+        self.value *= self.nu;
+        self.nu *= 2.0;
+    }
+
+    /// An accepted step of gain ratio `rho`: `lambda *= max(1/3, 1 - (2 rho - 1)^3)`.
+    fn accept(&mut self, gain_ratio: f64) {
+        self.value *= (1.0 / 3.0f64).max(1.0 - (2.0 * gain_ratio - 1.0).powi(3));
+        self.value = self.value.max(1e-15);
+        self.nu = 2.0;
+    }
+}
+
+/// A step that lowered the cost.
+struct Accepted {
+    step: Vec<f64>,
+    candidate: Values,
+    cost: f64,
+    gain_ratio: f64,
+}
+
+/// Solve the damped normal equations at `linearization`, raising the damping
+/// until a step lowers the cost (after the per-pose refinement) or the damping
+/// passes its limit; returns the accepted step, if any, and the trials made.
+fn damped_step(
+    graph: &FactorGraph,
+    groups: &LocalGroups,
+    system: &mut LinearSystem,
+    values: &Values,
+    linearization: &Linearization,
+    damping: &mut Damping,
+    params: &LmParams,
+) -> (Option<Accepted>, usize) {
+    let cost = linearization.cost;
+    let gradient = &linearization.gradient;
+    let diagonal: Vec<f64> = system
+        .diagonal(&linearization.hessian)
+        .iter()
+        .map(|d| d.clamp(1e-6, 1e32))
+        .collect();
+    let rhs: Vec<f64> = gradient.iter().map(|g| -g).collect();
+    let mut trials = 0;
+    while damping.value <= params.max_damping {
+        trials += 1;
+        let damp: Vec<f64> = diagonal.iter().map(|d| damping.value * d).collect();
+        let Some(step) = system.solve(&linearization.hessian, &damp, &rhs) else {
+            damping.reject();
+            continue;
+        };
+        // Predicted decrease of 1/2|r + J dx|^2: -g.dx - 1/2 dx.H dx = 1/2 dx.(lambda D dx - g).
+        let predicted: f64 = 0.5
+            * step
+                .iter()
+                .zip(&damp)
+                .zip(gradient)
+                .map(|((dx, d), g)| dx * (d * dx - g))
+                .sum::<f64>();
+        let mut candidate = retract_all(values, system, &step);
+        if !groups.is_empty() {
+            groups.refine(graph, &mut candidate);
+        }
+        match graph.cost(&candidate) {
+            Some(new_cost) if new_cost < cost && predicted > 0.0 => {
+                let gain_ratio = (cost - new_cost) / predicted;
+                damping.accept(gain_ratio);
+                let accepted = Accepted {
+                    step,
+                    candidate,
+                    cost: new_cost,
+                    gain_ratio,
+                };
+                return (Some(accepted), trials);
+            }
+            _ => damping.reject(),
+        }
+    }
+    (None, trials)
 }
 
 /// A rough scale of the free variables (Euclidean norm of the vector ones).
