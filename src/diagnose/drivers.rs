@@ -1,0 +1,262 @@
+//! Step 2: the residuals against the physical drivers of each cable and pose
+//! (tension, tension x length, cable length, sag, elevation, pulley wrap
+//! angle, platform position), by correlation.
+
+use nalgebra::Vector3;
+use serde::Serialize;
+
+use crate::calib::{CalibrationGraph, CalibrationResult};
+use crate::error::Result;
+use crate::model::effects::EffectKind;
+use crate::model::measurement::PoseMeasurement;
+use crate::model::robot::CABLE_COUNT;
+use crate::model::statics;
+use crate::stats::correlation;
+
+/// Two-sided p < 0.001 for a correlation's t statistic (normal approximation).
+pub const DRIVER_T_LIMIT: f64 = 3.29;
+
+/// Correlation of one residual with one physical driver over the poses (and cables).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DriverTest {
+    /// The residual (`encoder`, `load_cell`, `position_x|y|z`), normalised by its sigma.
+    pub residual: String,
+    /// The driver (see [`DRIVERS`]).
+    pub driver: String,
+    /// Number of points.
+    pub points: usize,
+    /// Pearson correlation.
+    pub correlation: f64,
+    /// `r sqrt((n - 2) / (1 - r^2))`.
+    pub t_statistic: f64,
+    /// `|t| > 3.29`: the residual carries structure along this driver.
+    pub significant: bool,
+}
+
+/// Normalised residuals against one driver, before and after the extension (for plots).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DriverSeries {
+    /// Residual name.
+    pub residual: String,
+    /// Driver name with unit.
+    pub driver: String,
+    /// `(driver, residual / sigma)` with the baseline model.
+    pub before: Vec<(f64, f64)>,
+    /// The same with the verdict's model (`None` for `none`).
+    pub after: Option<Vec<(f64, f64)>>,
+}
+
+/// Per pose of a fitted model: the drivers and normalised residuals.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct PoseSample {
+    /// Per cable: driver values in the order of [`DRIVERS`].
+    cable_drivers: [[f64; CABLE_DRIVER_COUNT]; CABLE_COUNT],
+    /// Platform position, metres.
+    position_m: Vector3<f64>,
+    /// Measured load-cell tension, newtons.
+    measured_tension_n: f64,
+    /// Encoder residual / sigma, per cable.
+    encoder: [f64; CABLE_COUNT],
+    /// Load-cell residual / sigma.
+    load_cell: f64,
+    /// Localiser position residual / sigma.
+    position: [f64; 3],
+}
+
+const CABLE_DRIVER_COUNT: usize = 7;
+
+/// The per-cable drivers, with units.
+pub const DRIVERS: [&str; CABLE_DRIVER_COUNT] = [
+    "tension at the pulley (N)",
+    "tension x length (kN m)",
+    "cable length (m)",
+    "mid-span sag (m)",
+    "elevation (deg)",
+    "pulley wrap angle (deg)",
+    "platform height (m)",
+];
+
+/// The driver and residual that show `effect` best.
+pub(super) fn winning_driver(effect: EffectKind) -> (&'static str, &'static str) {
+    match effect {
+        EffectKind::Elastic => ("encoder", DRIVERS[1]),
+        EffectKind::Pulley => ("encoder", DRIVERS[5]),
+        EffectKind::EncoderScale => ("encoder", DRIVERS[2]),
+        EffectKind::LoadCell => ("load_cell", "measured tension (N)"),
+        EffectKind::Com => ("encoder", DRIVERS[0]),
+    }
+}
+
+/// Drivers and normalised residuals of every pose of a fitted model.
+pub(super) fn samples(
+    result: &CalibrationResult,
+    used: &[PoseMeasurement],
+    built: &CalibrationGraph,
+) -> Result<Vec<PoseSample>> {
+    let graph = &built.graph;
+    let normalised = |kind: &str| -> Vec<Vec<f64>> {
+        graph
+            .factors
+            .iter()
+            .filter(|f| f.kind() == kind)
+            .map(|f| {
+                let r = f
+                    .evaluate(&graph.values, None)
+                    .unwrap_or_else(|| nalgebra::DVector::from_element(f.residual_dim(), f64::NAN));
+                r.iter().zip(f.sigmas().iter()).map(|(r, s)| r / s).collect()
+            })
+            .collect()
+    };
+    let encoders = normalised("catenary_length");
+    let cells = normalised("reference_tension");
+    let priors = normalised("pose_prior");
+    let robot = &result.robot;
+    let references = result.reference_tensions();
+    (0..used.len())
+        .map(|k| {
+            let pose = &result.poses[k];
+            let tensions = statics::cable_tensions(robot, pose, references[k])?;
+            let cables = statics::catenaries(robot, pose, &tensions);
+            let geometry = statics::cable_geometry(robot, pose);
+            let cable_drivers = std::array::from_fn(|i| {
+                let c = &cables[i];
+                let length = c.length_m();
+                let top_vertical = c.anchor_vertical_tension_n();
+                let top = c.horizontal_tension_n.hypot(top_vertical);
+                let sag = robot.cable_weight_n_per_m * c.span_m * c.span_m / (8.0 * c.horizontal_tension_n);
+                [
+                    top,
+                    top * length / 1e3,
+                    length,
+                    sag,
+                    geometry[i].height_difference_m.atan2(geometry[i].span_m).to_degrees(),
+                    (std::f64::consts::FRAC_PI_2 + (top_vertical / c.horizontal_tension_n).atan()).to_degrees(),
+                    pose.position_m.z,
+                ]
+            });
+            let prior = &priors[k];
+            let position_rows = prior.len() - 3;
+            Ok(PoseSample {
+                cable_drivers,
+                position_m: pose.position_m,
+                measured_tension_n: used[k].reference_tension_n,
+                encoder: std::array::from_fn(|i| encoders[k][i]),
+                load_cell: cells[k][0],
+                position: std::array::from_fn(|i| prior[position_rows + i]),
+            })
+        })
+        .collect()
+}
+
+/// `(driver, residual)` points of one residual against one driver.
+pub(super) fn series_of(samples: &[PoseSample], residual: &str, driver: &str) -> Vec<(f64, f64)> {
+    let mut points = Vec::new();
+    for s in samples {
+        let pose_driver = match driver {
+            "measured tension (N)" => Some(s.measured_tension_n),
+            "platform x (m)" => Some(s.position_m.x),
+            "platform y (m)" => Some(s.position_m.y),
+            _ => None,
+        };
+        match residual {
+            "encoder" => {
+                for i in 0..CABLE_COUNT {
+                    let x = pose_driver
+                        .or_else(|| DRIVERS.iter().position(|d| *d == driver).map(|d| s.cable_drivers[i][d]));
+                    if let Some(x) = x {
+                        points.push((x, s.encoder[i]));
+                    }
+                }
+            }
+            other => {
+                let y = match other {
+                    "load_cell" => s.load_cell,
+                    "position_x" => s.position[0],
+                    "position_y" => s.position[1],
+                    _ => s.position[2],
+                };
+                let x = pose_driver.or_else(|| {
+                    DRIVERS
+                        .iter()
+                        .position(|d| *d == driver)
+                        .map(|d| s.cable_drivers.iter().map(|c| c[d]).sum::<f64>() / CABLE_COUNT as f64)
+                });
+                if let Some(x) = x {
+                    points.push((x, y));
+                }
+            }
+        }
+    }
+    points
+}
+
+/// Every residual against every driver, strongest correlation first.
+pub(super) fn driver_tests(samples: &[PoseSample]) -> Vec<DriverTest> {
+    let residuals = ["encoder", "load_cell", "position_x", "position_y", "position_z"];
+    let mut drivers: Vec<&str> = DRIVERS.to_vec();
+    drivers.extend(["measured tension (N)", "platform x (m)", "platform y (m)"]);
+    let mut tests = Vec::new();
+    for residual in residuals {
+        for driver in &drivers {
+            let points = series_of(samples, residual, driver);
+            let (r, t) = correlation(&points);
+            if r.is_finite() {
+                tests.push(DriverTest {
+                    residual: residual.to_string(),
+                    driver: driver.to_string(),
+                    points: points.len(),
+                    correlation: r,
+                    t_statistic: t,
+                    significant: t.abs() > DRIVER_T_LIMIT,
+                });
+            }
+        }
+    }
+    tests.sort_by(|a, b| b.t_statistic.abs().total_cmp(&a.t_statistic.abs()));
+    tests
+}
+
+/// The driver most correlated with `residual`.
+pub(super) fn strongest_driver<'a>(drivers: &'a [DriverTest], residual: &str) -> &'a str {
+    drivers
+        .iter()
+        .find(|d| d.residual == residual)
+        .map_or(DRIVERS[0], |d| d.driver.as_str())
+}
+
+/// The residual against the driver that shows the verdict's effect best,
+/// before and after it (`after`: the verdict's fit and its samples), or
+/// against the strongest driver for `none`.
+pub(super) fn driver_series(
+    drivers: &[DriverTest],
+    before: &[PoseSample],
+    after: Option<(EffectKind, &[PoseSample])>,
+) -> DriverSeries {
+    match after {
+        Some((kind, after_samples)) => {
+            let (residual, driver) = winning_driver(kind);
+            let driver = if kind == EffectKind::Com {
+                strongest_driver(drivers, "encoder")
+            } else {
+                driver
+            };
+            DriverSeries {
+                residual: residual.to_string(),
+                driver: driver.to_string(),
+                before: series_of(before, residual, driver),
+                after: Some(series_of(after_samples, residual, driver)),
+            }
+        }
+        None => {
+            let strongest = drivers.first();
+            let residual = strongest.map_or("encoder", |d| d.residual.as_str());
+            let driver = strongest.map_or(DRIVERS[0], |d| d.driver.as_str());
+            DriverSeries {
+                residual: residual.to_string(),
+                driver: driver.to_string(),
+                before: series_of(before, residual, driver),
+                after: None,
+            }
+        }
+    }
+}

@@ -1,0 +1,106 @@
+//! Step 4: the report data: the diagnosis, and what the verdict's extension gains.
+
+use serde::Serialize;
+
+use super::candidates::CandidateFit;
+use super::drivers::{DriverSeries, DriverTest};
+use super::residual_tests::FactorTest;
+use crate::calib::{CalibrationError, ParameterUncertainty};
+use crate::model::robot::{Robot, CABLE_COUNT};
+
+/// What the chosen extension gains.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Gain {
+    /// Held-out normalised residual RMS of the baseline.
+    pub residual_rms_before: f64,
+    /// Held-out normalised residual RMS of the verdict's model (the baseline's for `none`).
+    pub residual_rms_after: f64,
+    /// Mean absolute anchor-coordinate error of the baseline against the truth, metres.
+    pub anchor_mae_before_m: Option<f64>,
+    /// The same for the verdict's model.
+    pub anchor_mae_after_m: Option<f64>,
+    /// Mean Euclidean anchor error of the baseline, metres (Table II's metric).
+    pub anchor_mean_euclidean_before_m: Option<f64>,
+    /// The same for the verdict's model.
+    pub anchor_mean_euclidean_after_m: Option<f64>,
+    /// Mean absolute length-offset error of the baseline, metres.
+    pub offset_mae_before_m: Option<f64>,
+    /// The same for the verdict's model.
+    pub offset_mae_after_m: Option<f64>,
+}
+
+/// The diagnosis of one dataset.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Diagnosis {
+    /// Robot name.
+    pub robot: String,
+    /// Poses used (those with an equilibrium).
+    pub poses_used: usize,
+    /// Measurement residual components `n` (encoders, load cell, localiser).
+    pub measurement_components: usize,
+    /// Baseline chi-square over all factors.
+    pub baseline_chi_square: f64,
+    /// Its degrees of freedom (measurements + statics constraints - unknowns).
+    pub baseline_dof: usize,
+    /// Whether the baseline's chi-square is within the 99.9 % quantile.
+    pub baseline_consistent: bool,
+    /// The a posteriori variance factor dividing every chi-square in the BIC
+    /// (1 unless the data are more precise than the stated noise).
+    pub variance_factor: f64,
+    /// Per factor type.
+    pub factor_tests: Vec<FactorTest>,
+    /// Residual-driver correlations of the baseline, strongest first.
+    pub drivers: Vec<DriverTest>,
+    /// The same with the verdict's model (empty for `none`): the structure left.
+    pub drivers_after: Vec<DriverTest>,
+    /// Baseline BIC.
+    pub baseline_bic: f64,
+    /// Baseline held-out residual RMS.
+    pub baseline_cv_rms: f64,
+    /// Every candidate.
+    pub candidates: Vec<CandidateFit>,
+    /// The effect found, or `none`.
+    pub verdict: String,
+    /// Why, in one sentence.
+    pub reason: String,
+    /// What the verdict's extension gains.
+    pub gain: Gain,
+    /// Given the truth: the baseline's anchor error over its stated 1-sigma
+    /// ([`error_over_sigma`]); above 1 the model error is visible in the anchors.
+    pub baseline_error_over_sigma: Option<f64>,
+    /// The verdict's calibrated robot (anchors, offsets, effects); the baseline's for `none`.
+    #[serde(skip)]
+    pub robot_after: Robot,
+    /// Residual against the winning driver (or the strongest, for `none`).
+    #[serde(skip)]
+    pub series: DriverSeries,
+}
+
+/// Mean over anchors of `|error| / sqrt(trace Sigma)` (NaN without a full-rank covariance).
+pub fn error_over_sigma(estimate: &Robot, truth: &Robot, uncertainty: &ParameterUncertainty) -> f64 {
+    match crate::calib::anchor_rms_bound_m(uncertainty) {
+        Some(bounds) => {
+            (0..CABLE_COUNT)
+                .map(|i| (estimate.anchors_m[i] - truth.anchors_m[i]).norm() / bounds[i])
+                .sum::<f64>()
+                / CABLE_COUNT as f64
+        }
+        None => f64::NAN,
+    }
+}
+
+/// The gain of `after` over `before`: held-out residuals, and errors against the truth if given.
+pub(super) fn gain(truth: Option<&Robot>, before: &Robot, after: &Robot, cv_before: f64, cv_after: f64) -> Gain {
+    let error = |r: &Robot| truth.map(|t| CalibrationError::between(r, t));
+    let (before_error, after_error) = (error(before), error(after));
+    Gain {
+        residual_rms_before: cv_before,
+        residual_rms_after: cv_after,
+        anchor_mae_before_m: before_error.map(|e| e.anchor_coordinate_mae_m),
+        anchor_mae_after_m: after_error.map(|e| e.anchor_coordinate_mae_m),
+        anchor_mean_euclidean_before_m: before_error.map(|e| e.anchor_mean_euclidean_m),
+        anchor_mean_euclidean_after_m: after_error.map(|e| e.anchor_mean_euclidean_m),
+        offset_mae_before_m: before_error.map(|e| e.offset_mae_m),
+        offset_mae_after_m: after_error.map(|e| e.offset_mae_m),
+    }
+}

@@ -1,0 +1,91 @@
+//! Step 1: the baseline's residuals tested against the stated noise, one
+//! chi-square test per factor type, and the a posteriori variance factor.
+
+use serde::Serialize;
+
+use crate::graph::{whitened_squared_norm, FactorGraph};
+use crate::stats::{chi_square_quantile_001, chi_square_quantile_999};
+
+/// The factor types that are measurements (the others are model constraints).
+pub const MEASUREMENT_KINDS: [&str; 3] = ["catenary_length", "reference_tension", "pose_prior"];
+
+/// Chi-square test of one factor type's normalised residuals against the stated noise.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FactorTest {
+    /// Factor type (`catenary_length`, `reference_tension`, `pose_prior`).
+    pub kind: String,
+    /// Residual components.
+    pub components: usize,
+    /// Sum of `(r / sigma)^2`.
+    pub chi_square: f64,
+    /// Its expectation: the components times the fit's overall `dof / components`.
+    pub expected: f64,
+    /// The 99.9 % quantile of chi-square with `expected` degrees of freedom.
+    pub limit: f64,
+    /// `chi_square <= limit`.
+    pub consistent: bool,
+}
+
+/// Residual components of the measurement factors.
+pub(super) fn measurement_components(graph: &FactorGraph) -> usize {
+    graph
+        .factors
+        .iter()
+        .filter(|f| MEASUREMENT_KINDS.contains(&f.kind()))
+        .map(|f| f.residual_dim())
+        .sum()
+}
+
+/// Chi-square of the measurement and statics factors (not the inactive tension guard).
+pub(super) fn total_chi_square(graph: &FactorGraph) -> f64 {
+    graph
+        .factors
+        .iter()
+        .filter(|f| f.kind() != "tension_guard")
+        .filter_map(|f| {
+            f.evaluate(&graph.values, None)
+                .map(|r| whitened_squared_norm(&r, f.sigmas()))
+        })
+        .sum()
+}
+
+/// The chi-square test of each measurement factor type.
+pub(super) fn factor_tests(graph: &FactorGraph, components: usize, dof: usize) -> Vec<FactorTest> {
+    MEASUREMENT_KINDS
+        .iter()
+        .map(|kind| {
+            let mut count = 0;
+            let mut chi = 0.0;
+            for f in graph.factors.iter().filter(|f| f.kind() == *kind) {
+                if let Some(r) = f.evaluate(&graph.values, None) {
+                    count += r.len();
+                    chi += whitened_squared_norm(&r, f.sigmas());
+                }
+            }
+            let expected = count as f64 * dof as f64 / components.max(1) as f64;
+            let limit = chi_square_quantile_999(expected.round().max(1.0) as usize);
+            FactorTest {
+                kind: kind.to_string(),
+                components: count,
+                chi_square: chi,
+                expected,
+                limit,
+                consistent: chi <= limit,
+            }
+        })
+        .collect()
+}
+
+/// The a posteriori variance factor (geodesy's "variance of unit weight"):
+/// when the baseline's chi-square is below the 0.1 % quantile for its degrees
+/// of freedom the data are more precise than the stated noise (e.g. simulated
+/// data without noise), and the information criteria use the residual scale
+/// the data show, `chi^2 / s^2` with `s^2 = chi^2 / dof`. Never scaled up: a
+/// too-large chi-square is what the candidates must explain.
+pub(super) fn variance_factor(baseline_chi_square: f64, dof: usize) -> f64 {
+    if baseline_chi_square < chi_square_quantile_001(dof) {
+        baseline_chi_square / dof as f64
+    } else {
+        1.0
+    }
+}
