@@ -82,10 +82,13 @@ class CableExtensions:
             catenary, :func:`elastic_free_length`); 0: inextensible.
         pulley_radius_m: Radius ``r`` of the swivelling pulley at every anchor, metres
             (:func:`pulley_exit`); 0: the cable leaves at the anchor point.
+        inverse_segments_squared: ``1/n^2`` for a cable modelled as a chain of
+            ``n`` straight elements (:func:`segmented_chain`); 0: the smooth cable.
     """
 
     axial_compliance_per_n: sf.Scalar
     pulley_radius_m: sf.Scalar
+    inverse_segments_squared: sf.Scalar = 0
 
 
 def top_tension(
@@ -208,6 +211,58 @@ def elastic_free_length(
     return unstretched, drop, t_top
 
 
+def segmented_chain(
+    span_m: sf.Scalar,
+    horizontal_tension_n: sf.Scalar,
+    vertical_tension_n: sf.Scalar,
+    cable: CableProperties,
+    inverse_segments_squared: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> tuple[sf.Scalar, sf.Scalar]:
+    """Length and drop of a chain of ``n`` straight elements minus the smooth catenary's, to order ``1/n^2``.
+
+    A finite-element cable of ``n`` equal straight elements of length
+    ``h = l/n`` with lumped node weights (``g_c h`` inside, half at each end;
+    the chain of ``src/sim/discretised.rs``) carries in element ``k`` the
+    vertical force ``V(s_k) = f_v + g_c s_k`` at the element's midpoint
+    ``s_k = (k + 1/2) h``. Its end-to-end span and rise are therefore the
+    midpoint rule applied to the smooth catenary's integrals
+    ``X(l) = int_0^l f_h/T ds`` and ``Z(l) = int_0^l V/T ds``
+    (``T = sqrt(f_h^2 + V^2)``), whose error is, by the Euler-Maclaurin
+    formula, ``int f - M(f) = h^2/24 [f']_0^l + O(h^4)``::
+
+        E_x = -(h^2 g_c f_h / 24) [V/T^3]_0^l,   E_z = (h^2 g_c f_h^2 / 24) [1/T^3]_0^l
+
+    The chain spanning the same ``L`` at the same end forces is longer than
+    the smooth cable ``l`` by ``dl = E_x / X'(l) = E_x T_top / f_h`` and
+    rises ``dz = (V_top / T_top) dl - E_z`` more. Both vanish as ``1/n^2``
+    (``h^2 = l^2 / n^2``); for a shallow cable ``dl`` reduces to the chord
+    deficit ``-(h^2/24) int kappa^2 ds`` of a polygon inscribed in the arc.
+
+    Args:
+        span_m: Horizontal span ``L`` from the cable's upper end to the attachment, metres.
+        horizontal_tension_n: ``f_h > 0``, newtons.
+        vertical_tension_n: ``f_v`` at the attachment, newtons.
+        cable: The cable's properties (``g_c``).
+        inverse_segments_squared: ``1/n^2`` (0: the smooth cable).
+        epsilon: Small positive number.
+
+    Returns:
+        ``(dl, dz)``: the chain's length and drop minus the smooth cable's, metres.
+    """
+    free_length = catenary_length(span_m, horizontal_tension_n, vertical_tension_n, cable, epsilon)
+    v_top, t_top = top_tension(free_length, horizontal_tension_n, vertical_tension_n, cable)
+    t_bottom = sf.sqrt(horizontal_tension_n**2 + vertical_tension_n**2)
+    element_squared = free_length**2 * inverse_segments_squared
+    g = cable.weight_n_per_m
+    error_x = -element_squared * g * horizontal_tension_n / 24 * (
+        v_top / t_top**3 - vertical_tension_n / t_bottom**3
+    )
+    error_z = element_squared * g * horizontal_tension_n**2 / 24 * (1 / t_top**3 - 1 / t_bottom**3)
+    length_change = error_x * t_top / horizontal_tension_n
+    return length_change, v_top / t_top * length_change - error_z
+
+
 def extended_cable(
     anchor_span_m: sf.Scalar,
     horizontal_tension_n: sf.Scalar,
@@ -216,20 +271,23 @@ def extended_cable(
     extensions: CableExtensions,
     epsilon: sf.Scalar,
 ) -> tuple[sf.Scalar, sf.Scalar]:
-    """Paid-out length and drop of a cable with pulley wrap and elasticity.
+    """Paid-out length and drop of a cable with pulley wrap, elasticity and finite elements.
 
     The free span runs from the pulley exit point (:func:`pulley_exit`) to the
-    attachment as an elastic catenary (:func:`elastic_free_length`); the drum
+    attachment as an elastic catenary (:func:`elastic_free_length`), or as a
+    chain of ``n`` straight elements (:func:`segmented_chain`, first order in
+    ``1/n^2``; the cross terms with ``k`` are of order ``k/n^2``); the drum
     pays out the free cable plus the arc on the groove, which is under the top
-    tension: ``paid_out = L0 + r wrap / (1 + k T_top)``. With ``r = 0`` and
-    ``k = 0`` this is exactly :func:`catenary_length` and :func:`catenary_drop`.
+    tension: ``paid_out = L0 + dl + r wrap / (1 + k T_top)``. With ``r = 0``,
+    ``k = 0`` and ``1/n^2 = 0`` this is exactly :func:`catenary_length` and
+    :func:`catenary_drop`.
 
     Args:
         anchor_span_m: Horizontal span from the anchor to the attachment, metres.
         horizontal_tension_n: ``f_h > 0``, newtons.
         vertical_tension_n: ``f_v`` at the attachment, newtons.
         cable: The cable's properties (``g_c``).
-        extensions: Compliance and pulley radius.
+        extensions: Compliance, pulley radius and ``1/n^2``.
         epsilon: Small positive number.
 
     Returns:
@@ -244,8 +302,11 @@ def extended_cable(
     unstretched, drop, t_top = elastic_free_length(
         span, horizontal_tension_n, vertical_tension_n, cable, compliance, epsilon
     )
-    paid_out = unstretched + radius * wrap / (1 + compliance * t_top)
-    return paid_out, drop - rise
+    chain_length, chain_drop = segmented_chain(
+        span, horizontal_tension_n, vertical_tension_n, cable, extensions.inverse_segments_squared, epsilon
+    )
+    paid_out = unstretched + chain_length + radius * wrap / (1 + compliance * t_top)
+    return paid_out, drop + chain_drop - rise
 
 
 def safe_divisor(x: sf.Scalar, epsilon: sf.Scalar) -> sf.Scalar:

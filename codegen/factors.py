@@ -397,17 +397,19 @@ def extended_cable(
     cable_weight_n_per_m: sf.Scalar,
     axial_compliance_per_mn: sf.Scalar,
     pulley_radius_m: sf.Scalar,
+    inverse_segments_squared: sf.Scalar,
     epsilon: sf.Scalar,
 ) -> sf.V2:
-    """Paid-out length and implied drop of one cable with pulley wrap and elasticity.
+    """Paid-out length and implied drop of one cable with pulley wrap, elasticity and finite elements.
 
     ``cable_model.extended_cable``: Irvine's elastic catenary to first order in
     ``1/EA`` from the swivelling pulley's exit point, plus the arc wrapped on
-    the pulley. The extended length factor is ``(1 + g_j) paid_out_j + l0_j -
+    the pulley, and the length and drop of a chain of ``n`` straight elements
+    to first order in ``1/n^2``. The extended length factor is ``(1 + g_j) paid_out_j + l0_j -
     z_enc,j`` (eq. 14 with an encoder scale error ``g_j``), the extended
     attachment factor ``drop_j - h_j`` (eq. 15, ``h_j`` from
-    :func:`cable_geometry`). With both effect parameters 0 the outputs are
-    exactly eq. (4) and the drop of eq. (1)-(3).
+    :func:`cable_geometry`). With the three effect parameters 0 the outputs
+    are exactly eq. (4) and the drop of eq. (1)-(3).
 
     Args:
         span_m: Horizontal span ``L`` from the anchor to the attachment, metres.
@@ -416,6 +418,7 @@ def extended_cable(
         cable_weight_n_per_m: Cable weight per metre ``g_c``, N/m (0: massless cable).
         axial_compliance_per_mn: ``1e6 / EA`` of the cable, 1/MN (0: inextensible).
         pulley_radius_m: Pulley radius ``r``, metres (0: point anchor).
+        inverse_segments_squared: ``1/n^2`` for a cable of ``n`` straight elements (0: smooth).
         epsilon: Small positive number (safe divisions, ``sinhc`` at ``g_c = 0``).
 
     Returns:
@@ -426,6 +429,7 @@ def extended_cable(
     extensions = cable_model.CableExtensions(
         axial_compliance_per_n=axial_compliance_per_mn * sf.Rational(1, 10**6),
         pulley_radius_m=pulley_radius_m,
+        inverse_segments_squared=inverse_segments_squared,
     )
     paid_out, drop = cable_model.extended_cable(
         span_m, horizontal_tension_n, vertical_tension_n, cable, extensions, epsilon

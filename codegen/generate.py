@@ -261,6 +261,7 @@ ARGUMENT_TYPES: dict[str, type] = {
     "measured_tension_n": sf.Symbol,
     "axial_compliance_per_mn": sf.Symbol,
     "pulley_radius_m": sf.Symbol,
+    "inverse_segments_squared": sf.Symbol,
     "span_m": sf.Symbol,
     "horizontal_tension_n": sf.Symbol,
     "vertical_tension_n": sf.Symbol,
@@ -281,6 +282,7 @@ JACOBIAN_BLOCKS: dict[str, tuple[str, str]] = {
     "com_offset_m": ("jacobian_com_offset", "`com_offset_m`, columns `[x, y, z]`"),
     "axial_compliance_per_mn": ("jacobian_axial_compliance", "`axial_compliance_per_mn`"),
     "pulley_radius_m": ("jacobian_pulley_radius", "`pulley_radius_m`"),
+    "inverse_segments_squared": ("jacobian_inverse_segments_squared", "`inverse_segments_squared`"),
     "span_m": ("jacobian_span", "`span_m`"),
     "horizontal_tension_n": ("jacobian_horizontal_tension", "`horizontal_tension_n`"),
     "vertical_tension_n": ("jacobian_vertical_tension", "`vertical_tension_n`"),
@@ -322,7 +324,14 @@ FUNCTIONS = (
     FunctionSpec(
         factors.extended_cable,
         "cable",
-        ("span_m", "horizontal_tension_n", "vertical_tension_n", "axial_compliance_per_mn", "pulley_radius_m"),
+        (
+            "span_m",
+            "horizontal_tension_n",
+            "vertical_tension_n",
+            "axial_compliance_per_mn",
+            "pulley_radius_m",
+            "inverse_segments_squared",
+        ),
     ),
     FunctionSpec(
         factors.load_cell_residual,

@@ -39,6 +39,8 @@ pub struct EffectVariables {
     /// to the nominal centre of mass): its moment arm `(R b_com) x z` vanishes
     /// for a level platform, so nearly level poses cannot determine it.
     pub com_shift: VariableId,
+    /// `[1/n^2]` of a cable of `n` straight elements (0: the smooth cable).
+    pub inverse_segments_squared: VariableId,
 }
 
 impl EffectVariables {
@@ -62,6 +64,7 @@ struct EffectArguments {
     gain_errors: Vector4<f64>,
     /// Nominal centre of mass plus the shift, platform frame.
     com_offset_m: Vector3<f64>,
+    inverse_segments_squared: f64,
 }
 
 fn effect_arguments(values: &Values, slots: &SlotOrder, effects: &EffectVariables) -> EffectArguments {
@@ -72,13 +75,14 @@ fn effect_arguments(values: &Values, slots: &SlotOrder, effects: &EffectVariable
         pulley_radius_m: values.vector(effects.pulley_radius)[0],
         gain_errors: Vector4::from_fn(|slot, _| gains[slots.cables[slot]]),
         com_offset_m: slots.com_offset_m + Vector3::new(shift[0], shift[1], 0.0),
+        inverse_segments_squared: values.vector(effects.inverse_segments_squared)[0],
     }
 }
 
 /// Number of geometry columns chained through `generated::extended_cable`:
 /// pose (6), reference tension (2), anchors (12, slot order), centre of mass (3),
-/// then compliance (1) and pulley radius (1).
-const CHAIN_COLUMNS: usize = 25;
+/// then compliance (1), pulley radius (1) and `1/n^2` (1).
+const CHAIN_COLUMNS: usize = 26;
 
 /// The extended cable model of one pose: per slot the paid-out length and
 /// `drop - h` (the attachment residual), with Jacobians by the chain rule
@@ -88,7 +92,7 @@ struct ExtendedCables {
     paid_out_m: Vector4<f64>,
     /// Attachment residual `drop - h` per slot, metres.
     height_residual_m: Vector4<f64>,
-    /// `d paid_out / d [pose, tension, anchors, com, compliance, radius]`.
+    /// `d paid_out / d [pose, tension, anchors, com, compliance, radius, 1/n^2]`.
     d_paid_out: SMatrix<f64, 4, CHAIN_COLUMNS>,
     /// `d height_residual / d [...]`, same columns.
     d_height: SMatrix<f64, 4, CHAIN_COLUMNS>,
@@ -133,7 +137,7 @@ fn extended_cables(
     for slot in 0..CABLE_COUNT {
         let row = 4 * slot;
         let (mut d_span, mut d_fh, mut d_fv) = (Vector2::zeros(), Vector2::zeros(), Vector2::zeros());
-        let (mut d_compliance, mut d_radius) = (Vector2::zeros(), Vector2::zeros());
+        let (mut d_compliance, mut d_radius, mut d_segments) = (Vector2::zeros(), Vector2::zeros(), Vector2::zeros());
         let cable = generated::extended_cable(
             geometry[row],
             geometry[row + 1],
@@ -141,12 +145,14 @@ fn extended_cables(
             slots.cable_weight_n_per_m,
             effects.compliance_per_mn,
             effects.pulley_radius_m,
+            effects.inverse_segments_squared,
             EPSILON,
             w.then_some(&mut d_span),
             w.then_some(&mut d_fh),
             w.then_some(&mut d_fv),
             w.then_some(&mut d_compliance),
             w.then_some(&mut d_radius),
+            w.then_some(&mut d_segments),
         );
         out.paid_out_m[slot] = cable[0];
         out.height_residual_m[slot] = cable[1] - geometry[row + 3];
@@ -171,28 +177,37 @@ fn extended_cables(
         out.d_paid_out[(slot, 24)] = d_radius[0];
         out.d_height[(slot, 23)] = d_compliance[1];
         out.d_height[(slot, 24)] = d_radius[1];
+        out.d_paid_out[(slot, 25)] = d_segments[0];
+        out.d_height[(slot, 25)] = d_segments[1];
     }
     out
 }
 
-/// Copy chained columns `[pose, tension, anchors, com, compliance, radius]` into
-/// the blocks `[pose, tension, anchor x4 (robot order), ...]` and the blocks
-/// with the given indices for compliance, radius and centre-of-mass shift.
+/// Where a factor keeps the effect blocks of its Jacobian.
+struct EffectBlocks {
+    compliance: usize,
+    radius: usize,
+    com: usize,
+    segments: usize,
+}
+
+/// Copy chained columns `[pose, tension, anchors, com, compliance, radius, 1/n^2]`
+/// into the blocks `[pose, tension, anchor x4 (robot order), ...]` and the
+/// effect blocks at `at`.
 fn split_chain(
     jacobian: &SMatrix<f64, 4, CHAIN_COLUMNS>,
     slots: &SlotOrder,
     blocks: &mut [DMatrix<f64>],
-    compliance_block: usize,
-    radius_block: usize,
-    com_block: usize,
+    at: EffectBlocks,
 ) {
     blocks[0].copy_from(&jacobian.fixed_columns::<6>(0));
     blocks[1].copy_from(&jacobian.fixed_columns::<2>(6));
     let anchors: SMatrix<f64, 4, 12> = jacobian.fixed_columns::<12>(8).into_owned();
     split_anchor_jacobian(&anchors, slots, &mut blocks[2..6]);
-    blocks[com_block].copy_from(&jacobian.fixed_columns::<2>(20));
-    blocks[compliance_block].copy_from(&jacobian.fixed_columns::<1>(23));
-    blocks[radius_block].copy_from(&jacobian.fixed_columns::<1>(24));
+    blocks[at.com].copy_from(&jacobian.fixed_columns::<2>(20));
+    blocks[at.compliance].copy_from(&jacobian.fixed_columns::<1>(23));
+    blocks[at.radius].copy_from(&jacobian.fixed_columns::<1>(24));
+    blocks[at.segments].copy_from(&jacobian.fixed_columns::<1>(25));
 }
 
 /// Extended length factor: `(1 + g_i) paid_out_i + l_i^0 - z_i^enc` with the
@@ -226,6 +241,7 @@ impl ExtendedLengthFactor {
             effects.pulley_radius,
             effects.encoder_gain_errors,
             effects.com_shift,
+            effects.inverse_segments_squared,
         ]);
         Self {
             variables,
@@ -259,7 +275,13 @@ impl Factor for ExtendedLengthFactor {
             for slot in 0..CABLE_COUNT {
                 chained.row_mut(slot).scale_mut(scale[slot]);
             }
-            split_chain(&chained, s, blocks, 10, 11, 13);
+            let at = EffectBlocks {
+                compliance: 10,
+                radius: 11,
+                com: 13,
+                segments: 14,
+            };
+            split_chain(&chained, s, blocks, at);
             blocks[6..10].iter_mut().for_each(|b| b.fill(0.0));
             blocks[12].fill(0.0);
             for (slot, &cable) in s.cables.iter().enumerate() {
@@ -302,7 +324,12 @@ impl ExtendedHeightFactor {
         sigma_m: f64,
     ) -> Self {
         let mut variables = variable_list(&pose, &globals, true, false);
-        variables.extend([effects.axial_compliance, effects.pulley_radius, effects.com_shift]);
+        variables.extend([
+            effects.axial_compliance,
+            effects.pulley_radius,
+            effects.com_shift,
+            effects.inverse_segments_squared,
+        ]);
         Self {
             variables,
             slots,
@@ -326,7 +353,13 @@ impl Factor for ExtendedHeightFactor {
         let e = effect_arguments(values, s, &self.effects);
         let cables = extended_cables(values, s, &self.globals, &self.pose, &e, jacobians.is_some());
         if let Some(blocks) = jacobians {
-            split_chain(&cables.d_height, s, blocks, 6, 7, 8);
+            let at = EffectBlocks {
+                compliance: 6,
+                radius: 7,
+                com: 8,
+                segments: 9,
+            };
+            split_chain(&cables.d_height, s, blocks, at);
             rows_to_cables(s, blocks);
         }
         Some(slots_to_cables(s, &cables.height_residual_m))

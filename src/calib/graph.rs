@@ -296,10 +296,12 @@ fn insert_effect_variables(values: &mut Values, robot: &Robot, free: Option<Effe
             &[e.load_cell_bias_n, e.load_cell_gain - 1.0],
         ),
         com_shift: vector("centre of mass shift", &e.com_shift_m[..2]),
+        inverse_segments_squared: vector("inverse segments squared", &[e.inverse_segments_squared()]),
     };
     for kind in EffectKind::ALL {
         values.set_fixed(variables.of(kind), Some(kind) != free);
     }
+    values.set_fixed(variables.inverse_segments_squared, true);
     variables
 }
 
@@ -312,6 +314,7 @@ pub fn effects_from_graph(template: &Robot, built: &CalibrationGraph) -> Option<
     let gains = values.vector(vars.encoder_gain_errors);
     let cell = values.vector(vars.load_cell);
     let com = values.vector(vars.com_shift);
+    let inverse_segments_squared = values.vector(vars.inverse_segments_squared)[0];
     Some(Effects {
         axial_stiffness_n: (compliance > 0.0).then(|| 1e6 / compliance),
         pulley_radius_m: values.vector(vars.pulley_radius)[0],
@@ -319,6 +322,7 @@ pub fn effects_from_graph(template: &Robot, built: &CalibrationGraph) -> Option<
         load_cell_bias_n: cell[0],
         load_cell_gain: 1.0 + cell[1],
         com_shift_m: [com[0], com[1], template.effects.com_shift_m[2]],
+        cable_segments: (inverse_segments_squared > 0.0).then(|| 1.0 / inverse_segments_squared.sqrt()),
     })
 }
 

@@ -18,6 +18,7 @@
 //! | `encoder-scale` | `gain` (all four encoders) or `gain1` .. `gain4` (> 0) |
 //! | `loadcell` | `bias_n` (N), `gain` (> 0) |
 //! | `com` | `dx_m`, `dy_m`, `dz_m` (platform frame, m) |
+//! | `segments` | `n` (number of straight elements of a finite-element cable, >= 1) |
 
 use serde::{Deserialize, Serialize};
 
@@ -61,6 +62,16 @@ pub struct Effects {
     /// A centre of mass offset: the payload's true centre of mass differs from
     /// the nominal one, which tilts the platform and redistributes the tensions.
     pub com_shift_m: [f64; 3],
+    /// Number `n` of straight elements of a finite-element cable (`segments:n`); `None`: the smooth cable.
+    ///
+    /// A cable modelled as `n` straight elements with lumped node weights (a
+    /// finite-element discretisation, as in RecurDyn's cables or sagcal's
+    /// discretised simulator) spans its geometry with a length that differs
+    /// from the smooth catenary's by a term of order `1/n^2` (the midpoint
+    /// rule's error, `codegen/cable_model.py::segmented_chain`); the fitted
+    /// parameter is `1/n^2`, continuous.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cable_segments: Option<f64>,
 }
 
 impl Default for Effects {
@@ -73,19 +84,26 @@ impl Default for Effects {
             load_cell_bias_n: 0.0,
             load_cell_gain: 1.0,
             com_shift_m: [0.0; 3],
+            cable_segments: None,
         }
     }
 }
 
 /// The effect names accepted by [`Effects::apply_spec`], with their parameters.
 pub const EFFECT_NAMES: &str =
-    "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m";
+    "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m, segments:n";
 
 impl Effects {
     /// The cables' axial compliance `1e6 / EA` in 1/MN (0: inextensible), the
     /// parameter the extended model fits.
     pub fn axial_compliance_per_mn(&self) -> f64 {
         self.axial_stiffness_n.map_or(0.0, |ea| 1e6 / ea)
+    }
+
+    /// `1 / n^2` of a finite-element cable of `n` elements (0: the smooth
+    /// cable), the parameter the extended model fits.
+    pub fn inverse_segments_squared(&self) -> f64 {
+        self.cable_segments.map_or(0.0, |n| 1.0 / (n * n))
     }
 
     /// True when no effect is present (the closed-form model describes the robot).
@@ -109,6 +127,7 @@ impl Effects {
             "encoder-scale" => &["gain", "gain1", "gain2", "gain3", "gain4"],
             "loadcell" => &["bias_n", "gain"],
             "com" => &["dx_m", "dy_m", "dz_m"],
+            "segments" => &["n"],
             other => return Err(format!("unknown effect `{other}` (effects: {EFFECT_NAMES})")),
         };
         if params.trim().is_empty() {
@@ -172,6 +191,14 @@ impl Effects {
                         .expect("known axis");
                     next.com_shift_m[axis] = value;
                 }
+                ("segments", _) => {
+                    if value < 1.0 {
+                        return Err(format!(
+                            "effect `{name}`: parameter `{key}` (number of cable elements) must be >= 1, got {value}"
+                        ));
+                    }
+                    next.cable_segments = Some(value);
+                }
                 _ => unreachable!("parameter names are checked above"),
             }
         }
@@ -210,6 +237,11 @@ impl Effects {
         if !self.com_shift_m.iter().all(|x| x.is_finite()) {
             return Err(format!("`com_shift_m` must be finite, got {:?}", self.com_shift_m));
         }
+        if let Some(n) = self.cable_segments {
+            if !(n.is_finite() && n >= 1.0) {
+                return Err(format!("`cable_segments` must be a finite number >= 1, got {n}"));
+            }
+        }
         Ok(())
     }
 
@@ -245,6 +277,9 @@ impl Effects {
         if self.com_shift_m != none.com_shift_m {
             let [x, y, z] = self.com_shift_m;
             specs.push(format!("com:dx_m={x},dy_m={y},dz_m={z}"));
+        }
+        if let Some(n) = self.cable_segments {
+            specs.push(format!("segments:n={n}"));
         }
         specs
     }
@@ -376,6 +411,7 @@ mod tests {
             "encoder-scale:gain1=1.001,gain3=0.999",
             "loadcell:bias_n=3,gain=1.01",
             "com:dx_m=0.02,dz_m=-0.05",
+            "segments:n=12",
         ])
         .unwrap();
         assert_eq!(e.axial_stiffness_n, Some(3e6));
@@ -384,6 +420,8 @@ mod tests {
         assert_eq!(e.load_cell_bias_n, 3.0);
         assert_eq!(e.load_cell_gain, 1.01);
         assert_eq!(e.com_shift_m, [0.02, 0.0, -0.05]);
+        assert_eq!(e.cable_segments, Some(12.0));
+        assert_eq!(e.inverse_segments_squared(), 1.0 / 144.0);
         // The specifications parse back to the same effects.
         let specs = e.specs();
         let again = parsed(&specs.iter().map(String::as_str).collect::<Vec<_>>()).unwrap();
@@ -415,6 +453,7 @@ mod tests {
                 &["effect `loadcell`", "unknown parameter `offset`"],
             ),
             ("com:dx=0.1", &["effect `com`", "unknown parameter `dx`"]),
+            ("segments:n=0.5", &["effect `segments`", "`n`", ">= 1"]),
         ];
         for (spec, needles) in cases {
             let mut effects = Effects::default();

@@ -24,10 +24,12 @@ use crate::model::statics::Equilibrium;
 use crate::sim::closed_form::SensorSampler;
 use crate::sim::discretised::{solve_forward, DiscretisedEquilibrium, DiscretisedOptions, InitialGuess};
 
-/// The discretised model's settings for `effects` with `segments` segments per cable.
+/// The discretised model's settings for `effects` with `segments` segments
+/// per cable, or, for a finite-element cable (`effects.cable_segments`), its
+/// own number of elements rounded to a whole number.
 pub fn discretised_options(robot: &Robot, effects: &Effects, segments: usize) -> DiscretisedOptions {
     DiscretisedOptions {
-        segments,
+        segments: effects.cable_segments.map_or(segments, |n| n.round().max(1.0) as usize),
         axial_stiffness_n: effects.axial_stiffness_n.unwrap_or(f64::INFINITY),
         pulley_radius_m: effects.pulley_radius_m,
         com_offset_m: Some(robot.com_offset_m + Vector3::from(effects.com_shift_m)),
