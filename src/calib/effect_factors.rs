@@ -41,6 +41,9 @@ pub struct EffectVariables {
     pub com_shift: VariableId,
     /// `[1/n^2]` of a cable of `n` straight elements (0: the smooth cable).
     pub inverse_segments_squared: VariableId,
+    /// `[g]`, an encoder scale error shared by the four drums, added to each
+    /// drum's own (reading = `(1 + g_i + g)` x paid-out length).
+    pub common_gain_error: VariableId,
 }
 
 impl EffectVariables {
@@ -52,6 +55,8 @@ impl EffectVariables {
             EffectKind::EncoderScale => self.encoder_gain_errors,
             EffectKind::LoadCell => self.load_cell,
             EffectKind::Com => self.com_shift,
+            EffectKind::CommonGain => self.common_gain_error,
+            EffectKind::Segments => self.inverse_segments_squared,
         }
     }
 }
@@ -69,11 +74,12 @@ struct EffectArguments {
 
 fn effect_arguments(values: &Values, slots: &SlotOrder, effects: &EffectVariables) -> EffectArguments {
     let gains = values.vector(effects.encoder_gain_errors);
+    let common = values.vector(effects.common_gain_error)[0];
     let shift = values.vector(effects.com_shift);
     EffectArguments {
         compliance_per_mn: values.vector(effects.axial_compliance)[0],
         pulley_radius_m: values.vector(effects.pulley_radius)[0],
-        gain_errors: Vector4::from_fn(|slot, _| gains[slots.cables[slot]]),
+        gain_errors: Vector4::from_fn(|slot, _| gains[slots.cables[slot]] + common),
         com_offset_m: slots.com_offset_m + Vector3::new(shift[0], shift[1], 0.0),
         inverse_segments_squared: values.vector(effects.inverse_segments_squared)[0],
     }
@@ -242,6 +248,7 @@ impl ExtendedLengthFactor {
             effects.encoder_gain_errors,
             effects.com_shift,
             effects.inverse_segments_squared,
+            effects.common_gain_error,
         ]);
         Self {
             variables,
@@ -287,6 +294,7 @@ impl Factor for ExtendedLengthFactor {
             for (slot, &cable) in s.cables.iter().enumerate() {
                 blocks[6 + cable][(slot, 0)] = 1.0;
                 blocks[12][(slot, cable)] = cables.paid_out_m[slot];
+                blocks[15][(slot, 0)] = cables.paid_out_m[slot];
             }
             rows_to_cables(s, blocks);
         }

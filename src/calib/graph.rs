@@ -13,7 +13,7 @@ use super::factors::{
 use super::options::{CableModel, CalibrationOptions, OrientationPrior};
 use crate::error::{Error, Result};
 use crate::graph::{FactorGraph, Values, VariableValue};
-use crate::model::effects::{EffectKind, Effects};
+use crate::model::effects::{EffectKind, EffectSet, Effects};
 use crate::model::measurement::PoseMeasurement;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
@@ -92,8 +92,8 @@ pub fn build_graph(
 ) -> CalibrationGraph {
     let mut graph = FactorGraph::new();
     let globals = insert_anchors_and_offsets(&mut graph.values, robot);
-    let extended = model == CableModel::Catenary && (!robot.effects.is_none() || options.free_effect.is_some());
-    let effect_variables = extended.then(|| insert_effect_variables(&mut graph.values, robot, options.free_effect));
+    let extended = model == CableModel::Catenary && (!robot.effects.is_none() || !options.free_effects.is_empty());
+    let effect_variables = extended.then(|| insert_effect_variables(&mut graph.values, robot, options.free_effects));
     let mut slot_order = SlotOrder::new(robot);
     if extended {
         // The vertical centre-of-mass shift is a known input (see `EffectVariables::com_shift`).
@@ -283,7 +283,7 @@ impl PoseFactors<'_> {
 
 /// The effect-parameter variables with the values of `robot.effects`, all
 /// fixed except those of `free`.
-fn insert_effect_variables(values: &mut Values, robot: &Robot, free: Option<EffectKind>) -> EffectVariables {
+fn insert_effect_variables(values: &mut Values, robot: &Robot, free: EffectSet) -> EffectVariables {
     let e = &robot.effects;
     let mut vector =
         |name: &str, data: &[f64]| values.insert(name, VariableValue::Vector(DVector::from_column_slice(data)));
@@ -297,11 +297,11 @@ fn insert_effect_variables(values: &mut Values, robot: &Robot, free: Option<Effe
         ),
         com_shift: vector("centre of mass shift", &e.com_shift_m[..2]),
         inverse_segments_squared: vector("inverse segments squared", &[e.inverse_segments_squared()]),
+        common_gain_error: vector("common encoder gain error", &[0.0]),
     };
     for kind in EffectKind::ALL {
-        values.set_fixed(variables.of(kind), Some(kind) != free);
+        values.set_fixed(variables.of(kind), !free.contains(kind));
     }
-    values.set_fixed(variables.inverse_segments_squared, true);
     variables
 }
 
@@ -312,13 +312,14 @@ pub fn effects_from_graph(template: &Robot, built: &CalibrationGraph) -> Option<
     let values = &built.graph.values;
     let compliance = values.vector(vars.axial_compliance)[0];
     let gains = values.vector(vars.encoder_gain_errors);
+    let common = values.vector(vars.common_gain_error)[0];
     let cell = values.vector(vars.load_cell);
     let com = values.vector(vars.com_shift);
     let inverse_segments_squared = values.vector(vars.inverse_segments_squared)[0];
     Some(Effects {
         axial_stiffness_n: (compliance > 0.0).then(|| 1e6 / compliance),
         pulley_radius_m: values.vector(vars.pulley_radius)[0],
-        encoder_gain: std::array::from_fn(|i| 1.0 + gains[i]),
+        encoder_gain: std::array::from_fn(|i| 1.0 + gains[i] + common),
         load_cell_bias_n: cell[0],
         load_cell_gain: 1.0 + cell[1],
         com_shift_m: [com[0], com[1], template.effects.com_shift_m[2]],

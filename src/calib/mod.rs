@@ -43,11 +43,13 @@ mod graph;
 mod init;
 mod options;
 mod orientation;
+mod predict;
 pub mod report;
 mod result;
 mod uncertainty;
 
 use crate::error::{Error, Result};
+use crate::model::effects::{EffectKind, Effects};
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::Robot;
 use crate::solver::{optimize, LmParams};
@@ -59,6 +61,7 @@ pub use graph::{
 pub use init::warm_start;
 pub use options::{CableModel, CalibrationOptions, OrientationPrior, RobustKernels};
 pub use orientation::OrientationCheck;
+pub use predict::predict_with_effects;
 pub use result::{
     factor_statistics, CalibrationResult, EffectEstimate, FactorStatistics, ParameterUncertainty, StageSummary,
 };
@@ -201,29 +204,29 @@ fn finish(
         reference_tensions_n,
         excluded_poses,
         orientation_check: None,
-        effect_estimate: None,
+        effect_estimates: Vec::new(),
     })
 }
 
-/// Re-estimate anchors, offsets and the parameters of `options.free_effect`
+/// Re-estimate anchors, offsets and the parameters of `options.free_effects`
+/// (none: the model of `options` as it is, e.g. without the orientation prior)
 /// with the extended model, starting from `baseline` (its anchors, offsets,
-/// poses and tensions; its excluded poses stay out). `options` should be the
-/// ones `baseline` was made with, resolved by [`CalibrationOptions::as_used_by`].
-pub fn refine_with_effect(
+/// poses, tensions and estimated effects; its excluded poses stay out).
+/// `options` should be the ones `baseline` was made with, resolved by
+/// [`CalibrationOptions::as_used_by`].
+pub fn refine_with_effects(
     baseline: &CalibrationResult,
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
 ) -> Result<CalibrationResult> {
-    let kind = options
-        .free_effect
-        .ok_or_else(|| Error::InvalidInput("refine_with_effect: no effect to estimate".into()))?;
+    let kinds = options.free_effects;
     let used: Vec<PoseMeasurement> = (0..measurements.len())
         .filter(|k| !baseline.excluded_poses.contains(k))
         .map(|k| measurements[k])
         .collect();
     if used.len() != baseline.poses.len() {
         return Err(Error::InvalidInput(format!(
-            "refine_with_effect: {} measurements used but the baseline has {} poses",
+            "refine_with_effects: {} measurements used but the baseline has {} poses",
             used.len(),
             baseline.poses.len()
         )));
@@ -236,11 +239,60 @@ pub fn refine_with_effect(
         CableModel::Catenary,
         options,
     );
+    set_effect_estimates(&mut built, &baseline.effect_estimates);
     let mut stages = baseline.stages.clone();
-    stages.push(solve_stage(&format!("extended ({kind})"), &mut built, &options.lm)?);
-    let estimate = effect_estimate(&built, kind)?;
+    let name = format!("extended ({kinds}, orientation prior {})", options.orientation_prior);
+    stages.push(solve_stage(&name, &mut built, &options.lm)?);
+    let estimates = kinds
+        .iter()
+        .map(|kind| effect_estimate(&built, kind))
+        .collect::<Result<Vec<_>>>()?;
     let mut result = finish(&baseline.robot, built, stages, baseline.excluded_poses.clone())?;
     result.orientation_check = baseline.orientation_check;
-    result.effect_estimate = Some(estimate);
+    result.effect_estimates = estimates;
     Ok(result)
+}
+
+/// `effects` with the estimated effects back at their neutral values (a
+/// common gain taken out of each drum's gain, where [`robot_from_graph`]
+/// folded it in), so that a graph built from them takes `estimates` on top
+/// ([`set_effect_estimates`]) without counting them twice.
+pub fn without_estimated(effects: &Effects, estimates: &[EffectEstimate]) -> Effects {
+    let neutral = Effects::default();
+    let mut out = *effects;
+    for estimate in estimates {
+        match estimate.effect {
+            EffectKind::Elastic => out.axial_stiffness_n = neutral.axial_stiffness_n,
+            EffectKind::Pulley => out.pulley_radius_m = neutral.pulley_radius_m,
+            EffectKind::EncoderScale => out.encoder_gain = neutral.encoder_gain,
+            EffectKind::LoadCell => {
+                out.load_cell_bias_n = neutral.load_cell_bias_n;
+                out.load_cell_gain = neutral.load_cell_gain;
+            }
+            EffectKind::Com => {
+                out.com_shift_m[0] = 0.0;
+                out.com_shift_m[1] = 0.0;
+            }
+            EffectKind::CommonGain => {
+                let common = estimate.values[0] - 1.0;
+                out.encoder_gain = out.encoder_gain.map(|g| g - common);
+            }
+            EffectKind::Segments => out.cable_segments = neutral.cable_segments,
+        }
+    }
+    out
+}
+
+/// Set the graph's effect variables to `estimates` (a fit's values, which
+/// the robot's `[effects]` cannot always hold: a negative compliance).
+pub fn set_effect_estimates(built: &mut CalibrationGraph, estimates: &[EffectEstimate]) {
+    let Some(vars) = built.effects else {
+        return;
+    };
+    for estimate in estimates {
+        built.graph.values.set(
+            vars.of(estimate.effect),
+            crate::graph::VariableValue::Vector(nalgebra::DVector::from_vec(estimate.variable_values())),
+        );
+    }
 }

@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use crate::graph::RobustKernel;
-use crate::model::effects::EffectKind;
+use crate::model::effects::EffectSet;
 use crate::model::sensors::SensorNoise;
 use crate::solver::LmParams;
 
@@ -95,10 +95,10 @@ pub struct CalibrationOptions {
     pub robust: RobustKernels,
     /// Solver settings.
     pub lm: LmParams,
-    /// An effect of the catalogue whose parameters are estimated too (the
-    /// extended model, [`crate::calib::effect_factors`]); `None`: the effects of the robot
-    /// file (`[effects]`, default none) are known inputs, held fixed.
-    pub free_effect: Option<EffectKind>,
+    /// The effects of the catalogue whose parameters are estimated too (the
+    /// extended model, [`crate::calib::effect_factors`]); empty: the effects
+    /// of the robot file (`[effects]`, default none) are known inputs, held fixed.
+    pub free_effects: EffectSet,
 }
 
 impl CalibrationOptions {
@@ -111,7 +111,7 @@ impl CalibrationOptions {
             height_sigma_m: 1e-4,
             robust: RobustKernels::default(),
             lm: LmParams::default(),
-            free_effect: None,
+            free_effects: EffectSet::NONE,
         }
     }
 }

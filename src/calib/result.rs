@@ -78,15 +78,16 @@ pub struct CalibrationResult {
     /// The orientation consistency test (catenary model with
     /// [`crate::calib::OrientationPrior::Auto`]; `None` otherwise).
     pub orientation_check: Option<OrientationCheck>,
-    /// The estimated effect ([`crate::calib::CalibrationOptions::free_effect`]), with 1-sigma.
-    pub effect_estimate: Option<EffectEstimate>,
+    /// The estimated effects ([`crate::calib::CalibrationOptions::free_effects`]),
+    /// with 1-sigma, in catalogue order.
+    pub effect_estimates: Vec<EffectEstimate>,
 }
 
 impl EffectEstimate {
     /// Report values (gains as `1 + error`) from the effect variable's contents.
     pub fn values_from_variable(kind: EffectKind, raw: &[f64]) -> Vec<f64> {
         match kind {
-            EffectKind::EncoderScale => raw.iter().map(|g| 1.0 + g).collect(),
+            EffectKind::EncoderScale | EffectKind::CommonGain => raw.iter().map(|g| 1.0 + g).collect(),
             EffectKind::LoadCell => vec![raw[0], 1.0 + raw[1]],
             _ => raw.to_vec(),
         }
@@ -96,7 +97,7 @@ impl EffectEstimate {
     /// inverse of [`EffectEstimate::values_from_variable`].
     pub fn variable_values(&self) -> Vec<f64> {
         match self.effect {
-            EffectKind::EncoderScale => self.values.iter().map(|g| g - 1.0).collect(),
+            EffectKind::EncoderScale | EffectKind::CommonGain => self.values.iter().map(|g| g - 1.0).collect(),
             EffectKind::LoadCell => vec![self.values[0], self.values[1] - 1.0],
             _ => self.values.clone(),
         }
@@ -114,6 +115,9 @@ pub struct EffectEstimate {
     pub values: Vec<f64>,
     /// 1-sigma of each estimate (NaN where the information matrix is singular).
     pub sigmas: Vec<f64>,
+    /// The estimates' marginal covariance, in the variable's units (gain
+    /// errors; NaN where the information matrix is singular).
+    pub covariance: Vec<Vec<f64>>,
 }
 
 impl CalibrationResult {

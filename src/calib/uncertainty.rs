@@ -25,15 +25,19 @@ pub(super) fn effect_estimate(built: &CalibrationGraph, kind: EffectKind) -> Res
     let id = vars.of(kind);
     let raw = built.graph.values.vector(id).clone();
     let values = EffectEstimate::values_from_variable(kind, raw.as_slice());
-    let sigmas = match marginal_covariance(&built.graph, &[id]).map_err(Error::InvalidInput)? {
-        Covariance::Full(c) => (0..raw.len()).map(|k| c[(k, k)].max(0.0).sqrt()).collect(),
-        Covariance::RankDeficient(_) => vec![f64::NAN; raw.len()],
+    let covariance: Vec<Vec<f64>> = match marginal_covariance(&built.graph, &[id]).map_err(Error::InvalidInput)? {
+        Covariance::Full(c) => (0..raw.len())
+            .map(|r| (0..raw.len()).map(|k| c[(r, k)]).collect())
+            .collect(),
+        Covariance::RankDeficient(_) => vec![vec![f64::NAN; raw.len()]; raw.len()],
     };
+    let sigmas = (0..raw.len()).map(|k| covariance[k][k].max(0.0).sqrt()).collect();
     Ok(EffectEstimate {
         effect: kind,
         names: kind.parameter_names().iter().map(|n| n.to_string()).collect(),
         values,
         sigmas,
+        covariance,
     })
 }
 

@@ -24,7 +24,8 @@ pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
     )?;
     let mut options = DiagnoseOptions::new(args.solver.options(&nominal)?);
     options.folds = args.folds;
-    options.min_bic_drop = args.min_bic_drop;
+    options.false_alarm = args.false_alarm;
+    options.orientation_hypothesis = !args.no_orientation_hypothesis;
     if let Some(list) = &args.candidates {
         options.candidates = list
             .split(',')
@@ -55,6 +56,9 @@ pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
         Some(dir) => Some(write_plots(dir, &diagnosis, &args.data)?),
         None => None,
     };
+    if let Some(out) = &args.out {
+        write_extended_robot(out, &diagnosis)?;
+    }
     if args.json {
         print_json(&diagnosis)
     } else {
@@ -62,8 +66,21 @@ pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
         if let Some(path) = plot_path {
             println!("plot written to {}", path.display());
         }
+        if let Some(out) = &args.out {
+            println!("robot with the selected model written to {}", out.display());
+        }
         Ok(())
     }
+}
+
+/// Write the selected model's robot, with a header naming the verdict.
+fn write_extended_robot(path: &Path, diagnosis: &Diagnosis) -> sagcal::Result<()> {
+    let text = diagnosis.robot_after.to_file_contents().to_toml()?;
+    let header = format!(
+        "# Calibrated by sagcal diagnose: anchors, encoder length offsets and the selected model ({}).\n",
+        diagnosis.verdict
+    );
+    sagcal::io::write_atomically(path, format!("{header}{text}").as_bytes())
 }
 
 fn file_name(text: &str) -> String {
@@ -115,37 +132,27 @@ fn write_plots(dir: &Path, diagnosis: &Diagnosis, data: &Path) -> sagcal::Result
     Ok(path)
 }
 
-fn opt(value: Option<f64>, digits: usize) -> String {
-    value.map_or_else(|| "-".into(), |v| format!("{v:.digits$}"))
-}
-
-/// The `count` strongest residual-driver correlations as a table.
-fn driver_table(tests: &[sagcal::diagnose::DriverTest], count: usize) -> String {
-    let mut table = Table::new(["residual", "driver", "points", "correlation", "t", "structure"]);
-    for t in tests.iter().take(count) {
-        table.row([
-            t.residual.clone(),
-            t.driver.clone(),
-            t.points.to_string(),
-            format!("{:+.3}", t.correlation),
-            format!("{:+.1}", t.t_statistic),
-            if t.significant {
-                "yes (p < 0.001)".into()
-            } else {
-                "no".to_string()
-            },
-        ]);
-    }
-    table.to_string()
-}
-
-/// The human-readable diagnosis.
+/// The human-readable diagnosis: the four steps of the search.
 pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
     let mut out = format!(
-        "sagcal diagnose: robot `{}`, {} poses, {} measurement components, {}-fold cross-validation\n\n",
-        d.robot, d.poses_used, d.measurement_components, options.folds
+        "sagcal diagnose: robot `{}`, {} poses, {} measurement components, {}-fold cross-validation, orientation prior {}\n\n",
+        d.robot, d.poses_used, d.measurement_components, options.folds, d.orientation_prior
     );
+    out += &render_residual_tests(d);
+    out += "\n2. residual structure (baseline): correlation with physical drivers, strongest first\n";
+    out += &driver_table(&d.drivers, 8);
     out += &format!(
+        "\n3. forward selection at a false-alarm rate of {:.0e} (baseline: held-out residual RMS {:.3})\n",
+        d.false_alarm, d.baseline_cv_rms
+    );
+    out += &render_candidates(d);
+    out += &render_verdict(d);
+    out
+}
+
+/// Step 1: the chi-square test per factor type.
+fn render_residual_tests(d: &Diagnosis) -> String {
+    let mut out = format!(
         "1. baseline model against the stated noise: chi-square {:.1} for {} degrees of freedom ({})\n",
         d.baseline_chi_square,
         d.baseline_dof,
@@ -180,27 +187,31 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
     out += &tests.to_string();
     if d.variance_factor != 1.0 {
         out += &format!(
-            "   the data are more precise than the stated noise: the information criteria use the a posteriori variance factor {:.4} (residual scale x{:.3})\n",
+            "   the data are more precise than the stated noise: the tests use the a posteriori variance factor {:.4} (residual scale x{:.3})\n",
             d.variance_factor,
             d.variance_factor.sqrt()
         );
     }
-    out += "\n2. residual structure (baseline): correlation with physical drivers, strongest first\n";
-    out += &driver_table(&d.drivers, 8);
-    out += &format!(
-        "\n3. candidate extensions (baseline: BIC {:.1}, held-out residual RMS {:.3})\n",
-        d.baseline_bic, d.baseline_cv_rms
-    );
-    let mut candidates = Table::new([
-        "effect",
+    out
+}
+
+/// Step 3: every hypothesis tested, step by step.
+fn render_candidates(d: &Diagnosis) -> String {
+    let mut table = Table::new([
+        "step",
+        "hypothesis",
+        "extends",
         "parameters (1-sigma)",
-        "delta BIC",
-        "held-out RMS",
+        "LR",
+        "dof",
+        "p-value",
+        "needs <",
+        "power",
         "anchor MAE m",
     ]);
     for c in &d.candidates {
-        let params = if c.params.is_empty() {
-            format!("failed: {}", c.error.clone().unwrap_or_default())
+        let params = if let Some(error) = &c.error {
+            format!("failed: {error}")
         } else {
             c.params
                 .iter()
@@ -212,16 +223,41 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
             Some(why) => format!("{params} [impossible: {why}]"),
             None => params,
         };
-        candidates.row([
-            c.effect.clone(),
+        table.row([
+            c.step.to_string(),
+            format!("{}{}", c.effect, if c.significant { " *" } else { "" }),
+            c.extends.clone(),
             params,
-            format!("{:+.1}", c.delta_bic),
-            format!("{:.3}", c.cv_rms),
+            format!("{:.1}", c.lr_statistic),
+            c.added_parameters.to_string(),
+            format!("{:.2e}", c.p_value),
+            format!("{:.1e}", c.p_threshold),
+            opt(c.power, 2),
             opt(c.anchor_mae_m, 4),
         ]);
     }
-    out += &candidates.to_string();
-    out += &format!("\n4. verdict: {}\n   {}\n", d.verdict, d.reason);
+    let mut out = table.to_string();
+    out += "   (* significant; power: of the test at the effect's smallest plausible magnitude for this robot)\n";
+    out
+}
+
+/// Step 4: the verdict, the selected effects, the gain and the structure left.
+fn render_verdict(d: &Diagnosis) -> String {
+    let mut out = format!("\n4. verdict: {}\n   {}\n", d.verdict, d.reason);
+    for e in &d.effects {
+        let params: Vec<String> = e
+            .params
+            .iter()
+            .map(|p| format!("{} {:.5e} +- {:.1e}", p.name, p.value, p.sigma))
+            .collect();
+        out += &format!("   {}: {}\n", e.effect, params.join(", "));
+    }
+    if !d.undetectable.is_empty() {
+        out += &format!(
+            "   not detectable at this noise with these poses (power < 0.9 at the smallest plausible magnitude): {}\n",
+            d.undetectable.join(", ")
+        );
+    }
     let g = &d.gain;
     out += &format!(
         "   gain: held-out residual RMS {:.3} -> {:.3}",
@@ -244,4 +280,28 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
         out += &driver_table(&d.drivers_after, 5);
     }
     out
+}
+
+fn opt(value: Option<f64>, digits: usize) -> String {
+    value.map_or_else(|| "-".into(), |v| format!("{v:.digits$}"))
+}
+
+/// The `count` strongest residual-driver correlations as a table.
+fn driver_table(tests: &[sagcal::diagnose::DriverTest], count: usize) -> String {
+    let mut table = Table::new(["residual", "driver", "points", "correlation", "t", "structure"]);
+    for t in tests.iter().take(count) {
+        table.row([
+            t.residual.clone(),
+            t.driver.clone(),
+            t.points.to_string(),
+            format!("{:+.3}", t.correlation),
+            format!("{:+.1}", t.t_statistic),
+            if t.significant {
+                "yes (p < 0.001)".into()
+            } else {
+                "no".to_string()
+            },
+        ]);
+    }
+    table.to_string()
 }

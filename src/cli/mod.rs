@@ -243,15 +243,22 @@ struct DiagnoseArgs {
     /// Write the plot of the residual against the winning driver (before and after) into this folder.
     #[arg(long)]
     plots: Option<PathBuf>,
-    /// Candidate effects, comma separated (default: elastic,pulley,encoder-scale,loadcell,com).
+    /// Candidate effects, comma separated (default: elastic,pulley,encoder-scale,loadcell,com,encoder-gain,segments).
     #[arg(long)]
     candidates: Option<String>,
+    /// Leave out the hypothesis "the localiser's orientations are unreliable".
+    #[arg(long)]
+    no_orientation_hypothesis: bool,
     /// Folds of the cross-validation over poses.
     #[arg(long, default_value_t = 5)]
     folds: usize,
-    /// Declare an effect only if it lowers the BIC by at least this much.
-    #[arg(long, default_value_t = 10.0)]
-    min_bic_drop: f64,
+    /// False-alarm rate of the whole search: the probability of declaring an
+    /// effect on data the baseline model describes.
+    #[arg(long, default_value_t = 1e-3)]
+    false_alarm: f64,
+    /// Write the selected model's calibrated robot (anchors, offsets, effects) here (TOML).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Print the diagnosis as JSON.
     #[arg(long)]
     json: bool,

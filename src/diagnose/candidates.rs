@@ -1,18 +1,179 @@
-//! Step 3a: every candidate effect of the catalogue fitted as an extension of
-//! the baseline's factor graph, scored by BIC and held-out residual.
+//! Step 3a: the hypotheses of the search (each effect of the catalogue, and
+//! the localiser's orientation freed), each fitted as an extension of the
+//! current model and tested against it.
 
 use serde::Serialize;
 
-use super::selection::cross_validate;
-use super::{Baseline, DiagnoseOptions, Progress};
+use super::residual_tests::total_chi_square;
+use super::selection::Search;
+use super::Baseline;
 use crate::calib::{
-    build_graph, refine_with_effect, CableModel, CalibrationError, CalibrationGraph, CalibrationOptions,
-    CalibrationResult, EffectEstimate,
+    build_graph, refine_with_effects, set_effect_estimates, without_estimated, CableModel, CalibrationError,
+    CalibrationGraph, CalibrationOptions, CalibrationResult, EffectEstimate, OrientationPrior,
 };
-use crate::graph::VariableValue;
-use crate::model::effects::EffectKind;
+use crate::error::Result;
+use crate::model::effect_ranges::smallest_plausible;
+use crate::model::effects::{EffectKind, EffectSet};
 use crate::model::measurement::PoseMeasurement;
-use crate::model::robot::Robot;
+use crate::stats::{chi_square_critical, chi_square_survival, noncentral_chi_square_survival, noncentrality_for_power};
+
+/// The power a test must have before its silence counts as evidence of absence.
+pub const DETECTION_POWER: f64 = 0.9;
+
+/// One hypothesis of the search.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Hypothesis {
+    /// An effect of the catalogue.
+    Effect(EffectKind),
+    /// The localiser's orientations are unreliable: every pose's orientation
+    /// is freed from its prior (3 parameters per pose).
+    OrientationFree,
+}
+
+impl Hypothesis {
+    /// The name in reports (`com`, ..., `orientation`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Hypothesis::Effect(kind) => kind.name(),
+            Hypothesis::OrientationFree => "orientation",
+        }
+    }
+}
+
+/// A fitted model of the search: the baseline plus hypotheses in the order added.
+#[derive(Debug, Clone)]
+pub(super) struct Model {
+    /// The hypotheses, in the order added.
+    pub hypotheses: Vec<Hypothesis>,
+    /// The fit.
+    pub result: CalibrationResult,
+    /// Its options (free effects, orientation prior).
+    pub options: CalibrationOptions,
+    /// Chi-square over all factors at the fit, with the orientation prior's
+    /// rows as the model has them.
+    pub chi_square: f64,
+}
+
+impl Model {
+    /// The baseline as a model of the search.
+    pub fn baseline(base: &Baseline) -> Self {
+        Self {
+            hypotheses: Vec::new(),
+            result: base.result.clone(),
+            options: base.options,
+            chi_square: base.chi_square,
+        }
+    }
+
+    /// `none`, or the hypotheses joined by `+` in the order added.
+    pub fn name(&self) -> String {
+        if self.hypotheses.is_empty() {
+            return "none".into();
+        }
+        let names: Vec<&str> = self.hypotheses.iter().map(|h| h.name()).collect();
+        names.join("+")
+    }
+
+    /// The effects the model estimates.
+    pub fn effects(&self) -> EffectSet {
+        self.hypotheses
+            .iter()
+            .filter_map(|h| match h {
+                Hypothesis::Effect(kind) => Some(*kind),
+                Hypothesis::OrientationFree => None,
+            })
+            .collect()
+    }
+
+    /// Whether `hypothesis` may be added: not already in, and not nested in an
+    /// effect that is (the common gain in the per-drum gains).
+    pub fn can_add(&self, hypothesis: Hypothesis) -> bool {
+        if self.hypotheses.contains(&hypothesis) {
+            return false;
+        }
+        match hypothesis {
+            Hypothesis::Effect(kind) => kind.nested_in().is_none_or(|outer| !self.effects().contains(outer)),
+            Hypothesis::OrientationFree => true,
+        }
+    }
+
+    /// Parameters `hypothesis` adds to this model: an effect's (less those of
+    /// an effect nested in it that it replaces), or 3 per pose.
+    pub fn added_parameters(&self, hypothesis: Hypothesis, poses: usize) -> usize {
+        match hypothesis {
+            Hypothesis::Effect(kind) => {
+                let replaced: usize = EffectKind::ALL
+                    .into_iter()
+                    .filter(|inner| inner.nested_in() == Some(kind) && self.effects().contains(*inner))
+                    .map(EffectKind::parameter_count)
+                    .sum();
+                kind.parameter_count() - replaced
+            }
+            Hypothesis::OrientationFree => 3 * poses,
+        }
+    }
+
+    /// This model fitted with `hypotheses` instead of its own, starting from
+    /// its solution (effects dropped go back to the robot file's values).
+    pub fn refit(
+        &self,
+        hypotheses: Vec<Hypothesis>,
+        base: &Baseline,
+        measurements: &[PoseMeasurement],
+    ) -> Result<Self> {
+        let mut effects: EffectSet = hypotheses
+            .iter()
+            .filter_map(|h| match h {
+                Hypothesis::Effect(kind) => Some(*kind),
+                Hypothesis::OrientationFree => None,
+            })
+            .collect();
+        for inner in EffectKind::ALL {
+            if inner.nested_in().is_some_and(|outer| effects.contains(outer)) {
+                effects = effects.without(inner);
+            }
+        }
+        let orientation_prior = if hypotheses.contains(&Hypothesis::OrientationFree) {
+            OrientationPrior::Off
+        } else {
+            base.options.orientation_prior
+        };
+        let options = CalibrationOptions {
+            free_effects: effects,
+            orientation_prior,
+            ..base.options
+        };
+        let mut start = self.result.clone();
+        start.robot.effects = base.result.robot.effects;
+        start.effect_estimates.retain(|e| effects.contains(e.effect));
+        let result = refine_with_effects(&start, measurements, &options)?;
+        let chi_square = total_chi_square(&rebuild(&result, &base.used, &options).graph);
+        Ok(Self {
+            hypotheses,
+            result,
+            options,
+            chi_square,
+        })
+    }
+
+    /// This model with `hypothesis` added.
+    pub fn with(&self, hypothesis: Hypothesis, base: &Baseline, measurements: &[PoseMeasurement]) -> Result<Self> {
+        let mut hypotheses = self.hypotheses.clone();
+        hypotheses.push(hypothesis);
+        self.refit(hypotheses, base, measurements)
+    }
+
+    /// This model without `hypothesis`.
+    pub fn without(&self, hypothesis: Hypothesis, base: &Baseline, measurements: &[PoseMeasurement]) -> Result<Self> {
+        let hypotheses = self.hypotheses.iter().copied().filter(|h| *h != hypothesis).collect();
+        self.refit(hypotheses, base, measurements)
+    }
+
+    /// The estimate of `kind`, if the model has it.
+    pub fn estimate(&self, kind: EffectKind) -> Option<&EffectEstimate> {
+        self.result.effect_estimates.iter().find(|e| e.effect == kind)
+    }
+}
 
 /// One estimated parameter.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -25,22 +186,39 @@ pub struct ParameterValue {
     pub sigma: f64,
 }
 
-/// One candidate extension, fitted.
+/// One hypothesis tested against the model of one step of the search.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CandidateFit {
-    /// The effect's name.
+    /// The hypothesis' name (an effect, or `orientation`).
     pub effect: String,
-    /// Estimated parameters (empty when the fit failed).
+    /// The step of the forward selection (1: against the baseline).
+    pub step: usize,
+    /// The model it extends (`none`: the baseline).
+    pub extends: String,
+    /// Estimated parameters (empty when the fit failed or for `orientation`).
     pub params: Vec<ParameterValue>,
-    /// Parameters added to the baseline.
+    /// Parameters added to the model it extends.
     pub added_parameters: usize,
     /// Sum of squared normalised residuals at the fit.
     pub chi_square: f64,
-    /// `chi_square + k ln n`.
-    pub bic: f64,
-    /// `bic - baseline bic` (negative: preferred over the baseline).
+    /// Likelihood-ratio statistic: the chi-square drop over the variance factor.
+    pub lr_statistic: f64,
+    /// Its p-value under "the hypothesis adds nothing" (chi-square, `added_parameters` dof).
+    pub p_value: f64,
+    /// The p-value below which it is declared: the false-alarm rate over the step's hypotheses.
+    pub p_threshold: f64,
+    /// `p_value < p_threshold`, converged and admissible.
+    pub significant: bool,
+    /// `chi_square / variance_factor + k ln n` minus the extended model's.
     pub delta_bic: f64,
-    /// Held-out residual RMS (normalised).
+    /// Power of the test at the effect's smallest physically plausible
+    /// magnitude for this robot (from the fit's Fisher information); `None`
+    /// for `orientation` or a singular information matrix.
+    pub power: Option<f64>,
+    /// Per parameter, the smallest magnitude the test detects with power
+    /// 0.9 (the others estimated too), in the variable's units (gains as errors).
+    pub min_detectable: Vec<f64>,
+    /// Held-out residual RMS (normalised): computed for the models the search selects, else NaN.
     pub cv_rms: f64,
     /// Whether the solver converged.
     pub converged: bool,
@@ -55,7 +233,8 @@ pub struct CandidateFit {
 }
 
 /// Why an estimate is physically impossible (a negative compliance or pulley
-/// radius, more than 3 sigma below zero), if it is.
+/// radius, more than 3 sigma below zero; more than one element for a chain
+/// is required too), or unidentifiable, if it is.
 pub(super) fn inadmissible(estimate: &EffectEstimate) -> Option<String> {
     if estimate.sigmas.iter().any(|s| !s.is_finite()) {
         return Some("not identifiable from these poses (singular information matrix)".into());
@@ -64,10 +243,10 @@ pub(super) fn inadmissible(estimate: &EffectEstimate) -> Option<String> {
     let what = match estimate.effect {
         EffectKind::Elastic => "axial compliance",
         EffectKind::Pulley => "pulley radius",
+        EffectKind::Segments => "1/n^2 of the cable's elements",
         _ => return None,
     };
-    (value < -3.0 * sigma.max(0.0) || (value < 0.0 && !sigma.is_finite()))
-        .then(|| format!("negative {what} ({value:.3e} +- {sigma:.1e})"))
+    (value < -3.0 * sigma.max(0.0)).then(|| format!("negative {what} ({value:.3e} +- {sigma:.1e})"))
 }
 
 /// The estimate's parameters with their 1-sigma, for the report.
@@ -85,91 +264,118 @@ pub(super) fn parameters(estimate: &EffectEstimate) -> Vec<ParameterValue> {
         .collect()
 }
 
-/// The graph of a fitted calibration (values at the fit), with the effect's
-/// variable set from its estimate (the robot file's effects cannot hold a
+/// The graph of a fitted calibration (values at the fit), with the effect
+/// variables set from the estimates (the robot file's effects cannot hold a
 /// negative compliance).
 pub(super) fn rebuild(
     result: &CalibrationResult,
     used: &[PoseMeasurement],
     options: &CalibrationOptions,
 ) -> CalibrationGraph {
+    let mut robot = result.robot.clone();
+    robot.effects = without_estimated(&robot.effects, &result.effect_estimates);
     let mut built = build_graph(
-        &result.robot,
+        &robot,
         used,
         &result.poses,
         &result.reference_tensions(),
         CableModel::Catenary,
         options,
     );
-    if let (Some(vars), Some(estimate)) = (built.effects, &result.effect_estimate) {
-        built.graph.values.set(
-            vars.of(estimate.effect),
-            VariableValue::Vector(nalgebra::DVector::from_vec(estimate.variable_values())),
-        );
-    }
+    set_effect_estimates(&mut built, &result.effect_estimates);
     built
 }
 
-/// Fit every candidate of `options.candidates` from the baseline: the
-/// report row of each, and the fits that succeeded.
-pub(super) fn fit_candidates(
-    base: &Baseline,
-    measurements: &[PoseMeasurement],
-    truth: Option<&Robot>,
-    options: &DiagnoseOptions,
-    progress: &mut Progress<'_>,
-) -> (Vec<CandidateFit>, Vec<(EffectKind, CalibrationResult)>) {
-    let mut candidates = Vec::new();
-    let mut fits: Vec<(EffectKind, CalibrationResult)> = Vec::new();
-    for &kind in &options.candidates {
-        progress.step(&format!("fit {kind}"));
-        let candidate_options = CalibrationOptions {
-            free_effect: Some(kind),
-            ..base.options
-        };
-        let fitted = refine_with_effect(&base.result, measurements, &candidate_options).and_then(|result| {
-            let cv = cross_validate(&result, &base.used, &candidate_options, options.folds, &mut |what| {
-                progress.step(&format!("{kind}: {what}"))
-            })?;
-            Ok((result, cv))
-        });
-        match fitted {
-            Ok((result, cv_rms)) => {
-                let graph = rebuild(&result, &base.used, &candidate_options);
-                let chi = super::residual_tests::total_chi_square(&graph.graph);
-                let estimate = result.effect_estimate.clone().expect("refine_with_effect sets it");
-                candidates.push(CandidateFit {
-                    effect: kind.name().to_string(),
-                    params: parameters(&estimate),
-                    added_parameters: kind.parameter_count(),
-                    chi_square: chi,
-                    bic: base.bic_of(chi, kind.parameter_count()),
-                    delta_bic: base.bic_of(chi, kind.parameter_count()) - base.bic,
-                    cv_rms,
-                    converged: result.converged(),
-                    anchor_mae_m: truth.map(|t| CalibrationError::between(&result.robot, t).anchor_coordinate_mae_m),
-                    error: None,
-                    inadmissible: inadmissible(&estimate),
-                });
-                fits.push((kind, result));
-            }
-            Err(e) => {
-                progress.skip(options.folds);
-                candidates.push(CandidateFit {
-                    effect: kind.name().to_string(),
-                    params: Vec::new(),
-                    added_parameters: kind.parameter_count(),
-                    chi_square: f64::NAN,
-                    bic: f64::NAN,
-                    delta_bic: f64::NAN,
-                    cv_rms: f64::NAN,
-                    converged: false,
-                    anchor_mae_m: None,
-                    error: Some(e.to_string()),
-                    inadmissible: None,
-                })
-            }
+/// The test of `hypothesis` against `model` at a step where `tested`
+/// hypotheses share the false-alarm rate: the fit (if it succeeded) and its row.
+pub(super) fn test_hypothesis(
+    search: &Search<'_>,
+    model: &Model,
+    hypothesis: Hypothesis,
+    tested: usize,
+    step: usize,
+) -> (Option<Model>, CandidateFit) {
+    let (base, measurements) = (search.base, search.measurements);
+    let added = model.added_parameters(hypothesis, base.used.len());
+    let p_threshold = search.options.false_alarm / tested as f64;
+    let mut row = CandidateFit {
+        effect: hypothesis.name().to_string(),
+        step,
+        extends: model.name(),
+        params: Vec::new(),
+        added_parameters: added,
+        chi_square: f64::NAN,
+        lr_statistic: f64::NAN,
+        p_value: f64::NAN,
+        p_threshold,
+        significant: false,
+        delta_bic: f64::NAN,
+        power: None,
+        min_detectable: Vec::new(),
+        cv_rms: f64::NAN,
+        converged: false,
+        anchor_mae_m: None,
+        error: None,
+        inadmissible: None,
+    };
+    let fit = match model.with(hypothesis, base, measurements) {
+        Ok(fit) => fit,
+        Err(e) => {
+            row.error = Some(e.to_string());
+            return (None, row);
+        }
+    };
+    let lr = (model.chi_square - fit.chi_square) / base.variance_factor;
+    row.chi_square = fit.chi_square;
+    row.lr_statistic = lr;
+    row.p_value = chi_square_survival(added, lr.max(0.0));
+    row.delta_bic = base.bic_of(fit.chi_square, added) - base.bic_of(model.chi_square, 0);
+    row.converged = fit.result.converged();
+    row.anchor_mae_m = search
+        .truth
+        .map(|t| CalibrationError::between(&fit.result.robot, t).anchor_coordinate_mae_m);
+    if let Hypothesis::Effect(kind) = hypothesis {
+        if let Some(estimate) = fit.estimate(kind) {
+            row.params = parameters(estimate);
+            row.inadmissible = inadmissible(estimate);
+            let critical = chi_square_critical(added, p_threshold);
+            let smallest = smallest_plausible(kind, &base.result.robot, base.mean_reference_tension_n);
+            row.power = power_at(estimate, &smallest, added, critical, base.variance_factor);
+            row.min_detectable = min_detectable(estimate, added, critical, base.variance_factor);
         }
     }
-    (candidates, fits)
+    row.significant = row.converged && row.inadmissible.is_none() && row.p_value < p_threshold;
+    (Some(fit), row)
+}
+
+/// The power of a chi-square test with `dof` degrees of freedom and critical
+/// value `critical` against the effect at `magnitude` (variable units): the
+/// non-centrality is `theta^T Sigma^-1 theta / s^2`, `Sigma` the estimate's
+/// covariance (the inverse Fisher information) and `s^2` the variance factor.
+fn power_at(
+    estimate: &EffectEstimate,
+    magnitude: &[f64],
+    dof: usize,
+    critical: f64,
+    variance_factor: f64,
+) -> Option<f64> {
+    let k = magnitude.len();
+    let covariance = nalgebra::DMatrix::from_fn(k, k, |r, c| estimate.covariance[r][c] * variance_factor);
+    let theta = nalgebra::DVector::from_column_slice(magnitude);
+    let solved = covariance.cholesky()?.solve(&theta);
+    let lambda = theta.dot(&solved);
+    lambda
+        .is_finite()
+        .then(|| noncentral_chi_square_survival(dof, lambda, critical))
+}
+
+/// Per parameter, the magnitude detected with power [`DETECTION_POWER`]
+/// when it alone is present: `sigma s sqrt(lambda_0.9)`.
+fn min_detectable(estimate: &EffectEstimate, dof: usize, critical: f64, variance_factor: f64) -> Vec<f64> {
+    let lambda = noncentrality_for_power(dof, critical, DETECTION_POWER);
+    estimate
+        .sigmas
+        .iter()
+        .map(|s| s * (variance_factor * lambda).sqrt())
+        .collect()
 }

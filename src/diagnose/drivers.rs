@@ -84,6 +84,8 @@ pub(super) fn winning_driver(effect: EffectKind) -> (&'static str, &'static str)
         EffectKind::EncoderScale => ("encoder", DRIVERS[2]),
         EffectKind::LoadCell => ("load_cell", "measured tension (N)"),
         EffectKind::Com => ("encoder", DRIVERS[0]),
+        EffectKind::CommonGain => ("encoder", DRIVERS[2]),
+        EffectKind::Segments => ("encoder", DRIVERS[3]),
     }
 }
 

@@ -2,24 +2,28 @@
 //!
 //! Given measurements, [`diagnose`]
 //!
-//! 1. calibrates with the baseline model (the paper's closed-form catenary)
-//!    and tests the normalised residuals against the stated sensor noise with
-//!    a chi-square test per factor type ([`FactorTest`]);
+//! 1. calibrates with the baseline model (the paper's closed-form catenary,
+//!    with every sensor as evidence: the localiser's orientation is a prior
+//!    unless turned off) and tests the normalised residuals against the
+//!    stated sensor noise with a chi-square test per factor type ([`FactorTest`]);
 //! 2. relates the residuals to physical drivers of each cable and pose
 //!    (tension, tension x length, cable length, sag, elevation, pulley wrap
 //!    angle, platform position) by correlation, and says which carry structure
 //!    ([`DriverTest`], `|t| > 3.29`, two-sided p < 0.001);
-//! 3. fits every candidate effect of the catalogue ([`EffectKind`]) as an
-//!    extension of the factor graph (extra parameter variables,
-//!    [`crate::calib::effect_factors`]), scores each by the Bayesian
-//!    information criterion `BIC = chi^2 + k ln n` (Schwarz 1978) and by
-//!    K-fold cross-validation over held-out poses, and declares an effect only
-//!    when the evidence is strong (`BIC` lower than the baseline's by at least
-//!    [`DiagnoseOptions::min_bic_drop`], 10 = "very strong" on the Kass &
-//!    Raftery 1995 scale, and a lower held-out residual); otherwise `none`;
-//! 4. reports the verdict, the effect's parameters with 1-sigma, and the gain:
-//!    held-out residual RMS before and after and, given the truth, anchor and
-//!    offset errors before and after.
+//! 3. searches the hypotheses, each effect of the catalogue ([`EffectKind`],
+//!    extra parameter variables of the factor graph,
+//!    [`crate::calib::effect_factors`]) and "the localiser's orientations are
+//!    unreliable" ([`Hypothesis::OrientationFree`], 3 parameters per pose), by
+//!    forward selection with likelihood-ratio tests at a stated false-alarm
+//!    rate and backward checks (`selection`), so that several effects can be
+//!    named at once; each test's power at the effect's smallest physically
+//!    plausible magnitude comes from the fit's Fisher information, and a
+//!    candidate whose power is below 0.9 is reported as not detectable at
+//!    this noise with these poses;
+//! 4. reports the verdict (the effects in the order added, joined by `+`, or
+//!    `none`), the parameters with 1-sigma, and the gain: held-out residual
+//!    RMS before and after and, given the truth, anchor and offset errors
+//!    before and after.
 //!
 //! Held-out residual: for each fold the model is re-fitted without the
 //! fold's poses; each held-out pose's own variables (pose, reference tension)
@@ -35,44 +39,51 @@ mod residual_tests;
 mod selection;
 pub mod verify;
 
-use crate::calib::{calibrate, CalibrationGraph, CalibrationOptions, CalibrationResult};
+use crate::calib::{calibrate, CalibrationGraph, CalibrationOptions, CalibrationResult, OrientationPrior};
 use crate::error::{Error, Result};
-use crate::model::effects::EffectKind;
+use crate::model::effects::{EffectKind, EffectSet};
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::stats::{self, chi_square_quantile_999};
 
-pub use candidates::{CandidateFit, ParameterValue};
+pub use candidates::{CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER};
 pub use drivers::{DriverSeries, DriverTest, DRIVERS, DRIVER_T_LIMIT};
-pub use report::{error_over_sigma, Diagnosis, Gain};
+pub use report::{error_over_sigma, Diagnosis, EffectFit, Gain};
 pub use residual_tests::{FactorTest, MEASUREMENT_KINDS};
+pub use selection::SelectionStep;
 
-use candidates::{fit_candidates, rebuild};
+use candidates::{parameters, rebuild};
 use drivers::{driver_series, driver_tests, samples};
 use residual_tests::{factor_tests, measurement_components, total_chi_square, variance_factor};
-use selection::{choose, cross_validate};
+use selection::{cross_validate, first_effect, forward_selection, Search};
 
 /// How to diagnose.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DiagnoseOptions {
-    /// The baseline calibration's options (their `free_effect` is ignored).
+    /// The baseline calibration's options (their `free_effects` are ignored;
+    /// the orientation prior is used unless it is `off`).
     pub calibration: CalibrationOptions,
-    /// The candidate extensions to fit.
+    /// The candidate effects of the search.
     pub candidates: Vec<EffectKind>,
+    /// Whether "the localiser's orientations are unreliable" is a hypothesis too.
+    pub orientation_hypothesis: bool,
     /// Folds of the cross-validation over poses (>= 2).
     pub folds: usize,
-    /// How much lower than the baseline's a candidate's BIC must be to declare it.
-    pub min_bic_drop: f64,
+    /// The false-alarm rate of the whole search: the probability of
+    /// declaring an effect on data the baseline describes (module docs).
+    pub false_alarm: f64,
 }
 
 impl DiagnoseOptions {
-    /// Every candidate of the catalogue, 5 folds, a BIC drop of 10.
+    /// Every candidate of the catalogue and the orientation hypothesis, 5
+    /// folds, a false-alarm rate of 0.1 %.
     pub fn new(calibration: CalibrationOptions) -> Self {
         Self {
             calibration,
             candidates: EffectKind::ALL.to_vec(),
+            orientation_hypothesis: true,
             folds: 5,
-            min_bic_drop: 10.0,
+            false_alarm: 1e-3,
         }
     }
 }
@@ -91,9 +102,9 @@ impl Progress<'_> {
         self.done += 1;
     }
 
-    /// Count `steps` steps as done without reporting them.
-    fn skip(&mut self, steps: usize) {
-        self.done += steps;
+    /// `steps` more steps than planned.
+    fn grow(&mut self, steps: usize) {
+        self.total += steps;
     }
 
     /// Report the end.
@@ -125,6 +136,8 @@ struct Baseline {
     variance_factor: f64,
     /// The baseline's BIC.
     bic: f64,
+    /// Mean load-cell reading over the poses used, newtons.
+    mean_reference_tension_n: f64,
 }
 
 impl Baseline {
@@ -135,8 +148,15 @@ impl Baseline {
         options: &DiagnoseOptions,
         progress: &mut Progress<'_>,
     ) -> Result<Self> {
+        // Every sensor is evidence: the localiser's orientation is a prior
+        // unless the user turned it off; "it is unreliable" is a hypothesis.
+        let orientation_prior = match options.calibration.orientation_prior {
+            OrientationPrior::Off => OrientationPrior::Off,
+            _ => OrientationPrior::On,
+        };
         let base_options = CalibrationOptions {
-            free_effect: None,
+            free_effects: EffectSet::NONE,
+            orientation_prior,
             ..options.calibration
         };
         progress.step("baseline calibration");
@@ -171,7 +191,10 @@ impl Baseline {
             dof,
             variance_factor: variance_factor(chi_square, dof),
             bic: f64::NAN,
+            mean_reference_tension_n: f64::NAN,
         };
+        base.mean_reference_tension_n =
+            base.used.iter().map(|m| m.reference_tension_n).sum::<f64>() / base.used.len() as f64;
         base.bic = base.bic_of(chi_square, 0);
         Ok(base)
     }
@@ -198,10 +221,15 @@ pub fn diagnose(
             options.folds
         )));
     }
-    let total = (1 + options.candidates.len()) * (1 + options.folds);
+    if !(options.false_alarm > 0.0 && options.false_alarm < 1.0) {
+        return Err(Error::InvalidInput(format!(
+            "diagnose: the false-alarm rate must be in (0, 1), got {}",
+            options.false_alarm
+        )));
+    }
     let mut progress = Progress {
         done: 0,
-        total,
+        total: 2 + 2 * options.folds,
         report: progress,
     };
     // 1. The baseline calibration, its residuals tested against the stated noise.
@@ -213,29 +241,39 @@ pub fn diagnose(
     let baseline_cv = cross_validate(&base.result, &base.used, &base.options, options.folds, &mut |what| {
         progress.step(&format!("baseline: {what}"))
     })?;
-    // 3. Every candidate fitted and scored; the verdict.
-    let (candidates, fits) = fit_candidates(&base, measurements, truth, options, &mut progress);
-    progress.finish();
-    let choice = choose(&candidates, baseline_cv, options.min_bic_drop);
-    // 4. The report: what the verdict's extension gains, and the structure left.
-    let winner_fit = choice
-        .winner
-        .and_then(|i| fits.iter().find(|(k, _)| k.name() == candidates[i].effect));
-    let after = winner_fit.map_or(&base.result, |(_, r)| r);
-    let cv_after = choice.winner.map_or(baseline_cv, |i| candidates[i].cv_rms);
-    let gain = report::gain(truth, &base.result.robot, &after.robot, baseline_cv, cv_after);
-    let (drivers_after, series) = match winner_fit {
-        Some((kind, result)) => {
-            let candidate_options = CalibrationOptions {
-                free_effect: Some(*kind),
-                ..base.options
-            };
-            let after_samples = samples(result, &base.used, &rebuild(result, &base.used, &candidate_options))?;
-            let series = driver_series(&drivers, &base_samples, Some((*kind, &after_samples)));
-            (driver_tests(&after_samples), series)
-        }
-        None => (Vec::new(), driver_series(&drivers, &base_samples, None)),
+    // 3. Forward selection of the hypotheses at the stated false-alarm rate.
+    let search = Search {
+        base: &base,
+        measurements,
+        truth,
+        options,
     };
+    let selection = forward_selection(&search, &mut progress);
+    let model = &selection.model;
+    let cv_after = if model.hypotheses.is_empty() {
+        baseline_cv
+    } else {
+        cross_validate(&model.result, &base.used, &model.options, options.folds, &mut |what| {
+            progress.step(&format!("{}: {what}", model.name()))
+        })?
+    };
+    progress.finish();
+    // 4. The report: what the selected extension gains, and the structure left.
+    let gain = report::gain(truth, &base.result.robot, &model.result.robot, baseline_cv, cv_after);
+    let (drivers_after, series) = if model.hypotheses.is_empty() {
+        (Vec::new(), driver_series(&drivers, &base_samples, None))
+    } else {
+        let after_samples = samples(
+            &model.result,
+            &base.used,
+            &rebuild(&model.result, &base.used, &model.options),
+        )?;
+        let shown = first_effect(model).map(|kind| (kind, after_samples.as_slice()));
+        let series = driver_series(&drivers, &base_samples, shown);
+        (driver_tests(&after_samples), series)
+    };
+    let reason = report::reason(&selection, &base, options);
+    let undetectable = report::undetectable(&selection);
     Ok(Diagnosis {
         robot: robot.name.clone(),
         poses_used: base.used.len(),
@@ -244,17 +282,30 @@ pub fn diagnose(
         baseline_dof: base.dof,
         baseline_consistent: base.chi_square <= chi_square_quantile_999(base.dof),
         variance_factor: base.variance_factor,
+        orientation_prior: base.options.orientation_prior,
+        false_alarm: options.false_alarm,
         factor_tests,
         drivers,
         drivers_after,
         baseline_bic: base.bic,
         baseline_cv_rms: baseline_cv,
-        candidates,
-        verdict: choice.verdict,
-        reason: choice.reason,
+        verdict: model.name(),
+        effects: model
+            .result
+            .effect_estimates
+            .iter()
+            .map(|e| report::EffectFit {
+                effect: e.effect.name().to_string(),
+                params: parameters(e),
+            })
+            .collect(),
+        steps: selection.steps,
+        undetectable,
+        candidates: selection.candidates,
+        reason,
         gain,
         baseline_error_over_sigma: truth.map(|t| error_over_sigma(&base.result.robot, t, &base.result.uncertainty)),
-        robot_after: after.robot.clone(),
+        robot_after: model.result.robot.clone(),
         series,
     })
 }

@@ -2,10 +2,12 @@
 
 use serde::Serialize;
 
-use super::candidates::CandidateFit;
+use super::candidates::{CandidateFit, ParameterValue, DETECTION_POWER};
 use super::drivers::{DriverSeries, DriverTest};
 use super::residual_tests::FactorTest;
-use crate::calib::{CalibrationError, ParameterUncertainty};
+use super::selection::{Selection, SelectionStep};
+use super::{Baseline, DiagnoseOptions};
+use crate::calib::{CalibrationError, OrientationPrior, ParameterUncertainty};
 use crate::model::robot::{Robot, CABLE_COUNT};
 
 /// What the chosen extension gains.
@@ -44,9 +46,13 @@ pub struct Diagnosis {
     pub baseline_dof: usize,
     /// Whether the baseline's chi-square is within the 99.9 % quantile.
     pub baseline_consistent: bool,
-    /// The a posteriori variance factor dividing every chi-square in the BIC
-    /// (1 unless the data are more precise than the stated noise).
+    /// The a posteriori variance factor dividing every chi-square of the
+    /// tests (1 unless the data are more precise than the stated noise).
     pub variance_factor: f64,
+    /// The localiser's orientation in the baseline (`on` unless turned off).
+    pub orientation_prior: OrientationPrior,
+    /// The false-alarm rate of the search.
+    pub false_alarm: f64,
     /// Per factor type.
     pub factor_tests: Vec<FactorTest>,
     /// Residual-driver correlations of the baseline, strongest first.
@@ -57,10 +63,17 @@ pub struct Diagnosis {
     pub baseline_bic: f64,
     /// Baseline held-out residual RMS.
     pub baseline_cv_rms: f64,
-    /// Every candidate.
-    pub candidates: Vec<CandidateFit>,
-    /// The effect found, or `none`.
+    /// The hypotheses selected, in the order added, joined by `+`; or `none`.
     pub verdict: String,
+    /// The selected effects with their parameters and 1-sigma.
+    pub effects: Vec<EffectFit>,
+    /// The steps of the forward selection that added something.
+    pub steps: Vec<SelectionStep>,
+    /// Candidates not selected whose test has power below 0.9 at their
+    /// smallest plausible magnitude: not detectable at this noise with these poses.
+    pub undetectable: Vec<String>,
+    /// Every hypothesis tested, at every step.
+    pub candidates: Vec<CandidateFit>,
     /// Why, in one sentence.
     pub reason: String,
     /// What the verdict's extension gains.
@@ -68,7 +81,7 @@ pub struct Diagnosis {
     /// Given the truth: the baseline's anchor error over its stated 1-sigma
     /// ([`error_over_sigma`]); above 1 the model error is visible in the anchors.
     pub baseline_error_over_sigma: Option<f64>,
-    /// The verdict's calibrated robot (anchors, offsets, effects); the baseline's for `none`.
+    /// The selected model's calibrated robot (anchors, offsets, effects); the baseline's for `none`.
     #[serde(skip)]
     pub robot_after: Robot,
     /// Residual against the winning driver (or the strongest, for `none`).
@@ -103,4 +116,64 @@ pub(super) fn gain(truth: Option<&Robot>, before: &Robot, after: &Robot, cv_befo
         offset_mae_before_m: before_error.map(|e| e.offset_mae_m),
         offset_mae_after_m: after_error.map(|e| e.offset_mae_m),
     }
+}
+
+/// One selected effect.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EffectFit {
+    /// The effect's name.
+    pub effect: String,
+    /// Its parameters with 1-sigma.
+    pub params: Vec<ParameterValue>,
+}
+
+/// Why the search selected what it did, in one sentence.
+pub(super) fn reason(selection: &Selection, base: &Baseline, options: &DiagnoseOptions) -> String {
+    let level = format!("false-alarm rate {:.0e}", options.false_alarm);
+    if selection.steps.is_empty() {
+        let best = selection
+            .candidates
+            .iter()
+            .filter(|c| c.p_value.is_finite())
+            .min_by(|a, b| a.p_value.total_cmp(&b.p_value));
+        return match best {
+            Some(c) => format!(
+                "no hypothesis is significant at {level}: the strongest, {}, has p = {:.2e} (needs < {:.2e}; likelihood ratio {:.1} on {} dof, variance factor {:.3})",
+                c.effect, c.p_value, c.p_threshold, c.lr_statistic, c.added_parameters, base.variance_factor
+            ),
+            None => "no hypothesis could be fitted".into(),
+        };
+    }
+    let steps: Vec<String> = selection
+        .steps
+        .iter()
+        .map(|s| {
+            let removed = if s.removed.is_empty() {
+                String::new()
+            } else {
+                format!(", then removed {}", s.removed.join(", "))
+            };
+            format!(
+                "step {}: {} (likelihood ratio {:.1} on {} dof, p = {:.2e} < {:.2e}){removed}",
+                s.step, s.added, s.lr_statistic, s.added_parameters, s.p_value, s.p_threshold
+            )
+        })
+        .collect();
+    format!("forward selection at {level}: {}", steps.join("; "))
+}
+
+/// The candidates of the last step whose power at their smallest plausible
+/// magnitude is below [`DETECTION_POWER`], with that power.
+pub(super) fn undetectable(selection: &Selection) -> Vec<String> {
+    let last = selection.candidates.iter().map(|c| c.step).max().unwrap_or(0);
+    selection
+        .candidates
+        .iter()
+        .filter(|c| c.step == last && !c.significant)
+        .filter_map(|c| {
+            c.power
+                .filter(|p| *p < DETECTION_POWER)
+                .map(|p| format!("{} (power {p:.2})", c.effect))
+        })
+        .collect()
 }

@@ -1,71 +1,175 @@
-//! Step 3b: model selection. Each candidate's held-out residual by K-fold
-//! cross-validation over poses, and the verdict: the lowest BIC among the
-//! candidates that beat the baseline's by the threshold and predict held-out
-//! poses better.
+//! Step 3b: model selection by forward selection with likelihood-ratio tests
+//! at a stated false-alarm rate, backward checks, and each selected model's
+//! held-out residual by K-fold cross-validation over poses.
+//!
+//! At each step every hypothesis not yet in the model is fitted as its
+//! extension and tested by the likelihood ratio `D = (chi^2_model -
+//! chi^2_extended) / s^2` (`s^2` the a posteriori variance factor), which is
+//! chi-square with the added parameters' degrees of freedom when the
+//! hypothesis adds nothing (Wilks). A hypothesis is significant when its
+//! p-value is below `alpha / m`, `m` the hypotheses tested at the step
+//! (Bonferroni): on data the model describes, the probability of declaring
+//! anything is at most `alpha`, and each later step adds a spurious effect
+//! with probability at most `alpha` too. Of the significant hypotheses the
+//! one with the lowest BIC (`D` less `k ln n`: the most evidence per
+//! parameter, so that a 2-parameter centre-of-mass shift that explains a tilt
+//! beats freeing 3 orientation parameters per pose) is added and the model
+//! refitted; every
+//! earlier hypothesis is then tested for removal at the same level
+//! (backward check), and the search goes on until nothing is significant.
 
-use super::candidates::{rebuild, CandidateFit};
+use serde::Serialize;
+
+use super::candidates::{rebuild, test_hypothesis, CandidateFit, Hypothesis, Model};
 use super::residual_tests::MEASUREMENT_KINDS;
-use crate::calib::{build_graph, CableModel, CalibrationGraph, CalibrationOptions, CalibrationResult};
+use super::{Baseline, DiagnoseOptions, Progress};
+use crate::calib::{
+    build_graph, CableModel, CalibrationGraph, CalibrationOptions, CalibrationResult, OrientationPrior,
+};
 use crate::error::{Error, Result};
 use crate::graph::whitened_squared_norm;
 use crate::model::effects::EffectKind;
 use crate::model::measurement::PoseMeasurement;
+use crate::model::robot::Robot;
 use crate::model::statics::CableTension;
 use crate::solver::optimize;
+use crate::stats::chi_square_survival;
 
-/// The verdict of the selection.
-pub(super) struct Verdict {
-    /// Index of the declared candidate, if any.
-    pub winner: Option<usize>,
-    /// Its effect's name, or `none`.
-    pub verdict: String,
-    /// Why, in one sentence.
-    pub reason: String,
+/// What the search works on.
+pub(super) struct Search<'a> {
+    /// The baseline fit.
+    pub base: &'a Baseline,
+    /// All measurements (the baseline's excluded poses stay out).
+    pub measurements: &'a [PoseMeasurement],
+    /// The truth, if known (for the report only).
+    pub truth: Option<&'a Robot>,
+    /// The options.
+    pub options: &'a DiagnoseOptions,
 }
 
-/// The lowest BIC among the candidates that beat the baseline's by
-/// `min_bic_drop`, predict held-out poses better than `baseline_cv` and are
-/// admissible; `none` otherwise.
-pub(super) fn choose(candidates: &[CandidateFit], baseline_cv: f64, min_bic_drop: f64) -> Verdict {
-    let winner = candidates
+/// One step of the forward selection.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SelectionStep {
+    /// 1-based step.
+    pub step: usize,
+    /// The hypothesis added.
+    pub added: String,
+    /// Its likelihood-ratio statistic against the previous model.
+    pub lr_statistic: f64,
+    /// Its degrees of freedom.
+    pub added_parameters: usize,
+    /// Its p-value.
+    pub p_value: f64,
+    /// The p-value it had to beat.
+    pub p_threshold: f64,
+    /// Hypotheses removed by the backward check after the addition.
+    pub removed: Vec<String>,
+}
+
+/// The outcome of the search.
+pub(super) struct Selection {
+    /// The selected model.
+    pub model: Model,
+    /// Every hypothesis tested, at every step.
+    pub candidates: Vec<CandidateFit>,
+    /// The steps that added something.
+    pub steps: Vec<SelectionStep>,
+}
+
+/// The hypotheses the search may add (`options.candidates`, and the
+/// orientation when the baseline uses the localiser's orientations).
+fn hypotheses(search: &Search<'_>) -> Vec<Hypothesis> {
+    let mut all: Vec<Hypothesis> = search
+        .options
+        .candidates
         .iter()
-        .enumerate()
-        .filter(|(_, c)| {
-            c.converged && c.inadmissible.is_none() && c.delta_bic <= -min_bic_drop && c.cv_rms < baseline_cv
-        })
-        .min_by(|a, b| a.1.bic.total_cmp(&b.1.bic))
-        .map(|(i, _)| i);
-    let best_other = candidates
-        .iter()
-        .filter(|c| c.delta_bic.is_finite() && c.inadmissible.is_none())
-        .min_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
-    let (verdict, reason) = match winner {
-        Some(i) => {
-            let c = &candidates[i];
-            (
-                c.effect.clone(),
-                format!(
-                    "{} lowers the BIC by {:.1} (threshold {:.0}) with {} parameter(s) and the held-out residual RMS from {:.3} to {:.3}",
-                    c.effect, -c.delta_bic, min_bic_drop, c.added_parameters, baseline_cv, c.cv_rms
-                ),
-            )
-        }
-        None => (
-            "none".to_string(),
-            match best_other {
-                Some(c) => format!(
-                    "no candidate is significant: the best, {}, changes the BIC by {:+.1} (needs <= -{:.0}) and the held-out residual RMS from {:.3} to {:.3}",
-                    c.effect, c.delta_bic, min_bic_drop, baseline_cv, c.cv_rms
-                ),
-                None => "no candidate could be fitted".to_string(),
-            },
-        ),
-    };
-    Verdict {
-        winner,
-        verdict,
-        reason,
+        .map(|k| Hypothesis::Effect(*k))
+        .collect();
+    if search.options.orientation_hypothesis && search.base.options.orientation_prior == OrientationPrior::On {
+        all.push(Hypothesis::OrientationFree);
     }
+    all
+}
+
+/// Forward selection from the baseline (module docs).
+pub(super) fn forward_selection(search: &Search<'_>, progress: &mut Progress<'_>) -> Selection {
+    let mut model = Model::baseline(search.base);
+    let mut candidates = Vec::new();
+    let mut steps = Vec::new();
+    let all = hypotheses(search);
+    for step in 1..=all.len() {
+        let open: Vec<Hypothesis> = all.iter().copied().filter(|h| model.can_add(*h)).collect();
+        if open.is_empty() {
+            break;
+        }
+        progress.grow(open.len());
+        let mut best: Option<(f64, Model, usize)> = None;
+        for &hypothesis in &open {
+            progress.step(&format!("step {step}: fit {}", hypothesis.name()));
+            let (fit, row) = test_hypothesis(search, &model, hypothesis, open.len(), step);
+            if let (Some(fit), true) = (fit, row.significant) {
+                let score = row.delta_bic;
+                if best.as_ref().is_none_or(|(b, _, _)| score < *b) {
+                    best = Some((score, fit, candidates.len()));
+                }
+            }
+            candidates.push(row);
+        }
+        let Some((_, extended, index)) = best else {
+            break;
+        };
+        let row = &candidates[index];
+        let mut selected = SelectionStep {
+            step,
+            added: row.effect.clone(),
+            lr_statistic: row.lr_statistic,
+            added_parameters: row.added_parameters,
+            p_value: row.p_value,
+            p_threshold: row.p_threshold,
+            removed: Vec::new(),
+        };
+        model = backward_check(search, extended, row.p_threshold, &mut selected.removed, progress);
+        steps.push(selected);
+    }
+    Selection {
+        model,
+        candidates,
+        steps,
+    }
+}
+
+/// Remove every earlier hypothesis of `model` whose removal the data do not
+/// reject at `p_threshold` (all but the one just added).
+fn backward_check(
+    search: &Search<'_>,
+    mut model: Model,
+    p_threshold: f64,
+    removed: &mut Vec<String>,
+    progress: &mut Progress<'_>,
+) -> Model {
+    let earlier: Vec<Hypothesis> = model.hypotheses[..model.hypotheses.len() - 1].to_vec();
+    for hypothesis in earlier {
+        progress.grow(1);
+        progress.step(&format!("backward check: {}", hypothesis.name()));
+        let Ok(reduced) = model.without(hypothesis, search.base, search.measurements) else {
+            continue;
+        };
+        let dof = reduced.added_parameters(hypothesis, search.base.used.len());
+        let lr = (reduced.chi_square - model.chi_square) / search.base.variance_factor;
+        if chi_square_survival(dof, lr.max(0.0)) >= p_threshold {
+            removed.push(hypothesis.name().to_string());
+            model = reduced;
+        }
+    }
+    model
+}
+
+/// The first effect of a model's hypotheses (for the plotted driver).
+pub(super) fn first_effect(model: &Model) -> Option<EffectKind> {
+    model.hypotheses.iter().find_map(|h| match h {
+        Hypothesis::Effect(kind) => Some(*kind),
+        Hypothesis::OrientationFree => None,
+    })
 }
 
 /// K-fold cross-validation of a fitted model over poses (module docs):

@@ -50,7 +50,12 @@ use serde::Serialize;
 use crate::calib::{build_graph, calibrate, CableModel, CalibrationError, CalibrationOptions};
 use crate::diagnose::{diagnose, DiagnoseOptions};
 use crate::error::{Error, Result};
-use crate::model::effects::{EffectKind, Effects};
+use crate::model::effect_ranges::{
+    axial_stiffness_range_n, com_shift_range_m, pulley_radius_range_m, COMMON_GAIN_HIGH, COMMON_GAIN_LOW,
+    SEGMENTS_HIGH, SEGMENTS_LOW,
+};
+pub use crate::model::effect_ranges::{effect_ranges, EffectRange, CABLE_DENSITY_KG_M3};
+use crate::model::effects::{EffectKind, EffectSet, Effects};
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::NoisePreset;
@@ -58,22 +63,6 @@ use crate::model::statics::CableTension;
 use crate::sim::closed_form::{sample_equilibria, Workspace};
 use crate::sim::effects::{measure_with_effects, solve_with_effects};
 use crate::solver::{marginal_covariance, Covariance};
-
-/// Density of the synthetic-fibre (aramid) cables, kg/m^3.
-pub const CABLE_DENSITY_KG_M3: f64 = 1440.0;
-/// Standard gravity, m/s^2.
-const GRAVITY: f64 = 9.81;
-
-/// The range an effect's magnitude is drawn from, for one robot.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct EffectRange {
-    /// The effect.
-    pub effect: String,
-    /// The range, in words with units.
-    pub range: String,
-    /// Why it is plausible.
-    pub justification: String,
-}
 
 /// Settings of the experiment.
 #[derive(Debug, Clone, PartialEq)]
@@ -125,82 +114,6 @@ pub struct HiddenCase {
     pub baseline_error_over_sigma: f64,
     /// Pulley cases: anchor error of a calibration given the true radius.
     pub anchor_mae_known_geometry_m: Option<f64>,
-}
-
-/// The magnitude ranges of every effect for `robot` (module docs).
-pub fn effect_ranges(robot: &Robot) -> Vec<EffectRange> {
-    let (ea_low, ea_high) = axial_stiffness_range_n(robot);
-    let (r_low, r_high) = pulley_radius_range_m(robot);
-    vec![
-        EffectRange {
-            effect: "elastic".into(),
-            range: format!("EA {ea_low:.3e} .. {ea_high:.3e} N (log-uniform)"),
-            justification: format!(
-                "{}: A = g_c / (rho g) = {:.2} mm^2 from {:.1} g/m at {CABLE_DENSITY_KG_M3} kg/m^3, rope modulus {:.0}-{:.0} GPa",
-                if is_large(robot) { "aramid rope" } else { "nylon braid" },
-                cross_section_m2(robot) * 1e6,
-                robot.cable_weight_n_per_m / GRAVITY * 1e3,
-                rope_modulus_pa(robot).0 / 1e9,
-                rope_modulus_pa(robot).1 / 1e9
-            ),
-        },
-        EffectRange {
-            effect: "pulley".into(),
-            range: format!("radius {r_low:.3} .. {r_high:.3} m"),
-            justification: "pulley sizes of winches for this cable and robot scale".into(),
-        },
-        EffectRange {
-            effect: "encoder-scale".into(),
-            range: "gain 1 +- (0.001 .. 0.003) per cable".into(),
-            justification: "effective drum radius uncertain by a fraction of the rope diameter".into(),
-        },
-        EffectRange {
-            effect: "loadcell".into(),
-            range: "bias +-(5 .. 12) % of the mean reference tension, gain 1 +- (0.02 .. 0.05)".into(),
-            justification: "zero and span errors of an uncalibrated load cell of 2-3 x the mean tension full scale".into(),
-        },
-        EffectRange {
-            effect: "com".into(),
-            range: format!(
-                "horizontal shift {:.2} .. {:.2} m, random direction",
-                com_shift_range_m(robot).0,
-                com_shift_range_m(robot).1
-            ),
-            justification: "payload mounted off the centre of the 0.42 m platform".into(),
-        },
-    ]
-}
-
-fn cross_section_m2(robot: &Robot) -> f64 {
-    robot.cable_weight_n_per_m / (CABLE_DENSITY_KG_M3 * GRAVITY)
-}
-
-/// The large robot (tens of kilograms, cables over 100 m) or a light one.
-fn is_large(robot: &Robot) -> bool {
-    robot.platform_weight_n > 100.0
-}
-
-/// Young's modulus range of the rope, pascals (module docs).
-fn rope_modulus_pa(robot: &Robot) -> (f64, f64) {
-    if is_large(robot) {
-        (30e9, 100e9)
-    } else {
-        (1e9, 3e9)
-    }
-}
-
-fn axial_stiffness_range_n(robot: &Robot) -> (f64, f64) {
-    let area = cross_section_m2(robot);
-    let (low, high) = rope_modulus_pa(robot);
-    (area * low, area * high)
-}
-
-fn com_shift_range_m(robot: &Robot) -> (f64, f64) {
-    if is_large(robot) {
-        (0.14, 0.25)
-    } else {
-        (0.08, 0.20)
-    }
 }
 
 /// The mean reference-cable tension over `poses` sampled equilibria, newtons.
@@ -274,14 +187,6 @@ pub fn mid_range_effects(robot: &Robot, mean_reference_tension_n: f64) -> Vec<(E
     ]
 }
 
-fn pulley_radius_range_m(robot: &Robot) -> (f64, f64) {
-    if is_large(robot) {
-        (0.1, 0.3)
-    } else {
-        (0.02, 0.05)
-    }
-}
-
 fn signed(rng: &mut impl Rng, low: f64, high: f64) -> f64 {
     let magnitude = rng.random_range(low..high);
     if rng.random_bool(0.5) {
@@ -321,6 +226,12 @@ pub fn draw_effects(
             let magnitude = rng.random_range(low..high);
             let angle = rng.random_range(0.0..std::f64::consts::TAU);
             e.com_shift_m = [magnitude * angle.cos(), magnitude * angle.sin(), 0.0];
+        }
+        Some(EffectKind::CommonGain) => {
+            e.encoder_gain = [1.0 + signed(rng, COMMON_GAIN_LOW, COMMON_GAIN_HIGH); CABLE_COUNT];
+        }
+        Some(EffectKind::Segments) => {
+            e.cable_segments = Some(rng.random_range(SEGMENTS_LOW..SEGMENTS_HIGH).round());
         }
     }
     e
@@ -492,7 +403,7 @@ pub fn identifiability(
     let mut known = truth.clone();
     known.effects = *effects;
     let calibration = CalibrationOptions {
-        free_effect: Some(effect),
+        free_effects: EffectSet::of(effect),
         ..CalibrationOptions::new(noise)
     };
     let true_poses: Vec<_> = solved.iter().map(|s| s.pose).collect();

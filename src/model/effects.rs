@@ -300,16 +300,23 @@ pub enum EffectKind {
     /// Horizontal centre-of-mass shift from the nominal one; two parameters
     /// (a vertical shift is not identifiable from nearly level poses).
     Com,
+    /// One encoder gain shared by the four drums (a common drum-radius or
+    /// counts-per-metre error); one parameter. Nested in [`EffectKind::EncoderScale`].
+    CommonGain,
+    /// The cable as a chain of `n` straight finite elements; one parameter, `1/n^2`.
+    Segments,
 }
 
 impl EffectKind {
     /// Every effect of the catalogue, in report order.
-    pub const ALL: [EffectKind; 5] = [
+    pub const ALL: [EffectKind; 7] = [
         EffectKind::Elastic,
         EffectKind::Pulley,
         EffectKind::EncoderScale,
         EffectKind::LoadCell,
         EffectKind::Com,
+        EffectKind::CommonGain,
+        EffectKind::Segments,
     ];
 
     /// The name used on the command line and in reports (`elastic`, `encoder-scale`, ...).
@@ -320,6 +327,8 @@ impl EffectKind {
             EffectKind::EncoderScale => "encoder-scale",
             EffectKind::LoadCell => "loadcell",
             EffectKind::Com => "com",
+            EffectKind::CommonGain => "encoder-gain",
+            EffectKind::Segments => "segments",
         }
     }
 
@@ -339,6 +348,8 @@ impl EffectKind {
             EffectKind::EncoderScale => &["gain1", "gain2", "gain3", "gain4"],
             EffectKind::LoadCell => &["bias_n", "gain"],
             EffectKind::Com => &["dx_m", "dy_m"],
+            EffectKind::CommonGain => &["gain"],
+            EffectKind::Segments => &["inverse_segments_squared"],
         }
     }
 
@@ -356,12 +367,89 @@ impl EffectKind {
             EffectKind::EncoderScale => effects.encoder_gain.to_vec(),
             EffectKind::LoadCell => vec![effects.load_cell_bias_n, effects.load_cell_gain],
             EffectKind::Com => effects.com_shift_m[..2].to_vec(),
+            EffectKind::CommonGain => vec![effects.encoder_gain.iter().sum::<f64>() / CABLE_COUNT as f64],
+            EffectKind::Segments => vec![effects.inverse_segments_squared()],
         }
     }
 
-    /// Whether `effects` contains this effect (a parameter away from its neutral value).
+    /// Whether `effects` contains this effect (a parameter away from its
+    /// neutral value). Encoder gains count as the common gain when the four
+    /// are equal and as per-drum gains otherwise.
     pub fn present_in(self, effects: &Effects) -> bool {
-        self.parameters(effects) != self.parameters(&Effects::default())
+        let gains = effects.encoder_gain;
+        let common = gains.iter().all(|g| *g == gains[0]);
+        match self {
+            EffectKind::EncoderScale => !common,
+            EffectKind::CommonGain => common && gains[0] != 1.0,
+            _ => self.parameters(effects) != self.parameters(&Effects::default()),
+        }
+    }
+
+    /// The effect that contains this one as a special case, if any: the
+    /// common encoder gain is the per-drum gains with four equal values.
+    pub fn nested_in(self) -> Option<EffectKind> {
+        (self == EffectKind::CommonGain).then_some(EffectKind::EncoderScale)
+    }
+}
+
+/// A set of effects of the catalogue (for an extended model with several at once).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+pub struct EffectSet(u16);
+
+impl EffectSet {
+    /// No effect.
+    pub const NONE: EffectSet = EffectSet(0);
+
+    /// The set holding `kind` alone.
+    pub fn of(kind: EffectKind) -> Self {
+        Self::NONE.with(kind)
+    }
+
+    /// This set and `kind`.
+    pub fn with(self, kind: EffectKind) -> Self {
+        Self(self.0 | 1 << kind as u16)
+    }
+
+    /// This set without `kind`.
+    pub fn without(self, kind: EffectKind) -> Self {
+        Self(self.0 & !(1 << kind as u16))
+    }
+
+    /// Whether `kind` is in the set.
+    pub fn contains(self, kind: EffectKind) -> bool {
+        self.0 & (1 << kind as u16) != 0
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// The effects in catalogue order.
+    pub fn iter(self) -> impl Iterator<Item = EffectKind> {
+        EffectKind::ALL.into_iter().filter(move |k| self.contains(*k))
+    }
+
+    /// Number of fitted parameters of all the set's effects.
+    pub fn parameter_count(self) -> usize {
+        self.iter().map(EffectKind::parameter_count).sum()
+    }
+}
+
+impl std::fmt::Display for EffectSet {
+    /// The names joined by `+` in catalogue order, or `none`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.is_empty() {
+            return f.write_str("none");
+        }
+        let names: Vec<&str> = self.iter().map(EffectKind::name).collect();
+        f.write_str(&names.join("+"))
+    }
+}
+
+impl FromIterator<EffectKind> for EffectSet {
+    fn from_iter<I: IntoIterator<Item = EffectKind>>(kinds: I) -> Self {
+        kinds.into_iter().fold(Self::NONE, Self::with)
     }
 }
 

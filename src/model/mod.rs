@@ -1,6 +1,7 @@
 //! Cable physics and the robot's kineto-statics (paper Sec. III).
 
 pub mod catenary;
+pub mod effect_ranges;
 pub mod effects;
 pub mod measurement;
 pub mod pose;

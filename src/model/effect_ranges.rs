@@ -1,0 +1,152 @@
+//! Physically plausible magnitudes of each effect for a robot, derived from
+//! its own data (rope cross-section from the cable weight, platform size):
+//! the ranges the hidden-effect experiment draws from and the magnitudes at
+//! which `diagnose` states the power of its tests.
+
+use serde::Serialize;
+
+use crate::model::effects::EffectKind;
+use crate::model::robot::Robot;
+
+/// Density of the synthetic-fibre (aramid) cables, kg/m^3.
+pub const CABLE_DENSITY_KG_M3: f64 = 1440.0;
+/// Standard gravity, m/s^2.
+const GRAVITY: f64 = 9.81;
+
+/// The range an effect's magnitude is drawn from, for one robot.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EffectRange {
+    /// The effect.
+    pub effect: String,
+    /// The range, in words with units.
+    pub range: String,
+    /// Why it is plausible.
+    pub justification: String,
+}
+
+/// The magnitude ranges of every effect for `robot` (module docs).
+pub fn effect_ranges(robot: &Robot) -> Vec<EffectRange> {
+    let (ea_low, ea_high) = axial_stiffness_range_n(robot);
+    let (r_low, r_high) = pulley_radius_range_m(robot);
+    vec![
+        EffectRange {
+            effect: "elastic".into(),
+            range: format!("EA {ea_low:.3e} .. {ea_high:.3e} N (log-uniform)"),
+            justification: format!(
+                "{}: A = g_c / (rho g) = {:.2} mm^2 from {:.1} g/m at {CABLE_DENSITY_KG_M3} kg/m^3, rope modulus {:.0}-{:.0} GPa",
+                if is_large(robot) { "aramid rope" } else { "nylon braid" },
+                cross_section_m2(robot) * 1e6,
+                robot.cable_weight_n_per_m / GRAVITY * 1e3,
+                rope_modulus_pa(robot).0 / 1e9,
+                rope_modulus_pa(robot).1 / 1e9
+            ),
+        },
+        EffectRange {
+            effect: "pulley".into(),
+            range: format!("radius {r_low:.3} .. {r_high:.3} m"),
+            justification: "pulley sizes of winches for this cable and robot scale".into(),
+        },
+        EffectRange {
+            effect: "encoder-scale".into(),
+            range: "gain 1 +- (0.001 .. 0.003) per cable".into(),
+            justification: "effective drum radius uncertain by a fraction of the rope diameter".into(),
+        },
+        EffectRange {
+            effect: "loadcell".into(),
+            range: "bias +-(5 .. 12) % of the mean reference tension, gain 1 +- (0.02 .. 0.05)".into(),
+            justification: "zero and span errors of an uncalibrated load cell of 2-3 x the mean tension full scale".into(),
+        },
+        EffectRange {
+            effect: "com".into(),
+            range: format!(
+                "horizontal shift {:.2} .. {:.2} m, random direction",
+                com_shift_range_m(robot).0,
+                com_shift_range_m(robot).1
+            ),
+            justification: "payload mounted off the centre of the 0.42 m platform".into(),
+        },
+        EffectRange {
+            effect: "encoder-gain".into(),
+            range: format!("gain 1 +- ({COMMON_GAIN_LOW} .. {COMMON_GAIN_HIGH}), the same on every drum"),
+            justification: "one drum radius or counts-per-metre figure used for all four winches".into(),
+        },
+        EffectRange {
+            effect: "segments".into(),
+            range: format!("{SEGMENTS_LOW} .. {SEGMENTS_HIGH} straight elements per cable"),
+            justification: "finite-element cable models (lumped-mass chains) of tens of elements".into(),
+        },
+    ]
+}
+
+/// A common encoder gain error's range (dimensionless).
+pub const COMMON_GAIN_LOW: f64 = 0.001;
+/// See [`COMMON_GAIN_LOW`].
+pub const COMMON_GAIN_HIGH: f64 = 0.003;
+/// The number of elements of a finite-element cable: fewest plausible.
+pub const SEGMENTS_LOW: f64 = 10.0;
+/// The number of elements of a finite-element cable: most plausible.
+pub const SEGMENTS_HIGH: f64 = 100.0;
+
+/// The smallest plausible magnitude of `kind` for `robot` as the effect
+/// variable's values (gains as errors, elastic as the compliance in 1/MN,
+/// segments as `1/n^2`), for the power of a test: the stiffest rope, the
+/// smallest pulley, gains off by 0.1 % with alternating signs, a load cell
+/// off by 5 % of `mean_reference_tension_n` and 2 % in gain, a 5 cm
+/// centre-of-mass shift along the diagonal, the finest plausible chain.
+pub fn smallest_plausible(kind: EffectKind, robot: &Robot, mean_reference_tension_n: f64) -> Vec<f64> {
+    match kind {
+        EffectKind::Elastic => vec![1e6 / axial_stiffness_range_n(robot).1],
+        EffectKind::Pulley => vec![pulley_radius_range_m(robot).0],
+        EffectKind::EncoderScale => vec![0.001, -0.001, 0.001, -0.001],
+        EffectKind::LoadCell => vec![0.05 * mean_reference_tension_n, 0.02],
+        EffectKind::Com => {
+            let low = com_shift_range_m(robot).0;
+            vec![low / 2f64.sqrt(), low / 2f64.sqrt()]
+        }
+        EffectKind::CommonGain => vec![COMMON_GAIN_LOW],
+        EffectKind::Segments => vec![1.0 / (SEGMENTS_HIGH * SEGMENTS_HIGH)],
+    }
+}
+
+fn cross_section_m2(robot: &Robot) -> f64 {
+    robot.cable_weight_n_per_m / (CABLE_DENSITY_KG_M3 * GRAVITY)
+}
+
+/// The large robot (tens of kilograms, cables over 100 m) or a light one.
+fn is_large(robot: &Robot) -> bool {
+    robot.platform_weight_n > 100.0
+}
+
+/// Young's modulus range of the rope, pascals (module docs).
+fn rope_modulus_pa(robot: &Robot) -> (f64, f64) {
+    if is_large(robot) {
+        (30e9, 160e9)
+    } else {
+        (1e9, 3e9)
+    }
+}
+
+/// The axial stiffness range `EA` of the robot's rope, newtons (low, high).
+pub fn axial_stiffness_range_n(robot: &Robot) -> (f64, f64) {
+    let area = cross_section_m2(robot);
+    let (low, high) = rope_modulus_pa(robot);
+    (area * low, area * high)
+}
+
+/// The horizontal centre-of-mass shift range, metres (low, high).
+pub fn com_shift_range_m(robot: &Robot) -> (f64, f64) {
+    if is_large(robot) {
+        (0.05, 0.25)
+    } else {
+        (0.05, 0.20)
+    }
+}
+
+/// The pulley radius range, metres (low, high).
+pub fn pulley_radius_range_m(robot: &Robot) -> (f64, f64) {
+    if is_large(robot) {
+        (0.1, 0.3)
+    } else {
+        (0.02, 0.05)
+    }
+}

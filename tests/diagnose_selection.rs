@@ -1,0 +1,174 @@
+//! `diagnose`'s forward selection (issue 14), fast subset: data from the
+//! discretised simulator with the true anchors off the nominal ones, each
+//! case seeded and printed. A 5 cm centre-of-mass shift under the paper's
+//! noise is named (its evidence is the platform's tilt, which the
+//! localiser's orientation carries); two effects at once are named as a
+//! pair; `none` stays `none` under both noise readings; an extension from
+//! the selected model predicts poses it was not fitted on better than the
+//! baseline.
+
+use nalgebra::Vector3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use sagcal::calib::{calibrate, predict_with_effects, CalibrationOptions, OrientationPrior};
+use sagcal::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
+use sagcal::model::effects::Effects;
+use sagcal::model::measurement::PoseMeasurement;
+use sagcal::model::sensors::{NoisePreset, SensorNoise};
+use sagcal::model::statics::{self, StaticsOptions};
+use sagcal::model::{Robot, CABLE_COUNT};
+use sagcal::sim::closed_form::{sample_equilibria, Workspace};
+use sagcal::sim::effects::measure_with_effects;
+
+/// Segments per cable of the discretised truth (fewer than the sweep's 50, for speed).
+const SEGMENTS: usize = 40;
+
+/// A truth 0.3 m off the nominal large robot per anchor coordinate with
+/// offsets of metres, `effects` acting, and `poses` measured with `noise`;
+/// returns the truth, the measurements and the nominal robot as the guess.
+fn case(effects: &[&str], noise: NoisePreset, poses: usize, seed: u64) -> (Robot, Vec<PoseMeasurement>, Robot) {
+    let nominal = Robot::builtin("large").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut truth = nominal.clone();
+    for i in 0..CABLE_COUNT {
+        truth.anchors_m[i] += Vector3::from_fn(|_, _| rng.random_range(-0.3..0.3));
+        truth.length_offsets_m[i] = rng.random_range(-3.0..3.0);
+    }
+    let mut e = Effects::default();
+    for spec in effects {
+        e.apply_spec(spec).unwrap();
+    }
+    let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), poses, &mut rng).unwrap();
+    let sigmas = noise.sigmas(truth.platform_weight_n);
+    let measurements = measure_with_effects(&truth, &e, &equilibria, &sigmas, SEGMENTS, &mut rng).unwrap();
+    truth.effects = e;
+    (truth, measurements, nominal)
+}
+
+fn run(effects: &[&str], noise: NoisePreset, seed: u64) -> (Robot, Vec<PoseMeasurement>, Diagnosis) {
+    let (truth, measurements, guess) = case(effects, noise, 30, seed);
+    let mut options = DiagnoseOptions::new(CalibrationOptions::new(noise.sigmas(truth.platform_weight_n)));
+    options.folds = 4;
+    let d = diagnose(&guess, &measurements, Some(&truth), &options, &mut |_, _, _| {}).unwrap();
+    println!(
+        "seed {seed}, {effects:?}, {noise:?} noise: verdict {}, {}; anchor MAE {:?} -> {:?} m",
+        d.verdict, d.reason, d.gain.anchor_mae_before_m, d.gain.anchor_mae_after_m
+    );
+    (truth, measurements, d)
+}
+
+fn named(d: &Diagnosis) -> Vec<String> {
+    let mut names: Vec<String> = d.verdict.split('+').map(String::from).collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn a_five_centimetre_com_shift_under_the_paper_noise_is_named() {
+    let (_, _, d) = run(&["com:dx_m=0.03,dy_m=-0.04"], NoisePreset::Paper, 21);
+    assert_eq!(d.verdict, "com");
+    let shift = &d.effects[0].params;
+    assert!(
+        (shift[0].value - 0.03).abs() < 4.0 * shift[0].sigma + 0.005,
+        "{shift:?}"
+    );
+    assert!(
+        (shift[1].value + 0.04).abs() < 4.0 * shift[1].sigma + 0.005,
+        "{shift:?}"
+    );
+    // Under the paper's noise the anchors' own noise (about 0.3 m, the
+    // Cramer-Rao bound of `experiment table2`) hides what a 5 cm shift does to
+    // them, so no anchor gain is asserted here; the held-out residual shows it.
+    assert!(d.gain.residual_rms_after < d.gain.residual_rms_before);
+}
+
+#[test]
+fn two_effects_at_once_are_named_as_a_pair() {
+    let (_, _, d) = run(&["com:dx_m=0.08", "elastic:ea_n=3e6"], NoisePreset::Authors, 22);
+    assert_eq!(named(&d), ["com", "elastic"]);
+    assert_eq!(d.effects.len(), 2);
+    let (_, _, d) = run(
+        &[
+            "encoder-scale:gain1=1.002,gain2=0.998,gain3=1.001,gain4=0.999",
+            "loadcell:bias_n=40",
+        ],
+        NoisePreset::Authors,
+        23,
+    );
+    assert_eq!(named(&d), ["encoder-scale", "loadcell"]);
+}
+
+#[test]
+fn none_stays_none_under_both_noise_readings() {
+    for (noise, seed) in [(NoisePreset::Paper, 24), (NoisePreset::Authors, 25)] {
+        let (_, _, d) = run(&[], noise, seed);
+        assert_eq!(d.verdict, "none", "{noise:?}: {}", d.reason);
+        assert!(d.steps.is_empty());
+        // The first step tests every hypothesis at alpha / m: none reaches it.
+        assert!(d.candidates.iter().all(|c| !c.significant));
+    }
+}
+
+#[test]
+fn the_selected_extension_predicts_unseen_poses_better() {
+    let (truth, measurements, d) = run(&["elastic:ea_n=2.5e6"], NoisePreset::Authors, 26);
+    assert_eq!(d.verdict, "elastic");
+    // Poses no fit saw, from the same truth, without noise.
+    let mut rng = ChaCha8Rng::seed_from_u64(99);
+    let mut plain = truth.clone();
+    plain.effects = Effects::default();
+    let equilibria = sample_equilibria(&plain, &Workspace::default_for(&plain), 12, &mut rng).unwrap();
+    let exact = SensorNoise {
+        encoder_sigma_m: 0.0,
+        load_cell_sigma_n: 0.0,
+        position_sigma_m: 0.0,
+        orientation_sigma_rad: 0.0,
+    };
+    let unseen = measure_with_effects(&plain, &truth.effects, &equilibria, &exact, SEGMENTS, &mut rng).unwrap();
+    assert_eq!(measurements.len(), 30);
+    let baseline_options = CalibrationOptions {
+        orientation_prior: OrientationPrior::On,
+        ..CalibrationOptions::new(NoisePreset::Authors.sigmas(truth.platform_weight_n))
+    };
+    let baseline = calibrate(&Robot::builtin("large").unwrap(), &measurements, &baseline_options).unwrap();
+    let rms = |robot: &Robot| {
+        let mut sum = 0.0;
+        for m in &unseen {
+            let start = statics::solve_with_reference_tension(
+                robot,
+                Vector3::from(m.position_m),
+                m.reference_tension_n,
+                None,
+                &StaticsOptions::default(),
+            )
+            .unwrap();
+            let predicted = predict_with_effects(robot, &start, m.reference_tension_n).unwrap();
+            for i in 0..CABLE_COUNT {
+                sum += (predicted.cable_lengths_m[i] - m.encoder_lengths_m[i]).powi(2);
+            }
+        }
+        (sum / (CABLE_COUNT * unseen.len()) as f64).sqrt()
+    };
+    let (before, after) = (rms(&baseline.robot), rms(&d.robot_after));
+    println!("unseen poses: length RMS baseline {before:.4} m, selected model {after:.4} m");
+    assert!(after < 0.5 * before, "{before} -> {after}");
+}
+
+#[test]
+fn calibrate_keeps_orientations_that_the_robot_files_effects_explain() {
+    let (truth, measurements, _) = case(&["com:dx_m=0.15"], NoisePreset::Paper, 30, 27);
+    let options = CalibrationOptions::new(NoisePreset::Paper.sigmas(truth.platform_weight_n));
+    // Without the shift the orientations contradict the statics and are dropped ...
+    let plain = calibrate(&Robot::builtin("large").unwrap(), &measurements, &options).unwrap();
+    assert!(!plain.orientation_check.unwrap().prior_used);
+    // ... with the shift as a known effect they agree and are kept.
+    let mut known = Robot::builtin("large").unwrap();
+    known.effects = truth.effects;
+    let result = calibrate(&known, &measurements, &options).unwrap();
+    let check = result.orientation_check.unwrap();
+    println!(
+        "seed 27: orientation chi-square {:.1} (limit {:.1})",
+        check.chi_square, check.limit
+    );
+    assert!(check.prior_used);
+}
