@@ -10,7 +10,7 @@ use rand_chacha::ChaCha8Rng;
 use sagcal::calib::{build_graph, CableModel, CalibrationOptions};
 use sagcal::graph::{FactorGraph, VariableValue};
 use sagcal::io::measurements::PoseMeasurement;
-use sagcal::model::effects::EffectKind;
+use sagcal::model::effects::{EffectKind, EffectSet};
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::statics::{CableTension, Equilibrium};
 use sagcal::model::{Effects, PlatformPose, Robot};
@@ -110,7 +110,7 @@ fn neutral_effects_reproduce_the_baseline_factors() {
         &options(),
     );
     let extended_options = CalibrationOptions {
-        free_effect: Some(EffectKind::Elastic),
+        free_effects: EffectSet::of(EffectKind::Elastic),
         ..options()
     };
     let extended = build_graph(
@@ -169,7 +169,7 @@ fn extended_jacobians_match_central_differences() {
     let mut worst = 0.0_f64;
     for kind in EffectKind::ALL {
         let opts = CalibrationOptions {
-            free_effect: Some(kind),
+            free_effects: EffectSet::of(kind),
             ..options()
         };
         let built = build_graph(&robot, &measurements, &poses, &tensions, CableModel::Catenary, &opts);

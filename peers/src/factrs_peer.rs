@@ -506,7 +506,7 @@ fn pose_residuals(platform: &Platform, m: &PoseMeasurement) -> PoseResiduals {
 /// no orientation prior): the peer must see the benchmark's graph exactly.
 fn check_supported(problem: &BenchmarkProblem) -> Result<(), String> {
     let o = &problem.options;
-    if !problem.initial.effects.is_none() || o.free_effect.is_some() {
+    if !problem.initial.effects.is_none() || !o.free_effects.is_empty() {
         return Err("factrs peer: the extended (effects) model is not implemented".into());
     }
     if o.model != CableModel::Catenary || o.orientation_prior != OrientationPrior::On {

@@ -8,6 +8,8 @@ use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 use serde::Serialize;
 
+use sagcal::model::effects::{EffectKind, EffectSet};
+
 use super::output::{print_json, Table};
 use super::Table2Args;
 
@@ -64,6 +66,7 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         offset_perturbation_m,
         basin_radius_m,
         orientation_prior: args.orientation_prior,
+        estimate: args.estimate.as_deref().map_or(Ok(EffectSet::NONE), parse_effect_set)?,
     };
     let total = (args.poses.len() * args.trials) as u64;
     let bar = ProgressBar::new(total);
@@ -177,4 +180,12 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         }
     }
     Ok(())
+}
+
+/// `--estimate`: effect names, comma separated.
+fn parse_effect_set(list: &str) -> sagcal::Result<EffectSet> {
+    list.split(',')
+        .map(EffectKind::parse)
+        .collect::<Result<EffectSet, _>>()
+        .map_err(|e| sagcal::Error::InvalidInput(format!("--estimate: {e}")))
 }

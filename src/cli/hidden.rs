@@ -1,34 +1,59 @@
-//! `sagcal experiment hidden-effects`: hide effects in simulated data and score `sagcal diagnose`.
+//! `sagcal experiment hidden-effects`: hide effects (none, one, or a pair) in
+//! simulated data and score `sagcal diagnose`.
 
 use std::collections::BTreeMap;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sagcal::experiments::hidden_effects::{
-    effect_ranges, identifiability, mean_reference_tension_n, mid_range_effects, run_sweep, smallest_effects,
-    EffectRange, HiddenCase, HiddenEffectOptions, Identifiability,
+    effect_ranges, identifiability, mean_reference_tension_n, run_sweep, smallest_effects, EffectRange, HiddenCase,
+    HiddenEffectOptions, Identifiability, PAIRS,
 };
 use sagcal::model::effects::EffectKind;
+use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 use serde::Serialize;
 
 use super::output::{print_json, Table};
 use super::HiddenEffectsArgs;
 
-/// Per robot and hidden effect: the score.
+/// A case is detectable when the diagnosis' test has at least this power at the true magnitude.
+const DETECTABLE_POWER: f64 = 0.9;
+
+/// Per robot, noise reading and hidden set: the score.
 #[derive(Debug, Clone, Serialize)]
 struct EffectScore {
     robot: String,
+    noise: NoisePreset,
     hidden: String,
     cases: usize,
     right: usize,
+    /// Cases whose tests have power >= 0.9 at the true magnitudes.
+    detectable: usize,
+    /// Right verdicts among them.
+    right_detectable: usize,
+    /// Mean power of the low-power cases (NaN if none).
+    low_power_mean: f64,
     /// Verdict -> count.
     verdicts: BTreeMap<String, usize>,
     anchor_mae_before_m: f64,
-    anchor_mae_extended_m: Option<f64>,
     anchor_mae_after_m: f64,
-    min_error_over_sigma: f64,
-    anchor_mae_known_geometry_m: Option<f64>,
-    scored: bool,
+    /// Detectable cases whose anchor error the verdict's model at least halved.
+    halved: usize,
+}
+
+/// The score of one robot under one noise reading.
+#[derive(Debug, Clone, Serialize)]
+struct Summary {
+    robot: String,
+    noise: NoisePreset,
+    /// Right set among the detectable single-effect cases.
+    single_right_rate: f64,
+    /// Right set among the detectable pair cases.
+    pair_right_rate: f64,
+    /// `none` cases given another verdict.
+    none_false_rejection_rate: f64,
+    /// Detectable cases (single and pairs) whose anchor error was at least halved.
+    halved_rate: f64,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -36,13 +61,10 @@ struct Report {
     seed: u64,
     seeds: usize,
     poses: usize,
-    noise: String,
+    noises: Vec<NoisePreset>,
     ranges: BTreeMap<String, Vec<EffectRange>>,
     scores: Vec<EffectScore>,
-    detection_rate: f64,
-    none_false_rejection_rate: f64,
-    anchor_ratio_extended_over_baseline: f64,
-    identifiability: Vec<Identifiability>,
+    summaries: Vec<Summary>,
     smallest: Vec<Identifiability>,
     cases: Vec<HiddenCase>,
 }
@@ -63,43 +85,11 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
     }
     let options = HiddenEffectOptions {
         poses: args.poses,
-        noise: args.noise,
+        noise: args.noise[0],
         segments: args.segments,
         ..HiddenEffectOptions::default()
     };
-    let total = robots.len() * (1 + EffectKind::ALL.len()) * args.seeds;
-    eprintln!(
-        "sagcal experiment hidden-effects: seed {}, {} seeds x {} effects (and none) x {} robot(s), {} poses, {:?} noise",
-        args.seed,
-        args.seeds,
-        EffectKind::ALL.len(),
-        robots.len(),
-        args.poses,
-        args.noise
-    );
-    let bar = ProgressBar::new(total as u64);
-    bar.set_style(
-        ProgressStyle::with_template("hidden effects [{bar:40}] {pos}/{len} cases, {elapsed} (eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    let cases = run_sweep(&robots, args.seeds, args.seed, &options, &|| bar.inc(1))?;
-    bar.finish_and_clear();
-    // Identifiability at mid-range magnitudes: an effect whose parameter the
-    // Fisher information cannot separate from the other unknowns at 3 sigma is
-    // left out of the detection score on that robot (with this evidence).
-    let mut identifiability_rows = Vec::new();
-    let mut unscored: Vec<(String, String)> = Vec::new();
-    for robot in &robots {
-        let mean_tension = mean_reference_tension_n(robot, args.poses, args.seed)?;
-        for (kind, effects) in mid_range_effects(robot, mean_tension) {
-            let id = identifiability(robot, kind, &effects, args.poses, args.seed, &options)?;
-            if kind == EffectKind::Pulley || id.sigma > id.value.abs() / 3.0 {
-                unscored.push((robot.name.clone(), kind.name().to_string()));
-            }
-            identifiability_rows.push(id);
-        }
-    }
+    let cases = sweep(args, &robots, &options)?;
     let mut smallest = Vec::new();
     for robot in &robots {
         let mean_tension = mean_reference_tension_n(robot, args.poses, args.seed)?;
@@ -107,71 +97,144 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
             smallest.push(identifiability(robot, kind, &effects, args.poses, args.seed, &options)?);
         }
     }
-    let mut scores = Vec::new();
-    for robot in &robots {
-        for hidden in std::iter::once("none").chain(EffectKind::ALL.map(|k| k.name())) {
-            let group: Vec<&HiddenCase> = cases
-                .iter()
-                .filter(|c| c.robot == robot.name && c.hidden == hidden)
-                .collect();
-            let mut verdicts = BTreeMap::new();
-            for c in &group {
-                *verdicts.entry(c.verdict.clone()).or_insert(0) += 1;
-            }
-            scores.push(EffectScore {
-                robot: robot.name.clone(),
-                hidden: hidden.to_string(),
-                cases: group.len(),
-                right: group.iter().filter(|c| c.correct).count(),
-                verdicts,
-                anchor_mae_before_m: mean(group.iter().map(|c| c.anchor_mae_before_m)),
-                anchor_mae_extended_m: (hidden != "none")
-                    .then(|| mean(group.iter().filter_map(|c| c.anchor_mae_extended_m))),
-                anchor_mae_after_m: mean(group.iter().map(|c| c.anchor_mae_after_m)),
-                min_error_over_sigma: group
-                    .iter()
-                    .map(|c| c.baseline_error_over_sigma)
-                    .fold(f64::INFINITY, f64::min),
-                anchor_mae_known_geometry_m: (hidden == "pulley")
-                    .then(|| mean(group.iter().filter_map(|c| c.anchor_mae_known_geometry_m))),
-                scored: !unscored.contains(&(robot.name.clone(), hidden.to_string())),
-            });
-        }
-    }
-    let detected: Vec<&EffectScore> = scores.iter().filter(|s| s.scored && s.hidden != "none").collect();
-    let detection_rate = detected.iter().map(|s| s.right).sum::<usize>() as f64
-        / detected.iter().map(|s| s.cases).sum::<usize>().max(1) as f64;
-    let nones: Vec<&EffectScore> = scores.iter().filter(|s| s.hidden == "none").collect();
-    let none_false_rejection_rate = 1.0
-        - nones.iter().map(|s| s.right).sum::<usize>() as f64
-            / nones.iter().map(|s| s.cases).sum::<usize>().max(1) as f64;
-    let anchor_ratio_extended_over_baseline = detected
-        .iter()
-        .filter_map(|s| s.anchor_mae_extended_m.map(|e| e / s.anchor_mae_before_m))
-        .fold(0.0, f64::max);
+    let scores = scores(&robots, &args.noise, &cases);
     let report = Report {
         seed: args.seed,
         seeds: args.seeds,
         poses: args.poses,
-        noise: format!("{:?}", args.noise).to_lowercase(),
+        noises: args.noise.clone(),
         ranges: robots.iter().map(|r| (r.name.clone(), effect_ranges(r))).collect(),
+        summaries: summaries(&robots, &args.noise, &scores),
         scores,
-        detection_rate,
-        none_false_rejection_rate,
-        anchor_ratio_extended_over_baseline,
-        identifiability: identifiability_rows,
         smallest,
         cases,
     };
     if args.json {
         return print_json(&report);
     }
+    print_report(args, &report);
+    Ok(())
+}
+
+/// The hidden sets of a sweep: none, each effect, each pair.
+fn hidden_sets() -> Vec<String> {
+    let mut sets = vec!["none".to_string()];
+    sets.extend(EffectKind::ALL.map(|k| k.name().to_string()));
+    sets.extend(PAIRS.map(|p| {
+        let mut names = [p[0].name(), p[1].name()];
+        names.sort();
+        names.join("+")
+    }));
+    sets
+}
+
+/// Run every case with a progress bar.
+fn sweep(args: &HiddenEffectsArgs, robots: &[Robot], options: &HiddenEffectOptions) -> sagcal::Result<Vec<HiddenCase>> {
+    let total = robots.len() * args.noise.len() * hidden_sets().len() * args.seeds;
+    eprintln!(
+        "sagcal experiment hidden-effects: seed {}, {} seeds x {} hidden sets (none, {} effects, {} pairs) x {} robot(s) x {:?} noise, {} poses",
+        args.seed,
+        args.seeds,
+        hidden_sets().len(),
+        EffectKind::ALL.len(),
+        PAIRS.len(),
+        robots.len(),
+        args.noise,
+        args.poses
+    );
+    let bar = ProgressBar::new(total as u64);
+    bar.set_style(
+        ProgressStyle::with_template("hidden effects [{bar:40}] {pos}/{len} cases, {elapsed} (eta {eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    let cases = run_sweep(robots, &args.noise, args.seeds, args.seed, options, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    Ok(cases)
+}
+
+/// The score of every robot, noise reading and hidden set.
+fn scores(robots: &[Robot], noises: &[NoisePreset], cases: &[HiddenCase]) -> Vec<EffectScore> {
+    let mut scores = Vec::new();
+    for robot in robots {
+        for noise in noises {
+            for hidden in hidden_sets() {
+                let group: Vec<&HiddenCase> = cases
+                    .iter()
+                    .filter(|c| c.robot == robot.name && c.noise == *noise && c.hidden == hidden)
+                    .collect();
+                scores.push(score(&robot.name, *noise, &hidden, &group));
+            }
+        }
+    }
+    scores
+}
+
+/// The score of one group of cases.
+fn score(robot: &str, noise: NoisePreset, hidden: &str, group: &[&HiddenCase]) -> EffectScore {
+    let detectable = |c: &&&HiddenCase| c.hidden != "none" && c.power.is_some_and(|p| p >= DETECTABLE_POWER);
+    let mut verdicts = BTreeMap::new();
+    for c in group {
+        *verdicts.entry(c.verdict.clone()).or_insert(0) += 1;
+    }
+    EffectScore {
+        robot: robot.to_string(),
+        noise,
+        hidden: hidden.to_string(),
+        cases: group.len(),
+        right: group.iter().filter(|c| c.correct).count(),
+        detectable: group.iter().filter(detectable).count(),
+        right_detectable: group.iter().filter(detectable).filter(|c| c.correct).count(),
+        low_power_mean: mean(group.iter().filter_map(|c| c.power).filter(|p| *p < DETECTABLE_POWER)),
+        verdicts,
+        anchor_mae_before_m: mean(group.iter().map(|c| c.anchor_mae_before_m)),
+        anchor_mae_after_m: mean(group.iter().map(|c| c.anchor_mae_after_m)),
+        halved: group
+            .iter()
+            .filter(detectable)
+            .filter(|c| c.anchor_mae_after_m <= 0.5 * c.anchor_mae_before_m)
+            .count(),
+    }
+}
+
+/// Per robot and noise reading: the rates the issue asks for.
+fn summaries(robots: &[Robot], noises: &[NoisePreset], scores: &[EffectScore]) -> Vec<Summary> {
+    let rate = |num: usize, den: usize| if den == 0 { f64::NAN } else { num as f64 / den as f64 };
+    let mut out = Vec::new();
+    for robot in robots {
+        for noise in noises {
+            let group: Vec<&EffectScore> = scores
+                .iter()
+                .filter(|s| s.robot == robot.name && s.noise == *noise)
+                .collect();
+            let sum = |pick: &dyn Fn(&EffectScore) -> bool, value: &dyn Fn(&EffectScore) -> usize| -> usize {
+                group.iter().filter(|s| pick(s)).map(|s| value(s)).sum()
+            };
+            let single = |s: &EffectScore| s.hidden != "none" && !s.hidden.contains('+');
+            let pair = |s: &EffectScore| s.hidden.contains('+');
+            let none = |s: &EffectScore| s.hidden == "none";
+            let effect = |s: &EffectScore| s.hidden != "none";
+            out.push(Summary {
+                robot: robot.name.clone(),
+                noise: *noise,
+                single_right_rate: rate(sum(&single, &|s| s.right_detectable), sum(&single, &|s| s.detectable)),
+                pair_right_rate: rate(sum(&pair, &|s| s.right_detectable), sum(&pair, &|s| s.detectable)),
+                none_false_rejection_rate: 1.0 - rate(sum(&none, &|s| s.right), sum(&none, &|s| s.cases)),
+                halved_rate: rate(sum(&effect, &|s| s.halved), sum(&effect, &|s| s.detectable)),
+            });
+        }
+    }
+    out
+}
+
+/// The readable report.
+fn print_report(args: &HiddenEffectsArgs, report: &Report) {
     println!(
-        "sagcal experiment hidden-effects --seeds {} --seed {} --poses {} --noise {}\n",
-        args.seeds, args.seed, args.poses, report.noise
+        "sagcal experiment hidden-effects --seeds {} --seed {} --poses {} --noise {:?}\n",
+        args.seeds, args.seed, args.poses, report.noises
     );
     for (robot, ranges) in &report.ranges {
-        println!("magnitudes drawn for `{robot}`:");
+        println!("magnitudes drawn for `{robot}` (true anchors off the nominal ones, offsets of metres):");
         let mut t = Table::new(["effect", "range", "why"]);
         for r in ranges {
             t.row([r.effect.clone(), r.range.clone(), r.justification.clone()]);
@@ -180,70 +243,68 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
     }
     let mut t = Table::new([
         "robot",
+        "noise",
         "hidden",
-        "right verdict",
+        "right",
+        "detectable (power >= 0.9)",
+        "right of detectable",
+        "low-power mean power",
         "verdicts",
         "anchor MAE baseline m",
-        "extended m",
         "verdict's m",
-        "min error/sigma",
-        "radius known m",
     ]);
     for s in &report.scores {
         let verdicts: Vec<String> = s.verdicts.iter().map(|(k, v)| format!("{k} {v}")).collect();
         t.row([
             s.robot.clone(),
-            if s.scored {
-                s.hidden.clone()
-            } else {
-                format!("{} (not scored)", s.hidden)
-            },
+            format!("{:?}", s.noise).to_lowercase(),
+            s.hidden.clone(),
             format!("{}/{}", s.right, s.cases),
+            s.detectable.to_string(),
+            format!("{}/{}", s.right_detectable, s.detectable),
+            if s.low_power_mean.is_finite() {
+                format!("{:.2}", s.low_power_mean)
+            } else {
+                "-".into()
+            },
             verdicts.join(", "),
             format!("{:.4}", s.anchor_mae_before_m),
-            s.anchor_mae_extended_m.map_or("-".into(), |v| format!("{v:.4}")),
             format!("{:.4}", s.anchor_mae_after_m),
-            format!("{:.2}", s.min_error_over_sigma),
-            s.anchor_mae_known_geometry_m.map_or("-".into(), |v| format!("{v:.4}")),
         ]);
     }
     println!("{t}");
-    println!(
-        "right verdict with an effect hidden (unidentifiable effects not scored): {:.1} %; `none` wrongly rejected: {:.1} %; worst extended/baseline anchor MAE: {:.3}\n",
-        100.0 * report.detection_rate,
-        100.0 * report.none_false_rejection_rate,
-        report.anchor_ratio_extended_over_baseline
-    );
-    println!(
-        "identifiability at mid-range magnitudes (Fisher information at the true equilibria, {} poses; an effect is not scored where sigma free > value / 3, the pulley never):",
-        args.poses
-    );
     let mut t = Table::new([
         "robot",
-        "effect",
-        "value (m or N)",
-        "sigma free",
-        "sigma alone",
-        "correlation with anchors",
-        "mimicking anchor shift m",
-        "baseline anchor bias m",
-        "baseline chi-square / dof",
+        "noise",
+        "right set, detectable single effects",
+        "right set, detectable pairs",
+        "`none` wrongly rejected",
+        "anchor error at least halved",
     ]);
-    for p in &report.identifiability {
+    let pct = |x: f64| {
+        if x.is_finite() {
+            format!("{:.1} %", 100.0 * x)
+        } else {
+            "-".into()
+        }
+    };
+    for s in &report.summaries {
         t.row([
-            p.robot.clone(),
-            p.effect.clone(),
-            format!("{:.3}", p.value),
-            format!("{:.4}", p.sigma),
-            format!("{:.5}", p.sigma_alone),
-            format!("{:.5}", p.correlation_with_anchors),
-            format!("{:.3}", p.mimicking_shift_mean_m),
-            format!("{:.3}", p.baseline_anchor_bias_m),
-            format!("{:.2} / {}", p.baseline_chi_square, p.baseline_dof),
+            s.robot.clone(),
+            format!("{:?}", s.noise).to_lowercase(),
+            pct(s.single_right_rate),
+            pct(s.pair_right_rate),
+            pct(s.none_false_rejection_rate),
+            pct(s.halved_rate),
         ]);
     }
     println!("{t}");
-    println!("the smallest magnitude of each scored range, noise-free data: the baseline's anchor bias over its 1-sigma (must exceed 1):");
+    print_smallest(&report.smallest);
+}
+
+/// The smallest magnitude of each range on noise-free data.
+fn print_smallest(smallest: &[Identifiability]) {
+    println!("the smallest magnitude of each range, noise-free data: the baseline's anchor bias over its 1-sigma:");
     let mut t = Table::new([
         "robot",
         "effect",
@@ -251,7 +312,7 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         "baseline anchor bias m",
         "bias / 1-sigma",
     ]);
-    for p in &report.smallest {
+    for p in smallest {
         t.row([
             p.robot.clone(),
             p.effect.clone(),
@@ -261,5 +322,4 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         ]);
     }
     println!("{t}");
-    Ok(())
 }

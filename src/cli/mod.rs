@@ -61,15 +61,24 @@ struct HiddenEffectsArgs {
     /// Static poses per case.
     #[arg(long, default_value_t = 35)]
     poses: usize,
-    /// Sensor noise of the data and the calibration.
-    #[arg(long, default_value = "authors", value_parser = sagcal::model::sensors::NoisePreset::parse)]
-    noise: sagcal::model::sensors::NoisePreset,
+    /// Sensor noise of the data and the calibration: paper, authors, or both.
+    #[arg(long, default_value = "both", value_parser = parse_noises)]
+    noise: std::vec::Vec<sagcal::model::sensors::NoisePreset>,
     /// Segments per cable of the discretised simulator.
     #[arg(long, default_value_t = 50)]
     segments: usize,
     /// Print JSON (with every case).
     #[arg(long)]
     json: bool,
+}
+
+/// `paper`, `authors` or `both`.
+fn parse_noises(text: &str) -> Result<Vec<sagcal::model::sensors::NoisePreset>, String> {
+    use sagcal::model::sensors::NoisePreset;
+    match text {
+        "both" => Ok(vec![NoisePreset::Paper, NoisePreset::Authors]),
+        other => NoisePreset::parse(other).map(|n| vec![n]),
+    }
 }
 
 fn parse_pose_counts(text: &str) -> Result<Vec<usize>, String> {
@@ -129,6 +138,10 @@ struct Table2Args {
     /// inconsistent with the statics), `on` or `off` (the statics decide).
     #[arg(long, default_value = "auto", value_parser = sagcal::calib::OrientationPrior::parse)]
     orientation_prior: sagcal::calib::OrientationPrior,
+    /// Effects estimated with the anchors (comma separated, e.g. a `diagnose`
+    /// verdict such as `encoder-gain,segments`); default: none.
+    #[arg(long)]
+    estimate: Option<String>,
     /// Print JSON.
     #[arg(long)]
     json: bool,

@@ -218,6 +218,9 @@ pub struct CandidateFit {
     /// Per parameter, the smallest magnitude the test detects with power
     /// 0.9 (the others estimated too), in the variable's units (gains as errors).
     pub min_detectable: Vec<f64>,
+    /// The estimate's covariance (variable units), for the power against other magnitudes.
+    #[serde(skip)]
+    pub covariance: Vec<Vec<f64>>,
     /// Held-out residual RMS (normalised): computed for the models the search selects, else NaN.
     pub cv_rms: f64,
     /// Whether the solver converged.
@@ -312,6 +315,7 @@ pub(super) fn test_hypothesis(
         delta_bic: f64::NAN,
         power: None,
         min_detectable: Vec::new(),
+        covariance: Vec::new(),
         cv_rms: f64::NAN,
         converged: false,
         anchor_mae_m: None,
@@ -337,6 +341,7 @@ pub(super) fn test_hypothesis(
     if let Hypothesis::Effect(kind) = hypothesis {
         if let Some(estimate) = fit.estimate(kind) {
             row.params = parameters(estimate);
+            row.covariance = estimate.covariance.clone();
             row.inadmissible = inadmissible(estimate);
             let critical = chi_square_critical(added, p_threshold);
             let smallest = smallest_plausible(kind, &base.result.robot, base.mean_reference_tension_n);
@@ -346,6 +351,24 @@ pub(super) fn test_hypothesis(
     }
     row.significant = row.converged && row.inadmissible.is_none() && row.p_value < p_threshold;
     (Some(fit), row)
+}
+
+/// The power of `row`'s test against the effect at `magnitude` (variable
+/// units, [`EffectKind::variable_values`]) with the diagnosis' variance
+/// factor; `None` without a full-rank covariance.
+pub fn power_against(row: &CandidateFit, magnitude: &[f64], variance_factor: f64) -> Option<f64> {
+    if row.covariance.len() != magnitude.len() || row.added_parameters == 0 {
+        return None;
+    }
+    let critical = chi_square_critical(row.added_parameters, row.p_threshold);
+    let covariance = nalgebra::DMatrix::from_fn(magnitude.len(), magnitude.len(), |r, c| {
+        row.covariance[r][c] * variance_factor
+    });
+    let theta = nalgebra::DVector::from_column_slice(magnitude);
+    let lambda = theta.dot(&covariance.cholesky()?.solve(&theta));
+    lambda
+        .is_finite()
+        .then(|| noncentral_chi_square_survival(row.added_parameters, lambda, critical))
 }
 
 /// The power of a chi-square test with `dof` degrees of freedom and critical

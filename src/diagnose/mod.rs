@@ -46,7 +46,7 @@ use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::stats::{self, chi_square_quantile_999};
 
-pub use candidates::{CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER};
+pub use candidates::{power_against, CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER};
 pub use drivers::{DriverSeries, DriverTest, DRIVERS, DRIVER_T_LIMIT};
 pub use report::{error_over_sigma, Diagnosis, EffectFit, Gain};
 pub use residual_tests::{FactorTest, MEASUREMENT_KINDS};

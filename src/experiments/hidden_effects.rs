@@ -48,7 +48,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::calib::{build_graph, calibrate, CableModel, CalibrationError, CalibrationOptions};
-use crate::diagnose::{diagnose, DiagnoseOptions};
+use crate::diagnose::{diagnose, power_against, DiagnoseOptions};
 use crate::error::{Error, Result};
 use crate::model::effect_ranges::{
     axial_stiffness_range_n, com_shift_range_m, pulley_radius_range_m, COMMON_GAIN_HIGH, COMMON_GAIN_LOW,
@@ -96,14 +96,20 @@ pub struct HiddenCase {
     pub robot: String,
     /// The case's seed.
     pub seed: u64,
-    /// The hidden effect, or `none`.
+    /// The sensor noise of the case.
+    pub noise: NoisePreset,
+    /// The hidden effects joined by `+` in sorted order, or `none`.
     pub hidden: String,
     /// The hidden effect's parameters (`sagcal simulate --effect` specifications).
     pub truth: String,
     /// The diagnosis' verdict.
     pub verdict: String,
-    /// Whether the verdict names the hidden effect.
+    /// Whether the verdict names exactly the hidden effects.
     pub correct: bool,
+    /// The smallest power, over the hidden effects, of the diagnosis' first
+    /// test at the effect's true magnitude (`None` for none or a singular
+    /// information matrix): the case is detectable when it is >= 0.9.
+    pub power: Option<f64>,
     /// Mean absolute anchor-coordinate error of the baseline, metres.
     pub anchor_mae_before_m: f64,
     /// The same for the verdict's model.
@@ -196,116 +202,167 @@ fn signed(rng: &mut impl Rng, low: f64, high: f64) -> f64 {
     }
 }
 
-/// Draw `effect`'s magnitude for `robot` (`None`: no effect).
+/// Draw the magnitudes of `hidden` for `robot` (empty: no effect), each
+/// from its range ([`effect_ranges`]).
 pub fn draw_effects(
     robot: &Robot,
-    effect: Option<EffectKind>,
+    hidden: &[EffectKind],
     mean_reference_tension_n: f64,
     rng: &mut impl Rng,
 ) -> Effects {
     let mut e = Effects::default();
+    for kind in hidden {
+        draw_effect(robot, *kind, mean_reference_tension_n, rng, &mut e);
+    }
+    e
+}
+
+/// Draw `effect`'s magnitude into `e`.
+fn draw_effect(robot: &Robot, effect: EffectKind, mean_reference_tension_n: f64, rng: &mut impl Rng, e: &mut Effects) {
     match effect {
-        None => {}
-        Some(EffectKind::Elastic) => {
+        EffectKind::Elastic => {
             let (low, high) = axial_stiffness_range_n(robot);
             e.axial_stiffness_n = Some((rng.random_range(low.ln()..high.ln())).exp());
         }
-        Some(EffectKind::Pulley) => {
+        EffectKind::Pulley => {
             let (low, high) = pulley_radius_range_m(robot);
             e.pulley_radius_m = rng.random_range(low..high);
         }
-        Some(EffectKind::EncoderScale) => {
+        EffectKind::EncoderScale => {
             e.encoder_gain = std::array::from_fn(|_| 1.0 + signed(rng, 0.001, 0.003));
         }
-        Some(EffectKind::LoadCell) => {
+        EffectKind::LoadCell => {
             e.load_cell_bias_n = signed(rng, 0.05, 0.12) * mean_reference_tension_n;
             e.load_cell_gain = 1.0 + signed(rng, 0.02, 0.05);
         }
-        Some(EffectKind::Com) => {
+        EffectKind::Com => {
             let (low, high) = com_shift_range_m(robot);
             let magnitude = rng.random_range(low..high);
             let angle = rng.random_range(0.0..std::f64::consts::TAU);
             e.com_shift_m = [magnitude * angle.cos(), magnitude * angle.sin(), 0.0];
         }
-        Some(EffectKind::CommonGain) => {
+        EffectKind::CommonGain => {
             e.encoder_gain = [1.0 + signed(rng, COMMON_GAIN_LOW, COMMON_GAIN_HIGH); CABLE_COUNT];
         }
-        Some(EffectKind::Segments) => {
+        EffectKind::Segments => {
             e.cable_segments = Some(rng.random_range(SEGMENTS_LOW..SEGMENTS_HIGH).round());
         }
     }
-    e
 }
 
-/// The measurements and truth of one case (seeded).
+/// The anchors of the true robot are drawn this far off the nominal ones,
+/// per coordinate, metres: the nominal robot file is only a guess.
+pub const TRUTH_ANCHOR_SPREAD_M: f64 = 0.5;
+/// The encoders' true length offsets are drawn from `+-` this, metres.
+pub const TRUTH_OFFSET_SPREAD_M: f64 = 3.0;
+
+/// One case's data: the measurements, the true robot (off the nominal one,
+/// its effects set) and the initial guess (the nominal robot).
 pub fn simulate_case(
-    truth: &Robot,
-    effect: Option<EffectKind>,
+    nominal: &Robot,
+    hidden: &[EffectKind],
     seed: u64,
     options: &HiddenEffectOptions,
-) -> Result<(Vec<PoseMeasurement>, Effects, Robot)> {
+) -> Result<(Vec<PoseMeasurement>, Robot, Robot)> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let equilibria = sample_equilibria(truth, &Workspace::default_for(truth), options.poses, &mut rng)?;
+    let mut truth = nominal.clone();
+    for i in 0..CABLE_COUNT {
+        let spread = TRUTH_ANCHOR_SPREAD_M;
+        truth.anchors_m[i] += Vector3::from_fn(|_, _| rng.random_range(-spread..spread));
+        truth.length_offsets_m[i] = rng.random_range(-TRUTH_OFFSET_SPREAD_M..TRUTH_OFFSET_SPREAD_M);
+    }
+    let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), options.poses, &mut rng)?;
     let mean_tension = equilibria
         .iter()
         .map(|eq| eq.tensions[truth.reference_cable].magnitude_n())
         .sum::<f64>()
         / equilibria.len() as f64;
-    let effects = draw_effects(truth, effect, mean_tension, &mut rng);
+    let effects = draw_effects(&truth, hidden, mean_tension, &mut rng);
     let noise = options.noise.sigmas(truth.platform_weight_n);
-    let measurements = measure_with_effects(truth, &effects, &equilibria, &noise, options.segments, &mut rng)?;
-    // The initial guess: anchors and offsets off by up to 0.5 m per coordinate.
-    let mut guess = truth.clone();
-    for i in 0..CABLE_COUNT {
-        guess.anchors_m[i] += Vector3::from_fn(|_, _| rng.random_range(-0.5..0.5));
-        guess.length_offsets_m[i] += rng.random_range(-0.5..0.5);
-    }
-    Ok((measurements, effects, guess))
+    let measurements = measure_with_effects(&truth, &effects, &equilibria, &noise, options.segments, &mut rng)?;
+    truth.effects = effects;
+    Ok((measurements, truth, nominal.clone()))
 }
 
-/// Run one case: simulate, diagnose blind, score.
+/// The pairs of effects the sweep hides together.
+pub const PAIRS: [[EffectKind; 2]; 3] = [
+    [EffectKind::Com, EffectKind::Elastic],
+    [EffectKind::EncoderScale, EffectKind::LoadCell],
+    [EffectKind::Elastic, EffectKind::CommonGain],
+];
+
+/// `none`, or the names joined by `+` in sorted order.
+fn set_name(names: impl Iterator<Item = String>) -> String {
+    let mut names: Vec<String> = names.filter(|n| n != "none").collect();
+    names.sort();
+    if names.is_empty() {
+        "none".into()
+    } else {
+        names.join("+")
+    }
+}
+
+/// Run one case: simulate `hidden` (empty: none) in a truth drawn off
+/// `nominal`, diagnose blind from the nominal robot, score.
 pub fn run_case(
-    truth: &Robot,
-    effect: Option<EffectKind>,
+    nominal: &Robot,
+    hidden: &[EffectKind],
     seed: u64,
     options: &HiddenEffectOptions,
 ) -> Result<HiddenCase> {
-    let (measurements, effects, guess) = simulate_case(truth, effect, seed, options)?;
+    let (measurements, truth, guess) = simulate_case(nominal, hidden, seed, options)?;
     let mut diagnose_options =
         DiagnoseOptions::new(CalibrationOptions::new(options.noise.sigmas(truth.platform_weight_n)));
     diagnose_options.folds = options.folds;
-    let mut truth_with_effects = truth.clone();
-    truth_with_effects.effects = effects;
     let diagnosis = diagnose(
         &guess,
         &measurements,
-        Some(&truth_with_effects),
+        Some(&truth),
         &diagnose_options,
         &mut |_, _, _| {},
     )?;
-    let hidden = effect.map_or("none", |k| k.name()).to_string();
-    let anchor_mae_extended_m = effect.and_then(|k| {
+    let hidden_name = set_name(hidden.iter().map(|k| k.name().to_string()));
+    let verdict_set = set_name(diagnosis.verdict.split('+').map(String::from));
+    let step_one = |k: EffectKind| {
         diagnosis
             .candidates
             .iter()
-            .find(|c| c.effect == k.name())
-            .and_then(|c| c.anchor_mae_m)
-    });
-    let anchor_mae_known_geometry_m = if effect == Some(EffectKind::Pulley) {
+            .find(|c| c.step == 1 && c.effect == k.name())
+    };
+    // Detectable: every hidden effect's first-step test has power >= 0.9 at its true magnitude.
+    let powers: Vec<Option<f64>> = hidden
+        .iter()
+        .map(|k| {
+            step_one(*k)
+                .and_then(|row| power_against(row, &k.variable_values(&truth.effects), diagnosis.variance_factor))
+        })
+        .collect();
+    let power = powers
+        .iter()
+        .copied()
+        .collect::<Option<Vec<f64>>>()
+        .map(|p| p.into_iter().fold(1.0, f64::min));
+    let anchor_mae_extended_m = match hidden {
+        [k] => step_one(*k).and_then(|c| c.anchor_mae_m),
+        _ => None,
+    };
+    let anchor_mae_known_geometry_m = if hidden.contains(&EffectKind::Pulley) {
         let mut known = guess.clone();
-        known.effects = effects;
+        known.effects = truth.effects;
         let result = calibrate(&known, &measurements, &diagnose_options.calibration)?;
-        Some(CalibrationError::between(&result.robot, truth).anchor_coordinate_mae_m)
+        Some(CalibrationError::between(&result.robot, &truth).anchor_coordinate_mae_m)
     } else {
         None
     };
     Ok(HiddenCase {
-        robot: truth.name.clone(),
+        robot: nominal.name.clone(),
+        noise: options.noise,
         seed,
-        truth: effects.to_string(),
-        correct: diagnosis.verdict == hidden,
+        truth: truth.effects.to_string(),
+        correct: verdict_set == hidden_name,
         verdict: diagnosis.verdict,
-        hidden,
+        hidden: hidden_name,
+        power: if hidden.is_empty() { None } else { power },
         anchor_mae_before_m: diagnosis.gain.anchor_mae_before_m.unwrap_or(f64::NAN),
         anchor_mae_after_m: diagnosis.gain.anchor_mae_after_m.unwrap_or(f64::NAN),
         anchor_mae_extended_m,
@@ -314,35 +371,52 @@ pub fn run_case(
     })
 }
 
-/// The seed of case `index` of `effect` on robot number `robot_index`: distinct for every case.
-pub fn case_seed(base_seed: u64, robot_index: usize, effect: Option<EffectKind>, index: usize) -> u64 {
-    let effect_index = effect.map_or(0, |k| 1 + EffectKind::ALL.iter().position(|e| *e == k).unwrap_or(0));
+/// The seed of case `index` of the effects `hidden` on robot number
+/// `robot_index`: distinct for every case (and the same as before for a
+/// single effect or none).
+pub fn case_seed(base_seed: u64, robot_index: usize, hidden: &[EffectKind], index: usize) -> u64 {
+    let position = |k: &EffectKind| 1 + EffectKind::ALL.iter().position(|e| e == k).unwrap_or(0);
+    let effect_index = hidden.iter().fold(0, |acc, k| acc * 10 + position(k));
     base_seed
         .wrapping_mul(1_000_003)
         .wrapping_add((robot_index as u64) * 100_000 + (effect_index as u64) * 10_000 + index as u64)
 }
 
-/// Run `seeds` cases of every effect and of none on every robot, in parallel.
-/// `progress()` is called after each case. A case that fails is an error naming it.
+/// Run `seeds` cases of none, of every effect and of every pair of
+/// [`PAIRS`] on every robot under every noise reading of `noises`, in
+/// parallel. `progress()` is called after each case. A case that fails is an
+/// error naming it.
 pub fn run_sweep(
     robots: &[Robot],
+    noises: &[NoisePreset],
     seeds: usize,
     base_seed: u64,
     options: &HiddenEffectOptions,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<HiddenCase>> {
-    let effects: Vec<Option<EffectKind>> = std::iter::once(None).chain(EffectKind::ALL.map(Some)).collect();
-    let jobs: Vec<(usize, Option<EffectKind>, usize)> = (0..robots.len())
-        .flat_map(|r| effects.iter().flat_map(move |e| (0..seeds).map(move |i| (r, *e, i))))
-        .collect();
+    let mut sets: Vec<Vec<EffectKind>> = vec![Vec::new()];
+    sets.extend(EffectKind::ALL.map(|k| vec![k]));
+    sets.extend(PAIRS.map(|p| p.to_vec()));
+    let mut jobs = Vec::new();
+    for (r, _) in robots.iter().enumerate() {
+        for noise in noises {
+            for set in &sets {
+                jobs.extend((0..seeds).map(|i| (r, *noise, set.clone(), i)));
+            }
+        }
+    }
     jobs.par_iter()
-        .map(|&(r, effect, index)| {
-            let seed = case_seed(base_seed, r, effect, index);
-            let case = run_case(&robots[r], effect, seed, options).map_err(|e| {
+        .map(|(r, noise, set, index)| {
+            let seed = case_seed(base_seed, *r, set, *index);
+            let case_options = HiddenEffectOptions {
+                noise: *noise,
+                ..*options
+            };
+            let case = run_case(&robots[*r], set, seed, &case_options).map_err(|e| {
                 Error::InvalidInput(format!(
-                    "hidden-effect case robot `{}`, effect {}, seed {seed}: {e}",
-                    robots[r].name,
-                    effect.map_or("none", |k| k.name())
+                    "hidden-effect case robot `{}`, effects {}, {noise:?} noise, seed {seed}: {e}",
+                    robots[*r].name,
+                    set_name(set.iter().map(|k| k.name().to_string()))
                 ))
             });
             progress();

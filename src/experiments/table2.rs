@@ -24,10 +24,11 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::calib::{
-    calibrate, cramer_rao_bound, CableModel, CalibrationError, CalibrationOptions, OrientationPrior,
-    ParameterUncertainty,
+    calibrate, cramer_rao_bound, refine_with_effects, CableModel, CalibrationError, CalibrationOptions,
+    OrientationPrior, ParameterUncertainty,
 };
 use crate::error::{Error, Result};
+use crate::model::effects::EffectSet;
 use crate::model::measurement::PoseMeasurement;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
@@ -112,6 +113,10 @@ pub struct Protocol {
     pub basin_radius_m: f64,
     /// Whether the localiser's orientation is a prior (see [`OrientationPrior`]).
     pub orientation_prior: OrientationPrior,
+    /// Effects estimated after the calibration (the extended model, e.g. a
+    /// `diagnose` verdict); none: the robot file's `[effects]`, if any, are
+    /// known inputs and the calibration is the paper's.
+    pub estimate: EffectSet,
 }
 
 /// One trial.
@@ -302,7 +307,16 @@ pub fn run_trial(
     let equilibria: Vec<Equilibrium> = chosen.iter().map(|&k| pool[k].equilibrium.clone()).collect();
     let lines = chosen.iter().map(|&k| pool[k].line).collect();
     let started = std::time::Instant::now();
-    let result = calibrate(&guess, &data, &options);
+    let result = calibrate(&guess, &data, &options).and_then(|baseline| {
+        if protocol.estimate.is_empty() {
+            return Ok(baseline);
+        }
+        let extended = CalibrationOptions {
+            free_effects: protocol.estimate,
+            ..options.as_used_by(&baseline)
+        };
+        refine_with_effects(&baseline, &data, &extended)
+    });
     let solve_ms = started.elapsed().as_secs_f64() * 1e3;
     // The bound of the estimator actually used: with the orientation prior if
     // the calibration kept it.

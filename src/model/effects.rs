@@ -372,6 +372,19 @@ impl EffectKind {
         }
     }
 
+    /// This effect's parameters in `effects` in the units of the extended
+    /// model's variables: gains as errors (`gain - 1`), the elastic cable as
+    /// its compliance in 1/MN, the segmented cable as `1/n^2`.
+    pub fn variable_values(self, effects: &Effects) -> Vec<f64> {
+        match self {
+            EffectKind::EncoderScale | EffectKind::CommonGain => {
+                self.parameters(effects).iter().map(|g| g - 1.0).collect()
+            }
+            EffectKind::LoadCell => vec![effects.load_cell_bias_n, effects.load_cell_gain - 1.0],
+            _ => self.parameters(effects),
+        }
+    }
+
     /// Whether `effects` contains this effect (a parameter away from its
     /// neutral value). Encoder gains count as the common gain when the four
     /// are equal and as per-drum gains otherwise.
