@@ -172,3 +172,89 @@ fn calibrate_keeps_orientations_that_the_robot_files_effects_explain() {
     );
     assert!(check.prior_used);
 }
+
+fn sagcal(dir: &std::path::Path, args: &[&str]) -> serde_json::Value {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sagcal"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("sagcal runs");
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap_or(serde_json::Value::Null)
+}
+
+#[test]
+fn an_extension_written_by_diagnose_improves_verify_on_unseen_poses() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let large = format!("{}/robots/large.toml", env!("CARGO_MANIFEST_DIR"));
+    for (seed, out) in [("31", "fit.csv"), ("32", "unseen.csv")] {
+        sagcal(
+            d,
+            &[
+                "simulate",
+                "--robot",
+                &large,
+                "--poses",
+                "30",
+                "--seed",
+                seed,
+                "--noise",
+                "authors",
+                "--effect",
+                "elastic:ea_n=2.5e6",
+                "--segments",
+                "40",
+                "--out",
+                out,
+            ],
+        );
+    }
+    sagcal(
+        d,
+        &[
+            "calibrate",
+            "--robot",
+            &large,
+            "--data",
+            "fit.csv",
+            "--noise",
+            "authors",
+            "--out",
+            "baseline.toml",
+            "--json",
+        ],
+    );
+    let diagnosis = sagcal(
+        d,
+        &[
+            "diagnose",
+            "--robot",
+            &large,
+            "--data",
+            "fit.csv",
+            "--noise",
+            "authors",
+            "--folds",
+            "4",
+            "--out",
+            "extended.toml",
+            "--json",
+        ],
+    );
+    assert_eq!(diagnosis["verdict"], "elastic");
+    let written = std::fs::read_to_string(d.join("extended.toml")).unwrap();
+    assert!(written.contains("axial_stiffness_n") && written.starts_with("# Calibrated by sagcal diagnose"));
+    let mpe = |robot: &str| {
+        let report = sagcal(d, &["verify", "--robot", robot, "--data", "unseen.csv", "--json"]);
+        assert_eq!(report["rows_unsolved"].as_array().unwrap().len(), 0, "{robot}");
+        report["mpe_length_pct"].as_f64().unwrap()
+    };
+    let (before, after) = (mpe("baseline.toml"), mpe("extended.toml"));
+    println!("unseen poses (seed 32): MPE-L baseline {before:.5} %, extension {after:.5} %");
+    assert!(after < 0.5 * before, "{before} -> {after}");
+}

@@ -110,6 +110,12 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
     if args.json {
         return print_json(&report);
     }
+    print_report(args, &truth, &report);
+    Ok(())
+}
+
+/// The readable Table II: per pose count, errors beside the bound and the paper.
+fn print_report(args: &Table2Args, truth: &Robot, report: &Table2Report) {
     println!(
         "Table II protocol: robot `{}`, {} data, {} noise, {:?} cable model, orientation prior {}, seed {}, initial guess {} m / {} m off",
         report.robot,
@@ -121,9 +127,12 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         args.model,
         args.orientation_prior,
         args.seed,
-        anchor_perturbation_m,
-        offset_perturbation_m
+        report.anchor_perturbation_m,
+        report.offset_perturbation_m
     );
+    if let Some(estimate) = &args.estimate {
+        println!("effects estimated with the anchors: {estimate}");
+    }
     let mut table = Table::new([
         "poses",
         "converged",
@@ -137,7 +146,7 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         "median ms",
     ]);
     for r in &report.results {
-        let paper = paper_numbers(&truth, r.poses);
+        let paper = paper_numbers(truth, r.poses);
         table.row([
             r.poses.to_string(),
             format!("{}/{}", r.converged, r.trials),
@@ -159,7 +168,7 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
     print!("{table}");
     println!("(CRLB: the error an unbiased estimator cannot beat on average, at the truth, for the same poses, noise and orientation prior;\n anchor errors are the mean Euclidean distance per anchor, as in the authors' program, +- the standard error of the mean over trials)");
     for r in &report.results {
-        if let Some((paper_anchor, _)) = paper_numbers(&truth, r.poses) {
+        if let Some((paper_anchor, _)) = paper_numbers(truth, r.poses) {
             let verdict = if paper_anchor < r.anchor_crlb_m {
                 "below the bound: not reachable by an unbiased estimator under this noise reading"
             } else {
@@ -179,7 +188,6 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
             );
         }
     }
-    Ok(())
 }
 
 /// `--estimate`: effect names, comma separated.

@@ -90,6 +90,20 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
         sagcal::io::write_atomically(path, text.as_bytes())?;
     }
     write_measurements(&args.out, &comments, &data)?;
+    print_ranges(&workspace, &equilibria);
+    println!(
+        "seed {}: {} poses of robot `{}` with {} noise written to {}",
+        args.seed,
+        args.poses,
+        truth.name,
+        args.noise,
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The workspace and the ranges of cable lengths and tensions it gave.
+fn print_ranges(workspace: &Workspace, equilibria: &[sagcal::model::statics::Equilibrium]) {
     let range = |values: &mut dyn Iterator<Item = f64>| {
         values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)))
     };
@@ -103,13 +117,4 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
         "workspace {:?} .. {:?} m: cable lengths {length_min:.1} .. {length_max:.1} m, tensions {tension_min:.1} .. {tension_max:.1} N",
         workspace.min_m, workspace.max_m
     );
-    println!(
-        "seed {}: {} poses of robot `{}` with {} noise written to {}",
-        args.seed,
-        args.poses,
-        truth.name,
-        args.noise,
-        args.out.display()
-    );
-    Ok(())
 }

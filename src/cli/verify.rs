@@ -1,6 +1,7 @@
 //! `sagcal verify`: the model against measured data.
 
-use sagcal::diagnose::verify::{verify, Closure, VerifyReport};
+use sagcal::diagnose::verify::{verify, Closure, MeasuredData, VerifyReport};
+use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
 use sagcal::io::recurdyn::{read_recurdyn, LoadOptions};
 use sagcal::model::statics::StaticsOptions;
 use sagcal::model::Robot;
@@ -10,15 +11,12 @@ use super::{ClosureArg, VerifyArgs};
 
 pub fn run(args: &VerifyArgs) -> sagcal::Result<()> {
     let robot = Robot::from_file(&args.robot)?;
-    let options = LoadOptions {
-        keep_rounded: args.keep_rounded,
-    };
-    let log = read_recurdyn(&args.data, &options)?;
+    let data = read_data(args, &robot)?;
     let closure = match args.close_with {
         ClosureArg::ReferenceTension => Closure::ReferenceTension,
         ClosureArg::CableLengths => Closure::CableLengths,
     };
-    let report = verify(&robot, &log, closure, &StaticsOptions::default());
+    let report = verify(&robot, &data, closure, &StaticsOptions::default());
     if args.json {
         print_json(&report)
     } else {
@@ -27,10 +25,29 @@ pub fn run(args: &VerifyArgs) -> sagcal::Result<()> {
     }
 }
 
+/// The data: a RecurDyn log with every cable's tension, or a sagcal measurement file.
+fn read_data(args: &VerifyArgs, robot: &Robot) -> sagcal::Result<MeasuredData> {
+    let set = read_measurements(
+        &args.data,
+        &ReadOptions {
+            reference_cable: robot.reference_cable,
+            keep_rounded: args.keep_rounded,
+        },
+    )?;
+    if set.format == MeasurementFormat::RecurDyn {
+        let options = LoadOptions {
+            keep_rounded: args.keep_rounded,
+        };
+        return Ok(MeasuredData::from_recurdyn(&read_recurdyn(&args.data, &options)?));
+    }
+    Ok(MeasuredData::from_measurements(&set, robot.reference_cable))
+}
+
 fn opt(value: Option<f64>, decimals: usize) -> String {
     value.map_or_else(|| "-".to_string(), |v| format!("{v:.decimals$}"))
 }
 
+/// The readable verification: per row, then what was left out, the orientation and the summary.
 fn render(report: &VerifyReport) -> String {
     let mut out = String::new();
     let closure = match report.closure {
@@ -74,7 +91,15 @@ fn render(report: &VerifyReport) -> String {
     }
     out += &table.to_string();
     out += "(dL: cable-length error; F: predicted tension; dF: tension error where the log has one; rot err: angle between\n logged and predicted orientation)\n\n";
+    out += &render_left_out(report);
+    out += &render_orientation(report);
+    out += &render_summary(report);
+    out
+}
 
+/// Rows the loader rejected and rows without an equilibrium.
+fn render_left_out(report: &VerifyReport) -> String {
+    let mut out = String::new();
     if !report.rows_rejected.is_empty() {
         out += &format!("rejected rows ({}):\n", report.rows_rejected.len());
         for r in &report.rows_rejected {
@@ -92,7 +117,12 @@ fn render(report: &VerifyReport) -> String {
         }
         out += "\n";
     }
-    out += "orientation: how each reading of the angle columns matches the model's equilibria\n";
+    out
+}
+
+/// How each reading of the angle columns matches the model's equilibria.
+fn render_orientation(report: &VerifyReport) -> String {
+    let mut out = "orientation: how each reading of the angle columns matches the model's equilibria\n".to_string();
     let mut conventions = Table::new(["reading", "mean deg", "median deg"]);
     for c in &report.orientation_conventions {
         conventions.row([
@@ -112,6 +142,11 @@ fn render(report: &VerifyReport) -> String {
         }
     }
     out += "\n";
+    out
+}
+
+/// MPE-L, MPE-F and the orientation error beside the paper's Table I.
+fn render_summary(report: &VerifyReport) -> String {
     let mut summary = Table::new(["summary", "sagcal", "paper Table I"]);
     summary.row([
         format!("rows verified (kept {})", report.rows_kept),
@@ -136,6 +171,5 @@ fn render(report: &VerifyReport) -> String {
         ),
         "-".into(),
     ]);
-    out += &summary.to_string();
-    out
+    summary.to_string()
 }

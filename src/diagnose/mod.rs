@@ -52,7 +52,7 @@ pub use report::{error_over_sigma, Diagnosis, EffectFit, Gain};
 pub use residual_tests::{FactorTest, MEASUREMENT_KINDS};
 pub use selection::SelectionStep;
 
-use candidates::{parameters, rebuild};
+use candidates::rebuild;
 use drivers::{driver_series, driver_tests, samples};
 use residual_tests::{factor_tests, measurement_components, total_chi_square, variance_factor};
 use selection::{cross_validate, first_effect, forward_selection, Search};
@@ -290,15 +290,7 @@ pub fn diagnose(
         baseline_bic: base.bic,
         baseline_cv_rms: baseline_cv,
         verdict: model.name(),
-        effects: model
-            .result
-            .effect_estimates
-            .iter()
-            .map(|e| report::EffectFit {
-                effect: e.effect.name().to_string(),
-                params: parameters(e),
-            })
-            .collect(),
+        effects: report::effect_fits(&model.result.effect_estimates),
         steps: selection.steps,
         undetectable,
         candidates: selection.candidates,

@@ -2,12 +2,12 @@
 
 use serde::Serialize;
 
-use super::candidates::{CandidateFit, ParameterValue, DETECTION_POWER};
+use super::candidates::{parameters, CandidateFit, ParameterValue, DETECTION_POWER};
 use super::drivers::{DriverSeries, DriverTest};
 use super::residual_tests::FactorTest;
 use super::selection::{Selection, SelectionStep};
 use super::{Baseline, DiagnoseOptions};
-use crate::calib::{CalibrationError, OrientationPrior, ParameterUncertainty};
+use crate::calib::{CalibrationError, EffectEstimate, OrientationPrior, ParameterUncertainty};
 use crate::model::robot::{Robot, CABLE_COUNT};
 
 /// What the chosen extension gains.
@@ -125,6 +125,17 @@ pub struct EffectFit {
     pub effect: String,
     /// Its parameters with 1-sigma.
     pub params: Vec<ParameterValue>,
+}
+
+/// The selected effects with their parameters, for the report.
+pub(super) fn effect_fits(estimates: &[EffectEstimate]) -> Vec<EffectFit> {
+    estimates
+        .iter()
+        .map(|e| EffectFit {
+            effect: e.effect.name().to_string(),
+            params: parameters(e),
+        })
+        .collect()
 }
 
 /// Why the search selected what it did, in one sentence.

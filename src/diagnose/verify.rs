@@ -10,17 +10,96 @@
 //! log it disagrees with the model's equilibrium by about 2 degrees and some
 //! rows carry permuted angle columns, so it is reported, not trusted
 //! ([`OrientationConventionFit`]).
+//!
+//! A robot file's `[effects]` are applied: with the load-cell closure the
+//! extended model's equilibrium and predicted encoder readings
+//! ([`crate::calib::predict_with_effects`]) replace the closed form's, so an
+//! extension written by `sagcal diagnose --out` can be measured on poses it
+//! was never fitted on. Data: a RecurDyn log (every cable's tension) or a
+//! sagcal measurement file (the encoder readings as lengths, the load cell
+//! as the reference cable's tension).
 
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Serialize;
 
-use crate::io::recurdyn::{RecurDynLog, RecurDynRow, RejectedRow};
+use crate::calib::predict_with_effects;
+use crate::io::measurements::MeasurementSet;
+use crate::io::recurdyn::{RecurDynLog, RejectedRow};
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::statics::{self, Equilibrium, StaticsOptions};
 
 /// The paper's Table I for the large robot (5 random poses).
 pub const PAPER_TABLE1_LARGE: (f64, f64) = (8.8947e-3, 0.9154);
+
+/// What one row of the data measured at a static pose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredRow {
+    /// Line number in the data file.
+    pub line: usize,
+    /// Platform position, metres.
+    pub position_m: [f64; 3],
+    /// Angles as the file gives them, degrees: `[pitch, roll, yaw]` columns read as roll, pitch, yaw.
+    pub roll_pitch_yaw_deg: [f64; 3],
+    /// Cable lengths (or encoder readings), metres.
+    pub cable_lengths_m: [f64; CABLE_COUNT],
+    /// Tension magnitudes at the attachments, newtons, where measured.
+    pub tensions_n: [Option<f64>; CABLE_COUNT],
+}
+
+/// The rows of a data file to verify, and the rows its loader rejected.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredData {
+    /// The file.
+    pub path: String,
+    /// Kept rows.
+    pub rows: Vec<MeasuredRow>,
+    /// Rows the loader rejected, with reasons.
+    pub rejected: Vec<RejectedRow>,
+}
+
+impl MeasuredData {
+    /// A RecurDyn log's rows (every cable's tension where logged).
+    pub fn from_recurdyn(log: &RecurDynLog) -> Self {
+        let rows = log
+            .rows
+            .iter()
+            .map(|row| MeasuredRow {
+                line: row.line,
+                position_m: row.position_m,
+                roll_pitch_yaw_deg: [row.roll_deg, row.pitch_deg, row.yaw_deg],
+                cable_lengths_m: row.cable_lengths_m,
+                tensions_n: std::array::from_fn(|i| row.tensions[i].map(|t| t.total_n)),
+            })
+            .collect();
+        Self {
+            path: log.path.display().to_string(),
+            rows,
+            rejected: log.rejected.clone(),
+        }
+    }
+
+    /// A sagcal measurement file's rows: encoder readings as lengths, the
+    /// load cell as the tension of `reference_cable` (0-based).
+    pub fn from_measurements(set: &MeasurementSet, reference_cable: usize) -> Self {
+        let rows = set
+            .poses
+            .iter()
+            .map(|m| MeasuredRow {
+                line: m.line,
+                position_m: m.position_m,
+                roll_pitch_yaw_deg: [m.roll_deg, m.pitch_deg, m.yaw_deg],
+                cable_lengths_m: m.encoder_lengths_m,
+                tensions_n: std::array::from_fn(|i| (i == reference_cable).then_some(m.reference_tension_n)),
+            })
+            .collect();
+        Self {
+            path: set.path.display().to_string(),
+            rows,
+            rejected: set.rejected.clone(),
+        }
+    }
+}
 
 /// Which measurement closes the one-parameter family of equilibria.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -133,27 +212,35 @@ pub struct VerifyReport {
     pub paper_table1_mpe_force_pct: f64,
 }
 
+/// The model's equilibrium for one row under `closure`: the closed form,
+/// refined by the extended model where the robot has `[effects]`.
 fn solve_row(
     robot: &Robot,
-    row: &RecurDynRow,
+    row: &MeasuredRow,
     closure: Closure,
     options: &StaticsOptions,
 ) -> crate::Result<Equilibrium> {
     let position = Vector3::from(row.position_m);
     match closure {
         Closure::ReferenceTension => {
-            let measured = row.tensions[robot.reference_cable]
-                .as_ref()
-                .map(|t| t.total_n)
-                .ok_or_else(|| {
-                    crate::Error::InvalidInput(format!(
-                        "row {}: no tension for the reference cable {}",
-                        row.line,
-                        robot.reference_cable + 1
-                    ))
-                })?;
-            statics::solve_with_reference_tension(robot, position, measured, None, options)
+            let measured = row.tensions_n[robot.reference_cable].ok_or_else(|| {
+                crate::Error::InvalidInput(format!(
+                    "row {}: no tension for the reference cable {}",
+                    row.line,
+                    robot.reference_cable + 1
+                ))
+            })?;
+            let closed = statics::solve_with_reference_tension(robot, position, measured, None, options)?;
+            if robot.effects.is_none() {
+                Ok(closed)
+            } else {
+                predict_with_effects(robot, &closed, measured)
+            }
         }
+        Closure::CableLengths if !robot.effects.is_none() => Err(crate::Error::InvalidInput(format!(
+            "row {}: the cable-lengths closure does not apply the robot file's [effects] ({}); use the reference-tension closure",
+            row.line, robot.effects
+        ))),
         Closure::CableLengths => statics::solve_with_cable_lengths(robot, position, &row.cable_lengths_m, options),
     }
 }
@@ -229,66 +316,55 @@ fn median(values: &[f64]) -> f64 {
     }
 }
 
-/// Verify the model on every kept row of `log`.
-pub fn verify(robot: &Robot, log: &RecurDynLog, closure: Closure, options: &StaticsOptions) -> VerifyReport {
-    let mut rows = Vec::new();
-    let mut unsolved = Vec::new();
-    let mut solved_orientations = Vec::new();
-    for row in &log.rows {
-        let equilibrium = match solve_row(robot, row, closure, options) {
-            Ok(eq) => eq,
-            Err(e) => {
-                unsolved.push(UnsolvedRow {
-                    line: row.line,
-                    reason: e.to_string(),
-                });
-                continue;
-            }
-        };
-        let file_angles = [row.pitch_deg, row.roll_deg, row.yaw_deg];
-        let measured_rotation = AngleReading::DOCUMENTED.rotation(file_angles);
-        let measured_pose = PlatformPose::new(Vector3::from(row.position_m), measured_rotation);
-        let predicted_tension_n: [f64; CABLE_COUNT] = std::array::from_fn(|i| equilibrium.tensions[i].magnitude_n());
-        let measured_tension_n: [Option<f64>; CABLE_COUNT] =
-            std::array::from_fn(|i| row.tensions[i].map(|t| t.total_n));
-        let tension_error_pct = std::array::from_fn(|i| {
-            let is_input = closure == Closure::ReferenceTension && i == robot.reference_cable;
-            match measured_tension_n[i] {
-                Some(m) if !is_input => Some(100.0 * (predicted_tension_n[i] - m).abs() / m),
-                _ => None,
-            }
-        });
-        let (r, p, y) = equilibrium.pose.roll_pitch_yaw_deg();
-        rows.push(RowVerification {
-            line: row.line,
-            position_m: row.position_m,
-            measured_length_m: row.cable_lengths_m,
-            predicted_length_m: equilibrium.cable_lengths_m,
-            length_error_pct: std::array::from_fn(|i| {
-                100.0 * (equilibrium.cable_lengths_m[i] - row.cable_lengths_m[i]).abs() / row.cable_lengths_m[i]
-            }),
-            measured_tension_n,
-            predicted_tension_n,
-            tension_error_pct,
-            measured_roll_pitch_yaw_deg: [row.roll_deg, row.pitch_deg, row.yaw_deg],
-            predicted_roll_pitch_yaw_deg: [r, p, y],
-            orientation_error_deg: measured_pose.angle_to_deg(&equilibrium.pose),
-            height_residual_m: equilibrium.max_height_residual_m(),
-        });
-        solved_orientations.push((row.line, file_angles, equilibrium.pose.rotation));
+/// Prediction against measurement for one solved row.
+fn compare_row(robot: &Robot, row: &MeasuredRow, closure: Closure, equilibrium: &Equilibrium) -> RowVerification {
+    let [roll, pitch, yaw] = row.roll_pitch_yaw_deg;
+    let measured_rotation = AngleReading::DOCUMENTED.rotation([pitch, roll, yaw]);
+    let measured_pose = PlatformPose::new(Vector3::from(row.position_m), measured_rotation);
+    let predicted_tension_n: [f64; CABLE_COUNT] = std::array::from_fn(|i| equilibrium.tensions[i].magnitude_n());
+    let measured_tension_n = row.tensions_n;
+    let tension_error_pct = std::array::from_fn(|i| {
+        let is_input = closure == Closure::ReferenceTension && i == robot.reference_cable;
+        match measured_tension_n[i] {
+            Some(m) if !is_input => Some(100.0 * (predicted_tension_n[i] - m).abs() / m),
+            _ => None,
+        }
+    });
+    let (r, p, y) = equilibrium.pose.roll_pitch_yaw_deg();
+    RowVerification {
+        line: row.line,
+        position_m: row.position_m,
+        measured_length_m: row.cable_lengths_m,
+        predicted_length_m: equilibrium.cable_lengths_m,
+        length_error_pct: std::array::from_fn(|i| {
+            100.0 * (equilibrium.cable_lengths_m[i] - row.cable_lengths_m[i]).abs() / row.cable_lengths_m[i]
+        }),
+        measured_tension_n,
+        predicted_tension_n,
+        tension_error_pct,
+        measured_roll_pitch_yaw_deg: row.roll_pitch_yaw_deg,
+        predicted_roll_pitch_yaw_deg: [r, p, y],
+        orientation_error_deg: measured_pose.angle_to_deg(&equilibrium.pose),
+        height_residual_m: equilibrium.max_height_residual_m(),
     }
+}
 
+/// Each reading of the angle columns against the model's orientations, best
+/// first, and the rows that a permuted reading explains far better.
+fn orientation_analysis(
+    solved: &[(usize, [f64; 3], UnitQuaternion<f64>)],
+) -> (Vec<OrientationConventionFit>, Vec<SuspectOrientationRow>) {
     let readings = AngleReading::all();
     let errors_per_reading: Vec<Vec<f64>> = readings
         .iter()
         .map(|reading| {
-            solved_orientations
+            solved
                 .iter()
                 .map(|(_, angles, model)| reading.rotation(*angles).angle_to(model).to_degrees())
                 .collect()
         })
         .collect();
-    let mut orientation_conventions: Vec<OrientationConventionFit> = readings
+    let mut conventions: Vec<OrientationConventionFit> = readings
         .iter()
         .zip(&errors_per_reading)
         .map(|(reading, errors)| OrientationConventionFit {
@@ -297,9 +373,9 @@ pub fn verify(robot: &Robot, log: &RecurDynLog, closure: Closure, options: &Stat
             median_error_deg: median(errors),
         })
         .collect();
-    orientation_conventions.sort_by(|a, b| a.mean_error_deg.total_cmp(&b.mean_error_deg));
+    conventions.sort_by(|a, b| a.mean_error_deg.total_cmp(&b.mean_error_deg));
     // Documented reading is index 0 of `readings`.
-    let suspect_orientation_rows = solved_orientations
+    let suspects = solved
         .iter()
         .enumerate()
         .filter_map(|(k, (line, _, _))| {
@@ -320,7 +396,28 @@ pub fn verify(robot: &Robot, log: &RecurDynLog, closure: Closure, options: &Stat
             })
         })
         .collect();
+    (conventions, suspects)
+}
 
+/// Verify the model on every kept row of `data`.
+pub fn verify(robot: &Robot, data: &MeasuredData, closure: Closure, options: &StaticsOptions) -> VerifyReport {
+    let mut rows = Vec::new();
+    let mut unsolved = Vec::new();
+    let mut solved_orientations = Vec::new();
+    for row in &data.rows {
+        match solve_row(robot, row, closure, options) {
+            Ok(equilibrium) => {
+                rows.push(compare_row(robot, row, closure, &equilibrium));
+                let [roll, pitch, yaw] = row.roll_pitch_yaw_deg;
+                solved_orientations.push((row.line, [pitch, roll, yaw], equilibrium.pose.rotation));
+            }
+            Err(e) => unsolved.push(UnsolvedRow {
+                line: row.line,
+                reason: e.to_string(),
+            }),
+        }
+    }
+    let (orientation_conventions, suspect_orientation_rows) = orientation_analysis(&solved_orientations);
     let length_errors: Vec<f64> = rows.iter().flat_map(|r| r.length_error_pct).collect();
     let force_errors: Vec<f64> = rows
         .iter()
@@ -329,10 +426,10 @@ pub fn verify(robot: &Robot, log: &RecurDynLog, closure: Closure, options: &Stat
     let orientation_errors: Vec<f64> = rows.iter().map(|r| r.orientation_error_deg).collect();
     VerifyReport {
         robot: robot.name.clone(),
-        data: log.path.display().to_string(),
+        data: data.path.clone(),
         closure,
-        rows_kept: log.rows.len(),
-        rows_rejected: log.rejected.clone(),
+        rows_kept: data.rows.len(),
+        rows_rejected: data.rejected.clone(),
         rows_unsolved: unsolved,
         mpe_length_pct: mean(&length_errors),
         max_length_error_pct: length_errors.iter().copied().fold(0.0, f64::max),
