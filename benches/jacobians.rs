@@ -66,6 +66,7 @@ fn point() -> Point {
         cable_vertical_tensions_n: Vector4::zeros(),
         axial_compliance_per_mn: 0.5,
         pulley_radius_m: 0.2,
+        inverse_segments_squared: 1.0 / 400.0,
         load_cell_bias_n: 3.0,
         load_cell_gain_error: 0.01,
     };
@@ -276,12 +277,13 @@ fn jacobians(c: &mut Criterion) {
         geometry,
         |j| vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2), dynamic(&j.3)],
     );
-    let per_cable: [Block; 5] = [
+    let per_cable: [Block; 6] = [
         Additive(|q| q.cable_spans_m.as_mut_slice()),
         Additive(|q| q.cable_horizontal_tensions_n.as_mut_slice()),
         Additive(|q| q.cable_vertical_tensions_n.as_mut_slice()),
         Additive(|q| std::slice::from_mut(&mut q.axial_compliance_per_mn)),
         Additive(|q| std::slice::from_mut(&mut q.pulley_radius_m)),
+        Additive(|q| std::slice::from_mut(&mut q.inverse_segments_squared)),
     ];
     group(c, "extended_cable", &p, &per_cable, extended, extended_blocks);
     let load_cell_blocks: [Block; 3] = [

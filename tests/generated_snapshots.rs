@@ -68,6 +68,7 @@ struct Inputs {
     measured_tension_n: f64,
     axial_compliance_per_mn: f64,
     pulley_radius_m: f64,
+    inverse_segments_squared: f64,
     load_cell_bias_n: f64,
     load_cell_gain_error: f64,
 }
@@ -93,6 +94,7 @@ fn inputs() -> Inputs {
         measured_tension_n: 610.0,
         axial_compliance_per_mn: 0.8,
         pulley_radius_m: 0.12,
+        inverse_segments_squared: 1.0 / 400.0,
         load_cell_bias_n: 1.5,
         load_cell_gain_error: -0.02,
     }
@@ -310,7 +312,8 @@ fn extended_cable_outputs() {
     );
     let mut out = String::new();
     for slot in 0..4 {
-        let (mut span, mut horizontal, mut vertical, mut compliance, mut radius) = (
+        let (mut span, mut horizontal, mut vertical, mut compliance, mut radius, mut segments) = (
+            nan::<2, 1>(),
             nan::<2, 1>(),
             nan::<2, 1>(),
             nan::<2, 1>(),
@@ -324,12 +327,14 @@ fn extended_cable_outputs() {
             x.cable_weight_n_per_m,
             x.axial_compliance_per_mn,
             x.pulley_radius_m,
+            x.inverse_segments_squared,
             EPSILON,
             Some(&mut span),
             Some(&mut horizontal),
             Some(&mut vertical),
             Some(&mut compliance),
             Some(&mut radius),
+            Some(&mut segments),
         );
         writeln!(out, "slot {slot}:").unwrap();
         format_block(&mut out, "cable", &value);
@@ -338,6 +343,7 @@ fn extended_cable_outputs() {
         format_block(&mut out, "jacobian_vertical_tension", &vertical);
         format_block(&mut out, "jacobian_axial_compliance", &compliance);
         format_block(&mut out, "jacobian_pulley_radius", &radius);
+        format_block(&mut out, "jacobian_inverse_segments_squared", &segments);
     }
     insta::assert_snapshot!(out);
 }

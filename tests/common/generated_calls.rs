@@ -39,6 +39,8 @@ pub struct Point {
     pub axial_compliance_per_mn: f64,
     /// Pulley radius, metres, shared by the four pulleys.
     pub pulley_radius_m: f64,
+    /// `1/n^2` of a cable of `n` straight elements, shared by the four cables.
+    pub inverse_segments_squared: f64,
     pub load_cell_bias_n: f64,
     pub load_cell_gain_error: f64,
 }
@@ -165,19 +167,19 @@ pub fn geometry(p: &Point, j: Option<&mut (M<16, 6>, M<16, 2>, M<16, 12>, M<16, 
     )
 }
 
-/// Per slot the 2x1 Jacobians of `extended_cable`: span, `f_h`, `f_v`, compliance, radius.
-pub type ExtendedJacobians = [(M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>); 4];
+/// Per slot the 2x1 Jacobians of `extended_cable`: span, `f_h`, `f_v`, compliance, radius, `1/n^2`.
+pub type ExtendedJacobians = [(M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>); 4];
 
 /// `extended_cable` of the four slots stacked: `[paid_out_0, drop_0, paid_out_1, ...]`.
 pub fn extended(p: &Point, mut j: Option<&mut ExtendedJacobians>) -> SVector<f64, 8> {
     let mut value = SVector::<f64, 8>::zeros();
     for s in 0..4 {
-        let (span, horizontal, vertical, compliance, radius) = match j.as_deref_mut() {
+        let (span, horizontal, vertical, compliance, radius, segments) = match j.as_deref_mut() {
             Some(j) => {
-                let (a, b, c, d, e) = &mut j[s];
-                (Some(a), Some(b), Some(c), Some(d), Some(e))
+                let (a, b, c, d, e, f) = &mut j[s];
+                (Some(a), Some(b), Some(c), Some(d), Some(e), Some(f))
             }
-            None => (None, None, None, None, None),
+            None => (None, None, None, None, None, None),
         };
         let cable = generated::extended_cable(
             p.cable_spans_m[s],
@@ -186,12 +188,14 @@ pub fn extended(p: &Point, mut j: Option<&mut ExtendedJacobians>) -> SVector<f64
             p.cable_weight_n_per_m,
             p.axial_compliance_per_mn,
             p.pulley_radius_m,
+            p.inverse_segments_squared,
             EPSILON,
             span,
             horizontal,
             vertical,
             compliance,
             radius,
+            segments,
         );
         value.fixed_rows_mut::<2>(2 * s).copy_from(&cable);
     }
@@ -199,16 +203,17 @@ pub fn extended(p: &Point, mut j: Option<&mut ExtendedJacobians>) -> SVector<f64
 }
 
 /// The per-slot Jacobians of [`extended`] as blocks of the stacked value: span, `f_h` and `f_v`
-/// (8x4, block diagonal), compliance and radius (8x1).
+/// (8x4, block diagonal), compliance, radius and `1/n^2` (8x1).
 pub fn extended_blocks(j: &ExtendedJacobians) -> Vec<DMatrix<f64>> {
     let mut blocks = vec![DMatrix::zeros(8, 4), DMatrix::zeros(8, 4), DMatrix::zeros(8, 4)];
-    blocks.extend([DMatrix::zeros(8, 1), DMatrix::zeros(8, 1)]);
-    for (s, (span, horizontal, vertical, compliance, radius)) in j.iter().enumerate() {
+    blocks.extend([DMatrix::zeros(8, 1), DMatrix::zeros(8, 1), DMatrix::zeros(8, 1)]);
+    for (s, (span, horizontal, vertical, compliance, radius, segments)) in j.iter().enumerate() {
         for (b, d) in [span, horizontal, vertical].into_iter().enumerate() {
             blocks[b].view_mut((2 * s, s), (2, 1)).copy_from(d);
         }
         blocks[3].view_mut((2 * s, 0), (2, 1)).copy_from(compliance);
         blocks[4].view_mut((2 * s, 0), (2, 1)).copy_from(radius);
+        blocks[5].view_mut((2 * s, 0), (2, 1)).copy_from(segments);
     }
     blocks
 }
