@@ -1,10 +1,13 @@
-//! The crate's layering, checked on its source: data flows one way,
+//! The crate's layout, checked on its source. Data flows one way,
 //! io -> model -> graph -> solver -> calib / diagnose / localize / plan ->
 //! experiments -> cli, and no module imports a module above it.
 //!
 //! `io` converts files into `model` types, so `io` may name `model`; `model`
 //! names no file type and nothing above itself. Doc comments may link
-//! anywhere: only code lines are checked.
+//! anywhere: only code lines are checked. And the source stays readable: no
+//! file under `src/` past 700 lines (but the discretised simulator and the
+//! hand-drawn figures) and no function past 100 lines, counted on
+//! rustfmt-formatted code.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -137,4 +140,84 @@ fn the_checker_sees_an_upward_import() {
     let text = "use crate::calib::calibrate; // crate::cli in a comment\n/// [`crate::plot`]\n";
     let named = named_modules(text);
     assert_eq!(named.into_iter().collect::<Vec<_>>(), vec!["calib".to_string()]);
+}
+
+/// Files allowed past [`MAX_FILE_LINES`]: the discretised simulator and the
+/// hand-drawn figures (one figure per file).
+const LONG_FILES_ALLOWED: &[&str] = &["sim/discretised.rs", "plot/"];
+/// The longest a file under `src/` may be, in lines.
+const MAX_FILE_LINES: usize = 700;
+/// The longest a function may be, in lines (signature to closing brace).
+const MAX_FUNCTION_LINES: usize = 100;
+
+/// Each function of rustfmt-formatted `text` as (name, first line, lines):
+/// from its `fn` line to the closing brace at the same indentation.
+fn functions(text: &str) -> Vec<(String, usize, usize)> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut found = Vec::new();
+    for (start, line) in lines.iter().enumerate() {
+        let trimmed = line.trim_start();
+        let indent = line.len() - trimmed.len();
+        let is_fn = trimmed.starts_with("fn ")
+            || trimmed.starts_with("pub fn ")
+            || trimmed.starts_with("pub(crate) fn ")
+            || trimmed.starts_with("pub(super) fn ")
+            || trimmed.starts_with("const fn ")
+            || trimmed.starts_with("pub const fn ");
+        if !is_fn || line.trim_end().ends_with(';') {
+            continue;
+        }
+        let name: String = trimmed
+            .split("fn ")
+            .nth(1)
+            .unwrap_or("")
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
+        let closing = " ".repeat(indent) + "}";
+        if let Some(end) = (start..lines.len())
+            .find(|&k| lines[k].trim_end() == closing || (k == start && line.trim_end().ends_with('}')))
+        {
+            found.push((name, start + 1, end - start + 1));
+        }
+    }
+    found
+}
+
+#[test]
+fn files_and_functions_stay_short() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let mut too_long = Vec::new();
+    for file in &files {
+        let relative = file.strip_prefix(&src).unwrap().to_string_lossy().replace('\\', "/");
+        let text = std::fs::read_to_string(file).unwrap();
+        let line_count = text.lines().count();
+        if line_count > MAX_FILE_LINES && !LONG_FILES_ALLOWED.iter().any(|a| relative.starts_with(a)) {
+            too_long.push(format!("src/{relative}: {line_count} lines (at most {MAX_FILE_LINES})"));
+        }
+        for (name, first, length) in functions(&text) {
+            if length > MAX_FUNCTION_LINES {
+                too_long.push(format!(
+                    "src/{relative}:{first}: fn {name} has {length} lines (at most {MAX_FUNCTION_LINES})"
+                ));
+            }
+        }
+    }
+    assert!(too_long.is_empty(), "split these:\n{}", too_long.join("\n"));
+}
+
+#[test]
+fn the_function_counter_measures_a_known_function() {
+    let text = "impl A {\n    pub fn short(&self) -> u8 {\n        1\n    }\n}\nfn outer() {\n    let x = 1;\n}\nfn one_line() {}\n";
+    let found = functions(text);
+    assert_eq!(
+        found,
+        vec![
+            ("short".to_string(), 2, 3),
+            ("outer".to_string(), 6, 3),
+            ("one_line".to_string(), 9, 1)
+        ]
+    );
 }

@@ -52,18 +52,18 @@ use super::svg::{esc, halo_text, n2, shorten, text_w, C_FRAME, C_GRID, C_MUTED, 
 pub struct AnchorPlotEntry {
     /// Name shown in the plot, e.g. `"A1"`.
     pub label: String,
-    /// Nominal position from the robot description [m]; drawn in the overview,
+    /// Nominal position from the robot description, metres; drawn in the overview,
     /// and in the zoomed panels when there is no `initial_m`.
     pub nominal_m: [f64; 3],
-    /// Initial guess the calibration started from [m], if different from the nominal.
+    /// Initial guess the calibration started from, metres, if different from the nominal.
     pub initial_m: Option<[f64; 3]>,
-    /// Calibrated position [m].
+    /// Calibrated position, metres.
     pub estimate_m: [f64; 3],
     /// 3x3 covariance of the estimate [m^2]; the error ellipses are drawn from
     /// its 2x2 blocks. Ignored (`covariance n/a`) when not finite, symmetric
     /// positive definite.
     pub covariance_m2: Option<[[f64; 3]; 3]>,
-    /// True position [m], when known (simulation).
+    /// True position, metres, when known (simulation).
     pub truth_m: Option<[f64; 3]>,
 }
 
@@ -76,7 +76,7 @@ pub struct AnchorPlot {
     pub caption: String,
     /// The anchors, each drawn in its own pair of zoomed panels.
     pub anchors: Vec<AnchorPlotEntry>,
-    /// Measured platform positions [m], drawn as small dots in the overview.
+    /// Measured platform positions, metres, drawn as small dots in the overview.
     pub platform_positions_m: Vec<[f64; 3]>,
 }
 
@@ -381,6 +381,34 @@ fn arrow(s: &mut String, x0: f64, y0: f64, x1: f64, y1: f64, color: &str) {
 // ---------------------------------------------------------------------------
 // Overview, legend, table.
 
+/// The overview's plot box and its metres-to-pixels map (top view).
+#[derive(Debug, Clone, Copy)]
+struct OverviewFrame {
+    bx: f64,
+    by: f64,
+    bw: f64,
+    bh: f64,
+    scale: f64,
+    /// Data centre, metres.
+    cxm: f64,
+    cym: f64,
+    /// Half the data range shown, metres.
+    half_w: f64,
+    half_h: f64,
+}
+
+impl OverviewFrame {
+    /// The pixel column of `x`, metres.
+    fn px(&self, x: f64) -> f64 {
+        self.bx + 0.5 * self.bw + (x - self.cxm) * self.scale
+    }
+
+    /// The pixel row of `y`, metres.
+    fn py(&self, y: f64) -> f64 {
+        self.by + 0.5 * self.bh - (y - self.cym) * self.scale
+    }
+}
+
 fn render_overview(s: &mut String, plot: &AnchorPlot, left: f64, top: f64, width: f64, height: f64) {
     let _ = writeln!(s, r#"<g class="overview">"#);
     let _ = writeln!(
@@ -389,12 +417,6 @@ fn render_overview(s: &mut String, plot: &AnchorPlot, left: f64, top: f64, width
         n2(left),
         n2(top + 14.0)
     );
-    // Plot box.
-    let bx = left + 50.0;
-    let by = top + 26.0;
-    let bw = width - 60.0;
-    let bh = height - 26.0 - 40.0;
-
     let anchors: Vec<[f64; 2]> = plot
         .anchors
         .iter()
@@ -409,7 +431,25 @@ fn render_overview(s: &mut String, plot: &AnchorPlot, left: f64, top: f64, width
         .map(|p| [p[0], p[1]])
         .filter(|p| finite2(*p))
         .collect();
+    // Plot box.
+    let boxed = (left + 50.0, top + 26.0, width - 60.0, height - 26.0 - 40.0);
+    let Some(f) = overview_frame(boxed, &anchors, &platform) else {
+        let _ = writeln!(s, "</g>");
+        return;
+    };
+    overview_grid(s, &f);
+    overview_points(s, &f, &anchors, &platform);
+    overview_anchors(s, &f, plot, &anchors);
+    let _ = writeln!(s, "</g>");
+}
 
+/// The box `(x, y, width, height)` fitted to the points with a 10 % margin,
+/// at least 1 m across; `None` if no finite scale results.
+fn overview_frame(
+    (bx, by, bw, bh): (f64, f64, f64, f64),
+    anchors: &[[f64; 2]],
+    platform: &[[f64; 2]],
+) -> Option<OverviewFrame> {
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
     for p in anchors.iter().chain(platform.iter()) {
@@ -430,17 +470,25 @@ fn render_overview(s: &mut String, plot: &AnchorPlot, left: f64, top: f64, width
     let (y0, y1) = (lo[1] - pad, hi[1] + pad);
     let scale = (bw / (x1 - x0)).min(bh / (y1 - y0));
     if !(scale.is_finite() && scale > 0.0) {
-        let _ = writeln!(s, "</g>");
-        return;
+        return None;
     }
     // Centre the data in the box.
-    let cxm = 0.5 * (x0 + x1);
-    let cym = 0.5 * (y0 + y1);
-    let half_w = 0.5 * bw / scale;
-    let half_h = 0.5 * bh / scale;
-    let px = |x: f64| bx + 0.5 * bw + (x - cxm) * scale;
-    let py = |y: f64| by + 0.5 * bh - (y - cym) * scale;
+    Some(OverviewFrame {
+        bx,
+        by,
+        bw,
+        bh,
+        scale,
+        cxm: 0.5 * (x0 + x1),
+        cym: 0.5 * (y0 + y1),
+        half_w: 0.5 * bw / scale,
+        half_h: 0.5 * bh / scale,
+    })
+}
 
+/// The overview's box, grid, ticks (absolute metres) and axis names.
+fn overview_grid(s: &mut String, f: &OverviewFrame) {
+    let (bx, by, bw, bh, scale) = (f.bx, f.by, f.bw, f.bh, f.scale);
     let _ = writeln!(
         s,
         r#"<rect x="{}" y="{}" width="{}" height="{}" fill="white" stroke="{C_FRAME}" stroke-width="1"/>"#,
@@ -449,16 +497,15 @@ fn render_overview(s: &mut String, plot: &AnchorPlot, left: f64, top: f64, width
         n2(bw),
         n2(bh)
     );
-    // Grid and ticks (absolute metres).
-    let step = nice_step_below(half_w.max(half_h) / 2.0);
+    let step = nice_step_below(f.half_w.max(f.half_h) / 2.0);
     let dec = decimals_for(step);
     let label_every = (40.0 / (step * scale)).ceil().max(1.0) as i64;
     let mut grid = String::new();
     let mut labels = String::new();
-    let ix0 = ((cxm - half_w) / step).ceil() as i64;
-    let ix1 = ((cxm + half_w) / step).floor() as i64;
+    let ix0 = ((f.cxm - f.half_w) / step).ceil() as i64;
+    let ix1 = ((f.cxm + f.half_w) / step).floor() as i64;
     for i in ix0..=ix1.min(ix0 + 200) {
-        let x = px(i as f64 * step);
+        let x = f.px(i as f64 * step);
         let _ = write!(grid, "M{} {} V{} ", n2(x), n2(by), n2(by + bh));
         if i % label_every == 0 {
             let _ = writeln!(
@@ -470,11 +517,11 @@ fn render_overview(s: &mut String, plot: &AnchorPlot, left: f64, top: f64, width
             );
         }
     }
-    let iy0 = ((cym - half_h) / step).ceil() as i64;
-    let iy1 = ((cym + half_h) / step).floor() as i64;
+    let iy0 = ((f.cym - f.half_h) / step).ceil() as i64;
+    let iy1 = ((f.cym + f.half_h) / step).floor() as i64;
     let label_every_y = (20.0 / (step * scale)).ceil().max(1.0) as i64;
     for i in iy0..=iy1.min(iy0 + 200) {
-        let y = py(i as f64 * step);
+        let y = f.py(i as f64 * step);
         let _ = write!(grid, "M{} {} H{} ", n2(bx), n2(y), n2(bx + bw));
         if i % label_every_y == 0 {
             let _ = writeln!(
@@ -506,8 +553,10 @@ fn render_overview(s: &mut String, plot: &AnchorPlot, left: f64, top: f64, width
         n2(bx - 40.0),
         n2(by + 0.5 * bh)
     );
+}
 
-    // Frame outline through the anchors (in the given order).
+/// The frame outline through the anchors (in the given order) and the platform positions.
+fn overview_points(s: &mut String, f: &OverviewFrame, anchors: &[[f64; 2]], platform: &[[f64; 2]]) {
     if anchors.len() >= 3 {
         let mut d = String::new();
         for (k, p) in anchors.iter().enumerate() {
@@ -515,8 +564,8 @@ fn render_overview(s: &mut String, plot: &AnchorPlot, left: f64, top: f64, width
                 d,
                 "{}{} {} ",
                 if k == 0 { "M" } else { "L" },
-                n2(px(p[0])),
-                n2(py(p[1]))
+                n2(f.px(p[0])),
+                n2(f.py(p[1]))
             );
         }
         d.push('Z');
@@ -525,17 +574,24 @@ fn render_overview(s: &mut String, plot: &AnchorPlot, left: f64, top: f64, width
             r#"<path d="{d}" fill="none" stroke="{C_AXIS}" stroke-width="1" stroke-dasharray="4 3"/>"#
         );
     }
-    // Platform positions.
     if !platform.is_empty() {
         let _ = writeln!(s, r#"<g class="platform" fill="{C_PLATFORM}" stroke="none">"#);
-        for p in &platform {
-            let _ = writeln!(s, r#"<circle cx="{}" cy="{}" r="1.6"/>"#, n2(px(p[0])), n2(py(p[1])));
+        for p in platform {
+            let _ = writeln!(
+                s,
+                r#"<circle cx="{}" cy="{}" r="1.6"/>"#,
+                n2(f.px(p[0])),
+                n2(f.py(p[1]))
+            );
         }
         let _ = writeln!(s, "</g>");
     }
-    // Anchors with labels pushed away from the centroid.
+}
+
+/// The anchors as stars with labels pushed away from their centroid.
+fn overview_anchors(s: &mut String, f: &OverviewFrame, plot: &AnchorPlot, anchors: &[[f64; 2]]) {
     let (mut gx, mut gy, mut cnt) = (0.0, 0.0, 0.0);
-    for p in &anchors {
+    for p in anchors {
         gx += p[0];
         gy += p[1];
         cnt += 1.0;
@@ -549,7 +605,7 @@ fn render_overview(s: &mut String, plot: &AnchorPlot, left: f64, top: f64, width
         if !finite2(p) {
             continue;
         }
-        let (x, y) = (px(p[0]), py(p[1]));
+        let (x, y) = (f.px(p[0]), f.py(p[1]));
         star(s, x, y, 6.0);
         let right = p[0] >= gx;
         let up = p[1] >= gy;
@@ -562,7 +618,6 @@ fn render_overview(s: &mut String, plot: &AnchorPlot, left: f64, top: f64, width
             esc(&shorten(&a.label, 12))
         );
     }
-    let _ = writeln!(s, "</g>");
 }
 
 fn render_legend(s: &mut String, left: f64, top: f64) {
@@ -787,39 +842,127 @@ fn render_anchor_cell(s: &mut String, index: usize, a: &AnchorPlotEntry, x: f64,
     let cov = valid_covariance(&a.covariance_m2);
     for (k, view) in [View::TopXy, View::SideXz].into_iter().enumerate() {
         let left = x + PANEL_LEFT + k as f64 * (PANEL + PANEL_GAP);
-        render_panel(s, index, a, cov.as_ref(), view, left, y + PANEL_TOP, PANEL);
+        render_panel(s, index, a, cov.as_ref(), view, (left, y + PANEL_TOP, PANEL));
     }
     let _ = writeln!(s, "</g>");
 }
 
-#[allow(clippy::too_many_arguments)]
+/// Where a zoomed panel sits and how it maps metres to pixels.
+#[derive(Debug, Clone, Copy)]
+struct PanelFrame {
+    left: f64,
+    top: f64,
+    size: f64,
+    /// Pixels per metre.
+    scale: f64,
+    /// The data point at the panel's centre (truth, else estimate), metres.
+    centre: [f64; 2],
+}
+
+impl PanelFrame {
+    /// Half the panel's side, pixels.
+    fn half_px(&self) -> f64 {
+        0.5 * self.size
+    }
+
+    /// The pixel column of the horizontal data coordinate `u`.
+    fn px(&self, u: f64) -> f64 {
+        self.left + self.half_px() + (u - self.centre[0]) * self.scale
+    }
+
+    /// The pixel row of the vertical data coordinate `v`.
+    fn py(&self, v: f64) -> f64 {
+        self.top + self.half_px() - (v - self.centre[1]) * self.scale
+    }
+}
+
+/// One zoomed panel of an anchor: what it shows, in the view's plane.
+struct PanelContent<'a> {
+    index: usize,
+    anchor: &'a AnchorPlotEntry,
+    cov: Option<&'a [[f64; 3]; 3]>,
+    view: View,
+    est: [f64; 2],
+    est_ok: bool,
+    truth: Option<[f64; 2]>,
+    ellipse: Option<SigmaEllipse>,
+}
+
+/// Grid spacing of a panel: step (m), label decimals, labels every so many steps.
+#[derive(Debug, Clone, Copy)]
+struct PanelTicks {
+    step: f64,
+    dec: usize,
+    label_every: i64,
+}
+
 fn render_panel(
     s: &mut String,
     index: usize,
     a: &AnchorPlotEntry,
     cov: Option<&[[f64; 3]; 3]>,
     view: View,
-    left: f64,
-    top: f64,
-    size: f64,
+    (left, top, size): (f64, f64, f64),
 ) {
     let (iu, iv) = view.axes();
     let proj = |p: &[f64; 3]| [p[iu], p[iv]];
     let est = proj(&a.estimate_m);
-    let truth = a.truth_m.as_ref().map(proj).filter(|p| finite2(*p));
     let est_ok = finite2(est);
-    let centre = truth.or(if est_ok { Some(est) } else { None });
-    let ellipse = cov.and_then(|c| sigma_ellipse(c[iu][iu], c[iu][iv], c[iv][iv]));
-    let half_px = 0.5 * size;
+    let content = PanelContent {
+        index,
+        anchor: a,
+        cov,
+        view,
+        est,
+        est_ok,
+        truth: a.truth_m.as_ref().map(proj).filter(|p| finite2(*p)),
+        ellipse: cov.and_then(|c| sigma_ellipse(c[iu][iu], c[iu][iv], c[iv][iv])),
+    };
+    let centre = content.truth.or(if est_ok { Some(est) } else { None });
+    let (half_m, scale) = panel_zoom(&content, centre, 0.5 * size);
+    let clip_id = panel_header(s, &content, (left, top, size), scale, half_m);
+    let Some(c) = centre else {
+        frame(s, left, top, size);
+        halo_text(
+            s,
+            left + 0.5 * size,
+            top + 0.5 * size + 4.0,
+            "middle",
+            C_MUTED,
+            "no finite position",
+        );
+        let _ = writeln!(s, "</g>");
+        return;
+    };
+    let f = PanelFrame {
+        left,
+        top,
+        size,
+        scale,
+        centre: c,
+    };
+    let ticks = panel_grid(s, &f, half_m);
+    let off_panel = panel_data(s, &f, &content, &clip_id);
+    frame(s, left, top, size);
+    if let Some((dx, dy, dist, init_name)) = off_panel {
+        off_panel_arrow(s, &f, (dx, dy), dist, init_name);
+    }
+    panel_axes(s, &f, view, ticks);
+    let _ = writeln!(s, "</g>");
+}
 
-    // Zoom: estimate, truth and the 3-sigma ellipse with a margin, at least +-0.05 m.
-    let (half_m, scale) = match centre {
+/// Zoom: estimate, truth and the 3-sigma ellipse with a margin, at least
+/// +-0.05 m: the half range (m) and the scale (px per m).
+fn panel_zoom(content: &PanelContent<'_>, centre: Option<[f64; 2]>, half_px: f64) -> (f64, f64) {
+    let (iu, iv) = content.view.axes();
+    let est = content.est;
+    match centre {
         Some(c) => {
             let mut need: f64 = 0.0;
-            for p in [Some(est).filter(|p| finite2(*p)), truth].into_iter().flatten() {
+            for p in [Some(est).filter(|p| finite2(*p)), content.truth].into_iter().flatten() {
                 need = need.max((p[0] - c[0]).abs()).max((p[1] - c[1]).abs());
             }
-            if let (Some(_), Some(cv), true) = (ellipse, cov, est_ok) {
+            if let (Some(_), Some(cv), true) = (content.ellipse, content.cov, content.est_ok) {
                 need = need
                     .max((est[0] - c[0]).abs() + 3.0 * cv[iu][iu].sqrt())
                     .max((est[1] - c[1]).abs() + 3.0 * cv[iv][iv].sqrt());
@@ -833,12 +976,23 @@ fn render_panel(
             }
         }
         None => (0.05, half_px / 0.05),
-    };
+    }
+}
 
+/// The panel's group, title, in-plane 1-sigma text, clip path and
+/// background; returns the clip path's id.
+fn panel_header(
+    s: &mut String,
+    content: &PanelContent<'_>,
+    (left, top, size): (f64, f64, f64),
+    scale: f64,
+    half_m: f64,
+) -> String {
+    let view = content.view;
     let _ = writeln!(
         s,
         r#"<g class="panel" data-anchor="{}" data-view="{}" data-scale-px-per-m="{:.6}" data-half-range-m="{:.6}">"#,
-        esc(&a.label),
+        esc(&content.anchor.label),
         view.id(),
         scale,
         half_m
@@ -851,7 +1005,7 @@ fn render_panel(
         n2(top - 7.0),
         view.title()
     );
-    let right_text = match (&ellipse, &cov) {
+    let right_text = match (&content.ellipse, &content.cov) {
         (Some(e), _) if e.major < 0.01 => format!(
             "1\u{3c3} {} \u{d7} {} mm",
             fmt_sig(1e3 * e.major, 2),
@@ -871,7 +1025,7 @@ fn render_panel(
             esc(&right_text)
         );
     }
-    let clip_id = format!("clip-{index}-{}", view.id());
+    let clip_id = format!("clip-{}-{}", content.index, view.id());
     let _ = writeln!(
         s,
         r#"<defs><clipPath id="{clip_id}"><rect x="{}" y="{}" width="{}" height="{}"/></clipPath></defs>"#,
@@ -888,25 +1042,13 @@ fn render_panel(
         n2(size),
         n2(size)
     );
+    clip_id
+}
 
-    let (un, vn) = view.axis_names();
-    let Some(c) = centre else {
-        frame(s, left, top, size);
-        halo_text(
-            s,
-            left + half_px,
-            top + half_px + 4.0,
-            "middle",
-            C_MUTED,
-            "no finite position",
-        );
-        let _ = writeln!(s, "</g>");
-        return;
-    };
-    let px = |u: f64| left + half_px + (u - c[0]) * scale;
-    let py = |v: f64| top + half_px - (v - c[1]) * scale;
-
-    // Grid, ticks and labels (metres relative to the centre).
+/// Grid, ticks and labels (metres relative to the centre), and the axes through it.
+fn panel_grid(s: &mut String, f: &PanelFrame, half_m: f64) -> PanelTicks {
+    let (left, top, size, scale) = (f.left, f.top, f.size, f.scale);
+    let half_px = f.half_px();
     let step = nice_step_below(half_m / 2.0);
     let dec = decimals_for(step);
     let label_every = (44.0 / (step * scale)).ceil().max(1.0) as i64;
@@ -968,11 +1110,24 @@ fn render_panel(
         n2(left + size)
     );
     s.push_str(&labels);
+    PanelTicks { step, dec, label_every }
+}
 
-    // Clipped data layer.
+/// The clipped data layer: the error ellipses, truth, estimate and the
+/// initial guess (a star when inside). Returns the initial guess's offset
+/// (px), distance (m) and name when it lies off the panel.
+fn panel_data(
+    s: &mut String,
+    f: &PanelFrame,
+    content: &PanelContent<'_>,
+    clip_id: &str,
+) -> Option<(f64, f64, f64, &'static str)> {
+    let (left, top, scale, c) = (f.left, f.top, f.scale, f.centre);
+    let half_px = f.half_px();
+    let est = content.est;
     let _ = writeln!(s, r#"<g clip-path="url(#{clip_id})">"#);
-    if let (Some(e), true) = (ellipse, est_ok) {
-        let (ex, ey) = (px(est[0]), py(est[1]));
+    if let (Some(e), true) = (content.ellipse, content.est_ok) {
+        let (ex, ey) = (f.px(est[0]), f.py(est[1]));
         for k in [3.0, 1.0] {
             let style = if k == 3.0 {
                 format!(r#"fill="none" stroke="{C_ESTIMATE}" stroke-width="1.1" stroke-dasharray="5 3""#)
@@ -995,18 +1150,20 @@ fn render_panel(
             );
         }
     }
-    if let Some(t) = truth {
-        cross(s, px(t[0]), py(t[1]), 5.5);
+    if let Some(t) = content.truth {
+        cross(s, f.px(t[0]), f.py(t[1]), 5.5);
     }
-    if est_ok {
-        dot(s, px(est[0]), py(est[1]), 4.0);
+    if content.est_ok {
+        dot(s, f.px(est[0]), f.py(est[1]), 4.0);
     }
     // Initial guess (or nominal): star if inside, arrow at the edge otherwise.
+    let a = content.anchor;
     let (init3, init_name) = match &a.initial_m {
         Some(p) => (p, "initial"),
         None => (&a.nominal_m, "nominal"),
     };
-    let init = proj(init3);
+    let (iu, iv) = content.view.axes();
+    let init = [init3[iu], init3[iv]];
     let mut off_panel = None;
     if finite2(init) {
         let dx = (init[0] - c[0]) * scale;
@@ -1014,106 +1171,119 @@ fn render_panel(
         if dx.abs() <= half_px - 7.0 && dy.abs() <= half_px - 7.0 {
             star(s, left + half_px + dx, top + half_px + dy, 7.0);
         } else if dx.is_finite() && dy.is_finite() {
-            off_panel = Some((dx, dy, (init[0] - c[0]).hypot(init[1] - c[1])));
+            off_panel = Some((dx, dy, (init[0] - c[0]).hypot(init[1] - c[1]), init_name));
         }
     }
     let _ = writeln!(s, "</g>");
-    frame(s, left, top, size);
+    off_panel
+}
 
-    if let Some((dx, dy, dist)) = off_panel {
-        let len = dx.hypot(dy);
-        let (ux, uy) = (dx / len, dy / len);
-        let inset = half_px - 4.0;
-        let tx = if ux.abs() > 1e-12 {
-            inset / ux.abs()
-        } else {
-            f64::INFINITY
-        };
-        let ty = if uy.abs() > 1e-12 {
-            inset / uy.abs()
-        } else {
-            f64::INFINITY
-        };
-        let t = tx.min(ty);
-        let (cx, cy) = (left + half_px, top + half_px);
-        let (tipx, tipy) = (cx + ux * t, cy + uy * t);
-        let (tailx, taily) = (tipx - 26.0 * ux, tipy - 26.0 * uy);
-        arrow(s, tailx, taily, tipx, tipy, C_INITIAL);
-        let dist_text = format!("{} m", fmt_len(dist));
-        let (lx, ly, anchor, lines);
-        if tx <= ty {
-            // Left or right edge: a narrow two-line label beside the edge, above
-            // or below the arrow, preferring the side away from the centre.
-            lines = vec![init_name.to_owned(), dist_text];
-            let right = ux > 0.0;
-            lx = if right { left + size - 4.0 } else { left + 4.0 };
-            anchor = if right { "end" } else { "start" };
-            let above_y = tipy.min(taily) - 8.0 - LINE_H;
-            let below_y = tipy.max(taily) + 16.0;
-            let fits = |y: f64| y >= top + 14.0 && y + LINE_H <= top + size - 5.0;
-            ly = if tipy < cy {
-                if fits(above_y) {
-                    above_y
-                } else {
-                    below_y
-                }
-            } else if fits(below_y) {
-                below_y
-            } else {
+/// An initial guess off the panel: an arrow at the edge towards it and a
+/// label with its distance, kept inside the panel.
+fn off_panel_arrow(s: &mut String, f: &PanelFrame, (dx, dy): (f64, f64), dist: f64, init_name: &str) {
+    let (left, top, size) = (f.left, f.top, f.size);
+    let half_px = f.half_px();
+    let len = dx.hypot(dy);
+    let (ux, uy) = (dx / len, dy / len);
+    let inset = half_px - 4.0;
+    let tx = if ux.abs() > 1e-12 {
+        inset / ux.abs()
+    } else {
+        f64::INFINITY
+    };
+    let ty = if uy.abs() > 1e-12 {
+        inset / uy.abs()
+    } else {
+        f64::INFINITY
+    };
+    let t = tx.min(ty);
+    let (cx, cy) = (left + half_px, top + half_px);
+    let (tipx, tipy) = (cx + ux * t, cy + uy * t);
+    let (tailx, taily) = (tipx - 26.0 * ux, tipy - 26.0 * uy);
+    arrow(s, tailx, taily, tipx, tipy, C_INITIAL);
+    let dist_text = format!("{} m", fmt_len(dist));
+    let (lx, ly, anchor, lines);
+    if tx <= ty {
+        // Left or right edge: a narrow two-line label beside the edge, above
+        // or below the arrow, preferring the side away from the centre.
+        lines = vec![init_name.to_owned(), dist_text];
+        let right = ux > 0.0;
+        lx = if right { left + size - 4.0 } else { left + 4.0 };
+        anchor = if right { "end" } else { "start" };
+        let above_y = tipy.min(taily) - 8.0 - LINE_H;
+        let below_y = tipy.max(taily) + 16.0;
+        let fits = |y: f64| y >= top + 14.0 && y + LINE_H <= top + size - 5.0;
+        ly = if tipy < cy {
+            if fits(above_y) {
                 above_y
-            };
-        } else {
-            // Top or bottom edge: one line to the side of the arrow, preferring
-            // the side away from the centre if the text fits there.
-            lines = vec![format!("{init_name} {dist_text}")];
-            let w = text_w(&lines[0], 12.0);
-            ly = 0.5 * (tipy + taily) + 4.0;
-            let left_x = tipx.min(tailx) - 8.0;
-            let right_x = tipx.max(tailx) + 8.0;
-            let fits_left = left_x - w >= left + 4.0;
-            let fits_right = right_x + w <= left + size - 4.0;
-            let go_left = if tipx < cx {
-                fits_left || !fits_right
             } else {
-                !fits_right && fits_left
-            };
-            if go_left {
-                lx = left_x;
-                anchor = "end";
-            } else {
-                lx = right_x;
-                anchor = "start";
+                below_y
             }
-        }
-        // Keep the label inside the panel.
-        let w = lines.iter().map(|l| text_w(l, 12.0)).fold(0.0, f64::max);
-        let (lo_x, hi_x) = match anchor {
-            "end" => (left + 4.0 + w, left + size - 4.0),
-            _ => (left + 4.0, left + size - 4.0 - w),
+        } else if fits(below_y) {
+            below_y
+        } else {
+            above_y
         };
-        let lx = if lo_x <= hi_x { lx.clamp(lo_x, hi_x) } else { lx };
-        let block = LINE_H * (lines.len() as f64 - 1.0);
-        let ly = ly.clamp(top + 14.0, (top + size - 5.0 - block).max(top + 14.0));
-        let mut body = String::new();
-        for (k, l) in lines.iter().enumerate() {
-            let _ = write!(
-                body,
-                r#"<tspan x="{}" dy="{}">{}</tspan>"#,
-                n2(lx),
-                if k == 0 { 0.0 } else { LINE_H },
-                esc(l)
-            );
+    } else {
+        // Top or bottom edge: one line to the side of the arrow, preferring
+        // the side away from the centre if the text fits there.
+        lines = vec![format!("{init_name} {dist_text}")];
+        let w = text_w(&lines[0], 12.0);
+        ly = 0.5 * (tipy + taily) + 4.0;
+        let left_x = tipx.min(tailx) - 8.0;
+        let right_x = tipx.max(tailx) + 8.0;
+        let fits_left = left_x - w >= left + 4.0;
+        let fits_right = right_x + w <= left + size - 4.0;
+        let go_left = if tipx < cx {
+            fits_left || !fits_right
+        } else {
+            !fits_right && fits_left
+        };
+        if go_left {
+            lx = left_x;
+            anchor = "end";
+        } else {
+            lx = right_x;
+            anchor = "start";
         }
-        let _ = writeln!(
-            s,
-            r#"<text class="off-panel" data-distance-m="{dist:.6}" x="{}" y="{}" text-anchor="{anchor}" fill="{C_INITIAL}" stroke="white" stroke-width="3" stroke-linejoin="round" paint-order="stroke">{body}</text>"#,
+    }
+    off_panel_label(s, f, (lx, ly), anchor, &lines, dist);
+}
+
+/// The off-panel label's lines at `(lx, ly)`, clamped inside the panel.
+fn off_panel_label(s: &mut String, f: &PanelFrame, (lx, ly): (f64, f64), anchor: &str, lines: &[String], dist: f64) {
+    let (left, top, size) = (f.left, f.top, f.size);
+    let w = lines.iter().map(|l| text_w(l, 12.0)).fold(0.0, f64::max);
+    let (lo_x, hi_x) = match anchor {
+        "end" => (left + 4.0 + w, left + size - 4.0),
+        _ => (left + 4.0, left + size - 4.0 - w),
+    };
+    let lx = if lo_x <= hi_x { lx.clamp(lo_x, hi_x) } else { lx };
+    let block = LINE_H * (lines.len() as f64 - 1.0);
+    let ly = ly.clamp(top + 14.0, (top + size - 5.0 - block).max(top + 14.0));
+    let mut body = String::new();
+    for (k, l) in lines.iter().enumerate() {
+        let _ = write!(
+            body,
+            r#"<tspan x="{}" dy="{}">{}</tspan>"#,
             n2(lx),
-            n2(ly)
+            if k == 0 { 0.0 } else { LINE_H },
+            esc(l)
         );
     }
+    let _ = writeln!(
+        s,
+        r#"<text class="off-panel" data-distance-m="{dist:.6}" x="{}" y="{}" text-anchor="{anchor}" fill="{C_INITIAL}" stroke="white" stroke-width="3" stroke-linejoin="round" paint-order="stroke">{body}</text>"#,
+        n2(lx),
+        n2(ly)
+    );
+}
 
-    // Axis names and scale bar below the panel.
-    let bar_m = step * label_every as f64;
+/// Axis names and the scale bar below the panel.
+fn panel_axes(s: &mut String, f: &PanelFrame, view: View, ticks: PanelTicks) {
+    let (left, top, size, scale) = (f.left, f.top, f.size, f.scale);
+    let (un, vn) = view.axis_names();
+    let bar_m = ticks.step * ticks.label_every as f64;
     let bar_px = bar_m * scale;
     let by = top + size + 31.0;
     if bar_px.is_finite() && bar_px > 0.0 && bar_px < size {
@@ -1131,7 +1301,7 @@ fn render_panel(
             r#"<text x="{}" y="{}">{} m</text>"#,
             n2(left + bar_px + 6.0),
             n2(by),
-            tick_label(label_every, step, dec)
+            tick_label(ticks.label_every, ticks.step, ticks.dec)
         );
     }
     let _ = writeln!(
@@ -1144,9 +1314,8 @@ fn render_panel(
         s,
         r#"<text x="{x}" y="{y}" text-anchor="middle" fill="{C_MUTED}" transform="rotate(-90 {x} {y})">&#916;{vn} [m]</text>"#,
         x = n2(left - 46.0),
-        y = n2(top + half_px)
+        y = n2(top + f.half_px())
     );
-    let _ = writeln!(s, "</g>");
 }
 
 fn frame(s: &mut String, left: f64, top: f64, size: f64) {

@@ -489,8 +489,27 @@ fn render_legend(s: &mut String, series: &[Prepared<'_>], left: f64, right: f64,
     let _ = writeln!(s, "</g>");
 }
 
+/// A residual panel's place and axes.
+struct PanelPlace<'a> {
+    left: f64,
+    top: f64,
+    xa: &'a Axis,
+    ya: &'a Axis,
+}
+
+impl PanelPlace<'_> {
+    /// The pixel column of driver value `x`.
+    fn px(&self, x: f64) -> f64 {
+        self.left + self.xa.frac(x) * PANEL_W
+    }
+
+    /// The pixel row of residual `y`.
+    fn py(&self, y: f64) -> f64 {
+        self.top + PANEL_H - self.ya.frac(y) * PANEL_H
+    }
+}
+
 fn render_panel(s: &mut String, plot: &ResidualPlot, p: &Prepared<'_>, xa: &Axis, ya: &Axis, left: f64, top: f64) {
-    let (colour, dark) = p.colours();
     let slope_attr = p.fit.map_or_else(|| "NaN".to_owned(), |f| format!("{}", f.slope));
     let _ = writeln!(
         s,
@@ -500,9 +519,7 @@ fn render_panel(s: &mut String, plot: &ResidualPlot, p: &Prepared<'_>, xa: &Axis
         p.points.len(),
         p.skipped
     );
-    let px = |x: f64| left + xa.frac(x) * PANEL_W;
-    let py = |y: f64| top + PANEL_H - ya.frac(y) * PANEL_H;
-
+    let place = PanelPlace { left, top, xa, ya };
     // Panel title.
     let heading = if p.name == "after" { "After" } else { "Before" };
     let _ = writeln!(
@@ -521,11 +538,41 @@ fn render_panel(s: &mut String, plot: &ResidualPlot, p: &Prepared<'_>, xa: &Axis
         n2(PANEL_W),
         n2(PANEL_H)
     );
+    panel_grid(s, &place);
+    panel_points(s, &place, p, &clip_id);
+    let _ = writeln!(
+        s,
+        r#"<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="{C_FRAME}" stroke-width="1"/>"#,
+        n2(left),
+        n2(top),
+        n2(PANEL_W),
+        n2(PANEL_H)
+    );
+    panel_notes(s, &place, p);
+    // Axis labels.
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
+        n2(left + 0.5 * PANEL_W),
+        n2(top + PANEL_H + 36.0),
+        esc(&plot.driver_label)
+    );
+    let _ = writeln!(
+        s,
+        r#"<text x="{x}" y="{y}" text-anchor="middle" transform="rotate(-90 {x} {y})">{}</text>"#,
+        esc(&plot.residual_label),
+        x = n2(left - 56.0),
+        y = n2(top + 0.5 * PANEL_H)
+    );
+    let _ = writeln!(s, "</g>");
+}
 
-    // Grid, zero line, tick labels.
+/// Grid, zero line and tick labels.
+fn panel_grid(s: &mut String, place: &PanelPlace<'_>) {
+    let (left, top, xa, ya) = (place.left, place.top, place.xa, place.ya);
     let mut grid = String::new();
     for i in xa.ticks() {
-        let x = px(i * xa.step());
+        let x = place.px(i * xa.step());
         let _ = write!(grid, "M{} {} V{} ", n2(x), n2(top), n2(top + PANEL_H));
         let _ = writeln!(
             s,
@@ -536,7 +583,7 @@ fn render_panel(s: &mut String, plot: &ResidualPlot, p: &Prepared<'_>, xa: &Axis
         );
     }
     for i in ya.ticks() {
-        let y = py(i * ya.step());
+        let y = place.py(i * ya.step());
         let _ = write!(grid, "M{} {} H{} ", n2(left), n2(y), n2(left + PANEL_W));
         let _ = writeln!(
             s,
@@ -556,27 +603,30 @@ fn render_panel(s: &mut String, plot: &ResidualPlot, p: &Prepared<'_>, xa: &Axis
             s,
             r#"<path class="zero" d="M{} {} H{}" stroke="{C_ZERO}" stroke-width="1.2" fill="none"/>"#,
             n2(left),
-            n2(py(0.0)),
+            n2(place.py(0.0)),
             n2(left + PANEL_W)
         );
     }
+}
 
-    // Points and binned means (inside the axes by construction), then the
-    // least-squares line clipped to the panel.
+/// Points and binned means (inside the axes by construction), then the
+/// least-squares line clipped to the panel.
+fn panel_points(s: &mut String, place: &PanelPlace<'_>, p: &Prepared<'_>, clip_id: &str) {
+    let (colour, dark) = p.colours();
     for &(x, y) in &p.points {
         let _ = writeln!(
             s,
             r#"<circle class="{}" cx="{}" cy="{}" r="2.6" fill="{colour}" fill-opacity="0.45" stroke="{colour}" stroke-width="0.6"/>"#,
             p.name,
-            n2(px(x)),
-            n2(py(y))
+            n2(place.px(x)),
+            n2(place.py(y))
         );
     }
     if p.bins.len() >= 2 {
         let pts: Vec<String> = p
             .bins
             .iter()
-            .map(|b| format!("{},{}", n2(px(b.0)), n2(py(b.1))))
+            .map(|b| format!("{},{}", n2(place.px(b.0)), n2(place.py(b.1))))
             .collect();
         let _ = writeln!(
             s,
@@ -587,34 +637,31 @@ fn render_panel(s: &mut String, plot: &ResidualPlot, p: &Prepared<'_>, xa: &Axis
             let _ = writeln!(
                 s,
                 r#"<rect class="bin-mean" x="{}" y="{}" width="6" height="6" fill="{dark}" stroke="white" stroke-width="1"/>"#,
-                n2(px(b.0) - 3.0),
-                n2(py(b.1) - 3.0)
+                n2(place.px(b.0) - 3.0),
+                n2(place.py(b.1) - 3.0)
             );
         }
     }
     if let Some(f) = p.fit {
+        let xa = place.xa;
         let _ = writeln!(s, r#"<g clip-path="url(#{clip_id})">"#);
         let line_y = |x: f64| f.mean_y + f.slope * (x - f.mean_x);
         let _ = writeln!(
             s,
             r#"<path class="fit" d="M{} {} L{} {}" stroke="{dark}" stroke-width="1.6" stroke-dasharray="6 4" fill="none"/>"#,
-            n2(px(xa.lo)),
-            n2(py(line_y(xa.lo))),
-            n2(px(xa.hi)),
-            n2(py(line_y(xa.hi)))
+            n2(place.px(xa.lo)),
+            n2(place.py(line_y(xa.lo))),
+            n2(place.px(xa.hi)),
+            n2(place.py(line_y(xa.hi)))
         );
         let _ = writeln!(s, "</g>");
     }
-    let _ = writeln!(
-        s,
-        r#"<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="{C_FRAME}" stroke-width="1"/>"#,
-        n2(left),
-        n2(top),
-        n2(PANEL_W),
-        n2(PANEL_H)
-    );
+}
 
-    // Slope, notes.
+/// The slope, and notes for an empty series or skipped points.
+fn panel_notes(s: &mut String, place: &PanelPlace<'_>, p: &Prepared<'_>) {
+    let (left, top) = (place.left, place.top);
+    let (_, dark) = p.colours();
     let slope_text = match p.fit {
         Some(f) => format!("slope {} per unit (n = {})", fmt_sig(f.slope, 3), p.points.len()),
         None => format!("slope n/a (n = {})", p.points.len()),
@@ -638,23 +685,6 @@ fn render_panel(s: &mut String, plot: &ResidualPlot, p: &Prepared<'_>, xa: &Axis
         );
         halo_text(s, left + 8.0, top + PANEL_H - 8.0, "start", C_MUTED, &note);
     }
-
-    // Axis labels.
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
-        n2(left + 0.5 * PANEL_W),
-        n2(top + PANEL_H + 36.0),
-        esc(&plot.driver_label)
-    );
-    let _ = writeln!(
-        s,
-        r#"<text x="{x}" y="{y}" text-anchor="middle" transform="rotate(-90 {x} {y})">{}</text>"#,
-        esc(&plot.residual_label),
-        x = n2(left - 56.0),
-        y = n2(top + 0.5 * PANEL_H)
-    );
-    let _ = writeln!(s, "</g>");
 }
 
 // ---------------------------------------------------------------------------
