@@ -69,9 +69,13 @@ struct Report {
     cases: Vec<HiddenCase>,
 }
 
+/// The mean of the finite values; NaN without any.
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
     let v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
-    v.iter().sum::<f64>() / v.len().max(1) as f64
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.iter().sum::<f64>() / v.len() as f64
 }
 
 pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {

@@ -162,7 +162,7 @@ pub(super) fn reason(selection: &Selection, base: &Baseline, options: &DiagnoseO
             let removed = if s.removed.is_empty() {
                 String::new()
             } else {
-                format!(", then removed {}", s.removed.join(", "))
+                format!(", then removed or replaced: {}", s.removed.join(", "))
             };
             format!(
                 "step {}: {} (likelihood ratio {:.1} on {} dof, p = {:.2e} < {:.2e}){removed}",

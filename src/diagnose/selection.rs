@@ -16,7 +16,9 @@
 //! beats freeing 3 orientation parameters per pose) is added and the model
 //! refitted; every
 //! earlier hypothesis is then tested for removal at the same level
-//! (backward check), and the search goes on until nothing is significant.
+//! (backward check), an effect that contains a simpler one (four drum gains,
+//! one common gain) is replaced by it where the data do not reject the
+//! simpler one, and the search goes on until nothing is significant.
 
 use serde::Serialize;
 
@@ -62,7 +64,8 @@ pub struct SelectionStep {
     pub p_value: f64,
     /// The p-value it had to beat.
     pub p_threshold: f64,
-    /// Hypotheses removed by the backward check after the addition.
+    /// Hypotheses removed by the backward check after the addition, and
+    /// effects replaced by a simpler nested one (`encoder-scale by encoder-gain`).
     pub removed: Vec<String>,
 }
 
@@ -128,7 +131,8 @@ pub(super) fn forward_selection(search: &Search<'_>, progress: &mut Progress<'_>
             p_threshold: row.p_threshold,
             removed: Vec::new(),
         };
-        model = backward_check(search, extended, row.p_threshold, &mut selected.removed, progress);
+        let checked = backward_check(search, extended, row.p_threshold, &mut selected.removed, progress);
+        model = simplify_nested(search, checked, row.p_threshold, &mut selected.removed, progress);
         steps.push(selected);
     }
     Selection {
@@ -159,6 +163,41 @@ fn backward_check(
         if chi_square_survival(dof, lr.max(0.0)) >= p_threshold {
             removed.push(hypothesis.name().to_string());
             model = reduced;
+        }
+    }
+    model
+}
+
+/// Replace every effect of `model` that contains a simpler one (the per-drum
+/// gains contain one common gain) by the simpler one where the data do not
+/// reject it at `p_threshold`: the likelihood ratio of the difference, on the
+/// parameters the simpler effect drops.
+fn simplify_nested(
+    search: &Search<'_>,
+    mut model: Model,
+    p_threshold: f64,
+    replaced: &mut Vec<String>,
+    progress: &mut Progress<'_>,
+) -> Model {
+    for inner in EffectKind::ALL {
+        let Some(outer) = inner.nested_in() else {
+            continue;
+        };
+        let Some(at) = model.hypotheses.iter().position(|h| *h == Hypothesis::Effect(outer)) else {
+            continue;
+        };
+        progress.grow(1);
+        progress.step(&format!("nested check: {} for {}", inner.name(), outer.name()));
+        let mut hypotheses = model.hypotheses.clone();
+        hypotheses[at] = Hypothesis::Effect(inner);
+        let Ok(simpler) = model.refit(hypotheses, search.base, search.measurements) else {
+            continue;
+        };
+        let dof = outer.parameter_count() - inner.parameter_count();
+        let lr = (simpler.chi_square - model.chi_square) / search.base.variance_factor;
+        if chi_square_survival(dof, lr.max(0.0)) >= p_threshold {
+            replaced.push(format!("{} by {}", outer.name(), inner.name()));
+            model = simpler;
         }
     }
     model
