@@ -8,7 +8,7 @@ use super::residual_tests::total_chi_square;
 use super::selection::Search;
 use super::Baseline;
 use crate::calib::{
-    build_graph, refine_with_effects, set_effect_estimates, without_estimated, CableModel, CalibrationError,
+    build_graph, calibrate, refine_with_effects, set_effect_estimates, without_estimated, CableModel, CalibrationError,
     CalibrationGraph, CalibrationOptions, CalibrationResult, EffectEstimate, OrientationPrior,
 };
 use crate::error::Result;
@@ -146,8 +146,27 @@ impl Model {
         let mut start = self.result.clone();
         start.robot.effects = base.result.robot.effects;
         start.effect_estimates.retain(|e| effects.contains(e.effect));
-        let result = refine_with_effects(&start, measurements, &options)?;
-        let chi_square = total_chi_square(&rebuild(&result, &base.used, &options).graph);
+        let mut result = refine_with_effects(&start, measurements, &options)?;
+        let mut chi_square = total_chi_square(&rebuild(&result, &base.used, &options).graph);
+        // A second start: the whole staged calibration from the initial guess
+        // with this model, so that a baseline caught in a wrong basin does not
+        // trap its extensions. The lower chi-square over the same poses wins.
+        if !hypotheses.is_empty() {
+            // The fit's effects go back to the known inputs before the refinement
+            // estimates them (the robot's `[effects]` cannot hold every estimate).
+            let fresh = calibrate(&base.guess, measurements, &options).and_then(|mut fresh| {
+                fresh.robot.effects = base.result.robot.effects;
+                refine_with_effects(&fresh, measurements, &options)
+            });
+            if let Ok(fresh) = fresh {
+                if fresh.excluded_poses == base.result.excluded_poses {
+                    let fresh_chi_square = total_chi_square(&rebuild(&fresh, &base.used, &options).graph);
+                    if fresh_chi_square < chi_square {
+                        (result, chi_square) = (fresh, fresh_chi_square);
+                    }
+                }
+            }
+        }
         Ok(Self {
             hypotheses,
             result,

@@ -138,6 +138,8 @@ struct Baseline {
     bic: f64,
     /// Mean load-cell reading over the poses used, newtons.
     mean_reference_tension_n: f64,
+    /// The initial guess every calibration starts from.
+    guess: Robot,
 }
 
 impl Baseline {
@@ -192,6 +194,7 @@ impl Baseline {
             variance_factor: variance_factor(chi_square, dof),
             bic: f64::NAN,
             mean_reference_tension_n: f64::NAN,
+            guess: robot.clone(),
         };
         base.mean_reference_tension_n =
             base.used.iter().map(|m| m.reference_tension_n).sum::<f64>() / base.used.len() as f64;
