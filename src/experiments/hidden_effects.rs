@@ -41,14 +41,14 @@
 //! `[effects] pulley_radius_m`), and each pulley case also reports the anchor
 //! error of a calibration that is given the radius.
 
-use nalgebra::{DMatrix, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::calib::{build_graph, calibrate, CableModel, CalibrationError, CalibrationOptions};
-use crate::diagnose::{diagnose, power_against, DiagnoseOptions};
+use crate::diagnose::{diagnose, power_against, CandidateFit, DiagnoseOptions};
 use crate::error::{Error, Result};
 use crate::model::effect_ranges::{
     axial_stiffness_range_n, com_shift_range_m, pulley_radius_range_m, COMMON_GAIN_HIGH, COMMON_GAIN_LOW,
@@ -63,6 +63,7 @@ use crate::model::statics::CableTension;
 use crate::sim::closed_form::{sample_equilibria, Workspace};
 use crate::sim::effects::{measure_with_effects, solve_with_effects};
 use crate::solver::{marginal_covariance, Covariance};
+use crate::stats::{chi_square_critical, noncentral_chi_square_survival};
 
 /// Settings of the experiment.
 #[derive(Debug, Clone, PartialEq)]
@@ -107,8 +108,9 @@ pub struct HiddenCase {
     /// Whether the verdict names exactly the hidden effects.
     pub correct: bool,
     /// The smallest power, over the hidden effects, of the diagnosis' first
-    /// test at the effect's true magnitude (`None` for none or a singular
-    /// information matrix): the case is detectable when it is >= 0.9.
+    /// test at the effect's true magnitude, and for per-drum gains of telling
+    /// them from one common gain (`None` for none or a singular information
+    /// matrix): the case is detectable when it is >= 0.9.
     pub power: Option<f64>,
     /// Mean absolute anchor-coordinate error of the baseline, metres.
     pub anchor_mae_before_m: f64,
@@ -333,8 +335,15 @@ pub fn run_case(
     let powers: Vec<Option<f64>> = hidden
         .iter()
         .map(|k| {
-            step_one(*k)
-                .and_then(|row| power_against(row, &k.variable_values(&truth.effects), diagnosis.variance_factor))
+            step_one(*k).and_then(|row| {
+                let theta = k.variable_values(&truth.effects);
+                let full = power_against(row, &theta, diagnosis.variance_factor)?;
+                // An effect that contains a simpler one must also be told from it.
+                match EffectKind::ALL.into_iter().find(|inner| inner.nested_in() == Some(*k)) {
+                    Some(inner) => Some(full.min(nested_power(row, &theta, inner, diagnosis.variance_factor)?)),
+                    None => Some(full),
+                }
+            })
         })
         .collect();
     let power = powers
@@ -369,6 +378,29 @@ pub fn run_case(
         baseline_error_over_sigma: diagnosis.baseline_error_over_sigma.unwrap_or(f64::NAN),
         anchor_mae_known_geometry_m,
     })
+}
+
+/// The power of telling `theta` (variable units, `row`'s effect) from the
+/// nested effect `inner` (equal gains: the multiples of `1`): the
+/// non-centrality `min_c (theta - c 1)^T Sigma^-1 (theta - c 1) / s^2` on the
+/// parameters the nested effect drops, at `row`'s false-alarm level.
+fn nested_power(row: &CandidateFit, theta: &[f64], inner: EffectKind, variance_factor: f64) -> Option<f64> {
+    let k = theta.len();
+    if row.covariance.len() != k {
+        return None;
+    }
+    let covariance = DMatrix::from_fn(k, k, |r, c| row.covariance[r][c] * variance_factor);
+    let cholesky = covariance.cholesky()?;
+    let theta = DVector::from_column_slice(theta);
+    let ones = DVector::from_element(k, 1.0);
+    let common = ones.dot(&cholesky.solve(&theta)) / ones.dot(&cholesky.solve(&ones));
+    let deviation = &theta - ones * common;
+    let lambda = deviation.dot(&cholesky.solve(&deviation));
+    let dof = k - inner.parameter_count();
+    let critical = chi_square_critical(dof, row.p_threshold);
+    lambda
+        .is_finite()
+        .then(|| noncentral_chi_square_survival(dof, lambda, critical))
 }
 
 /// The seed of case `index` of the effects `hidden` on robot number
