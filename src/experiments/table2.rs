@@ -319,14 +319,17 @@ pub fn run_trial(
     });
     let solve_ms = started.elapsed().as_secs_f64() * 1e3;
     // The bound of the estimator actually used: with the orientation prior if
-    // the calibration kept it.
+    // the calibration kept it, and the estimated effects free.
     let orientation_prior_used = result
         .as_ref()
         .ok()
         .and_then(|r| r.orientation_check.map(|c| c.prior_used));
-    let bound_options = match &result {
-        Ok(r) => options.as_used_by(r),
-        Err(_) => options,
+    let bound_options = CalibrationOptions {
+        free_effects: protocol.estimate,
+        ..match &result {
+            Ok(r) => options.as_used_by(r),
+            Err(_) => options,
+        }
     };
     let (anchor_crlb_m, offset_crlb_m) =
         cramer_rao_bound(truth, &equilibria, &bound_options).map_or((None, None), |b| bound_summary(&b));
