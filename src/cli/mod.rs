@@ -77,7 +77,9 @@ fn parse_noises(text: &str) -> Result<Vec<sagcal::model::sensors::NoisePreset>, 
     use sagcal::model::sensors::NoisePreset;
     match text {
         "both" => Ok(vec![NoisePreset::Paper, NoisePreset::Authors]),
-        other => NoisePreset::parse(other).map(|n| vec![n]),
+        other => NoisePreset::parse(other)
+            .map(|n| vec![n])
+            .map_err(|e| format!("{e}, or `both` (paper and authors)")),
     }
 }
 

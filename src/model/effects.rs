@@ -334,10 +334,10 @@ impl EffectKind {
 
     /// Parse [`EffectKind::name`].
     pub fn parse(text: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|k| k.name() == text.trim())
-            .ok_or_else(|| format!("unknown effect `{text}` (effects: {EFFECT_NAMES})"))
+        Self::ALL.into_iter().find(|k| k.name() == text.trim()).ok_or_else(|| {
+            let names: Vec<&str> = Self::ALL.iter().map(|k| k.name()).collect();
+            format!("unknown effect `{text}` (effects: {})", names.join(", "))
+        })
     }
 
     /// Names of the fitted parameters, in the order of [`EffectKind::parameters`].
