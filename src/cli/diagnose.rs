@@ -2,16 +2,16 @@
 
 use std::path::Path;
 
-use indicatif::{ProgressBar, ProgressStyle};
 use sagcal::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::model::effects::EffectKind;
 use sagcal::model::Robot;
 use sagcal::plot::residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
 
-use super::output::{print_json, Table};
+use super::output::{opt, print_json, progress_bar, Table};
 use super::DiagnoseArgs;
 
+/// Diagnose the data against the nominal robot, write the requested files, print the report (or JSON).
 pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
     let nominal = Robot::from_file(&args.robot)?;
     let truth = args.truth.as_deref().map(Robot::from_file).transpose()?;
@@ -33,12 +33,7 @@ pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
             .collect::<Result<_, _>>()
             .map_err(|e| sagcal::Error::InvalidInput(format!("--candidates: {e}")))?;
     }
-    let bar = ProgressBar::new(1);
-    bar.set_style(
-        ProgressStyle::with_template("{msg:40} [{bar:30}] {pos}/{len} fits, {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
+    let bar = progress_bar(1, "{msg:40} [{bar:30}] {pos}/{len} fits, {elapsed}");
     let diagnosis = diagnose(
         &nominal,
         &data.poses,
@@ -83,6 +78,7 @@ fn write_extended_robot(path: &Path, diagnosis: &Diagnosis) -> sagcal::Result<()
     sagcal::io::write_atomically(path, format!("{header}{text}").as_bytes())
 }
 
+/// `text` as a file name: ASCII letters (lower-cased) and digits, each run of anything else one `_`, none at the ends.
 fn file_name(text: &str) -> String {
     text.chars()
         .map(|c| {
@@ -99,6 +95,7 @@ fn file_name(text: &str) -> String {
         .join("_")
 }
 
+/// Write the residual plot against the winning driver (before and after) into `dir`; its path.
 fn write_plots(dir: &Path, diagnosis: &Diagnosis, data: &Path) -> sagcal::Result<std::path::PathBuf> {
     std::fs::create_dir_all(dir).map_err(|e| {
         sagcal::Error::InvalidInput(format!("--plots {}: cannot create the folder: {e}", dir.display()))
@@ -280,10 +277,6 @@ fn render_verdict(d: &Diagnosis) -> String {
         out += &driver_table(&d.drivers_after, 5);
     }
     out
-}
-
-fn opt(value: Option<f64>, digits: usize) -> String {
-    value.map_or_else(|| "-".into(), |v| format!("{v:.digits$}"))
 }
 
 /// The `count` strongest residual-driver correlations as a table.

@@ -1,8 +1,7 @@
 //! `sagcal experiment table2`: the paper's calibration protocol.
 
-use indicatif::{ProgressBar, ProgressStyle};
 use sagcal::calib::{CableModel, OrientationPrior};
-use sagcal::experiments::table2::{pose_pool, run_protocol, PoseCountResult, Protocol, Source};
+use sagcal::experiments::table2::{pose_pool, run_protocol, PoolPose, PoseCountResult, Protocol, Source};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
@@ -10,7 +9,7 @@ use serde::Serialize;
 
 use sagcal::model::effects::{EffectKind, EffectSet};
 
-use super::output::{print_json, Table};
+use super::output::{print_json, progress_bar, Table};
 use super::Table2Args;
 
 /// The paper's Table II: (poses, anchor MAE m, offset MAE m) per robot.
@@ -33,6 +32,7 @@ struct Table2Report {
     results: Vec<PoseCountResult>,
 }
 
+/// The paper's (anchor, offset) MAE for this robot and pose count, if it gives one.
 fn paper_numbers(robot: &Robot, poses: usize) -> Option<(f64, f64)> {
     let table: &[(usize, f64, f64)] = if robot.platform_weight_n < 100.0 {
         &PAPER_SMALL
@@ -42,15 +42,9 @@ fn paper_numbers(robot: &Robot, poses: usize) -> Option<(f64, f64)> {
     table.iter().find(|(n, _, _)| *n == poses).map(|(_, a, o)| (*a, *o))
 }
 
+/// Run the Table II protocol on the log's poses and print the table (or JSON).
 pub fn run(args: &Table2Args) -> sagcal::Result<()> {
     let truth = Robot::from_file(&args.robot)?;
-    let light = truth.platform_weight_n < 100.0;
-    let anchor_perturbation_m = args.anchor_perturbation_m.unwrap_or(if light { 1.0 } else { 10.0 });
-    let offset_perturbation_m = args.offset_perturbation_m.unwrap_or(if light { 10.0 } else { 80.0 });
-    let basin_radius_m = args.basin_radius_m.unwrap_or(match args.model {
-        CableModel::Catenary => 0.3 * anchor_perturbation_m,
-        CableModel::Rigid => f64::INFINITY,
-    });
     let data = read_measurements(
         &args.data,
         &ReadOptions {
@@ -59,7 +53,41 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         },
     )?;
     let pool = pose_pool(&truth, &data.poses, args.source)?;
-    let protocol = Protocol {
+    let protocol = protocol(args, &truth)?;
+    let results = run_trials(args, &truth, &pool, &protocol)?;
+    let report = Table2Report {
+        robot: truth.name.clone(),
+        data: args.data.display().to_string(),
+        source: args.source,
+        noise: args.noise,
+        model: args.model,
+        seed: args.seed,
+        anchor_perturbation_m: protocol.anchor_perturbation_m,
+        offset_perturbation_m: protocol.offset_perturbation_m,
+        basin_radius_m: protocol.basin_radius_m,
+        orientation_prior: args.orientation_prior,
+        pool_size: pool.len(),
+        results,
+    };
+    if args.json {
+        return print_json(&report);
+    }
+    print_table(args, &truth, &report);
+    print_bound_verdicts(&truth, &report);
+    Ok(())
+}
+
+/// The protocol of the arguments, with the robot's default perturbations
+/// (10 m / 80 m off, 1 m / 10 m for a light robot) and basin radius.
+fn protocol(args: &Table2Args, truth: &Robot) -> sagcal::Result<Protocol> {
+    let light = truth.platform_weight_n < 100.0;
+    let anchor_perturbation_m = args.anchor_perturbation_m.unwrap_or(if light { 1.0 } else { 10.0 });
+    let offset_perturbation_m = args.offset_perturbation_m.unwrap_or(if light { 10.0 } else { 80.0 });
+    let basin_radius_m = args.basin_radius_m.unwrap_or(match args.model {
+        CableModel::Catenary => 0.3 * anchor_perturbation_m,
+        CableModel::Rigid => f64::INFINITY,
+    });
+    Ok(Protocol {
         noise: args.noise,
         model: args.model,
         anchor_perturbation_m,
@@ -67,14 +95,18 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         basin_radius_m,
         orientation_prior: args.orientation_prior,
         estimate: args.estimate.as_deref().map_or(Ok(EffectSet::NONE), parse_effect_set)?,
-    };
+    })
+}
+
+/// The trials of every pose count, announced on stderr, with a progress bar.
+fn run_trials(
+    args: &Table2Args,
+    truth: &Robot,
+    pool: &[PoolPose],
+    protocol: &Protocol,
+) -> sagcal::Result<Vec<PoseCountResult>> {
     let total = (args.poses.len() * args.trials) as u64;
-    let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} trials, {elapsed} (eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
+    let bar = progress_bar(total, "{msg} [{bar:40}] {pos}/{len} trials, {elapsed} (eta {eta})");
     bar.set_message(format!("table2 seed {}", args.seed));
     eprintln!(
         "sagcal experiment table2: seed {}, {} trials x {:?} poses, {} noise, {:?} model, {} data ({} usable poses)",
@@ -89,33 +121,16 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         },
         pool.len()
     );
-    let results = run_protocol(&truth, &pool, &args.poses, args.trials, args.seed, &protocol, &|| {
+    let results = run_protocol(truth, pool, &args.poses, args.trials, args.seed, protocol, &|| {
         bar.inc(1)
     })?;
     bar.finish_and_clear();
-    let report = Table2Report {
-        robot: truth.name.clone(),
-        data: args.data.display().to_string(),
-        source: args.source,
-        noise: args.noise,
-        model: args.model,
-        seed: args.seed,
-        anchor_perturbation_m,
-        offset_perturbation_m,
-        basin_radius_m,
-        orientation_prior: args.orientation_prior,
-        pool_size: pool.len(),
-        results,
-    };
-    if args.json {
-        return print_json(&report);
-    }
-    print_report(args, &truth, &report);
-    Ok(())
+    Ok(results)
 }
 
-/// The readable Table II: per pose count, errors beside the bound and the paper.
-fn print_report(args: &Table2Args, truth: &Robot, report: &Table2Report) {
+/// The readable Table II: the protocol's heading, then per pose count the
+/// errors beside the bound and the paper, with the bound's legend.
+fn print_table(args: &Table2Args, truth: &Robot, report: &Table2Report) {
     println!(
         "Table II protocol: robot `{}`, {} data, {} noise, {:?} cable model, orientation prior {}, seed {}, initial guess {} m / {} m off",
         report.robot,
@@ -167,6 +182,11 @@ fn print_report(args: &Table2Args, truth: &Robot, report: &Table2Report) {
     }
     print!("{table}");
     println!("(CRLB: the error an unbiased estimator cannot beat on average, at the truth, for the same poses, noise and orientation prior;\n anchor errors are the mean Euclidean distance per anchor, as in the authors' program, +- the standard error of the mean over trials)");
+}
+
+/// Per pose count: whether the paper's anchor error is below the bound, and
+/// the trials that did not converge.
+fn print_bound_verdicts(truth: &Robot, report: &Table2Report) {
     for r in &report.results {
         if let Some((paper_anchor, _)) = paper_numbers(truth, r.poses) {
             let verdict = if paper_anchor < r.anchor_crlb_m {

@@ -3,7 +3,6 @@
 
 use std::collections::BTreeMap;
 
-use indicatif::{ProgressBar, ProgressStyle};
 use sagcal::experiments::hidden_effects::{
     effect_ranges, identifiability, mean_reference_tension_n, run_sweep, smallest_effects, EffectRange, HiddenCase,
     HiddenEffectOptions, Identifiability, PAIRS,
@@ -13,7 +12,7 @@ use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 use serde::Serialize;
 
-use super::output::{print_json, Table};
+use super::output::{print_json, progress_bar, Table};
 use super::HiddenEffectsArgs;
 
 /// A case is detectable when the diagnosis' test has at least this power at the true magnitude.
@@ -78,6 +77,7 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
 
+/// Run the sweep, score it and print the report (or JSON).
 pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
     let robots: Vec<Robot> = args
         .robots
@@ -146,11 +146,9 @@ fn sweep(args: &HiddenEffectsArgs, robots: &[Robot], options: &HiddenEffectOptio
         args.noise,
         args.poses
     );
-    let bar = ProgressBar::new(total as u64);
-    bar.set_style(
-        ProgressStyle::with_template("hidden effects [{bar:40}] {pos}/{len} cases, {elapsed} (eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
+    let bar = progress_bar(
+        total as u64,
+        "hidden effects [{bar:40}] {pos}/{len} cases, {elapsed} (eta {eta})",
     );
     let cases = run_sweep(robots, &args.noise, args.seeds, args.seed, options, &|| bar.inc(1))?;
     bar.finish_and_clear();
@@ -245,6 +243,13 @@ fn print_report(args: &HiddenEffectsArgs, report: &Report) {
         }
         println!("{t}");
     }
+    print_scores(&report.scores);
+    print_summaries(&report.summaries);
+    print_smallest(&report.smallest);
+}
+
+/// Per robot, noise reading and hidden set: verdicts, detectability and anchor errors.
+fn print_scores(scores: &[EffectScore]) {
     let mut t = Table::new([
         "robot",
         "noise",
@@ -257,7 +262,7 @@ fn print_report(args: &HiddenEffectsArgs, report: &Report) {
         "anchor MAE baseline m",
         "verdict's m",
     ]);
-    for s in &report.scores {
+    for s in scores {
         let verdicts: Vec<String> = s.verdicts.iter().map(|(k, v)| format!("{k} {v}")).collect();
         t.row([
             s.robot.clone(),
@@ -277,6 +282,10 @@ fn print_report(args: &HiddenEffectsArgs, report: &Report) {
         ]);
     }
     println!("{t}");
+}
+
+/// Per robot and noise reading: the rates of right verdicts, false rejections and halved errors.
+fn print_summaries(summaries: &[Summary]) {
     let mut t = Table::new([
         "robot",
         "noise",
@@ -292,7 +301,7 @@ fn print_report(args: &HiddenEffectsArgs, report: &Report) {
             "-".into()
         }
     };
-    for s in &report.summaries {
+    for s in summaries {
         t.row([
             s.robot.clone(),
             format!("{:?}", s.noise).to_lowercase(),
@@ -303,7 +312,6 @@ fn print_report(args: &HiddenEffectsArgs, report: &Report) {
         ]);
     }
     println!("{t}");
-    print_smallest(&report.smallest);
 }
 
 /// The smallest magnitude of each range on noise-free data.

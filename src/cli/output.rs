@@ -1,5 +1,6 @@
 //! Plain-text tables and JSON output shared by the commands.
 
+use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
 /// A left-aligned first column, right-aligned others, columns sized to fit.
@@ -55,6 +56,22 @@ impl std::fmt::Display for Table {
         }
         Ok(())
     }
+}
+
+/// `value` with `decimals` decimals, or `-` when there is none.
+pub fn opt(value: Option<f64>, decimals: usize) -> String {
+    value.map_or_else(|| "-".to_string(), |v| format!("{v:.decimals$}"))
+}
+
+/// A progress bar of `len` steps drawn with `template` (indicatif's syntax), filled with `=>`.
+pub fn progress_bar(len: u64, template: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template(template)
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar
 }
 
 /// Serialise `value` as pretty JSON to stdout.

@@ -2,17 +2,46 @@
 //! with `--effect` (or a robot file with `[effects]`), from the discretised
 //! simulator with those effects acting.
 
+use std::path::Path;
+
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sagcal::io::measurements::write_measurements;
-use sagcal::model::Robot;
+use sagcal::model::statics::Equilibrium;
+use sagcal::model::{PoseMeasurement, Robot};
 use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
 use sagcal::sim::discretised::MAX_SEGMENTS;
 use sagcal::sim::effects::measure_with_effects;
 
 use super::SimulateArgs;
 
+/// Simulate measurements of the robot, write them (and the truth), report what was drawn.
 pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
+    let (truth, from_file) = load_truth(args)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    let workspace = Workspace::default_for(&truth);
+    let equilibria = sample_equilibria(&truth, &workspace, args.poses, &mut rng)?;
+    let data = measure_poses(args, &truth, from_file, &equilibria, &mut rng)?;
+    if let Some(path) = &args.truth {
+        write_truth(path, args, &truth)?;
+    }
+    write_measurements(&args.out, &comments(args, &truth, &workspace), &data)?;
+    print_ranges(&workspace, &equilibria);
+    println!(
+        "seed {}: {} poses of robot `{}` with {} noise written to {}",
+        args.seed,
+        args.poses,
+        truth.name,
+        args.noise,
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The true robot with its effects (the robot file's `[effects]`, if any, then
+/// every `--effect` in order) and whether the file brought effects; checks
+/// `--poses` and, with effects, `--segments`.
+fn load_truth(args: &SimulateArgs) -> sagcal::Result<(Robot, bool)> {
     let mut truth = Robot::from_file(&args.robot)?;
     if args.poses == 0 {
         return Err(sagcal::Error::InvalidInput("--poses must be at least 1".into()));
@@ -25,32 +54,45 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
             .apply_spec(spec)
             .map_err(|e| sagcal::Error::InvalidInput(format!("--effect `{spec}`: {e}")))?;
     }
-    let effects = truth.effects;
-    if !effects.is_none() && !(1..=MAX_SEGMENTS).contains(&args.segments) {
+    if !truth.effects.is_none() && !(1..=MAX_SEGMENTS).contains(&args.segments) {
         return Err(sagcal::Error::InvalidInput(format!(
             "--segments must be between 1 and {MAX_SEGMENTS}, got {}",
             args.segments
         )));
     }
-    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
-    let workspace = Workspace::default_for(&truth);
-    let equilibria = sample_equilibria(&truth, &workspace, args.poses, &mut rng)?;
+    Ok((truth, from_file))
+}
+
+/// Noisy measurements at the equilibria: from the closed-form model, or, with
+/// effects, from the discretised simulator (announced on stdout).
+fn measure_poses(
+    args: &SimulateArgs,
+    truth: &Robot,
+    from_file: bool,
+    equilibria: &[Equilibrium],
+    rng: &mut ChaCha8Rng,
+) -> sagcal::Result<Vec<PoseMeasurement>> {
+    let effects = truth.effects;
     let noise = args.noise.sigmas(truth.platform_weight_n);
-    let data = if effects.is_none() {
-        measure(&truth, &equilibria, &noise, &mut rng)
-    } else {
-        println!(
-            "effects{}: {effects}; seed {}; discretised simulator, {} segments per cable",
-            if from_file {
-                " (robot file's [effects] included)"
-            } else {
-                ""
-            },
-            args.seed,
-            args.segments
-        );
-        measure_with_effects(&truth, &effects, &equilibria, &noise, args.segments, &mut rng)?
-    };
+    if effects.is_none() {
+        return Ok(measure(truth, equilibria, &noise, rng));
+    }
+    println!(
+        "effects{}: {effects}; seed {}; discretised simulator, {} segments per cable",
+        if from_file {
+            " (robot file's [effects] included)"
+        } else {
+            ""
+        },
+        args.seed,
+        args.segments
+    );
+    measure_with_effects(truth, &effects, equilibria, &noise, args.segments, rng)
+}
+
+/// The measurement file's comment lines: generator, robot, seed, noise, workspace and effects.
+fn comments(args: &SimulateArgs, truth: &Robot, workspace: &Workspace) -> Vec<String> {
+    let effects = truth.effects;
     let model = if effects.is_none() {
         "closed-form catenary model".to_string()
     } else {
@@ -74,36 +116,30 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
     if !effects.is_none() {
         comments.push(format!("effects {effects}"));
     }
-    if let Some(path) = &args.truth {
-        let effects_note = if effects.is_none() {
-            String::new()
-        } else {
-            format!(", effects {effects} ({} segments)", args.segments)
-        };
-        let text = format!(
-            "# The truth of a sagcal simulation: seed {}, {} poses, noise {}{effects_note}.\n{}",
-            args.seed,
-            args.poses,
-            args.noise,
-            truth.to_file_contents().to_toml()?
-        );
-        sagcal::io::write_atomically(path, text.as_bytes())?;
-    }
-    write_measurements(&args.out, &comments, &data)?;
-    print_ranges(&workspace, &equilibria);
-    println!(
-        "seed {}: {} poses of robot `{}` with {} noise written to {}",
+    comments
+}
+
+/// Write the truth (robot TOML with offsets and effects, under a comment
+/// naming the simulation) to `path`, atomically.
+fn write_truth(path: &Path, args: &SimulateArgs, truth: &Robot) -> sagcal::Result<()> {
+    let effects = truth.effects;
+    let effects_note = if effects.is_none() {
+        String::new()
+    } else {
+        format!(", effects {effects} ({} segments)", args.segments)
+    };
+    let text = format!(
+        "# The truth of a sagcal simulation: seed {}, {} poses, noise {}{effects_note}.\n{}",
         args.seed,
         args.poses,
-        truth.name,
         args.noise,
-        args.out.display()
+        truth.to_file_contents().to_toml()?
     );
-    Ok(())
+    sagcal::io::write_atomically(path, text.as_bytes())
 }
 
 /// The workspace and the ranges of cable lengths and tensions it gave.
-fn print_ranges(workspace: &Workspace, equilibria: &[sagcal::model::statics::Equilibrium]) {
+fn print_ranges(workspace: &Workspace, equilibria: &[Equilibrium]) {
     let range = |values: &mut dyn Iterator<Item = f64>| {
         values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)))
     };

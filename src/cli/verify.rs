@@ -6,9 +6,10 @@ use sagcal::io::recurdyn::{read_recurdyn, LoadOptions};
 use sagcal::model::statics::StaticsOptions;
 use sagcal::model::Robot;
 
-use super::output::{print_json, Table};
+use super::output::{opt, print_json, Table};
 use super::{ClosureArg, VerifyArgs};
 
+/// Verify the model against the data and print the report (or JSON).
 pub fn run(args: &VerifyArgs) -> sagcal::Result<()> {
     let robot = Robot::from_file(&args.robot)?;
     let data = read_data(args, &robot)?;
@@ -41,10 +42,6 @@ fn read_data(args: &VerifyArgs, robot: &Robot) -> sagcal::Result<MeasuredData> {
         return Ok(MeasuredData::from_recurdyn(&read_recurdyn(&args.data, &options)?));
     }
     Ok(MeasuredData::from_measurements(&set, robot.reference_cable))
-}
-
-fn opt(value: Option<f64>, decimals: usize) -> String {
-    value.map_or_else(|| "-".to_string(), |v| format!("{v:.decimals$}"))
 }
 
 /// The readable verification: per row, then what was left out, the orientation and the summary.
