@@ -39,8 +39,8 @@ use sagcal::model::{PlatformPose, Robot};
 mod generated_calls;
 
 use generated_calls::{
-    attachment_height, catenary_length, dynamic, extended, extended_blocks, geometry, load_cell, pose_prior,
-    reference_tension, rigid_length, tensions, Point,
+    attachment_height, catenary_length, dynamic, extended, extended_blocks, geometry, load_cell, mounted_pose_prior,
+    pose_prior, reference_tension, rigid_length, tensions, Point,
 };
 
 /// A large-robot operating point where all four cables pull.
@@ -69,6 +69,7 @@ fn point() -> Point {
         inverse_segments_squared: 1.0 / 400.0,
         load_cell_bias_n: 3.0,
         load_cell_gain_error: 0.01,
+        localiser_mount_rad: Vector3::new(0.02, -0.01, 0.015),
     };
     let g = geometry(&p, None);
     p.cable_spans_m = Vector4::from_fn(|j, _| g[4 * j]);
@@ -261,6 +262,15 @@ fn jacobians(c: &mut Criterion) {
         |j| vec![dynamic(j)],
     );
     group(c, "pose_prior_residual", &p, &[Pose], pose_prior, |j| vec![dynamic(j)]);
+    let mount = Additive(|q| q.localiser_mount_rad.as_mut_slice());
+    group(
+        c,
+        "mounted_pose_prior_residual",
+        &p,
+        &[Pose, mount],
+        mounted_pose_prior,
+        |j| vec![dynamic(&j.0), dynamic(&j.1)],
+    );
     group(
         c,
         "rigid_length_residual",

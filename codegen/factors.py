@@ -305,6 +305,43 @@ def pose_prior_residual(
     return sf.V6(list(rotation_error) + list(position_m - prior_position_m))
 
 
+def mounted_pose_prior_residual(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    prior_position_m: sf.V3,
+    prior_rotation_xyzw: sf.V4,
+    localiser_mount_rad: sf.V3,
+    epsilon: sf.Scalar,
+) -> sf.V6:
+    """Pose prior factor of a localiser mounted with a rotation ``M = Exp(m)``: ``[Log(M R_prior^-1 R); p - p_prior]``.
+
+    A localiser fixed to the platform with its axes turned by ``M`` (platform
+    frame) reports the orientation of its own body, ``R_prior = R M``, so the
+    platform orientation it implies is ``R_prior M^-1`` and the rotation error
+    is ``Log((R_prior M^-1)^-1 R) = Log(M R_prior^-1 R)`` (:func:`rotation_log`).
+    With ``m = 0`` this is :func:`pose_prior_residual`. The mount is one
+    rotation shared by every pose (3 parameters, a structured localiser fault),
+    where freeing every orientation costs 3 per pose. The position rows are
+    unchanged (the localiser's origin is taken at the platform origin).
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        prior_position_m: Measured (prior) platform origin, metres.
+        prior_rotation_xyzw: Measured (prior) orientation, quaternion ``[x, y, z, w]``.
+        localiser_mount_rad: The mounting rotation ``m`` as a rotation vector, platform frame, radians.
+        epsilon: Small positive number (the logarithm and exponential near the identity).
+
+    Returns:
+        The 6-vector ``[rotation error (rad, 3); position error (m, 3)]``.
+    """
+    rotation = rotation_from_storage(rotation_xyzw)
+    prior_rotation = rotation_from_storage(prior_rotation_xyzw)
+    mount = sf.Rot3.from_tangent(localiser_mount_rad, epsilon=epsilon)
+    rotation_error = rotation_log(mount * prior_rotation.inverse() * rotation, epsilon)
+    return sf.V6(list(rotation_error) + list(position_m - prior_position_m))
+
+
 def rigid_length_residual(
     position_m: sf.V3,
     rotation_xyzw: sf.V4,

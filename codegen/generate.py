@@ -250,6 +250,7 @@ ARGUMENT_TYPES: dict[str, type] = {
     "rotation_xyzw": sf.V4,
     "prior_position_m": sf.V3,
     "prior_rotation_xyzw": sf.V4,
+    "localiser_mount_rad": sf.V3,
     "reference_tension_n": sf.V2,
     "anchors_m": sf.Matrix34,
     "attachments_m": sf.Matrix34,
@@ -288,6 +289,7 @@ JACOBIAN_BLOCKS: dict[str, tuple[str, str]] = {
     "vertical_tension_n": ("jacobian_vertical_tension", "`vertical_tension_n`"),
     "load_cell_bias_n": ("jacobian_load_cell_bias", "`load_cell_bias_n`"),
     "load_cell_gain_error": ("jacobian_load_cell_gain_error", "`load_cell_gain_error`"),
+    "localiser_mount_rad": ("jacobian_localiser_mount", "`localiser_mount_rad`, columns `[x, y, z]` of the rotation vector"),
 }
 
 
@@ -315,6 +317,7 @@ FUNCTIONS = (
     FunctionSpec(factors.attachment_height_residual, "residual", ("pose", "reference_tension_n", "anchors_m")),
     FunctionSpec(factors.reference_tension_residual, "residual", ("reference_tension_n",)),
     FunctionSpec(factors.pose_prior_residual, "residual", ("pose",)),
+    FunctionSpec(factors.mounted_pose_prior_residual, "residual", ("pose", "localiser_mount_rad")),
     FunctionSpec(factors.rigid_length_residual, "residual", ("pose", "anchors_m", "length_offsets_m")),
     FunctionSpec(
         factors.cable_geometry,

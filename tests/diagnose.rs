@@ -155,8 +155,8 @@ fn diagnose_cli_json_plots_and_errors() {
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["verdict"], "elastic");
     let candidates = json["candidates"].as_array().unwrap();
-    // Step 1 tests the seven effects and the orientation against the baseline.
-    assert_eq!(candidates.iter().filter(|c| c["step"] == 1).count(), 8);
+    // Step 1 tests the eight effects (the localiser mount among them) and the orientation against the baseline.
+    assert_eq!(candidates.iter().filter(|c| c["step"] == 1).count(), 9);
     for c in candidates {
         for key in [
             "effect",

@@ -98,6 +98,31 @@ fn two_effects_at_once_are_named_as_a_pair() {
     assert_eq!(named(&d), ["encoder-scale", "loadcell"]);
 }
 
+/// A structured localiser fault: one mounting rotation for every pose (3
+/// parameters) is named and measured, not absorbed by freeing 3 orientation
+/// components per pose or by a centre-of-mass shift that tilts the platform;
+/// with a shift as well, the pair is named.
+#[test]
+fn a_localiser_mount_is_named_alone_and_beside_a_com_shift() {
+    let (truth, _, d) = run(
+        &["localiser-mount:rx_deg=1.2,ry_deg=-0.6,rz_deg=0.9"],
+        NoisePreset::Paper,
+        28,
+    );
+    assert_eq!(d.verdict, "localiser-mount", "{}", d.reason);
+    let mount = &d.effects[0].params;
+    for (k, p) in mount.iter().enumerate() {
+        let true_deg = truth.effects.localiser_mount_deg[k];
+        assert!((p.value - true_deg).abs() < 4.0 * p.sigma + 0.05, "{mount:?}");
+    }
+    let (_, _, d) = run(
+        &["com:dx_m=-0.06,dy_m=0.05", "localiser-mount:rx_deg=-0.8,rz_deg=1.5"],
+        NoisePreset::Authors,
+        29,
+    );
+    assert_eq!(named(&d), ["com", "localiser-mount"], "{}", d.reason);
+}
+
 #[test]
 fn none_stays_none_under_both_noise_readings() {
     for (noise, seed) in [(NoisePreset::Paper, 24), (NoisePreset::Authors, 25)] {
@@ -168,6 +193,21 @@ fn calibrate_keeps_orientations_that_the_robot_files_effects_explain() {
     let check = result.orientation_check.unwrap();
     println!(
         "seed 27: orientation chi-square {:.1} (limit {:.1})",
+        check.chi_square, check.limit
+    );
+    assert!(check.prior_used);
+    // The same for a localiser mounted 2 degrees off: dropped without it, kept with it.
+    let (truth, measurements, _) = case(&["localiser-mount:rx_deg=1.5,ry_deg=1.3"], NoisePreset::Paper, 30, 30);
+    let plain = calibrate(&Robot::builtin("large").unwrap(), &measurements, &options).unwrap();
+    assert!(!plain.orientation_check.unwrap().prior_used);
+    let mut known = Robot::builtin("large").unwrap();
+    known.effects = truth.effects;
+    let check = calibrate(&known, &measurements, &options)
+        .unwrap()
+        .orientation_check
+        .unwrap();
+    println!(
+        "seed 30: orientation chi-square with the mount known {:.1} (limit {:.1})",
         check.chi_square, check.limit
     );
     assert!(check.prior_used);

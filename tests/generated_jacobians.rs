@@ -151,6 +151,7 @@ fn random_point(regime: &Regime, rng: &mut ChaCha8Rng) -> Point {
         inverse_segments_squared: 0.0,
         load_cell_bias_n: 0.0,
         load_cell_gain_error: 0.0,
+        localiser_mount_rad: Vector3::zeros(),
     }
 }
 
@@ -180,6 +181,9 @@ fn with_effects(mut point: Point, index: usize, rng: &mut ChaCha8Rng) -> Point {
     } else {
         0.0
     };
+    // A mount of up to 5 degrees per axis, zero on every fifth point (drawn last).
+    let mount = Vector3::from_fn(|_, _| rng.random_range(-5f64..5.0).to_radians());
+    point.localiser_mount_rad = if index % 5 == 0 { Vector3::zeros() } else { mount };
     point
 }
 
@@ -203,6 +207,8 @@ enum Block {
     InverseSegmentsSquared,
     LoadCellBias,
     LoadCellGain,
+    /// The localiser's mounting rotation vector (`mounted_pose_prior_residual`).
+    LocaliserMount,
 }
 
 impl Block {
@@ -212,7 +218,7 @@ impl Block {
             Block::ReferenceTension => 2,
             Block::Anchors => 12,
             Block::LengthOffsets => 4,
-            Block::ComOffset => 3,
+            Block::ComOffset | Block::LocaliserMount => 3,
             Block::Span | Block::HorizontalTension | Block::VerticalTension => 4,
             Block::AxialCompliance
             | Block::PulleyRadius
@@ -236,6 +242,7 @@ impl Block {
             Block::AxialCompliance | Block::LoadCellBias => 1e-3,
             Block::PulleyRadius | Block::LoadCellGain => 1e-4,
             Block::InverseSegmentsSquared => 1e-4,
+            Block::LocaliserMount => 1e-4,
         }
     }
 
@@ -260,6 +267,7 @@ impl Block {
             Block::InverseSegmentsSquared => moved.inverse_segments_squared += t,
             Block::LoadCellBias => moved.load_cell_bias_n += t,
             Block::LoadCellGain => moved.load_cell_gain_error += t,
+            Block::LocaliserMount => moved.localiser_mount_rad[k] += t,
         }
         moved
     }
@@ -316,6 +324,12 @@ fn pose_prior(p: &Point) -> Evaluation {
     (column(value), vec![dynamic(&j)])
 }
 
+fn mounted_pose_prior(p: &Point) -> Evaluation {
+    let mut j = (nan(), nan());
+    let value = calls::mounted_pose_prior(p, Some(&mut j));
+    (column(value), vec![dynamic(&j.0), dynamic(&j.1)])
+}
+
 fn rigid_length(p: &Point) -> Evaluation {
     let mut j = (nan(), nan(), nan());
     let value = calls::rigid_length(p, Some(&mut j));
@@ -347,7 +361,7 @@ fn load_cell(p: &Point) -> Evaluation {
     (column(value), vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)])
 }
 
-const FUNCTIONS: [Function; 9] = [
+const FUNCTIONS: [Function; 10] = [
     Function {
         name: "cable_tensions_from_reference",
         blocks: &[Block::Pose, Block::ReferenceTension, Block::Anchors],
@@ -377,6 +391,11 @@ const FUNCTIONS: [Function; 9] = [
         name: "pose_prior_residual",
         blocks: &[Block::Pose],
         evaluate: pose_prior,
+    },
+    Function {
+        name: "mounted_pose_prior_residual",
+        blocks: &[Block::Pose, Block::LocaliserMount],
+        evaluate: mounted_pose_prior,
     },
     Function {
         name: "rigid_length_residual",
@@ -1008,6 +1027,7 @@ fn massless_catenary_equals_rigid_cable_at_a_symmetric_equilibrium() {
                 inverse_segments_squared: 0.0,
                 load_cell_bias_n: 0.0,
                 load_cell_gain_error: 0.0,
+                localiser_mount_rad: Vector3::zeros(),
             };
             let f = tensions(&p).0;
             for j in 1..4 {
@@ -1081,5 +1101,36 @@ fn pose_prior_is_well_behaved_at_and_near_the_prior() {
             (&value - &expected).amax() < 1e-12 * angle.max(1e-3),
             "angle {angle}: {value} vs {expected}"
         );
+    }
+}
+
+/// The mounted pose prior against nalgebra: zero for a localiser that reads
+/// `R Exp(m)`, the plain prior at `m = 0`, and `Log(Exp(m) R_prior^-1 R)` otherwise.
+#[test]
+fn mounted_pose_prior_matches_the_rotation_algebra() {
+    let mut rng = ChaCha8Rng::seed_from_u64(41);
+    for regime in [large(), small()] {
+        for _ in 0..20 {
+            let mut p = random_point(&regime, &mut rng);
+            let mount = Vector3::from_fn(|_, _| rng.random_range(-0.08..0.08));
+            let exp_m = UnitQuaternion::from_scaled_axis(mount);
+            p.localiser_mount_rad = Vector3::zeros();
+            let plain = calls::pose_prior(&p, None);
+            let zero_mount = calls::mounted_pose_prior(&p, None);
+            assert!((plain - zero_mount).amax() < 1e-15, "m = 0: {plain} vs {zero_mount}");
+            p.localiser_mount_rad = mount;
+            let general = calls::mounted_pose_prior(&p, None);
+            let expected = (exp_m * p.prior.rotation.inverse() * p.pose.rotation).scaled_axis();
+            assert!(
+                (general.fixed_rows::<3>(0) - expected).amax() < 1e-12,
+                "{general} vs {expected}"
+            );
+            p.prior = PlatformPose::new(p.pose.position_m, p.pose.rotation * exp_m);
+            let reading = calls::mounted_pose_prior(&p, None);
+            assert!(
+                reading.amax() < 1e-12,
+                "a mounted reading of the pose itself: {reading}"
+            );
+        }
     }
 }

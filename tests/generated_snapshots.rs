@@ -41,6 +41,10 @@ fn generated_sources() {
             include_str!("../generated/pose_prior_residual.rs"),
         ),
         (
+            "mounted_pose_prior_residual",
+            include_str!("../generated/mounted_pose_prior_residual.rs"),
+        ),
+        (
             "rigid_length_residual",
             include_str!("../generated/rigid_length_residual.rs"),
         ),
@@ -236,6 +240,27 @@ fn pose_prior_residual_outputs() {
     let mut out = String::new();
     format_block(&mut out, "residual", &value);
     format_block(&mut out, "jacobian_pose", &pose);
+    insta::assert_snapshot!(out);
+}
+
+#[test]
+fn mounted_pose_prior_residual_outputs() {
+    let x = inputs();
+    let (mut pose, mut mount) = (nan::<6, 6>(), nan::<6, 3>());
+    let value = generated::mounted_pose_prior_residual(
+        &x.pose.position_m,
+        &x.pose.rotation_xyzw(),
+        &x.prior.position_m,
+        &x.prior.rotation_xyzw(),
+        &Vector3::new(0.02, -0.01, 0.015),
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut mount),
+    );
+    let mut out = String::new();
+    format_block(&mut out, "residual", &value);
+    format_block(&mut out, "jacobian_pose", &pose);
+    format_block(&mut out, "jacobian_localiser_mount", &mount);
     insta::assert_snapshot!(out);
 }
 

@@ -5,7 +5,9 @@ use std::sync::Arc;
 
 use nalgebra::{DVector, Vector3};
 
-use super::effect_factors::{EffectVariables, ExtendedHeightFactor, ExtendedLengthFactor, LoadCellFactor};
+use super::effect_factors::{
+    EffectVariables, ExtendedHeightFactor, ExtendedLengthFactor, LoadCellFactor, MountedPosePriorFactor,
+};
 use super::factors::{
     AttachmentHeightFactor, CalibrationVariables, CatenaryLengthFactor, PosePriorFactor, PoseVariables,
     ReferenceTensionFactor, RigidLengthFactor, SlotOrder, TensionGuardFactor,
@@ -175,13 +177,25 @@ impl PoseFactors<'_> {
         let orientation_sigma = (self.options.orientation_prior == OrientationPrior::On
             || self.model == CableModel::Rigid)
             .then_some(noise.orientation_sigma_rad);
-        graph.add(PosePriorFactor::new(
-            vars.pose,
-            &measured_pose(m),
-            noise.position_sigma_m,
-            orientation_sigma,
-            self.options.robust.pose_prior,
-        ));
+        match (orientation_sigma, self.effects) {
+            (Some(orientation_sigma), Some(effects)) if self.model == CableModel::Catenary => {
+                graph.add(MountedPosePriorFactor::new(
+                    vars.pose,
+                    effects.localiser_mount,
+                    &measured_pose(m),
+                    noise.position_sigma_m,
+                    orientation_sigma,
+                    self.options.robust.pose_prior,
+                ))
+            }
+            _ => graph.add(PosePriorFactor::new(
+                vars.pose,
+                &measured_pose(m),
+                noise.position_sigma_m,
+                orientation_sigma,
+                self.options.robust.pose_prior,
+            )),
+        };
         match (self.model, self.effects) {
             (CableModel::Rigid, _) => self.add_rigid(graph, vars, m),
             (CableModel::Catenary, Some(effects)) => {
@@ -298,6 +312,7 @@ fn insert_effect_variables(values: &mut Values, robot: &Robot, free: EffectSet) 
         com_shift: vector("centre of mass shift", &e.com_shift_m[..2]),
         inverse_segments_squared: vector("inverse segments squared", &[e.inverse_segments_squared()]),
         common_gain_error: vector("common encoder gain error", &[0.0]),
+        localiser_mount: vector("localiser mount (deg)", &e.localiser_mount_deg),
     };
     for kind in EffectKind::ALL {
         values.set_fixed(variables.of(kind), !free.contains(kind));
@@ -324,6 +339,7 @@ pub fn effects_from_graph(template: &Robot, built: &CalibrationGraph) -> Option<
         load_cell_gain: 1.0 + cell[1],
         com_shift_m: [com[0], com[1], template.effects.com_shift_m[2]],
         cable_segments: (inverse_segments_squared > 0.0).then(|| 1.0 / inverse_segments_squared.sqrt()),
+        localiser_mount_deg: std::array::from_fn(|i| values.vector(vars.localiser_mount)[i]),
     })
 }
 

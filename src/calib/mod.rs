@@ -278,6 +278,7 @@ pub fn without_estimated(effects: &Effects, estimates: &[EffectEstimate]) -> Eff
                 out.encoder_gain = out.encoder_gain.map(|g| g - common);
             }
             EffectKind::Segments => out.cable_segments = neutral.cable_segments,
+            EffectKind::LocaliserMount => out.localiser_mount_deg = neutral.localiser_mount_deg,
         }
     }
     out

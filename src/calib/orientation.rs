@@ -30,15 +30,19 @@ pub struct OrientationCheck {
     pub mean_angle_deg: f64,
 }
 
-/// Chi-square of the localiser's orientations against the fitted poses of a
-/// calibration made with the orientation prior. Conservative: the fitted
+/// Chi-square of the localiser's orientations (less the robot's localiser
+/// mount, [`crate::model::effects::Effects::localiser_mount_deg`]) against the
+/// fitted poses of a calibration made with the orientation prior. Conservative: the fitted
 /// orientation is pulled towards the measured one, so consistent data give
 /// less than the `3 N` degrees of freedom tested against.
 fn orientation_check(result: &CalibrationResult, measurements: &[PoseMeasurement], sigma_rad: f64) -> OrientationCheck {
     let used = (0..measurements.len()).filter(|k| !result.excluded_poses.contains(k));
+    // A localiser mounted with a rotation M reads R M: the platform orientation it implies is R_read M^-1.
+    let mount = result.robot.effects.localiser_mount_deg.map(f64::to_radians);
+    let unmount = nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::from(mount)).inverse();
     let angles: Vec<f64> = used
         .zip(&result.poses)
-        .map(|(k, fitted)| measured_pose(&measurements[k]).rotation.angle_to(&fitted.rotation))
+        .map(|(k, fitted)| (measured_pose(&measurements[k]).rotation * unmount).angle_to(&fitted.rotation))
         .collect();
     let chi_square = angles.iter().map(|a| (a / sigma_rad).powi(2)).sum();
     let components = 3 * angles.len();

@@ -26,7 +26,9 @@ pub enum Hypothesis {
     /// An effect of the catalogue.
     Effect(EffectKind),
     /// The localiser's orientations are unreliable: every pose's orientation
-    /// is freed from its prior (3 parameters per pose).
+    /// is freed from its prior (3 parameters per pose). It contains the
+    /// structured fault [`EffectKind::LocaliserMount`] (one rotation for all
+    /// poses), which it replaces.
     OrientationFree,
 }
 
@@ -92,13 +94,15 @@ impl Model {
             return false;
         }
         match hypothesis {
+            Hypothesis::Effect(EffectKind::LocaliserMount) => !self.hypotheses.contains(&Hypothesis::OrientationFree),
             Hypothesis::Effect(kind) => kind.nested_in().is_none_or(|outer| !self.effects().contains(outer)),
             Hypothesis::OrientationFree => true,
         }
     }
 
     /// Parameters `hypothesis` adds to this model: an effect's (less those of
-    /// an effect nested in it that it replaces), or 3 per pose.
+    /// an effect nested in it that it replaces), or 3 per pose (less the
+    /// localiser mount's 3 it replaces).
     pub fn added_parameters(&self, hypothesis: Hypothesis, poses: usize) -> usize {
         match hypothesis {
             Hypothesis::Effect(kind) => {
@@ -109,18 +113,30 @@ impl Model {
                     .sum();
                 kind.parameter_count() - replaced
             }
-            Hypothesis::OrientationFree => 3 * poses,
+            Hypothesis::OrientationFree => {
+                let mount = self.effects().contains(EffectKind::LocaliserMount);
+                3 * poses
+                    - if mount {
+                        EffectKind::LocaliserMount.parameter_count()
+                    } else {
+                        0
+                    }
+            }
         }
     }
 
     /// This model fitted with `hypotheses` instead of its own, starting from
-    /// its solution (effects dropped go back to the robot file's values).
+    /// its solution (effects dropped go back to the robot file's values; the
+    /// localiser mount is dropped where every orientation is free).
     pub fn refit(
         &self,
-        hypotheses: Vec<Hypothesis>,
+        mut hypotheses: Vec<Hypothesis>,
         base: &Baseline,
         measurements: &[PoseMeasurement],
     ) -> Result<Self> {
+        if hypotheses.contains(&Hypothesis::OrientationFree) {
+            hypotheses.retain(|h| *h != Hypothesis::Effect(EffectKind::LocaliserMount));
+        }
         let mut effects: EffectSet = hypotheses
             .iter()
             .filter_map(|h| match h {

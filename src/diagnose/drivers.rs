@@ -86,6 +86,9 @@ pub(super) fn winning_driver(effect: EffectKind) -> (&'static str, &'static str)
         EffectKind::Com => ("encoder", DRIVERS[0]),
         EffectKind::CommonGain => ("encoder", DRIVERS[2]),
         EffectKind::Segments => ("encoder", DRIVERS[3]),
+        // A mount turns the orientation readings only; its trace in the other
+        // residuals is the statics' answer to the tilt, strongest in the tension.
+        EffectKind::LocaliserMount => ("encoder", DRIVERS[0]),
     }
 }
 

@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use super::candidates::{parameters, CandidateFit, ParameterValue, DETECTION_POWER};
+use super::candidates::{parameters, CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER};
 use super::drivers::{DriverSeries, DriverTest};
 use super::residual_tests::FactorTest;
 use super::selection::{Selection, SelectionStep};
@@ -170,7 +170,15 @@ pub(super) fn reason(selection: &Selection, base: &Baseline, options: &DiagnoseO
             )
         })
         .collect();
-    format!("forward selection at {level}: {}", steps.join("; "))
+    let mut text = format!("forward selection at {level}: {}", steps.join("; "));
+    if selection.model.hypotheses.contains(&Hypothesis::OrientationFree) {
+        text.push_str(
+            "; the localiser's orientations stay freed pose by pose: neither one mounting rotation \
+             (alone or beside an effect of the catalogue) nor any other effect tested explains their \
+             disagreement with the statics",
+        );
+    }
+    text
 }
 
 /// The candidates of the last step whose power at their smallest plausible

@@ -22,7 +22,7 @@
 
 use serde::Serialize;
 
-use super::candidates::{rebuild, test_hypothesis, CandidateFit, Hypothesis, Model};
+use super::candidates::{inadmissible, rebuild, test_hypothesis, CandidateFit, Hypothesis, Model};
 use super::residual_tests::MEASUREMENT_KINDS;
 use super::{Baseline, DiagnoseOptions, Progress};
 use crate::calib::{
@@ -80,15 +80,18 @@ pub(super) struct Selection {
 }
 
 /// The hypotheses the search may add (`options.candidates`, and the
-/// orientation when the baseline uses the localiser's orientations).
+/// orientation freed when the baseline uses the localiser's orientations;
+/// without them the localiser mount has no evidence and is left out).
 fn hypotheses(search: &Search<'_>) -> Vec<Hypothesis> {
+    let orientations = search.base.options.orientation_prior == OrientationPrior::On;
     let mut all: Vec<Hypothesis> = search
         .options
         .candidates
         .iter()
+        .filter(|k| orientations || **k != EffectKind::LocaliserMount)
         .map(|k| Hypothesis::Effect(*k))
         .collect();
-    if search.options.orientation_hypothesis && search.base.options.orientation_prior == OrientationPrior::On {
+    if search.options.orientation_hypothesis && orientations {
         all.push(Hypothesis::OrientationFree);
     }
     all
@@ -132,7 +135,8 @@ pub(super) fn forward_selection(search: &Search<'_>, progress: &mut Progress<'_>
             removed: Vec::new(),
         };
         let checked = backward_check(search, extended, row.p_threshold, &mut selected.removed, progress);
-        model = simplify_nested(search, checked, row.p_threshold, &mut selected.removed, progress);
+        let simpler = simplify_nested(search, checked, row.p_threshold, &mut selected.removed, progress);
+        model = simplify_orientation(search, simpler, row.p_threshold, &mut selected.removed, progress);
         steps.push(selected);
     }
     Selection {
@@ -201,6 +205,98 @@ fn simplify_nested(
         }
     }
     model
+}
+
+/// Replace freed orientations (3 parameters per pose) by one localiser mount
+/// (3 in all) where the data do not reject the structured fault at
+/// `p_threshold`: the likelihood ratio on the `3 (poses - 1)` parameters the
+/// mount drops. Where the mount alone is rejected, the freed orientations
+/// may also be standing in for a physical effect that tilts the platform
+/// (a centre-of-mass shift) as well as the mount: the best effect `X`
+/// significant beside the mount is found, and `mount + X` replaces the
+/// orientations if the data do not reject it against `orientation + X`
+/// (nested, the same `3 (poses - 1)` parameters).
+fn simplify_orientation(
+    search: &Search<'_>,
+    model: Model,
+    p_threshold: f64,
+    replaced: &mut Vec<String>,
+    progress: &mut Progress<'_>,
+) -> Model {
+    let mount = Hypothesis::Effect(EffectKind::LocaliserMount);
+    let Some(at) = model.hypotheses.iter().position(|h| *h == Hypothesis::OrientationFree) else {
+        return model;
+    };
+    if !search.options.candidates.contains(&EffectKind::LocaliserMount) {
+        return model;
+    }
+    let (base, measurements) = (search.base, search.measurements);
+    let dof = 3 * base.used.len() - EffectKind::LocaliserMount.parameter_count();
+    let rejected = |simpler: &Model, full: &Model| {
+        let lr = (simpler.chi_square - full.chi_square) / base.variance_factor;
+        chi_square_survival(dof, lr.max(0.0)) < p_threshold
+    };
+    progress.grow(1);
+    progress.step("nested check: localiser-mount for orientation");
+    let mut hypotheses = model.hypotheses.clone();
+    hypotheses[at] = mount;
+    let Ok(simpler) = model.refit(hypotheses, base, measurements) else {
+        return model;
+    };
+    if !rejected(&simpler, &model) {
+        replaced.push(format!("orientation by {}", EffectKind::LocaliserMount.name()));
+        return simpler;
+    }
+    let Some((effect, with_effect)) = best_effect_beside(search, &simpler, p_threshold, progress) else {
+        return model;
+    };
+    progress.grow(1);
+    progress.step(&format!(
+        "nested check: localiser-mount+{} for orientation",
+        effect.name()
+    ));
+    let Ok(full) = model.with(Hypothesis::Effect(effect), base, measurements) else {
+        return model;
+    };
+    if rejected(&with_effect, &full) {
+        return model;
+    }
+    replaced.push(format!(
+        "orientation by {}+{}",
+        EffectKind::LocaliserMount.name(),
+        effect.name()
+    ));
+    with_effect
+}
+
+/// The effect whose addition to `model` lowers its chi-square most among
+/// those significant at `p_threshold`, with the extended fit.
+fn best_effect_beside(
+    search: &Search<'_>,
+    model: &Model,
+    p_threshold: f64,
+    progress: &mut Progress<'_>,
+) -> Option<(EffectKind, Model)> {
+    let mut best: Option<(EffectKind, Model)> = None;
+    for &effect in &search.options.candidates {
+        let hypothesis = Hypothesis::Effect(effect);
+        if !model.can_add(hypothesis) {
+            continue;
+        }
+        progress.grow(1);
+        progress.step(&format!("fit localiser-mount+{}", effect.name()));
+        let Ok(fit) = model.with(hypothesis, search.base, search.measurements) else {
+            continue;
+        };
+        let dof = model.added_parameters(hypothesis, search.base.used.len());
+        let lr = (model.chi_square - fit.chi_square) / search.base.variance_factor;
+        let admissible = fit.estimate(effect).is_none_or(|e| inadmissible(e).is_none());
+        let significant = fit.result.converged() && admissible && chi_square_survival(dof, lr.max(0.0)) < p_threshold;
+        if significant && best.as_ref().is_none_or(|(_, b)| fit.chi_square < b.chi_square) {
+            best = Some((effect, fit));
+        }
+    }
+    best
 }
 
 /// The first effect of a model's hypotheses (for the plotted driver).

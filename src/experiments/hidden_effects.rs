@@ -52,7 +52,7 @@ use crate::diagnose::{diagnose, power_against, CandidateFit, DiagnoseOptions};
 use crate::error::{Error, Result};
 use crate::model::effect_ranges::{
     axial_stiffness_range_n, com_shift_range_m, pulley_radius_range_m, COMMON_GAIN_HIGH, COMMON_GAIN_LOW,
-    SEGMENTS_HIGH, SEGMENTS_LOW,
+    LOCALISER_MOUNT_HIGH_DEG, LOCALISER_MOUNT_LOW_DEG, SEGMENTS_HIGH, SEGMENTS_LOW,
 };
 pub use crate::model::effect_ranges::{effect_ranges, EffectRange, CABLE_DENSITY_KG_M3};
 use crate::model::effects::{EffectKind, EffectSet, Effects};
@@ -248,6 +248,14 @@ fn draw_effect(robot: &Robot, effect: EffectKind, mean_reference_tension_n: f64,
         }
         EffectKind::Segments => {
             e.cable_segments = Some(rng.random_range(SEGMENTS_LOW..SEGMENTS_HIGH).round());
+        }
+        EffectKind::LocaliserMount => {
+            let angle = rng.random_range(LOCALISER_MOUNT_LOW_DEG..LOCALISER_MOUNT_HIGH_DEG);
+            // A uniform direction on the sphere: z uniform in [-1, 1], azimuth uniform.
+            let z: f64 = rng.random_range(-1.0..1.0);
+            let azimuth = rng.random_range(0.0..std::f64::consts::TAU);
+            let r = (1.0 - z * z).sqrt();
+            e.localiser_mount_deg = [angle * r * azimuth.cos(), angle * r * azimuth.sin(), angle * z];
         }
     }
 }

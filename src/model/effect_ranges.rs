@@ -71,6 +71,11 @@ pub fn effect_ranges(robot: &Robot) -> Vec<EffectRange> {
             justification: "one drum radius or counts-per-metre figure used for all four winches".into(),
         },
         EffectRange {
+            effect: "localiser-mount".into(),
+            range: format!("rotation {LOCALISER_MOUNT_LOW_DEG} .. {LOCALISER_MOUNT_HIGH_DEG} deg about a random axis"),
+            justification: "a localiser (IMU, camera, marker body) bolted to the platform with its axes off by a few degrees".into(),
+        },
+        EffectRange {
             effect: "segments".into(),
             range: format!("{SEGMENTS_LOW} .. {SEGMENTS_HIGH} straight elements per cable"),
             justification: "finite-element cable models (lumped-mass chains) of tens of elements".into(),
@@ -78,6 +83,10 @@ pub fn effect_ranges(robot: &Robot) -> Vec<EffectRange> {
     ]
 }
 
+/// The localiser's mounting rotation angle: smallest plausible, degrees.
+pub const LOCALISER_MOUNT_LOW_DEG: f64 = 0.5;
+/// The localiser's mounting rotation angle: largest plausible, degrees.
+pub const LOCALISER_MOUNT_HIGH_DEG: f64 = 3.0;
 /// A common encoder gain error's range (dimensionless).
 pub const COMMON_GAIN_LOW: f64 = 0.001;
 /// See [`COMMON_GAIN_LOW`].
@@ -92,7 +101,8 @@ pub const SEGMENTS_HIGH: f64 = 100.0;
 /// segments as `1/n^2`), for the power of a test: the stiffest rope, the
 /// smallest pulley, gains off by 0.1 % with alternating signs, a load cell
 /// off by 5 % of `mean_reference_tension_n` and 2 % in gain, a 5 cm
-/// centre-of-mass shift along the diagonal, the finest plausible chain.
+/// centre-of-mass shift along the diagonal, the finest plausible chain, a
+/// localiser turned by 0.5 degrees about the diagonal of its axes.
 pub fn smallest_plausible(kind: EffectKind, robot: &Robot, mean_reference_tension_n: f64) -> Vec<f64> {
     match kind {
         EffectKind::Elastic => vec![1e6 / axial_stiffness_range_n(robot).1],
@@ -105,6 +115,7 @@ pub fn smallest_plausible(kind: EffectKind, robot: &Robot, mean_reference_tensio
         }
         EffectKind::CommonGain => vec![COMMON_GAIN_LOW],
         EffectKind::Segments => vec![1.0 / (SEGMENTS_HIGH * SEGMENTS_HIGH)],
+        EffectKind::LocaliserMount => vec![LOCALISER_MOUNT_LOW_DEG / 3f64.sqrt(); 3],
     }
 }
 

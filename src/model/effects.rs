@@ -19,6 +19,7 @@
 //! | `loadcell` | `bias_n` (N), `gain` (> 0) |
 //! | `com` | `dx_m`, `dy_m`, `dz_m` (platform frame, m) |
 //! | `segments` | `n` (number of straight elements of a finite-element cable, >= 1) |
+//! | `localiser-mount` | `rx_deg`, `ry_deg`, `rz_deg` (the localiser's mounting rotation, a rotation vector in the platform frame, degrees) |
 
 use serde::{Deserialize, Serialize};
 
@@ -72,6 +73,19 @@ pub struct Effects {
     /// parameter is `1/n^2`, continuous.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cable_segments: Option<f64>,
+    /// The localiser's mounting rotation as a rotation vector `m` in the
+    /// platform frame, degrees (`localiser-mount:rx_deg,ry_deg,rz_deg`); 0: aligned.
+    ///
+    /// A localiser fixed to the platform with its axes turned by `M = Exp(m)`
+    /// reports the orientation of its own body, `R M` instead of the
+    /// platform's `R`: one rotation shared by every pose, a structured fault
+    /// of the orientation readings (`codegen/factors.py::mounted_pose_prior_residual`).
+    #[serde(skip_serializing_if = "is_zero3")]
+    pub localiser_mount_deg: [f64; 3],
+}
+
+fn is_zero3(v: &[f64; 3]) -> bool {
+    v.iter().all(|x| *x == 0.0)
 }
 
 impl Default for Effects {
@@ -85,13 +99,14 @@ impl Default for Effects {
             load_cell_gain: 1.0,
             com_shift_m: [0.0; 3],
             cable_segments: None,
+            localiser_mount_deg: [0.0; 3],
         }
     }
 }
 
 /// The effect names accepted by [`Effects::apply_spec`], with their parameters.
 pub const EFFECT_NAMES: &str =
-    "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m, segments:n";
+    "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m, segments:n, localiser-mount:rx_deg,ry_deg,rz_deg";
 
 impl Effects {
     /// The cables' axial compliance `1e6 / EA` in 1/MN (0: inextensible), the
@@ -128,6 +143,7 @@ impl Effects {
             "loadcell" => &["bias_n", "gain"],
             "com" => &["dx_m", "dy_m", "dz_m"],
             "segments" => &["n"],
+            "localiser-mount" => &["rx_deg", "ry_deg", "rz_deg"],
             other => return Err(format!("unknown effect `{other}` (effects: {EFFECT_NAMES})")),
         };
         if params.trim().is_empty() {
@@ -199,6 +215,13 @@ impl Effects {
                     }
                     next.cable_segments = Some(value);
                 }
+                ("localiser-mount", k) => {
+                    let axis = ["rx_deg", "ry_deg", "rz_deg"]
+                        .iter()
+                        .position(|a| *a == k)
+                        .expect("known axis");
+                    next.localiser_mount_deg[axis] = value;
+                }
                 _ => unreachable!("parameter names are checked above"),
             }
         }
@@ -242,6 +265,12 @@ impl Effects {
                 return Err(format!("`cable_segments` must be a finite number >= 1, got {n}"));
             }
         }
+        if !self.localiser_mount_deg.iter().all(|x| x.is_finite()) {
+            return Err(format!(
+                "`localiser_mount_deg` must be finite, got {:?}",
+                self.localiser_mount_deg
+            ));
+        }
         Ok(())
     }
 
@@ -281,6 +310,10 @@ impl Effects {
         if let Some(n) = self.cable_segments {
             specs.push(format!("segments:n={n}"));
         }
+        if self.localiser_mount_deg != none.localiser_mount_deg {
+            let [x, y, z] = self.localiser_mount_deg;
+            specs.push(format!("localiser-mount:rx_deg={x},ry_deg={y},rz_deg={z}"));
+        }
         specs
     }
 }
@@ -305,11 +338,15 @@ pub enum EffectKind {
     CommonGain,
     /// The cable as a chain of `n` straight finite elements; one parameter, `1/n^2`.
     Segments,
+    /// The localiser's mounting rotation (a rotation vector, degrees); three
+    /// parameters shared by every pose. Nested in freeing every pose's
+    /// orientation (`sagcal diagnose`'s `orientation` hypothesis).
+    LocaliserMount,
 }
 
 impl EffectKind {
     /// Every effect of the catalogue, in report order.
-    pub const ALL: [EffectKind; 7] = [
+    pub const ALL: [EffectKind; 8] = [
         EffectKind::Elastic,
         EffectKind::Pulley,
         EffectKind::EncoderScale,
@@ -317,6 +354,7 @@ impl EffectKind {
         EffectKind::Com,
         EffectKind::CommonGain,
         EffectKind::Segments,
+        EffectKind::LocaliserMount,
     ];
 
     /// The name used on the command line and in reports (`elastic`, `encoder-scale`, ...).
@@ -329,6 +367,7 @@ impl EffectKind {
             EffectKind::Com => "com",
             EffectKind::CommonGain => "encoder-gain",
             EffectKind::Segments => "segments",
+            EffectKind::LocaliserMount => "localiser-mount",
         }
     }
 
@@ -350,6 +389,7 @@ impl EffectKind {
             EffectKind::Com => &["dx_m", "dy_m"],
             EffectKind::CommonGain => &["gain"],
             EffectKind::Segments => &["inverse_segments_squared"],
+            EffectKind::LocaliserMount => &["rx_deg", "ry_deg", "rz_deg"],
         }
     }
 
@@ -369,6 +409,7 @@ impl EffectKind {
             EffectKind::Com => effects.com_shift_m[..2].to_vec(),
             EffectKind::CommonGain => vec![effects.encoder_gain.iter().sum::<f64>() / CABLE_COUNT as f64],
             EffectKind::Segments => vec![effects.inverse_segments_squared()],
+            EffectKind::LocaliserMount => effects.localiser_mount_deg.to_vec(),
         }
     }
 
@@ -513,6 +554,7 @@ mod tests {
             "loadcell:bias_n=3,gain=1.01",
             "com:dx_m=0.02,dz_m=-0.05",
             "segments:n=12",
+            "localiser-mount:rx_deg=0.5,rz_deg=-1.5",
         ])
         .unwrap();
         assert_eq!(e.axial_stiffness_n, Some(3e6));
@@ -523,6 +565,7 @@ mod tests {
         assert_eq!(e.com_shift_m, [0.02, 0.0, -0.05]);
         assert_eq!(e.cable_segments, Some(12.0));
         assert_eq!(e.inverse_segments_squared(), 1.0 / 144.0);
+        assert_eq!(e.localiser_mount_deg, [0.5, 0.0, -1.5]);
         // The specifications parse back to the same effects.
         let specs = e.specs();
         let again = parsed(&specs.iter().map(String::as_str).collect::<Vec<_>>()).unwrap();

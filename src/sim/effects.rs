@@ -12,12 +12,13 @@
 //! With no effect the discretised robot converges to the closed-form one as
 //! `O(1/n^2)` in the segment count `n`, and so do the data.
 
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 use rand::Rng;
 
 use crate::error::{Error, Result};
 use crate::model::effects::Effects;
 use crate::model::measurement::PoseMeasurement;
+use crate::model::pose::PlatformPose;
 use crate::model::robot::Robot;
 use crate::model::sensors::SensorNoise;
 use crate::model::statics::Equilibrium;
@@ -81,6 +82,7 @@ pub fn solve_with_effects(
 /// discretised equilibrium's pose perturbed on its tangent space; encoder
 /// `i` = `encoder_gain[i] * paid_out_i + length_offsets_m[i]` + noise; load
 /// cell = `load_cell_bias_n + load_cell_gain * |F_ref|` + noise with `F_ref`
+/// (a mounted localiser reads `R Exp(m)`, [`localiser_reading`])
 /// the reference cable's force on the platform. The random numbers are drawn
 /// in the order of [`crate::sim::closed_form::measure`], so with no effect the
 /// same seed gives the same noise. Every pose is solved before any noise is
@@ -102,7 +104,18 @@ pub fn measure_with_effects(
                 std::array::from_fn(|i| effects.encoder_gain[i] * eq.paid_out_lengths_m[i] + robot.length_offsets_m[i]);
             let force = eq.cables[robot.reference_cable].platform_force_n.norm();
             let tension = effects.load_cell_bias_n + effects.load_cell_gain * force;
-            sensors.read(&eq.pose, lengths, tension, rng)
+            sensors.read(&localiser_reading(&eq.pose, effects), lengths, tension, rng)
         })
         .collect())
+}
+
+/// The pose a localiser mounted with `effects.localiser_mount_deg` reports at
+/// `pose` before its noise: its own body's orientation `R Exp(m)` (`m` the
+/// mount's rotation vector in the platform frame) at the platform origin.
+pub fn localiser_reading(pose: &PlatformPose, effects: &Effects) -> PlatformPose {
+    let mount = Vector3::from(effects.localiser_mount_deg.map(f64::to_radians));
+    PlatformPose {
+        rotation: pose.rotation * UnitQuaternion::from_scaled_axis(mount),
+        ..*pose
+    }
 }

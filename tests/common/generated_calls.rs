@@ -43,6 +43,8 @@ pub struct Point {
     pub inverse_segments_squared: f64,
     pub load_cell_bias_n: f64,
     pub load_cell_gain_error: f64,
+    /// The localiser's mounting rotation vector, radians.
+    pub localiser_mount_rad: Vector3<f64>,
 }
 
 // Each generated function at a point, with all its Jacobians (`Some`) or none.
@@ -124,6 +126,23 @@ pub fn pose_prior(p: &Point, j: Option<&mut M<6, 6>>) -> SVector<f64, 6> {
         &p.prior.rotation_xyzw(),
         EPSILON,
         j,
+    )
+}
+
+pub fn mounted_pose_prior(p: &Point, j: Option<&mut (M<6, 6>, M<6, 3>)>) -> SVector<f64, 6> {
+    let (pose, mount) = match j {
+        Some((a, b)) => (Some(a), Some(b)),
+        None => (None, None),
+    };
+    generated::mounted_pose_prior_residual(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.prior.position_m,
+        &p.prior.rotation_xyzw(),
+        &p.localiser_mount_rad,
+        EPSILON,
+        pose,
+        mount,
     )
 }
 
