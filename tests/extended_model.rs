@@ -50,6 +50,7 @@ fn from_discretised(
             yaw_deg,
             encoder_lengths_m: std::array::from_fn(|i| eq.paid_out_lengths_m[i] + robot.length_offsets_m[i]),
             reference_tension_n: force.norm(),
+            excluded: Default::default(),
         });
         poses.push(eq.pose);
         tensions.push(CableTension {
@@ -96,6 +97,7 @@ fn neutral_effects_reproduce_the_baseline_factors() {
                 yaw_deg,
                 encoder_lengths_m: std::array::from_fn(|i| eq.cable_lengths_m[i] + 0.01 * i as f64),
                 reference_tension_n: eq.tensions[robot.reference_cable].magnitude_n() + 3.0,
+                excluded: Default::default(),
             }
         })
         .collect();
@@ -161,6 +163,7 @@ fn extended_jacobians_match_central_differences() {
                 yaw_deg,
                 encoder_lengths_m: eq.cable_lengths_m,
                 reference_tension_n: eq.tensions[robot.reference_cable].magnitude_n(),
+                excluded: Default::default(),
             }
         })
         .collect();

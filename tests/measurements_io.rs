@@ -125,6 +125,7 @@ fn tricky_poses() -> Vec<PoseMeasurement> {
             yaw_deg: 5e-324,
             encoder_lengths_m: [183.324069126233, -12.5, 0.0, 1e300],
             reference_tension_n: 698.722056942942,
+            excluded: Default::default(),
         },
         PoseMeasurement {
             line: 17,
@@ -134,6 +135,7 @@ fn tricky_poses() -> Vec<PoseMeasurement> {
             yaw_deg: 123456789.12345679,
             encoder_lengths_m: [1e-7, -1e-7, 171.686733095484, 9007199254740991.0],
             reference_tension_n: f64::MIN_POSITIVE,
+            excluded: Default::default(),
         },
         PoseMeasurement {
             line: 0,
@@ -143,6 +145,7 @@ fn tricky_poses() -> Vec<PoseMeasurement> {
             yaw_deg: -2.3271554167164,
             encoder_lengths_m: [156.778902665505, 171.962857387867, 184.290054861894, 170.209354387472],
             reference_tension_n: 722.490692830791,
+            excluded: Default::default(),
         },
     ]
 }
@@ -229,6 +232,7 @@ fn reads_comments_blank_lines_crlf_bom_and_spaces() {
             yaw_deg: 3.0,
             encoder_lengths_m: [180.125, -0.5, 0.0, 171.75],
             reference_tension_n: 600.5,
+            excluded: Default::default(),
         }
     );
     assert_eq!(
@@ -241,6 +245,7 @@ fn reads_comments_blank_lines_crlf_bom_and_spaces() {
             yaw_deg: 7.0,
             encoder_lengths_m: [-100.0, 10.0, 3.0, 0.5],
             reference_tension_n: 1e-3,
+            excluded: Default::default(),
         }
     );
 }
@@ -271,6 +276,7 @@ fn shared_recurdyn_log() {
             yaw_deg: 0.971850603803798,
             encoder_lengths_m: [183.324069126233, 169.162981532604, 155.642263929178, 170.927219368362],
             reference_tension_n: 698.722056942942,
+            excluded: Default::default(),
         }
     );
     let line5 = set.poses.iter().find(|p| p.line == 5).expect("line 5 kept");

@@ -14,9 +14,9 @@ use super::factors::{
 };
 use super::options::{CableModel, CalibrationOptions, OrientationPrior};
 use crate::error::{Error, Result};
-use crate::graph::{FactorGraph, Values, VariableValue};
+use crate::graph::{Factor, FactorGraph, MaskedFactor, Values, VariableValue};
 use crate::model::effects::{EffectKind, EffectSet, Effects};
-use crate::model::measurement::PoseMeasurement;
+use crate::model::measurement::{PoseMeasurement, Sensor};
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::statics::CableTension;
@@ -177,9 +177,9 @@ impl PoseFactors<'_> {
         let orientation_sigma = (self.options.orientation_prior == OrientationPrior::On
             || self.model == CableModel::Rigid)
             .then_some(noise.orientation_sigma_rad);
-        match (orientation_sigma, self.effects) {
+        let prior: Box<dyn Factor> = match (orientation_sigma, self.effects) {
             (Some(orientation_sigma), Some(effects)) if self.model == CableModel::Catenary => {
-                graph.add(MountedPosePriorFactor::new(
+                Box::new(MountedPosePriorFactor::new(
                     vars.pose,
                     effects.localiser_mount,
                     &measured_pose(m),
@@ -188,7 +188,7 @@ impl PoseFactors<'_> {
                     self.options.robust.pose_prior,
                 ))
             }
-            _ => graph.add(PosePriorFactor::new(
+            _ => Box::new(PosePriorFactor::new(
                 vars.pose,
                 &measured_pose(m),
                 noise.position_sigma_m,
@@ -196,6 +196,18 @@ impl PoseFactors<'_> {
                 self.options.robust.pose_prior,
             )),
         };
+        // Rows `[orientation (3)]; position (3)]`, the orientation rows only with its prior.
+        let orientation_rows = if orientation_sigma.is_some() { 3 } else { 0 };
+        let dropped: Vec<usize> = m
+            .excluded
+            .iter()
+            .filter_map(|sensor| match sensor {
+                Sensor::Orientation(a) if orientation_rows == 3 => Some(a),
+                Sensor::Position(a) => Some(orientation_rows + a),
+                _ => None,
+            })
+            .collect();
+        push_masked(graph, prior, &dropped);
         match (self.model, self.effects) {
             (CableModel::Rigid, _) => self.add_rigid(graph, vars, m),
             (CableModel::Catenary, Some(effects)) => {
@@ -212,40 +224,43 @@ impl PoseFactors<'_> {
     /// The straight-cable length factor; the reference tension is held fixed.
     fn add_rigid(&self, graph: &mut FactorGraph, vars: PoseVariables, m: &PoseMeasurement) {
         graph.values.set_fixed(vars.reference_tension, true);
-        graph.add(RigidLengthFactor::new(
+        let lengths = RigidLengthFactor::new(
             self.slots.clone(),
             self.globals,
             vars,
             &m.encoder_lengths_m,
             self.options.noise.encoder_sigma_m,
             self.options.robust.encoder,
-        ));
+        );
+        push_masked(graph, Box::new(lengths), &encoder_rows(m));
     }
 
     /// The paper's factors: catenary length (eq. 14), attachment height
     /// (eq. 15), reference tension (eq. 16).
     fn add_catenary(&self, graph: &mut FactorGraph, vars: PoseVariables, m: &PoseMeasurement) {
         let noise = &self.options.noise;
-        graph.add(CatenaryLengthFactor::new(
+        let lengths = CatenaryLengthFactor::new(
             self.slots.clone(),
             self.globals,
             vars,
             &m.encoder_lengths_m,
             noise.encoder_sigma_m,
             self.options.robust.encoder,
-        ));
+        );
+        push_masked(graph, Box::new(lengths), &encoder_rows(m));
         graph.add(AttachmentHeightFactor::new(
             self.slots.clone(),
             self.globals,
             vars,
             self.options.height_sigma_m,
         ));
-        graph.add(ReferenceTensionFactor::new(
+        let cell = ReferenceTensionFactor::new(
             vars.reference_tension,
             m.reference_tension_n,
             noise.load_cell_sigma_n,
             self.options.robust.load_cell,
-        ));
+        );
+        push_masked(graph, Box::new(cell), &load_cell_rows(m));
     }
 
     /// The extended model's factors: length and height with the effect
@@ -258,7 +273,7 @@ impl PoseFactors<'_> {
         effects: EffectVariables,
     ) {
         let noise = &self.options.noise;
-        graph.add(ExtendedLengthFactor::new(
+        let lengths = ExtendedLengthFactor::new(
             self.slots.clone(),
             self.globals,
             effects,
@@ -266,7 +281,8 @@ impl PoseFactors<'_> {
             &m.encoder_lengths_m,
             noise.encoder_sigma_m,
             self.options.robust.encoder,
-        ));
+        );
+        push_masked(graph, Box::new(lengths), &encoder_rows(m));
         graph.add(ExtendedHeightFactor::new(
             self.slots.clone(),
             self.globals,
@@ -274,13 +290,14 @@ impl PoseFactors<'_> {
             vars,
             self.options.height_sigma_m,
         ));
-        graph.add(LoadCellFactor::new(
+        let cell = LoadCellFactor::new(
             vars.reference_tension,
             effects.load_cell,
             m.reference_tension_n,
             noise.load_cell_sigma_n,
             self.options.robust.load_cell,
-        ));
+        );
+        push_masked(graph, Box::new(cell), &load_cell_rows(m));
     }
 
     /// Every cable's tension kept positive (inactive at the optimum).
@@ -292,6 +309,32 @@ impl PoseFactors<'_> {
             self.tension_floor_n,
             self.tension_floor_n,
         ));
+    }
+}
+
+/// Add `factor` without its rows `dropped` (readings left out as gross
+/// errors, [`PoseMeasurement::excluded`]); a factor with every row dropped is left out.
+fn push_masked(graph: &mut FactorGraph, factor: Box<dyn Factor>, dropped: &[usize]) {
+    if dropped.is_empty() {
+        graph.factors.push(factor);
+    } else if let Some(masked) = MaskedFactor::new(factor, dropped) {
+        graph.factors.push(Box::new(masked));
+    }
+}
+
+/// The length factors' rows (robot cable order) of the excluded encoders.
+fn encoder_rows(m: &PoseMeasurement) -> Vec<usize> {
+    (0..CABLE_COUNT)
+        .filter(|i| m.excluded.contains(Sensor::Encoder(*i)))
+        .collect()
+}
+
+/// The load-cell factor's row, if the reading is excluded.
+fn load_cell_rows(m: &PoseMeasurement) -> Vec<usize> {
+    if m.excluded.contains(Sensor::LoadCell) {
+        vec![0]
+    } else {
+        Vec::new()
     }
 }
 

@@ -40,7 +40,9 @@
 pub mod effect_factors;
 pub mod factors;
 mod graph;
+pub mod gross_errors;
 mod init;
+pub mod mistakes;
 mod options;
 mod orientation;
 mod predict;

@@ -46,6 +46,7 @@ pub fn predict_with_effects(robot: &Robot, start: &Equilibrium, load_cell_n: f64
         yaw_deg,
         encoder_lengths_m: [0.0; CABLE_COUNT],
         reference_tension_n: load_cell_n,
+        excluded: Default::default(),
     };
     let options = CalibrationOptions {
         orientation_prior: OrientationPrior::Off,

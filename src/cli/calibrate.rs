@@ -2,14 +2,14 @@
 
 use std::path::Path;
 
+use sagcal::calib::gross_errors::{calibrate_checked, GrossErrorOptions, Verdict};
 use sagcal::calib::report::CalibrationReport;
-use sagcal::calib::{
-    calibrate, CableModel, CalibrationOptions, CalibrationResult, OrientationPrior, ParameterUncertainty,
-};
+use sagcal::calib::{CableModel, CalibrationOptions, CalibrationResult, OrientationPrior, ParameterUncertainty};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::model::Robot;
 use sagcal::plot::{anchor_plot_svg, write_svg, AnchorPlot, AnchorPlotEntry};
 
+use super::gross_errors::{self, GrossErrorReport};
 use super::output::{print_json, Table};
 use super::CalibrateArgs;
 
@@ -23,12 +23,40 @@ pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
         },
     )?;
     let options = args.solver.options(&nominal)?;
-    let result = calibrate(&nominal, &data.poses, &options)?;
-    let lines: Vec<usize> = data.poses.iter().map(|p| p.line).collect();
-    let report = CalibrationReport::new(&result, &nominal, options.model, &lines, None);
+    if !(args.false_alarm > 0.0 && args.false_alarm < 1.0) {
+        return Err(sagcal::Error::InvalidInput(format!(
+            "--false-alarm must be between 0 and 1, got {}",
+            args.false_alarm
+        )));
+    }
+    let check = GrossErrorOptions {
+        false_alarm: args.false_alarm,
+        ..GrossErrorOptions::default()
+    };
+    let checked = calibrate_checked(&nominal, &data.poses, &options, &check)?;
+    let result = &checked.result;
+    let lines: Vec<usize> = checked.measurements.iter().map(|p| p.line).collect();
+    let report = CalibrationReport::new(result, &nominal, options.model, &lines, None);
+    let gross = GrossErrorReport::new(&checked);
+    let refused = matches!(checked.verdict, Verdict::Inconsistent { .. }) && !args.accept_inconsistent;
+    if refused {
+        // Nothing is written: the report goes out, then the error names the sensors.
+        if !args.json {
+            print!("{}", render(&report, &options));
+            print!("{}", gross_errors::render(&gross));
+        }
+        let Verdict::Inconsistent { reason } = &checked.verdict else {
+            unreachable!("refused only when inconsistent")
+        };
+        return Err(sagcal::Error::InvalidInput(format!(
+            "{}: the calibration fails its own consistency tests, so no robot file is written \
+             (--accept-inconsistent writes it anyway): {reason}",
+            args.data.display()
+        )));
+    }
     // Write files only after everything succeeded, each atomically.
     if let Some(out) = &args.out {
-        write_robot(out, &result.robot)?;
+        write_robot_with_verdict(out, &result.robot, &checked.verdict)?;
     }
     if let Some(plot) = &args.plot {
         let positions: Vec<[f64; 3]> = data.poses.iter().map(|p| p.position_m).collect();
@@ -36,15 +64,19 @@ pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
             plot,
             &nominal,
             None,
-            &result,
+            result,
             &positions,
             &format!("sagcal calibrate --data {}", args.data.display()),
         )?;
     }
     if args.json {
-        print_json(&report)
+        print_json(&CheckedReport {
+            report,
+            gross_errors: gross,
+        })
     } else {
         print!("{}", render(&report, &options));
+        print!("{}", gross_errors::render(&gross));
         if let Some(out) = &args.out {
             println!("calibrated robot written to {}", out.display());
         }
@@ -57,9 +89,27 @@ pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
 
 /// Write a robot TOML atomically.
 pub fn write_robot(path: &Path, robot: &Robot) -> sagcal::Result<()> {
+    write_robot_with_verdict(path, robot, &Verdict::Consistent)
+}
+
+/// Write a robot TOML atomically, with the consistency verdict in its header comment.
+pub fn write_robot_with_verdict(path: &Path, robot: &Robot, verdict: &Verdict) -> sagcal::Result<()> {
     let text = robot.to_file_contents().to_toml()?;
-    let header = "# Calibrated by sagcal: anchors and encoder length offsets estimated from measurements.\n";
+    let mut header =
+        "# Calibrated by sagcal: anchors and encoder length offsets estimated from measurements.\n".to_string();
+    if let Verdict::Inconsistent { reason } = verdict {
+        header +=
+            &format!("# WARNING: written with --accept-inconsistent; the fit FAILS its consistency tests: {reason}\n");
+    }
     sagcal::io::write_atomically(path, format!("{header}{text}").as_bytes())
+}
+
+/// The JSON of `sagcal calibrate`: the report and its gross-error tests.
+#[derive(serde::Serialize)]
+struct CheckedReport {
+    #[serde(flatten)]
+    report: CalibrationReport,
+    gross_errors: GrossErrorReport,
 }
 
 /// The anchor plot of a calibration.

@@ -5,6 +5,7 @@ mod calibrate;
 mod demo;
 mod diagnose;
 mod experiment;
+mod gross_errors;
 mod hidden;
 mod output;
 mod simulate;
@@ -240,6 +241,14 @@ struct CalibrateArgs {
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
+    /// Write the calibrated robot even when the fit fails its own consistency
+    /// tests (the verdict is recorded in the file's header comment).
+    #[arg(long)]
+    accept_inconsistent: bool,
+    /// False-alarm rate of the gross-error tests (per reading, over all
+    /// readings; per sensor type, over the types).
+    #[arg(long, default_value_t = 1e-3)]
+    false_alarm: f64,
     #[command(flatten)]
     solver: SolverArgs,
 }

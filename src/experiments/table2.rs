@@ -242,6 +242,7 @@ fn noisy_measurements(
                 yaw_deg,
                 encoder_lengths_m,
                 reference_tension_n: p.reference_tension_n + normal(noise.load_cell_sigma_n),
+                excluded: Default::default(),
             }
         })
         .collect()

@@ -8,9 +8,11 @@
 //! wrapped in [`crate::calib`]), `sigma_f` its per-component standard
 //! deviations and `rho_f` its robust kernel.
 
+pub mod masked;
 pub mod robust;
 pub mod values;
 
+pub use masked::MaskedFactor;
 pub use robust::RobustKernel;
 pub use values::{Values, VariableId, VariableValue};
 

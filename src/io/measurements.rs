@@ -387,6 +387,7 @@ fn from_recurdyn(row: &RecurDynRow, reference_cable: usize) -> Option<PoseMeasur
         yaw_deg: row.yaw_deg,
         encoder_lengths_m: row.cable_lengths_m,
         reference_tension_n: tension.total_n,
+        excluded: Default::default(),
     })
 }
 
@@ -467,6 +468,7 @@ fn parse_row(text: &[u8], line: usize, path: &Path) -> Result<PoseMeasurement> {
         yaw_deg: yaw,
         encoder_lengths_m: [l1, l2, l3, l4],
         reference_tension_n: f_ref,
+        excluded: Default::default(),
     })
 }
 

@@ -21,4 +21,89 @@ pub struct PoseMeasurement {
     pub encoder_lengths_m: [f64; 4],
     /// Load-cell tension of the reference cable at the platform attachment, newtons (positive).
     pub reference_tension_n: f64,
+    /// Readings the calibration leaves out (gross errors found by data
+    /// snooping, `crate::calib::gross_errors`); empty as read from a file.
+    #[serde(default, skip_serializing_if = "ReadingSet::is_empty")]
+    pub excluded: ReadingSet,
+}
+
+/// One reading of a pose: a sensor, and for encoders and localiser axes which one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Sensor {
+    /// The encoder of cable `i` (0-based, the robot's cable order).
+    Encoder(usize),
+    /// The load cell on the reference cable.
+    LoadCell,
+    /// The localiser's position along world axis `0..3` (x, y, z).
+    Position(usize),
+    /// The localiser's orientation about axis `0..3` of its rotation error (x, y, z).
+    Orientation(usize),
+}
+
+impl Sensor {
+    /// Every reading of a pose, in a fixed order.
+    pub const ALL: [Sensor; 11] = [
+        Sensor::Encoder(0),
+        Sensor::Encoder(1),
+        Sensor::Encoder(2),
+        Sensor::Encoder(3),
+        Sensor::LoadCell,
+        Sensor::Position(0),
+        Sensor::Position(1),
+        Sensor::Position(2),
+        Sensor::Orientation(0),
+        Sensor::Orientation(1),
+        Sensor::Orientation(2),
+    ];
+
+    fn bit(self) -> u16 {
+        let index = match self {
+            Sensor::Encoder(i) => i.min(3),
+            Sensor::LoadCell => 4,
+            Sensor::Position(a) => 5 + a.min(2),
+            Sensor::Orientation(a) => 8 + a.min(2),
+        };
+        1 << index
+    }
+
+    /// The reading in words: `encoder of cable 2`, `load cell`, `localiser x`, `localiser orientation about x`.
+    pub fn describe(self) -> String {
+        const AXES: [&str; 3] = ["x", "y", "z"];
+        match self {
+            Sensor::Encoder(i) => format!("encoder of cable {}", i + 1),
+            Sensor::LoadCell => "load cell".into(),
+            Sensor::Position(a) => format!("localiser {}", AXES[a.min(2)]),
+            Sensor::Orientation(a) => format!("localiser orientation about {}", AXES[a.min(2)]),
+        }
+    }
+}
+
+/// A set of readings of one pose ([`Sensor`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash, Serialize, Deserialize)]
+pub struct ReadingSet(u16);
+
+impl ReadingSet {
+    /// No reading.
+    pub const NONE: ReadingSet = ReadingSet(0);
+
+    /// This set and `sensor`.
+    pub fn with(self, sensor: Sensor) -> Self {
+        Self(self.0 | sensor.bit())
+    }
+
+    /// Whether `sensor` is in the set.
+    pub fn contains(self, sensor: Sensor) -> bool {
+        self.0 & sensor.bit() != 0
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(&self) -> bool {
+        self.0 == 0
+    }
+
+    /// The readings in the set, in [`Sensor::ALL`] order.
+    pub fn iter(self) -> impl Iterator<Item = Sensor> {
+        Sensor::ALL.into_iter().filter(move |s| self.contains(*s))
+    }
 }

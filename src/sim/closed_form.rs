@@ -135,6 +135,7 @@ impl SensorSampler {
             yaw_deg,
             encoder_lengths_m,
             reference_tension_n: reference_tension_n + self.load_cell.sample(rng),
+            excluded: Default::default(),
         }
     }
 }

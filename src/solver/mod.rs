@@ -23,12 +23,14 @@
 mod covariance;
 mod linear_system;
 mod local;
+mod redundancy;
 mod schur;
 
 use local::LocalGroups;
 
 pub use covariance::{marginal_covariance, Covariance, UnobservableDirection};
 pub use linear_system::LinearSystem;
+pub use redundancy::redundancy_numbers;
 
 use serde::Serialize;
 

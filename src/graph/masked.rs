@@ -1,0 +1,122 @@
+//! A factor with some of its rows left out: the readings a gross-error test
+//! removed (`crate::calib::gross_errors`). The rows are dropped, not
+//! down-weighted, so the per-type statistics count only the readings used.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::{Factor, RobustKernel, Values, VariableId};
+
+/// `inner` without the residual rows `dropped` (indices into its residual).
+pub struct MaskedFactor {
+    inner: Box<dyn Factor>,
+    /// The rows of `inner` that are kept, in order.
+    kept: Vec<usize>,
+    sigmas: DVector<f64>,
+}
+
+impl MaskedFactor {
+    /// `inner` without the rows `dropped`; `None` when every row is dropped
+    /// (the factor then has nothing left to say and is left out whole).
+    pub fn new(inner: Box<dyn Factor>, dropped: &[usize]) -> Option<Self> {
+        let kept: Vec<usize> = (0..inner.residual_dim()).filter(|r| !dropped.contains(r)).collect();
+        if kept.is_empty() {
+            return None;
+        }
+        let sigmas = DVector::from_iterator(kept.len(), kept.iter().map(|&r| inner.sigmas()[r]));
+        Some(Self { inner, kept, sigmas })
+    }
+}
+
+impl Factor for MaskedFactor {
+    fn variables(&self) -> &[VariableId] {
+        self.inner.variables()
+    }
+    fn residual_dim(&self) -> usize {
+        self.kept.len()
+    }
+    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        let rows = self.inner.residual_dim();
+        let residual = match jacobians {
+            None => self.inner.evaluate(values, None)?,
+            Some(blocks) => {
+                let mut full: Vec<DMatrix<f64>> = blocks.iter().map(|b| DMatrix::zeros(rows, b.ncols())).collect();
+                let residual = self.inner.evaluate(values, Some(&mut full))?;
+                for (block, full) in blocks.iter_mut().zip(&full) {
+                    for (k, &r) in self.kept.iter().enumerate() {
+                        block.row_mut(k).copy_from(&full.row(r));
+                    }
+                }
+                residual
+            }
+        };
+        Some(DVector::from_iterator(
+            self.kept.len(),
+            self.kept.iter().map(|&r| residual[r]),
+        ))
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn robust_kernel(&self) -> RobustKernel {
+        self.inner.robust_kernel()
+    }
+    fn kind(&self) -> &'static str {
+        self.inner.kind()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::VariableValue;
+
+    /// `r = [x0, 2 x0, 3 x0]` on one scalar variable.
+    struct Three {
+        variables: [VariableId; 1],
+        sigmas: DVector<f64>,
+    }
+
+    impl Factor for Three {
+        fn variables(&self) -> &[VariableId] {
+            &self.variables
+        }
+        fn residual_dim(&self) -> usize {
+            3
+        }
+        fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+            let x = values.vector(self.variables[0])[0];
+            if let Some(blocks) = jacobians {
+                blocks[0].copy_from(&DMatrix::from_column_slice(3, 1, &[1.0, 2.0, 3.0]));
+            }
+            Some(DVector::from_column_slice(&[x, 2.0 * x, 3.0 * x]))
+        }
+        fn sigmas(&self) -> &DVector<f64> {
+            &self.sigmas
+        }
+        fn kind(&self) -> &'static str {
+            "three"
+        }
+    }
+
+    #[test]
+    fn drops_the_rows_and_keeps_the_rest() {
+        let mut values = Values::default();
+        let x = values.insert("x", VariableValue::Vector(DVector::from_element(1, 2.0)));
+        let inner = Box::new(Three {
+            variables: [x],
+            sigmas: DVector::from_column_slice(&[0.1, 0.2, 0.3]),
+        });
+        let masked = MaskedFactor::new(inner, &[1]).unwrap();
+        assert_eq!(masked.residual_dim(), 2);
+        assert_eq!(masked.sigmas().as_slice(), &[0.1, 0.3]);
+        let mut blocks = vec![DMatrix::zeros(2, 1)];
+        let r = masked.evaluate(&values, Some(&mut blocks)).unwrap();
+        assert_eq!(r.as_slice(), &[2.0, 6.0]);
+        assert_eq!(blocks[0].as_slice(), &[1.0, 3.0]);
+        let all = Box::new(Three {
+            variables: [x],
+            sigmas: DVector::from_element(3, 1.0),
+        });
+        assert!(MaskedFactor::new(all, &[0, 1, 2]).is_none());
+    }
+}
