@@ -10,6 +10,7 @@ use sagcal::experiments::hidden_effects::{
 use sagcal::model::effects::EffectKind;
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
+use sagcal::sim::closed_form::Closure;
 use serde::Serialize;
 
 use super::output::{print_json, progress_bar, Table};
@@ -58,6 +59,7 @@ struct Summary {
 #[derive(Debug, Clone, Serialize)]
 struct Report {
     seed: u64,
+    closure: Closure,
     seeds: usize,
     poses: usize,
     noises: Vec<NoisePreset>,
@@ -91,6 +93,7 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         poses: args.poses,
         noise: args.noise[0],
         segments: args.segments,
+        closure: args.closure,
         ..HiddenEffectOptions::default()
     };
     let cases = sweep(args, &robots, &options)?;
@@ -104,6 +107,7 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
     let scores = scores(&robots, &args.noise, &cases);
     let report = Report {
         seed: args.seed,
+        closure: args.closure,
         seeds: args.seeds,
         poses: args.poses,
         noises: args.noise.clone(),
@@ -136,8 +140,9 @@ fn hidden_sets() -> Vec<String> {
 fn sweep(args: &HiddenEffectsArgs, robots: &[Robot], options: &HiddenEffectOptions) -> sagcal::Result<Vec<HiddenCase>> {
     let total = robots.len() * args.noise.len() * hidden_sets().len() * args.seeds;
     eprintln!(
-        "sagcal experiment hidden-effects: seed {}, {} seeds x {} hidden sets (none, {} effects, {} pairs) x {} robot(s) x {:?} noise, {} poses",
+        "sagcal experiment hidden-effects: seed {}, {} closure, {} seeds x {} hidden sets (none, {} effects, {} pairs) x {} robot(s) x {:?} noise, {} poses",
         args.seed,
+        args.closure,
         args.seeds,
         hidden_sets().len(),
         EffectKind::ALL.len(),
@@ -232,8 +237,12 @@ fn summaries(robots: &[Robot], noises: &[NoisePreset], scores: &[EffectScore]) -
 /// The readable report.
 fn print_report(args: &HiddenEffectsArgs, report: &Report) {
     println!(
-        "sagcal experiment hidden-effects --seeds {} --seed {} --poses {} --noise {:?}\n",
-        args.seeds, args.seed, args.poses, report.noises
+        "sagcal experiment hidden-effects --seeds {} --seed {} --poses {} --noise {:?} --closure {}\n",
+        args.seeds,
+        args.seed,
+        args.poses,
+        report.noises,
+        args.closure.name()
     );
     for (robot, ranges) in &report.ranges {
         println!("magnitudes drawn for `{robot}` (true anchors off the nominal ones, offsets of metres):");

@@ -68,6 +68,10 @@ struct HiddenEffectsArgs {
     /// Segments per cable of the discretised simulator.
     #[arg(long, default_value_t = 50)]
     segments: usize,
+    /// How each pose closes its family of equilibria: level (the most level member),
+    /// yaw (a random yaw within +-1 degree) or mixed (about half each).
+    #[arg(long, default_value = "mixed", value_parser = sagcal::sim::closed_form::Closure::parse)]
+    closure: sagcal::sim::closed_form::Closure,
     /// Print JSON (with every case).
     #[arg(long)]
     json: bool,
@@ -318,6 +322,10 @@ struct SimulateArgs {
     /// Segments per cable of the discretised simulator (only used with effects).
     #[arg(long, default_value_t = 100)]
     segments: usize,
+    /// How each pose closes its family of equilibria: level (the most level member),
+    /// yaw (a random yaw within +-1 degree) or mixed (about half each).
+    #[arg(long, default_value = "level", value_parser = sagcal::sim::closed_form::Closure::parse)]
+    closure: sagcal::sim::closed_form::Closure,
 }
 
 #[derive(Debug, Clone, clap::Args)]

@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use sagcal::io::measurements::write_measurements;
 use sagcal::model::statics::Equilibrium;
 use sagcal::model::{PoseMeasurement, Robot};
-use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
+use sagcal::sim::closed_form::{measure, sample_equilibria_with, Closure, Workspace};
 use sagcal::sim::discretised::MAX_SEGMENTS;
 use sagcal::sim::effects::measure_with_effects;
 
@@ -20,7 +20,7 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
     let (truth, from_file) = load_truth(args)?;
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     let workspace = Workspace::default_for(&truth);
-    let equilibria = sample_equilibria(&truth, &workspace, args.poses, &mut rng)?;
+    let equilibria = sample_equilibria_with(&truth, &workspace, args.poses, args.closure, &mut rng)?;
     let data = measure_poses(args, &truth, from_file, &equilibria, &mut rng)?;
     if let Some(path) = &args.truth {
         write_truth(path, args, &truth)?;
@@ -28,11 +28,12 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
     write_measurements(&args.out, &comments(args, &truth, &workspace), &data)?;
     print_ranges(&workspace, &equilibria);
     println!(
-        "seed {}: {} poses of robot `{}` with {} noise written to {}",
+        "seed {}: {} poses of robot `{}` with {} noise{} written to {}",
         args.seed,
         args.poses,
         truth.name,
         args.noise,
+        closure_note(args.closure),
         args.out.display()
     );
     Ok(())
@@ -104,12 +105,13 @@ fn comments(args: &SimulateArgs, truth: &Robot, workspace: &Workspace) -> Vec<St
     let mut comments = vec![
         format!("simulated by sagcal {} ({model})", env!("CARGO_PKG_VERSION")),
         format!(
-            "robot {} ({}), {} poses, seed {}, noise {}",
+            "robot {} ({}), {} poses, seed {}, noise {}{}",
             truth.name,
             args.robot.display(),
             args.poses,
             args.seed,
-            args.noise
+            args.noise,
+            closure_note(args.closure)
         ),
         format!("workspace {:?} .. {:?} m", workspace.min_m, workspace.max_m),
     ];
@@ -129,13 +131,24 @@ fn write_truth(path: &Path, args: &SimulateArgs, truth: &Robot) -> sagcal::Resul
         format!(", effects {effects} ({} segments)", args.segments)
     };
     let text = format!(
-        "# The truth of a sagcal simulation: seed {}, {} poses, noise {}{effects_note}.\n{}",
+        "# The truth of a sagcal simulation: seed {}, {} poses, noise {}{}{effects_note}.\n{}",
         args.seed,
         args.poses,
         args.noise,
+        closure_note(args.closure),
         truth.to_file_contents().to_toml()?
     );
     sagcal::io::write_atomically(path, text.as_bytes())
+}
+
+/// `, closure yaw (+-1 deg)` for a closure other than level (whose files and
+/// messages stay as they were), else nothing.
+fn closure_note(closure: Closure) -> String {
+    if closure == Closure::Level {
+        String::new()
+    } else {
+        format!(", closure {closure}")
+    }
 }
 
 /// The workspace and the ranges of cable lengths and tensions it gave.

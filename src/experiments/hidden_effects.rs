@@ -32,6 +32,13 @@
 //! anchor error to its stated 1-sigma: above 1, every magnitude drawn changes
 //! the calibrated anchors by more than their uncertainty.
 //!
+//! # Poses
+//!
+//! Each case's static poses close their family of equilibria by
+//! [`HiddenEffectOptions::closure`]: by default about half are the most level
+//! member, the others the member of a random yaw within
+//! [`DEFAULT_MAX_YAW_DEG`], as a robot settles wherever its statics put it.
+//!
 //! # Scoring
 //!
 //! A case is right when the verdict names the hidden effect (`none` for none).
@@ -60,7 +67,7 @@ use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::NoisePreset;
 use crate::model::statics::CableTension;
-use crate::sim::closed_form::{sample_equilibria, Workspace};
+use crate::sim::closed_form::{sample_equilibria, sample_equilibria_with, Closure, Workspace, DEFAULT_MAX_YAW_DEG};
 use crate::sim::effects::{measure_with_effects, solve_with_effects};
 use crate::solver::{marginal_covariance, Covariance};
 use crate::stats::{chi_square_critical, noncentral_chi_square_survival};
@@ -76,16 +83,24 @@ pub struct HiddenEffectOptions {
     pub segments: usize,
     /// Folds of the diagnosis' cross-validation.
     pub folds: usize,
+    /// How each pose closes its family of equilibria: the most level member
+    /// or one of a random yaw ([`Closure`]).
+    pub closure: Closure,
 }
 
 impl Default for HiddenEffectOptions {
-    /// 35 poses, the authors' noise, 50 segments, 5 folds.
+    /// 35 poses, the authors' noise, 50 segments, 5 folds, about half the
+    /// poses closed by a yaw within [`DEFAULT_MAX_YAW_DEG`] (the rest level).
     fn default() -> Self {
         Self {
             poses: 35,
             noise: NoisePreset::Authors,
             segments: 50,
             folds: 5,
+            closure: Closure::Mixed {
+                yaw_fraction: 0.5,
+                max_yaw_deg: DEFAULT_MAX_YAW_DEG,
+            },
         }
     }
 }
@@ -267,7 +282,8 @@ pub const TRUTH_ANCHOR_SPREAD_M: f64 = 0.5;
 pub const TRUTH_OFFSET_SPREAD_M: f64 = 3.0;
 
 /// One case's data: the measurements, the true robot (off the nominal one,
-/// its effects set) and the initial guess (the nominal robot).
+/// its effects set) and the initial guess (the nominal robot). The poses are
+/// closed by `options.closure`.
 pub fn simulate_case(
     nominal: &Robot,
     hidden: &[EffectKind],
@@ -281,7 +297,8 @@ pub fn simulate_case(
         truth.anchors_m[i] += Vector3::from_fn(|_, _| rng.random_range(-spread..spread));
         truth.length_offsets_m[i] = rng.random_range(-TRUTH_OFFSET_SPREAD_M..TRUTH_OFFSET_SPREAD_M);
     }
-    let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), options.poses, &mut rng)?;
+    let workspace = Workspace::default_for(&truth);
+    let equilibria = sample_equilibria_with(&truth, &workspace, options.poses, options.closure, &mut rng)?;
     let mean_tension = equilibria
         .iter()
         .map(|eq| eq.tensions[truth.reference_cable].magnitude_n())
@@ -509,7 +526,7 @@ pub fn identifiability(
     options: &HiddenEffectOptions,
 ) -> Result<Identifiability> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let equilibria = sample_equilibria(truth, &Workspace::default_for(truth), poses, &mut rng)?;
+    let equilibria = sample_equilibria_with(truth, &Workspace::default_for(truth), poses, options.closure, &mut rng)?;
     let solved = solve_with_effects(truth, effects, &equilibria, options.segments)?;
     let noise = options.noise.sigmas(truth.platform_weight_n);
     let free = NoisePreset::None.sigmas(truth.platform_weight_n);

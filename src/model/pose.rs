@@ -54,6 +54,14 @@ impl PlatformPose {
         (r.to_degrees(), p.to_degrees(), y.to_degrees())
     }
 
+    /// Yaw, radians in `(-pi, pi]`: the rotation about the world z axis, the
+    /// `yaw` of `R = Rz(yaw) * Ry(pitch) * Rx(roll)` ([`Self::roll_pitch_yaw_deg`]),
+    /// `atan2(R[1,0], R[0,0])`: the heading of the platform's x axis projected
+    /// on the horizontal plane.
+    pub fn yaw_rad(&self) -> f64 {
+        self.rotation.euler_angles().2
+    }
+
     /// The quaternion as SymForce stores it: `[x, y, z, w]`.
     pub fn rotation_xyzw(&self) -> Vector4<f64> {
         let q = self.rotation.quaternion();

@@ -17,9 +17,11 @@
 //! measurement closes it:
 //! * (a) [`solve_with_reference_tension`]: the load cell's tension magnitude (eq. 16);
 //! * (b) [`solve_with_cable_lengths`]: the four cable lengths (least squares);
-//! * (c) [`solve_forward`]: cable lengths only, position unknown too (localisation).
+//! * (c) [`solve_forward`]: cable lengths only, position unknown too (localisation);
+//! * or, for simulation, the platform's orientation: the most level member
+//!   ([`solve_level`]) or the member of a given yaw ([`solve_with_yaw`]).
 //!
-//! This module holds the equations; `solve` the three solvers. Both are
+//! This module holds the equations; `solve` the solvers. Both are
 //! hand-written and share no code with `generated/`: the tests compare the two.
 
 use nalgebra::{Matrix6, SMatrix, Vector3, Vector6};
@@ -32,8 +34,8 @@ use crate::model::robot::{Robot, CABLE_COUNT};
 mod solve;
 
 pub use solve::{
-    feasible_start, reference_tension_magnitude_guess, solve_forward, solve_level, solve_with_cable_lengths,
-    solve_with_reference_tension,
+    feasible_start, reference_tension_magnitude_guess, scan_family, solve_forward, solve_level,
+    solve_with_cable_lengths, solve_with_reference_tension, solve_with_yaw, YAW_TOLERANCE_RAD,
 };
 
 /// Tension of one cable at its platform attachment, paper eq. (7).

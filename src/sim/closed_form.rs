@@ -6,11 +6,13 @@
 //! ([`statics::solve_level`]) with its reference tension scaled by a random
 //! factor in `[0.98, 1.02]`, which keeps the platform within a few degrees of
 //! level and the tensions as even as in the RecurDyn log. Positions without a
-//! positive-tension equilibrium are redrawn.
+//! positive-tension equilibrium are redrawn. [`sample_equilibria_with`] can
+//! close the family by a random yaw instead ([`Closure`]), for some or all poses.
 
 use nalgebra::{Vector3, Vector6};
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
+use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::model::measurement::PoseMeasurement;
@@ -50,36 +52,171 @@ impl Workspace {
     }
 }
 
-/// Draw `count` static equilibria spread over `workspace`.
+/// Draw `count` static equilibria spread over `workspace`, each the most level
+/// member of its family ([`Closure::Level`]).
 pub fn sample_equilibria(
     robot: &Robot,
     workspace: &Workspace,
     count: usize,
     rng: &mut impl Rng,
 ) -> Result<Vec<Equilibrium>> {
+    sample_equilibria_with(robot, workspace, count, Closure::Level, rng)
+}
+
+/// The yaw bound of [`Closure::Yaw`] and [`Closure::Mixed`] by default,
+/// degrees: reachable at most positions of both built-in robots (the large
+/// robot's family spans only about -1.5 .. +2 degrees of yaw, the small
+/// robot's about -20 .. +10).
+pub const DEFAULT_MAX_YAW_DEG: f64 = 1.0;
+
+/// How a sampled pose closes the one-parameter family of equilibria at its
+/// position (module docs of [`crate::model::statics`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Closure {
+    /// The most level member, its reference tension scaled by a random factor
+    /// in `[0.98, 1.02]` ([`statics::solve_level`]): a robot commanded to a
+    /// level, unrotated platform.
+    Level,
+    /// The member of a yaw drawn uniformly in `+-max_yaw_deg`
+    /// ([`statics::solve_with_yaw`]): a platform settled wherever its statics put it.
+    Yaw {
+        /// The bound of the yaw drawn, degrees.
+        max_yaw_deg: f64,
+    },
+    /// Each pose by the yaw closure with probability `yaw_fraction`, else level.
+    Mixed {
+        /// The probability of the yaw closure per pose, 0 .. 1.
+        yaw_fraction: f64,
+        /// The bound of the yaw drawn, degrees.
+        max_yaw_deg: f64,
+    },
+}
+
+impl Closure {
+    /// `level`, `yaw` or `mixed` (half the poses by yaw), with [`DEFAULT_MAX_YAW_DEG`].
+    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+        match text {
+            "level" => Ok(Self::Level),
+            "yaw" => Ok(Self::Yaw {
+                max_yaw_deg: DEFAULT_MAX_YAW_DEG,
+            }),
+            "mixed" => Ok(Self::Mixed {
+                yaw_fraction: 0.5,
+                max_yaw_deg: DEFAULT_MAX_YAW_DEG,
+            }),
+            other => Err(format!("unknown closure `{other}`: level, yaw or mixed")),
+        }
+    }
+
+    /// `level`, `yaw` or `mixed`: what [`Closure::parse`] reads.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Level => "level",
+            Self::Yaw { .. } => "yaw",
+            Self::Mixed { .. } => "mixed",
+        }
+    }
+
+    fn validate(&self) -> Result<()> {
+        let (fraction, max_yaw_deg) = match *self {
+            Self::Level => return Ok(()),
+            Self::Yaw { max_yaw_deg } => (1.0, max_yaw_deg),
+            Self::Mixed {
+                yaw_fraction,
+                max_yaw_deg,
+            } => (yaw_fraction, max_yaw_deg),
+        };
+        if !((0.0..=1.0).contains(&fraction) && max_yaw_deg.is_finite() && max_yaw_deg >= 0.0) {
+            return Err(Error::InvalidInput(format!(
+                "closure {self}: the yaw fraction must be in 0 .. 1 and the yaw bound a non-negative number of degrees"
+            )));
+        }
+        Ok(())
+    }
+
+    /// The next pose's yaw bound, degrees, or `None` for the level closure
+    /// (draws one number for [`Closure::Mixed`], none otherwise).
+    fn draw(&self, rng: &mut impl Rng) -> Option<f64> {
+        match *self {
+            Self::Level => None,
+            Self::Yaw { max_yaw_deg } => Some(max_yaw_deg),
+            Self::Mixed {
+                yaw_fraction,
+                max_yaw_deg,
+            } => rng.random_bool(yaw_fraction).then_some(max_yaw_deg),
+        }
+    }
+}
+
+impl std::fmt::Display for Closure {
+    /// `level`, `yaw (+-1 deg)`, `mixed (50 % yaw, +-1 deg)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Level => write!(f, "level"),
+            Self::Yaw { max_yaw_deg } => write!(f, "yaw (+-{max_yaw_deg} deg)"),
+            Self::Mixed {
+                yaw_fraction,
+                max_yaw_deg,
+            } => write!(f, "mixed ({} % yaw, +-{max_yaw_deg} deg)", 100.0 * yaw_fraction),
+        }
+    }
+}
+
+/// Draw `count` static equilibria spread over `workspace`, each closed by
+/// `closure`. A pose's closure is chosen first (a [`Closure::Mixed`] draw),
+/// then positions (and yaws) are drawn until one has that equilibrium: a
+/// position without it, or where the family does not reach the drawn yaw, is
+/// redrawn. [`Closure::Level`] draws exactly what [`sample_equilibria`] always did.
+pub fn sample_equilibria_with(
+    robot: &Robot,
+    workspace: &Workspace,
+    count: usize,
+    closure: Closure,
+    rng: &mut impl Rng,
+) -> Result<Vec<Equilibrium>> {
+    closure.validate()?;
     let options = StaticsOptions::default();
     let mut poses = Vec::with_capacity(count);
     let mut attempts = 0;
     while poses.len() < count {
-        attempts += 1;
-        if attempts > 100 * count + 1000 {
-            return Err(Error::InvalidInput(format!(
-                "only {} of {count} reachable static poses found in the workspace {workspace:?}",
-                poses.len()
-            )));
-        }
-        let position = Vector3::from_fn(|i, _| rng.random_range(workspace.min_m[i]..=workspace.max_m[i]));
-        let Ok(level) = statics::solve_level(robot, position, &options) else {
-            continue;
-        };
-        let magnitude = level.tensions[robot.reference_cable].magnitude_n() * rng.random_range(0.98..=1.02);
-        if let Ok(eq) =
-            statics::solve_with_reference_tension(robot, position, magnitude, Some(level.pose.rotation), &options)
-        {
-            poses.push(eq);
+        let max_yaw_deg = closure.draw(rng);
+        loop {
+            attempts += 1;
+            if attempts > 100 * count + 1000 {
+                return Err(Error::InvalidInput(format!(
+                    "only {} of {count} reachable static poses ({closure} closure) found in the workspace {workspace:?}",
+                    poses.len()
+                )));
+            }
+            let position = Vector3::from_fn(|i, _| rng.random_range(workspace.min_m[i]..=workspace.max_m[i]));
+            let pose = match max_yaw_deg {
+                None => level_pose(robot, position, &options, rng),
+                Some(max) => {
+                    let yaw_rad = rng.random_range(-max..=max).to_radians();
+                    statics::solve_with_yaw(robot, position, yaw_rad, &options).ok()
+                }
+            };
+            if let Some(eq) = pose {
+                poses.push(eq);
+                break;
+            }
         }
     }
     Ok(poses)
+}
+
+/// The most level equilibrium at `position`, its reference tension scaled by
+/// a random factor in `[0.98, 1.02]` (drawn only where the level member exists).
+fn level_pose(
+    robot: &Robot,
+    position: Vector3<f64>,
+    options: &StaticsOptions,
+    rng: &mut impl Rng,
+) -> Option<Equilibrium> {
+    let level = statics::solve_level(robot, position, options).ok()?;
+    let magnitude = level.tensions[robot.reference_cable].magnitude_n() * rng.random_range(0.98..=1.02);
+    statics::solve_with_reference_tension(robot, position, magnitude, Some(level.pose.rotation), options).ok()
 }
 
 fn normal(sigma: f64) -> Normal<f64> {

@@ -229,6 +229,210 @@ pub fn solve_level(robot: &Robot, position_m: Vector3<f64>, options: &StaticsOpt
         .ok_or_else(|| Error::NoEquilibrium(format!("position {:?}: level search failed", position_m.as_slice())))
 }
 
+/// The grid of the family scans, as multiples of
+/// [`reference_tension_magnitude_guess`]: 0.5, 0.55, .., 2 (as in [`solve_level`]).
+const FAMILY_GRID: std::ops::RangeInclusive<usize> = 0..=30;
+/// The grid point at 1 x the guess, where a family scan starts.
+const FAMILY_GRID_GUESS: usize = 10;
+
+fn family_factor(index: usize) -> f64 {
+    0.5 + 0.05 * index as f64
+}
+
+/// Adjacent scanned members further apart than this (rotation angle, radians)
+/// lie on different branches: no yaw bracket between them.
+const FAMILY_BRANCH_JUMP_RAD: f64 = 0.2;
+/// How close the yaw closure brings the yaw to its target, radians.
+pub const YAW_TOLERANCE_RAD: f64 = 1e-10;
+
+/// `a - b` wrapped into `(-pi, pi]`.
+fn angle_difference_rad(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(std::f64::consts::TAU);
+    if d > std::f64::consts::PI {
+        d - std::f64::consts::TAU
+    } else {
+        d
+    }
+}
+
+/// The one-parameter family at `position_m` on the grid of reference-tension
+/// magnitudes `0.5 .. 2 x` [`reference_tension_magnitude_guess`], in
+/// increasing magnitude: `(magnitude_n, equilibrium)` for every grid point
+/// with a positive-tension equilibrium. The scan follows the family by
+/// continuation: it starts at the guess from a level platform and walks up,
+/// then down, each solve started from the previous member's orientation (a
+/// level start far from level can land on another branch, e.g. the platform
+/// turned by ~180 degrees).
+pub fn scan_family(robot: &Robot, position_m: Vector3<f64>, options: &StaticsOptions) -> Vec<(f64, Equilibrium)> {
+    let guess = reference_tension_magnitude_guess(robot, position_m);
+    let solve = |index: usize, start: Option<UnitQuaternion<f64>>| {
+        let magnitude = guess * family_factor(index);
+        solve_with_reference_tension(robot, position_m, magnitude, start, options)
+            .ok()
+            .map(|eq| (magnitude, eq))
+    };
+    let centre = solve(FAMILY_GRID_GUESS, None);
+    let centre_rotation = centre.as_ref().map(|(_, eq)| eq.pose.rotation);
+    let walk = |indices: &mut dyn Iterator<Item = usize>| {
+        let mut start = centre_rotation;
+        let mut members = Vec::new();
+        for index in indices {
+            if let Some(member) = solve(index, start) {
+                start = Some(member.1.pose.rotation);
+                members.push(member);
+            }
+        }
+        members
+    };
+    let up = walk(&mut (FAMILY_GRID_GUESS + 1..=*FAMILY_GRID.end()));
+    let mut members = walk(&mut (*FAMILY_GRID.start()..FAMILY_GRID_GUESS).rev());
+    members.reverse();
+    members.extend(centre);
+    members.extend(up);
+    members
+}
+
+/// The yaw closure: the static equilibrium at `position_m` whose yaw
+/// ([`PlatformPose::yaw_rad`]: `R = Rz(yaw) Ry(pitch) Rx(roll)`, the rotation
+/// about the world z axis) is `yaw_rad`, to [`YAW_TOLERANCE_RAD`].
+///
+/// With one reference cable, the six equilibrium equations (paper eq. 5-8)
+/// give the other cables' tensions (eq. 11) and the four catenaries must reach
+/// their attachments (eq. 15): orientation (3) and reference tension (2)
+/// against four height equations leave one free parameter at a fixed
+/// position. The load cell (eq. 16, [`solve_with_reference_tension`]) or the
+/// most level member ([`solve_level`]) close it; here the yaw does, as a
+/// platform settles wherever its statics put it. The family is scanned over
+/// the reference-tension magnitude ([`scan_family`]); a bracket where
+/// `yaw - yaw_rad` changes sign between adjacent members of one branch (the
+/// most level one if there are several) is then refined by the Illinois variant of
+/// regula falsi, every evaluation an exact (a)-solve.
+///
+/// Fails with [`Error::NoEquilibrium`] where the family does not reach the
+/// yaw, naming the yaw range it spans at `position_m`.
+pub fn solve_with_yaw(
+    robot: &Robot,
+    position_m: Vector3<f64>,
+    yaw_rad: f64,
+    options: &StaticsOptions,
+) -> Result<Equilibrium> {
+    if !yaw_rad.is_finite() {
+        return Err(Error::InvalidInput(format!(
+            "yaw must be a finite angle, got {yaw_rad} rad"
+        )));
+    }
+    let members = scan_family(robot, position_m, options);
+    let offset = |eq: &Equilibrium| angle_difference_rad(eq.pose.yaw_rad(), yaw_rad);
+    if let Some((_, eq)) = members.iter().find(|(_, eq)| offset(eq).abs() <= YAW_TOLERANCE_RAD) {
+        return Ok(eq.clone());
+    }
+    let bracket = members
+        .windows(2)
+        .filter(|pair| {
+            let (a, b) = (offset(&pair[0].1), offset(&pair[1].1));
+            // Through zero, not through the +-pi of the wrapped offset, and on one branch.
+            a.signum() != b.signum()
+                && (a - b).abs() < std::f64::consts::PI
+                && pair[0].1.pose.rotation.angle_to(&pair[1].1.pose.rotation) < FAMILY_BRANCH_JUMP_RAD
+        })
+        .min_by(|a, b| {
+            let tilt =
+                |pair: &[(f64, Equilibrium)]| pair[0].1.pose.rotation.angle().max(pair[1].1.pose.rotation.angle());
+            tilt(a).total_cmp(&tilt(b))
+        });
+    let Some(pair) = bracket else {
+        return Err(unreachable_yaw(robot, position_m, yaw_rad, &members));
+    };
+    let evaluate = |magnitude: f64, start: &Equilibrium| {
+        solve_with_reference_tension(robot, position_m, magnitude, Some(start.pose.rotation), options).ok()
+    };
+    refine_yaw(&pair[0], &pair[1], &offset, &evaluate).ok_or_else(|| {
+        Error::NoEquilibrium(format!(
+            "position {:?}: the yaw search for {:.4} deg did not converge between reference tensions {:.3} and {:.3} N",
+            position_m.as_slice(),
+            yaw_rad.to_degrees(),
+            pair[0].0,
+            pair[1].0
+        ))
+    })
+}
+
+/// The error of a yaw the family at `position_m` does not reach.
+fn unreachable_yaw(robot: &Robot, position_m: Vector3<f64>, yaw_rad: f64, members: &[(f64, Equilibrium)]) -> Error {
+    let guess = reference_tension_magnitude_guess(robot, position_m);
+    let (low, high) = (
+        family_factor(*FAMILY_GRID.start()) * guess,
+        family_factor(*FAMILY_GRID.end()) * guess,
+    );
+    if members.is_empty() {
+        return Error::NoEquilibrium(format!(
+            "position {:?}: no positive-tension equilibrium for reference tensions between {low:.1} and {high:.1} N",
+            position_m.as_slice()
+        ));
+    }
+    let (min, max) = members
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (_, eq)| {
+            let yaw = eq.pose.yaw_rad();
+            (lo.min(yaw), hi.max(yaw))
+        });
+    Error::NoEquilibrium(format!(
+        "position {:?}: no equilibrium with yaw {:.3} deg; the family spans yaw {:.3} .. {:.3} deg for reference tensions between {low:.1} and {high:.1} N",
+        position_m.as_slice(),
+        yaw_rad.to_degrees(),
+        min.to_degrees(),
+        max.to_degrees()
+    ))
+}
+
+/// Regula falsi (Illinois) on the reference-tension magnitude between two
+/// members whose yaw offsets have opposite signs, until the offset is below
+/// [`YAW_TOLERANCE_RAD`]; bisection where an evaluation fails. Each trial is
+/// solved from the orientation of the nearer bracket end.
+fn refine_yaw(
+    low: &(f64, Equilibrium),
+    high: &(f64, Equilibrium),
+    offset: &dyn Fn(&Equilibrium) -> f64,
+    evaluate: &dyn Fn(f64, &Equilibrium) -> Option<Equilibrium>,
+) -> Option<Equilibrium> {
+    let (mut a, mut b) = (low.clone(), high.clone());
+    let (mut fa, mut fb) = (offset(&a.1), offset(&b.1));
+    let mut kept = 0i8;
+    for _ in 0..100 {
+        let secant = b.0 - fb * (b.0 - a.0) / (fb - fa);
+        let middle = 0.5 * (a.0 + b.0);
+        let start = |x: f64| if (x - a.0).abs() < (b.0 - x).abs() { &a.1 } else { &b.1 };
+        let inside = secant.is_finite() && secant > a.0.min(b.0) && secant < a.0.max(b.0);
+        let trial = inside.then(|| evaluate(secant, start(secant))).flatten();
+        let (x, eq) = match trial {
+            Some(eq) => (secant, eq),
+            None => (middle, evaluate(middle, start(middle))?),
+        };
+        let fx = offset(&eq);
+        if fx.abs() <= YAW_TOLERANCE_RAD {
+            return Some(eq);
+        }
+        if (b.0 - a.0).abs() <= 1e-14 * x.abs() {
+            return None;
+        }
+        if fx.signum() == fa.signum() {
+            (a, fa) = ((x, eq), fx);
+            // b kept twice in a row: halve its offset (Illinois) so the secant moves b too.
+            if kept == 1 {
+                fb *= 0.5;
+            }
+            kept = 1;
+        } else {
+            (b, fb) = ((x, eq), fx);
+            if kept == -1 {
+                fa *= 0.5;
+            }
+            kept = -1;
+        }
+    }
+    None
+}
+
 /// A rough reference-tension magnitude for a position, newtons: the straight-cable
 /// force balance `sum t_i e_i = m_e g z` solved in the least-norm sense.
 pub fn reference_tension_magnitude_guess(robot: &Robot, position_m: Vector3<f64>) -> f64 {
