@@ -63,6 +63,10 @@ fn verify_beats_table_one_on_the_recurdyn_data() {
     for row in report["rows"].as_array().unwrap() {
         assert!(row["height_residual_m"].as_f64().unwrap() < 1e-9);
     }
+    // The large robot's column of the paper's Table I.
+    assert_eq!(report["paper_table1"]["robot"], "large");
+    assert_eq!(report["paper_table1"]["mpe_length_pct"], 8.8947e-3);
+    assert_eq!(report["paper_table1"]["mpe_force_pct"], 0.9154);
 }
 
 #[test]
@@ -162,4 +166,98 @@ fn usage_errors_exit_with_two() {
     assert_eq!(out.status.code(), Some(2));
     let out = sagcal(&["no-such-command"]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+/// A sagcal measurement file of `robots/small.toml`, simulated without noise into `dir`.
+fn simulated_small(dir: &Path) -> String {
+    let data = dir.join("small.csv");
+    let out = sagcal(&[
+        "simulate",
+        "--robot",
+        "robots/small.toml",
+        "--poses",
+        "3",
+        "--noise",
+        "none",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    data.to_str().unwrap().to_string()
+}
+
+/// `sagcal verify` with these arguments: its text and its JSON.
+fn verify_text_and_json(args: &[&str]) -> (String, serde_json::Value) {
+    let out = sagcal(args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let out = sagcal(&[args, &["--json"]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json = String::from_utf8(out.stdout).unwrap();
+    for output in [&text, &json] {
+        let not_a_number = output
+            .split(|c: char| c.is_whitespace() || c == ',' || c == '/')
+            .find(|word| ["NaN", "inf", "-inf"].contains(word));
+        assert!(not_a_number.is_none(), "{output}");
+    }
+    (text, serde_json::from_str(&json).unwrap())
+}
+
+#[test]
+fn no_tension_to_compare_is_a_dash_with_a_reason_and_the_small_robot_gets_its_own_paper_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated_small(dir.path());
+    let (text, json) = verify_text_and_json(&["verify", "--robot", "robots/small.toml", "--data", &data]);
+    // A sagcal file logs the reference cable's tension only, and that tension closes the model.
+    let mpe_f = text.lines().find(|l| l.starts_with("MPE-F, tension %")).unwrap();
+    assert!(mpe_f.contains("(0 comparisons)"), "{mpe_f}");
+    assert_eq!(mpe_f.split_whitespace().nth(5), Some("-"), "{mpe_f}");
+    assert!(text.contains("MPE-F is -: no tension to compare"), "{text}");
+    assert!(json["mpe_force_pct"].is_null(), "{json}");
+    assert!(json["mpe_force_reason"]
+        .as_str()
+        .unwrap()
+        .contains("no tension to compare"));
+    assert_eq!(json["force_comparisons"], 0);
+    // The small robot's column of Table I, not the large one's.
+    assert!(text.contains("paper Table I (small)"), "{text}");
+    assert!(text.contains("0.9046") && text.contains("0.0074"), "{text}");
+    assert!(
+        !text.contains("(large)") && !text.contains("0.9154") && !text.contains("0.0089"),
+        "{text}"
+    );
+    assert_eq!(json["paper_table1"]["robot"], "small");
+    assert_eq!(json["paper_table1"]["mpe_force_pct"], 0.9046);
+    // Closed with the cable lengths, the reference tension is a prediction: MPE-F has a value.
+    let (text, json) = verify_text_and_json(&[
+        "verify",
+        "--robot",
+        "robots/small.toml",
+        "--data",
+        &data,
+        "--close-with",
+        "cable-lengths",
+    ]);
+    assert!(json["mpe_force_pct"].as_f64().unwrap() < 1e-6, "{json}");
+    assert!(json.get("mpe_force_reason").is_none(), "{json}");
+    assert!(!text.contains("MPE-F is -"), "{text}");
+}
+
+#[test]
+fn a_users_own_robot_gets_no_paper_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated_small(dir.path());
+    let own = std::fs::read_to_string("robots/small.toml").unwrap();
+    assert!(own.contains("paper_robot = \"small\""));
+    let own: String = own
+        .lines()
+        .filter(|l| !l.starts_with("paper_robot"))
+        .map(|l| format!("{}\n", l.replace("name = \"small\"", "name = \"mine\"")))
+        .collect();
+    let own = write(dir.path(), "mine.toml", &own);
+    let (text, json) = verify_text_and_json(&["verify", "--robot", &own, "--data", &data]);
+    assert!(!text.contains("paper Table I ("), "{text}");
+    assert!(!text.contains("0.9154") && !text.contains("0.9046"), "{text}");
+    assert!(text.contains("no paper Table I column: robot `mine`"), "{text}");
+    assert!(json["paper_table1"].is_null(), "{json}");
 }

@@ -252,6 +252,16 @@ fn small_log_parses() {
         .map(|r| r.line)
         .collect();
     assert_eq!(lines, vec![3, 5]);
+    // So are lines of spaces and tabs, before the header too (as the measurement loader skips them).
+    let spaces = format!(" \n{HEADER}\n\t\n{ROW_A}\r\n  \r\n{ROW_B}\n \t \n");
+    let (_file, result) = load(&spaces);
+    let lines: Vec<usize> = result
+        .expect("log with lines of spaces")
+        .rows
+        .iter()
+        .map(|r| r.line)
+        .collect();
+    assert_eq!(lines, vec![4, 6]);
 }
 
 #[test]

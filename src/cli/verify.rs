@@ -120,6 +120,9 @@ fn render_left_out(report: &VerifyReport) -> String {
 /// How each reading of the angle columns matches the model's equilibria.
 fn render_orientation(report: &VerifyReport) -> String {
     let mut out = "orientation: how each reading of the angle columns matches the model's equilibria\n".to_string();
+    if report.orientation_conventions.is_empty() {
+        return out + "  - (no row solved)\n\n";
+    }
     let mut conventions = Table::new(["reading", "mean deg", "median deg"]);
     for c in &report.orientation_conventions {
         conventions.row([
@@ -142,31 +145,54 @@ fn render_orientation(report: &VerifyReport) -> String {
     out
 }
 
-/// MPE-L, MPE-F and the orientation error beside the paper's Table I.
+/// MPE-L, MPE-F and the orientation error, beside the paper's Table I column
+/// for the robot when it is one of the paper's; then why a value is missing.
 fn render_summary(report: &VerifyReport) -> String {
-    let mut summary = Table::new(["summary", "sagcal", "paper Table I"]);
-    summary.row([
-        format!("rows verified (kept {})", report.rows_kept),
-        report.rows.len().to_string(),
-        "5".into(),
-    ]);
-    summary.row([
-        "MPE-L, cable length %".to_string(),
-        format!("{:.4}", report.mpe_length_pct),
-        format!("{:.4}", report.paper_table1_mpe_length_pct),
-    ]);
-    summary.row([
-        format!("MPE-F, tension % ({} comparisons)", report.force_comparisons),
-        format!("{:.4}", report.mpe_force_pct),
-        format!("{:.4}", report.paper_table1_mpe_force_pct),
-    ]);
-    summary.row([
-        "orientation error deg (mean / max)".to_string(),
-        format!(
-            "{:.2} / {:.2}",
-            report.orientation_error_deg, report.max_orientation_error_deg
-        ),
-        "-".into(),
-    ]);
-    summary.to_string()
+    let paper = report.paper_table1.as_ref();
+    let mut header = vec!["summary".to_string(), "sagcal".to_string()];
+    header.extend(paper.map(|p| format!("paper Table I ({})", p.robot.name())));
+    let mut summary = Table::new(header);
+    let mut row = |cells: [String; 2], paper_cell: Option<String>| {
+        summary.row(cells.into_iter().chain(paper.and(paper_cell)));
+    };
+    row(
+        [
+            format!("rows verified (kept {})", report.rows_kept),
+            report.rows.len().to_string(),
+        ],
+        paper.map(|p| p.poses.to_string()),
+    );
+    row(
+        ["MPE-L, cable length %".to_string(), opt(report.mpe_length_pct, 4)],
+        paper.map(|p| format!("{:.4}", p.mpe_length_pct)),
+    );
+    row(
+        [
+            format!("MPE-F, tension % ({} comparisons)", report.force_comparisons),
+            opt(report.mpe_force_pct, 4),
+        ],
+        paper.map(|p| format!("{:.4}", p.mpe_force_pct)),
+    );
+    row(
+        [
+            "orientation error deg (mean / max)".to_string(),
+            format!(
+                "{} / {}",
+                opt(report.orientation_error_deg, 2),
+                opt(report.max_orientation_error_deg, 2)
+            ),
+        ],
+        Some("-".into()),
+    );
+    let mut out = summary.to_string();
+    if let Some(reason) = &report.mpe_force_reason {
+        out += &format!("MPE-F is -: {reason}\n");
+    }
+    if paper.is_none() {
+        out += &format!(
+            "no paper Table I column: robot `{}` is not one of the paper's robots (its file has no `paper_robot`)\n",
+            report.robot
+        );
+    }
+    out
 }

@@ -26,11 +26,35 @@ use crate::calib::predict_with_effects;
 use crate::io::measurements::MeasurementSet;
 use crate::io::recurdyn::{RecurDynLog, RejectedRow};
 use crate::model::pose::PlatformPose;
-use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::robot::{PaperRobot, Robot, CABLE_COUNT};
 use crate::model::statics::{self, Equilibrium, StaticsOptions};
 
-/// The paper's Table I for the large robot (5 random poses).
-pub const PAPER_TABLE1_LARGE: (f64, f64) = (8.8947e-3, 0.9154);
+/// One robot's column of the paper's Table I (model verification).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PaperTable1 {
+    /// The paper's robot the column is for.
+    pub robot: PaperRobot,
+    /// Static poses the paper verified on.
+    pub poses: usize,
+    /// Mean percentage error of the predicted cable lengths (MPE-L), %.
+    pub mpe_length_pct: f64,
+    /// Mean percentage error of the predicted cable forces (MPE-F), %.
+    pub mpe_force_pct: f64,
+}
+
+/// The paper's Table I column for `robot` (both columns over 5 random poses).
+pub fn paper_table1(robot: PaperRobot) -> PaperTable1 {
+    let (mpe_length_pct, mpe_force_pct) = match robot {
+        PaperRobot::Large => (8.8947e-3, 0.9154),
+        PaperRobot::Small => (7.3595e-3, 0.9046),
+    };
+    PaperTable1 {
+        robot,
+        poses: 5,
+        mpe_length_pct,
+        mpe_force_pct,
+    }
+}
 
 /// What one row of the data measured at a static pose.
 #[derive(Debug, Clone, PartialEq)]
@@ -190,26 +214,30 @@ pub struct VerifyReport {
     pub rows_unsolved: Vec<UnsolvedRow>,
     /// Per-row results.
     pub rows: Vec<RowVerification>,
-    /// Mean percentage error of the cable lengths over all solved rows and cables (MPE-L).
-    pub mpe_length_pct: f64,
-    /// Largest percentage length error.
-    pub max_length_error_pct: f64,
-    /// Mean percentage error of the tensions not used as input (MPE-F).
-    pub mpe_force_pct: f64,
+    /// Mean percentage error of the cable lengths over all solved rows and
+    /// cables (MPE-L); `None` (JSON `null`) when no row was solved.
+    pub mpe_length_pct: Option<f64>,
+    /// Largest percentage length error; `None` when no row was solved.
+    pub max_length_error_pct: Option<f64>,
+    /// Mean percentage error of the tensions not used as input (MPE-F);
+    /// `None` (JSON `null`) when there is no tension to compare, see `mpe_force_reason`.
+    pub mpe_force_pct: Option<f64>,
+    /// Why `mpe_force_pct` is `None` (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mpe_force_reason: Option<String>,
     /// Number of tension comparisons behind MPE-F.
     pub force_comparisons: usize,
-    /// Mean orientation error with the documented convention, degrees.
-    pub orientation_error_deg: f64,
-    /// Largest orientation error, degrees.
-    pub max_orientation_error_deg: f64,
+    /// Mean orientation error with the documented convention, degrees; `None` when no row was solved.
+    pub orientation_error_deg: Option<f64>,
+    /// Largest orientation error, degrees; `None` when no row was solved.
+    pub max_orientation_error_deg: Option<f64>,
     /// Every reading of the angle columns tried, best first.
     pub orientation_conventions: Vec<OrientationConventionFit>,
     /// Rows that look like they carry permuted angle columns.
     pub suspect_orientation_rows: Vec<SuspectOrientationRow>,
-    /// The paper's Table I (MPE-L %, MPE-F %) for comparison.
-    pub paper_table1_mpe_length_pct: f64,
-    /// See `paper_table1_mpe_length_pct`.
-    pub paper_table1_mpe_force_pct: f64,
+    /// The paper's Table I column for this robot, when the robot file names
+    /// one of the paper's robots (`paper_robot`); `None` (JSON `null`) otherwise.
+    pub paper_table1: Option<PaperTable1>,
 }
 
 /// The model's equilibrium for one row under `closure`: the closed form,
@@ -298,21 +326,24 @@ impl AngleReading {
     }
 }
 
-fn mean(values: &[f64]) -> f64 {
-    if values.is_empty() {
-        f64::NAN
-    } else {
-        values.iter().sum::<f64>() / values.len() as f64
-    }
+/// The mean, `None` for no values.
+fn mean(values: &[f64]) -> Option<f64> {
+    (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
 }
 
-fn median(values: &[f64]) -> f64 {
+/// The largest value, `None` for no values.
+fn max(values: &[f64]) -> Option<f64> {
+    values.iter().copied().reduce(f64::max)
+}
+
+/// The median, `None` for no values.
+fn median(values: &[f64]) -> Option<f64> {
     let mut sorted = values.to_vec();
     sorted.sort_by(f64::total_cmp);
     match sorted.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => sorted[n / 2],
-        n => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
+        0 => None,
+        n if n % 2 == 1 => Some(sorted[n / 2]),
+        n => Some(0.5 * (sorted[n / 2 - 1] + sorted[n / 2])),
     }
 }
 
@@ -364,13 +395,16 @@ fn orientation_analysis(
                 .collect()
         })
         .collect();
+    // No solved row: no convention to rank.
     let mut conventions: Vec<OrientationConventionFit> = readings
         .iter()
         .zip(&errors_per_reading)
-        .map(|(reading, errors)| OrientationConventionFit {
-            convention: reading.name(),
-            mean_error_deg: mean(errors),
-            median_error_deg: median(errors),
+        .filter_map(|(reading, errors)| {
+            Some(OrientationConventionFit {
+                convention: reading.name(),
+                mean_error_deg: mean(errors)?,
+                median_error_deg: median(errors)?,
+            })
         })
         .collect();
     conventions.sort_by(|a, b| a.mean_error_deg.total_cmp(&b.mean_error_deg));
@@ -397,6 +431,21 @@ fn orientation_analysis(
         })
         .collect();
     (conventions, suspects)
+}
+
+/// Why no tension could be compared (MPE-F has no value), for `solved` solved rows.
+fn no_tension_reason(robot: &Robot, closure: Closure, solved: usize) -> String {
+    if solved == 0 {
+        return "no row was solved, so no tension was predicted".to_string();
+    }
+    match closure {
+        Closure::ReferenceTension => format!(
+            "no tension to compare: the only tension the data logs is reference cable {}'s, an input of this \
+             closure (a sagcal measurement file logs the load cell only); `--close-with cable-lengths` predicts it",
+            robot.reference_cable + 1
+        ),
+        Closure::CableLengths => "no tension to compare: the solved rows log no tension".to_string(),
+    }
 }
 
 /// Verify the model on every kept row of `data`.
@@ -432,15 +481,17 @@ pub fn verify(robot: &Robot, data: &MeasuredData, closure: Closure, options: &St
         rows_rejected: data.rejected.clone(),
         rows_unsolved: unsolved,
         mpe_length_pct: mean(&length_errors),
-        max_length_error_pct: length_errors.iter().copied().fold(0.0, f64::max),
+        max_length_error_pct: max(&length_errors),
         mpe_force_pct: mean(&force_errors),
+        mpe_force_reason: force_errors
+            .is_empty()
+            .then(|| no_tension_reason(robot, closure, rows.len())),
         force_comparisons: force_errors.len(),
         orientation_error_deg: mean(&orientation_errors),
-        max_orientation_error_deg: orientation_errors.iter().copied().fold(0.0, f64::max),
+        max_orientation_error_deg: max(&orientation_errors),
         orientation_conventions,
         suspect_orientation_rows,
-        paper_table1_mpe_length_pct: PAPER_TABLE1_LARGE.0,
-        paper_table1_mpe_force_pct: PAPER_TABLE1_LARGE.1,
+        paper_table1: robot.paper_robot.map(paper_table1),
         rows,
     }
 }

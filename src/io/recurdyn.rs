@@ -7,7 +7,8 @@
 //! ```
 //!
 //! (22 named columns and an empty trailing one that holds a free-text marker,
-//! ignored). Units: metres, degrees, newtons. `fci`, `fzi`, `fhi` are the total,
+//! ignored). Blank lines (empty or only whitespace) are skipped anywhere, as
+//! [`crate::io::measurements`] skips them. Units: metres, degrees, newtons. `fci`, `fzi`, `fhi` are the total,
 //! vertical and horizontal tension of cable `i` at the platform attachment.
 //! Cable 1 is the reference cable: its `fc1` and `fz1` are always required.
 //! For cables 2..4 the forces are optional: all three empty, or `fc`/`fz` given
@@ -182,7 +183,7 @@ pub fn read_recurdyn(path: &Path, options: &LoadOptions) -> Result<RecurDynLog> 
     let mut lines = LineCounter::new(&bytes);
 
     // Header.
-    if !read_record(&mut reader, &mut record, path)? {
+    if !read_filled_record(&mut reader, &mut record, path)? {
         return Err(format_error(
             path,
             format!("empty file: expected a RecurDyn header `{},`", COLUMNS.join(",")),
@@ -212,7 +213,7 @@ pub fn read_recurdyn(path: &Path, options: &LoadOptions) -> Result<RecurDynLog> 
     let mut kept_values: HashMap<[Option<u64>; N_DATA], usize> = HashMap::new();
     let mut kept_poses: HashMap<[u64; N_POSE], usize> = HashMap::new();
 
-    while read_record(&mut reader, &mut record, path)? {
+    while read_filled_record(&mut reader, &mut record, path)? {
         let line = lines.line_of(&record);
         let values = parse_record(&record, n_fields, line, path)?;
         let row = build_row(&values, line, path)?;
@@ -275,6 +276,20 @@ impl Value {
 /// Read the next record; `false` at the end of the file.
 fn read_record(reader: &mut csv::Reader<&[u8]>, record: &mut csv::ByteRecord, path: &Path) -> Result<bool> {
     reader.read_byte_record(record).map_err(|e| csv_error(e, path))
+}
+
+/// Read the next record that is not a blank line; `false` at the end of the file.
+///
+/// The csv reader skips empty lines but reads a line of spaces as a record of
+/// one blank field: such a line is skipped here too.
+fn read_filled_record(reader: &mut csv::Reader<&[u8]>, record: &mut csv::ByteRecord, path: &Path) -> Result<bool> {
+    while read_record(reader, record, path)? {
+        let blank = record.len() == 1 && record[0].iter().all(u8::is_ascii_whitespace);
+        if !blank {
+            return Ok(true);
+        }
+    }
+    Ok(false)
 }
 
 /// Turn a csv error into a crate error.

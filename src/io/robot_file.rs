@@ -18,6 +18,13 @@
 //! [effects]                        # optional: effects beyond the closed-form model
 //! axial_stiffness_n = 3e6          # (written by `simulate --truth`; the calibration ignores it)
 //! ```
+//!
+//! An optional top-level `paper_robot = "large"` (or `"small"`) says the file
+//! describes one of the paper's two robots, so that `sagcal verify` prints that
+//! robot's column of the paper's Table I beside its own numbers; a robot
+//! without it gets no paper column. Files written from a robot (`calibrate
+//! --out`, `diagnose --out`, `simulate --truth`) keep it: they describe the
+//! same robot.
 
 use std::path::{Path, PathBuf};
 
@@ -26,7 +33,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::model::effects::Effects;
-use crate::model::robot::{Robot, Workspace, CABLE_COUNT};
+use crate::model::robot::{PaperRobot, Robot, Workspace, CABLE_COUNT};
 
 /// One cable of a robot file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -44,6 +51,10 @@ pub struct CableEntry {
 pub struct RobotFile {
     /// Human-readable name.
     pub name: String,
+    /// Which of the paper's robots this file describes (optional: `large` or
+    /// `small`); `sagcal verify` prints that robot's paper Table I column.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paper_robot: Option<PaperRobot>,
     /// 1-based index of the reference cable (the one with the load cell).
     pub reference_cable: usize,
     /// Platform weight `m_e g`, newtons.
@@ -198,6 +209,7 @@ impl Robot {
             length_offsets_m,
             workspace,
             effects,
+            paper_robot: file.paper_robot,
         })
     }
 
@@ -205,6 +217,7 @@ impl Robot {
     pub fn to_file_contents(&self) -> RobotFile {
         RobotFile {
             name: self.name.clone(),
+            paper_robot: self.paper_robot,
             reference_cable: self.reference_cable + 1,
             platform_weight_n: self.platform_weight_n,
             cable_weight_n_per_m: self.cable_weight_n_per_m,

@@ -35,6 +35,30 @@ pub struct Robot {
     /// robot file's optional `[effects]`, written by `simulate --truth`; the
     /// calibration ignores it). Default: none.
     pub effects: Effects,
+    /// Which of the paper's robots this is, if the robot file says so (its
+    /// optional `paper_robot`); only used to print the paper's numbers beside sagcal's.
+    pub paper_robot: Option<PaperRobot>,
+}
+
+/// The two robots of the paper's Sec. V (Table I): a robot file names one with
+/// `paper_robot = "large"` or `"small"`; a robot without it is none of them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PaperRobot {
+    /// The large-scale robot (240 x 220 x 50 m, 34 kg; `robots/large.toml`).
+    Large,
+    /// The small-scale robot (12.5 x 4.5 x 28.5 m, 4.4 kg; `robots/small.toml`).
+    Small,
+}
+
+impl PaperRobot {
+    /// The name used in robot files and reports: `large` or `small`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PaperRobot::Large => "large",
+            PaperRobot::Small => "small",
+        }
+    }
 }
 
 /// An axis-aligned box of platform positions, world frame, metres.
