@@ -32,13 +32,14 @@ use serde::Serialize;
 
 use super::mistakes::{self, Mistake};
 use super::{build_graph, calibrate, set_effect_estimates, without_estimated, CableModel, CalibrationGraph};
-use super::{CalibrationOptions, CalibrationResult, OrientationPrior};
+use super::{CalibrationOptions, CalibrationResult, OrientationPrior, RobustKernels};
 use crate::error::{Error, Result};
-use crate::graph::VariableId;
+use crate::graph::{RobustKernel, VariableId};
 use crate::model::measurement::{PoseMeasurement, Sensor};
 use crate::model::robot::CABLE_COUNT;
 use crate::solver::redundancy_numbers;
 use crate::stats::{chi_square_critical, chi_square_survival};
+use std::collections::HashMap;
 
 /// The factor kinds whose rows are readings.
 const READING_KINDS: [&str; 4] = ["catenary_length", "rigid_length", "reference_tension", "pose_prior"];
@@ -194,90 +195,229 @@ pub struct CheckedCalibration {
 }
 
 /// Calibrate with gross-error detection (module docs): check the data for
-/// common mistakes, calibrate, test, leave the most significant flagged
-/// reading out and calibrate again until nothing is flagged, then name what
-/// the exclusions look like and give the verdict.
+/// common mistakes, screen them with a robust fit, then calibrate, test,
+/// leave the most significant flagged reading out and calibrate again until
+/// nothing is flagged, take back what the final fit does not reject, name
+/// what the exclusions look like and give the verdict.
 pub fn calibrate_checked(
     initial: &crate::model::Robot,
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
     check: &GrossErrorOptions,
 ) -> Result<CheckedCalibration> {
-    let mut found = mistakes::before_calibration(initial, measurements);
+    let found = mistakes::before_calibration(initial, measurements);
     let (mut current, rows) = mistakes::without_rows_outside(measurements, &found);
     let total_readings = current.len() * (CABLE_COUNT + 1);
-    let limit = ((check.max_excluded_fraction * total_readings as f64).floor() as usize).max(1);
-    let mut excluded: Vec<ExcludedReading> = Vec::new();
-    let mut stepped = 0;
+    let mut state = Exclusions {
+        excluded: Vec::new(),
+        stepped: 0,
+        limit: ((check.max_excluded_fraction * total_readings as f64).floor() as usize).max(1),
+        step_cable: None,
+    };
+    let units = found.iter().any(Mistake::is_unit_mistake);
+    if !units {
+        robust_screen(initial, &mut current, options, check, &mut state);
+    }
+    let mut retried = false;
     loop {
         let result = calibrate(initial, &current, options)?;
         let test = test_fit(&result, &current, options, check)?;
-        // More failing readings than single blunders may account for: an
-        // encoder whose offset jumped part-way (re-homing) leaves out the
-        // shorter run of rows of that cable, once per cable.
-        if test.flagged.len() + excluded.len() - stepped > limit && stepped == 0 {
-            let at_fit = residuals_at_fit(&result, &current, options);
+        let at_fit = residuals_at_fit(&result, &current, options);
+        if !units && state.stepped == 0 && test.flagged.len() + state.counted() > state.limit {
             if let Some((cable, rows_off)) = mistakes::offset_step(&current, &at_fit, check.false_alarm) {
-                for &k in &rows_off {
-                    current[k].excluded = current[k].excluded.with(Sensor::Encoder(cable));
-                    let (e, sigma) = at_fit[&(k, Sensor::Encoder(cable))];
-                    excluded.push(ExcludedReading {
-                        test: ReadingTest {
-                            pose: k,
-                            line: current[k].line,
-                            sensor: Sensor::Encoder(cable),
-                            residual: e,
-                            sigma,
-                            redundancy: f64::NAN,
-                            w: e / sigma,
-                            estimated_error: -e,
-                        },
-                        explanation: None,
-                    });
-                }
-                stepped = rows_off.len();
+                state.leave_out_step(&mut current, &at_fit, cable, &rows_off);
                 continue;
             }
         }
-        let next = test.flagged.first().copied();
-        match next {
-            Some(worst) if excluded.len() - stepped < limit && found.iter().all(|m| !m.is_unit_mistake()) => {
-                current[worst.pose].excluded = current[worst.pose].excluded.with(worst.sensor);
-                excluded.push(ExcludedReading {
-                    test: worst,
-                    explanation: None,
-                });
-            }
+        match test.flagged.first().copied() {
+            Some(worst) if !units && state.counted() < state.limit => state.leave_out(&mut current, worst),
+            _ if !retried && take_back(&mut current, &at_fit, &test, &mut state) => retried = true,
             _ => {
-                // Each left-out reading's error against the final fit, which it did not pull.
-                let at_fit = residuals_at_fit(&result, &current, options);
-                for x in &mut excluded {
-                    if let Some(&(e, _)) = at_fit.get(&(x.test.pose, x.test.sensor)) {
-                        x.test.residual = e;
-                        x.test.estimated_error = -e;
-                    }
-                }
-                found.extend(mistakes::after_calibration(&current, &rows, &at_fit, &mut excluded));
-                // Report rows as given (rows outside the frame were left out before the fit).
-                let mut test = test;
-                for t in test.flagged.iter_mut().chain(test.largest.as_mut()) {
-                    t.pose = rows[t.pose];
-                }
-                for x in &mut excluded {
-                    x.test.pose = rows[x.test.pose];
-                }
-                let verdict = verdict(&test, excluded.len() - stepped, limit, &found);
-                return Ok(CheckedCalibration {
-                    result,
-                    measurements: current,
-                    rows,
-                    excluded,
-                    mistakes: found,
-                    test,
-                    verdict,
-                });
+                return Ok(finish(result, current, rows, state, found, test, &at_fit));
             }
         }
+    }
+}
+
+/// The readings left out so far.
+struct Exclusions {
+    excluded: Vec<ExcludedReading>,
+    /// How many of them an offset step left out (not counted against `limit`).
+    stepped: usize,
+    /// At most this many single readings.
+    limit: usize,
+    /// The cable whose offset step was left out, if any.
+    step_cable: Option<usize>,
+}
+
+impl Exclusions {
+    /// Single readings left out (an offset step's rows not counted).
+    fn counted(&self) -> usize {
+        self.excluded.len() - self.stepped
+    }
+
+    fn leave_out(&mut self, current: &mut [PoseMeasurement], test: ReadingTest) {
+        current[test.pose].excluded = current[test.pose].excluded.with(test.sensor);
+        self.excluded.push(ExcludedReading {
+            test,
+            explanation: None,
+        });
+    }
+
+    /// Leave out `cable`'s readings in `rows_off` (an offset step).
+    fn leave_out_step(
+        &mut self,
+        current: &mut [PoseMeasurement],
+        at_fit: &HashMap<(usize, Sensor), (f64, f64)>,
+        cable: usize,
+        rows_off: &[usize],
+    ) {
+        for &k in rows_off {
+            let sensor = Sensor::Encoder(cable);
+            let Some(&(e, sigma)) = at_fit.get(&(k, sensor)) else {
+                continue;
+            };
+            if current[k].excluded.contains(sensor) {
+                continue;
+            }
+            self.leave_out(current, unweighed_test(k, current[k].line, sensor, e, sigma));
+            self.stepped += 1;
+        }
+        self.step_cable = Some(cable);
+    }
+}
+
+/// A reading's test from its residual alone (no redundancy number: at a robust
+/// fit, or for a reading the fit did not use), `w = e / sigma`.
+fn unweighed_test(pose: usize, line: usize, sensor: Sensor, e: f64, sigma: f64) -> ReadingTest {
+    ReadingTest {
+        pose,
+        line,
+        sensor,
+        residual: e,
+        sigma,
+        redundancy: f64::NAN,
+        w: e / sigma,
+        estimated_error: -e,
+    }
+}
+
+/// The robust kernel of the screening fit (Cauchy, in sigmas; Triggs et al.
+/// 2000 sec. 3): a gross error's pull on the fit falls as `1/|r|`, so a
+/// slipped encoder or swapped cables cannot drag the start into a wrong basin.
+const SCREEN_KERNEL: RobustKernel = RobustKernel::Cauchy(2.3849);
+
+/// Screen the data with a robust fit: an offset step in one cable's
+/// residuals, and every reading beyond the critical `|e / sigma|` (Bonferroni
+/// over the readings) when there are no more than `limit`, are left out
+/// before the least-squares fit, which the test-and-remove loop then checks
+/// (and [`take_back`] gives back what the final fit does not reject).
+fn robust_screen(
+    initial: &crate::model::Robot,
+    current: &mut [PoseMeasurement],
+    options: &CalibrationOptions,
+    check: &GrossErrorOptions,
+    state: &mut Exclusions,
+) {
+    let kernel = |k: RobustKernel| if k == RobustKernel::None { SCREEN_KERNEL } else { k };
+    let robust = CalibrationOptions {
+        robust: RobustKernels {
+            encoder: kernel(options.robust.encoder),
+            load_cell: kernel(options.robust.load_cell),
+            pose_prior: kernel(options.robust.pose_prior),
+        },
+        ..*options
+    };
+    let Ok(result) = calibrate(initial, current, &robust) else {
+        return;
+    };
+    let at_fit = residuals_at_fit(&result, current, options);
+    if let Some((cable, rows_off)) = mistakes::offset_step(current, &at_fit, check.false_alarm) {
+        state.leave_out_step(current, &at_fit, cable, &rows_off);
+    }
+    let critical = chi_square_critical(1, check.false_alarm / at_fit.len().max(1) as f64).sqrt();
+    let mut suspects: Vec<ReadingTest> = at_fit
+        .iter()
+        .filter(|((k, sensor), (e, sigma))| (e / sigma).abs() > critical && !current[*k].excluded.contains(*sensor))
+        .map(|(&(k, sensor), &(e, sigma))| unweighed_test(k, current[k].line, sensor, e, sigma))
+        .collect();
+    suspects.sort_by(|a, b| b.w.abs().total_cmp(&a.w.abs()));
+    if suspects.len() <= state.limit {
+        for test in suspects {
+            state.leave_out(current, test);
+        }
+    }
+}
+
+/// Give back every reading left out (other than an offset step's) whose
+/// residual against `at_fit`, the fit without it, is within the critical
+/// `|w|` of `test`: the screening is a first guess, the final fit decides.
+/// Returns whether any came back.
+fn take_back(
+    current: &mut [PoseMeasurement],
+    at_fit: &HashMap<(usize, Sensor), (f64, f64)>,
+    test: &ConsistencyTest,
+    state: &mut Exclusions,
+) -> bool {
+    let before = state.excluded.len();
+    state.excluded.retain(|x| {
+        let key = (x.test.pose, x.test.sensor);
+        // Readings the least-squares loop left out (with a redundancy number) stay out.
+        let keep_out = x.test.redundancy.is_finite()
+            || at_fit
+                .get(&key)
+                .is_none_or(|(e, sigma)| (e / sigma).abs() > test.critical_w);
+        if !keep_out {
+            current[x.test.pose].excluded = current[x.test.pose].excluded.without(x.test.sensor);
+        }
+        keep_out
+    });
+    state.excluded.len() < before
+}
+
+/// The checked calibration of the final fit: each left-out reading's error
+/// against it, the mistakes that explain them, rows as given, the verdict.
+fn finish(
+    result: CalibrationResult,
+    current: Vec<PoseMeasurement>,
+    rows: Vec<usize>,
+    mut state: Exclusions,
+    mut found: Vec<Mistake>,
+    mut test: ConsistencyTest,
+    at_fit: &HashMap<(usize, Sensor), (f64, f64)>,
+) -> CheckedCalibration {
+    // Each left-out reading's error against the final fit, which it did not pull.
+    for x in &mut state.excluded {
+        if let Some(&(e, _)) = at_fit.get(&(x.test.pose, x.test.sensor)) {
+            x.test.residual = e;
+            x.test.estimated_error = -e;
+        }
+    }
+    if let Some(cable) = state.step_cable {
+        found.extend(mistakes::name_step(cable, &rows, &mut state.excluded));
+    }
+    found.extend(mistakes::after_calibration(
+        &current,
+        &rows,
+        at_fit,
+        &mut state.excluded,
+    ));
+    // Report rows as given (rows outside the frame were left out before the fit).
+    for t in test.flagged.iter_mut().chain(test.largest.as_mut()) {
+        t.pose = rows[t.pose];
+    }
+    for x in &mut state.excluded {
+        x.test.pose = rows[x.test.pose];
+    }
+    let verdict = verdict(&test, state.counted(), state.limit, &found);
+    CheckedCalibration {
+        result,
+        measurements: current,
+        rows,
+        excluded: state.excluded,
+        mistakes: found,
+        test,
+        verdict,
     }
 }
 
@@ -307,7 +447,7 @@ fn verdict(test: &ConsistencyTest, excluded: usize, limit: usize, found: &[Mista
     }
     for t in test.sensor_types.iter().filter(|t| !t.consistent) {
         reasons.push(format!(
-            "the {} fail their chi-square test: {:.1} against an expected {:.1} (p = {:.1e})",
+            "the {} readings fail their chi-square test: {:.1} against an expected {:.1} (p = {:.1e})",
             t.sensor, t.chi_square, t.redundancy, t.p_value
         ));
     }
@@ -411,7 +551,7 @@ pub fn residuals_at_fit(
     result: &CalibrationResult,
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
-) -> std::collections::HashMap<(usize, Sensor), (f64, f64)> {
+) -> HashMap<(usize, Sensor), (f64, f64)> {
     let (indices, mut used) = used_measurements(result, measurements);
     for m in &mut used {
         m.excluded = crate::model::measurement::ReadingSet::NONE;
@@ -420,7 +560,7 @@ pub fn residuals_at_fit(
     let with_orientation =
         options.as_used_by(result).orientation_prior == OrientationPrior::On || options.model == CableModel::Rigid;
     let owner = pose_owners(&built);
-    let mut all = std::collections::HashMap::new();
+    let mut all = HashMap::new();
     for factor in &built.graph.factors {
         let Some(&k) = factor.variables().iter().find_map(|v| owner.get(v)) else {
             continue;
@@ -436,7 +576,7 @@ pub fn residuals_at_fit(
 }
 
 /// Pose and reference-tension variables to the index of their pose.
-fn pose_owners(built: &CalibrationGraph) -> std::collections::HashMap<VariableId, usize> {
+fn pose_owners(built: &CalibrationGraph) -> HashMap<VariableId, usize> {
     built
         .poses
         .iter()
@@ -470,7 +610,7 @@ fn summarise(tests: Vec<ReadingTest>, check: &GrossErrorOptions) -> ConsistencyT
     flagged.sort_by(|a, b| b.w.abs().total_cmp(&a.w.abs()));
     let largest = tests.iter().copied().max_by(|a, b| a.w.abs().total_cmp(&b.w.abs()));
     let types: [(&str, SensorFilter); 4] = [
-        ("encoders", |s| matches!(s, Sensor::Encoder(_))),
+        ("encoder", |s| matches!(s, Sensor::Encoder(_))),
         ("load cell", |s| s == Sensor::LoadCell),
         ("localiser position", |s| matches!(s, Sensor::Position(_))),
         ("localiser orientation", |s| matches!(s, Sensor::Orientation(_))),

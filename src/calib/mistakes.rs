@@ -14,9 +14,10 @@
 //! - **two cables' readings swapped in a row**: a flagged encoder reading
 //!   whose value fits another cable of the same row, and that cable's reading
 //!   fits the first, both within 5 sigma of the fit's predictions;
-//! - **an encoder whose offset jumps between rows (re-homing)**: two or more
-//!   readings of one cable left out with the same estimated error (within
-//!   5 sigma of each other);
+//! - **an encoder whose offset jumps between rows (re-homing)**: a step in
+//!   one cable's residuals over the rows (`offset_step`, the shorter run left
+//!   out), or three or more readings of one cable left out with the same
+//!   estimated error (within 5 sigma of each other, over 10 sigma from 0);
 //! - **a pose whose readings fail together**: three or more readings of one
 //!   row left out that nothing above explains.
 
@@ -344,13 +345,39 @@ pub fn offset_step(
     best.map(|(_, cable, _, rows)| (cable, rows))
 }
 
+/// The re-homing mistake of an offset step of `cable` that was left out:
+/// the readings of that cable without a redundancy number (left out as a
+/// run, not one by one), named with their mean error at the final fit.
+pub fn name_step(cable: usize, rows: &[usize], excluded: &mut [ExcludedReading]) -> Option<Mistake> {
+    let mine: Vec<usize> = (0..excluded.len())
+        .filter(|&x| excluded[x].test.sensor == Sensor::Encoder(cable) && excluded[x].test.redundancy.is_nan())
+        .collect();
+    let (first, last) = (&excluded[*mine.first()?].test, &excluded[*mine.last()?].test);
+    let mean = mine.iter().map(|&x| excluded[x].test.estimated_error).sum::<f64>() / mine.len() as f64;
+    let message = format!(
+        "the encoder of cable {} reads {mean:+.4} m off in {} rows, from {} to {}: its offset jumped (re-homed drum?) and those readings are left out",
+        cable + 1,
+        mine.len(),
+        row_name(rows[first.pose], first.line),
+        row_name(rows[last.pose], last.line)
+    );
+    for &x in &mine {
+        excluded[x].explanation = Some(message.clone());
+    }
+    Some(Mistake {
+        kind: MistakeKind::Rehoming,
+        message,
+        rows: mine.iter().map(|&x| rows[excluded[x].test.pose]).collect(),
+    })
+}
+
 fn rehoming(excluded: &mut [ExcludedReading], rows: &[usize]) -> Vec<Mistake> {
     let mut found = Vec::new();
     for cable in 0..CABLE_COUNT {
         let mut mine: Vec<usize> = (0..excluded.len())
             .filter(|&x| excluded[x].explanation.is_none() && excluded[x].test.sensor == Sensor::Encoder(cable))
             .collect();
-        if mine.len() < 2 {
+        if mine.len() < 3 {
             continue;
         }
         mine.sort_by_key(|&x| excluded[x].test.pose);
@@ -359,7 +386,8 @@ fn rehoming(excluded: &mut [ExcludedReading], rows: &[usize]) -> Vec<Mistake> {
         let (lo, hi) = errors
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), e| (l.min(*e), h.max(*e)));
-        if hi - lo > 5.0 * sigma {
+        let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+        if hi - lo > 5.0 * sigma || mean.abs() < 10.0 * sigma {
             continue;
         }
         let first = &excluded[mine[0]].test;

@@ -92,6 +92,11 @@ impl ReadingSet {
         Self(self.0 | sensor.bit())
     }
 
+    /// This set without `sensor`.
+    pub fn without(self, sensor: Sensor) -> Self {
+        Self(self.0 & !sensor.bit())
+    }
+
     /// Whether `sensor` is in the set.
     pub fn contains(self, sensor: Sensor) -> bool {
         self.0 & sensor.bit() != 0
