@@ -259,3 +259,19 @@ fn calibrate_refuses_an_inconsistent_fit_and_writes_nothing() {
         .unwrap()
         .starts_with("# WARNING: written with --accept-inconsistent"));
 }
+
+#[test]
+fn diagnose_leaves_out_the_same_blunders_and_reports_them() {
+    use sagcal::diagnose::{diagnose, DiagnoseOptions};
+    let (_, mut data, guess) = case(NoisePreset::Paper, 69);
+    data[12].encoder_lengths_m.swap(1, 3);
+    let options = CalibrationOptions::new(NoisePreset::Paper.sigmas(guess.platform_weight_n));
+    let mut diagnose_options = DiagnoseOptions::new(options);
+    diagnose_options.folds = 4;
+    let d = diagnose(&guess, &data, None, &diagnose_options, &mut |_, _, _| {}).unwrap();
+    println!("verdict {}: {}", d.verdict, d.reason);
+    assert_eq!(d.excluded_readings.len(), 2, "{:#?}", d.excluded_readings);
+    assert!(d.mistakes.iter().any(|m| m.kind == MistakeKind::SwappedCables && m.rows == [12]));
+    // The blunder is not mistaken for a model error.
+    assert_eq!(d.verdict, "none");
+}

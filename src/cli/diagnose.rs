@@ -135,6 +135,7 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
         "sagcal diagnose: robot `{}`, {} poses, {} measurement components, {}-fold cross-validation, orientation prior {}\n\n",
         d.robot, d.poses_used, d.measurement_components, options.folds, d.orientation_prior
     );
+    out += &render_gross_errors(d);
     out += &render_residual_tests(d);
     out += "\n2. residual structure (baseline): correlation with physical drivers, strongest first\n";
     out += &driver_table(&d.drivers, 8);
@@ -145,6 +146,22 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
     out += &render_candidates(d);
     out += &render_verdict(d);
     out
+}
+
+/// Step 0: readings left out as gross errors, and mistakes named.
+fn render_gross_errors(d: &Diagnosis) -> String {
+    let mut out = String::from("0. gross errors (the tests of `sagcal calibrate`): ");
+    if d.excluded_readings.is_empty() && d.mistakes.is_empty() {
+        return out + "no reading left out\n\n";
+    }
+    out += &format!("{} readings left out\n", d.excluded_readings.len());
+    for x in &d.excluded_readings {
+        out += &format!("   {}\n", x.test.describe());
+    }
+    for m in &d.mistakes {
+        out += &format!("   MISTAKE: {}\n", m.message);
+    }
+    out + "\n"
 }
 
 /// Step 1: the chi-square test per factor type.

@@ -5,10 +5,11 @@
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use crate::calib::{CalibrationGraph, CalibrationResult};
+use super::candidates::rebuild;
+use crate::calib::{CalibrationOptions, CalibrationResult};
 use crate::error::Result;
 use crate::model::effects::EffectKind;
-use crate::model::measurement::PoseMeasurement;
+use crate::model::measurement::{PoseMeasurement, ReadingSet, Sensor};
 use crate::model::robot::CABLE_COUNT;
 use crate::model::statics;
 use crate::stats::correlation;
@@ -92,12 +93,22 @@ pub(super) fn winning_driver(effect: EffectKind) -> (&'static str, &'static str)
     }
 }
 
-/// Drivers and normalised residuals of every pose of a fitted model.
+/// Drivers and normalised residuals of every pose of a fitted model
+/// (`options` as it was fitted with); a reading left out as a gross error
+/// ([`PoseMeasurement::excluded`]) is NaN and takes no part in the tests.
 pub(super) fn samples(
     result: &CalibrationResult,
     used: &[PoseMeasurement],
-    built: &CalibrationGraph,
+    options: &CalibrationOptions,
 ) -> Result<Vec<PoseSample>> {
+    let unmasked: Vec<PoseMeasurement> = used
+        .iter()
+        .map(|m| PoseMeasurement {
+            excluded: ReadingSet::NONE,
+            ..*m
+        })
+        .collect();
+    let built = rebuild(result, &unmasked, options);
     let graph = &built.graph;
     let normalised = |kind: &str| -> Vec<Vec<f64>> {
         graph
@@ -141,13 +152,15 @@ pub(super) fn samples(
             });
             let prior = &priors[k];
             let position_rows = prior.len() - 3;
+            let out = used[k].excluded;
+            let unless = |sensor: Sensor, value: f64| if out.contains(sensor) { f64::NAN } else { value };
             Ok(PoseSample {
                 cable_drivers,
                 position_m: pose.position_m,
                 measured_tension_n: used[k].reference_tension_n,
-                encoder: std::array::from_fn(|i| encoders[k][i]),
-                load_cell: cells[k][0],
-                position: std::array::from_fn(|i| prior[position_rows + i]),
+                encoder: std::array::from_fn(|i| unless(Sensor::Encoder(i), encoders[k][i])),
+                load_cell: unless(Sensor::LoadCell, cells[k][0]),
+                position: std::array::from_fn(|i| unless(Sensor::Position(i), prior[position_rows + i])),
             })
         })
         .collect()
@@ -169,7 +182,9 @@ pub(super) fn series_of(samples: &[PoseSample], residual: &str, driver: &str) ->
                     let x = pose_driver
                         .or_else(|| DRIVERS.iter().position(|d| *d == driver).map(|d| s.cable_drivers[i][d]));
                     if let Some(x) = x {
-                        points.push((x, s.encoder[i]));
+                        if s.encoder[i].is_finite() {
+                            points.push((x, s.encoder[i]));
+                        }
                     }
                 }
             }
@@ -186,7 +201,7 @@ pub(super) fn series_of(samples: &[PoseSample], residual: &str, driver: &str) ->
                         .position(|d| *d == driver)
                         .map(|d| s.cable_drivers.iter().map(|c| c[d]).sum::<f64>() / CABLE_COUNT as f64)
                 });
-                if let Some(x) = x {
+                if let (Some(x), true) = (x, y.is_finite()) {
                     points.push((x, y));
                 }
             }

@@ -39,10 +39,12 @@ mod residual_tests;
 mod selection;
 pub mod verify;
 
+use crate::calib::gross_errors::{calibrate_checked, ExcludedReading, GrossErrorOptions, Verdict};
+use crate::calib::mistakes::{Mistake, MistakeKind};
 use crate::calib::{calibrate, CalibrationGraph, CalibrationOptions, CalibrationResult, OrientationPrior};
 use crate::error::{Error, Result};
 use crate::model::effects::{EffectKind, EffectSet};
-use crate::model::measurement::PoseMeasurement;
+use crate::model::measurement::{PoseMeasurement, ReadingSet};
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::stats::{self, chi_square_quantile_999};
 
@@ -232,14 +234,17 @@ pub fn diagnose(
     }
     let mut progress = Progress {
         done: 0,
-        total: 2 + 2 * options.folds,
+        total: 3 + 2 * options.folds,
         report: progress,
     };
+    // 0. Gross errors: blunders and common mistakes are not model errors.
+    let (cleaned, excluded_readings, mistakes) = screen_gross_errors(robot, measurements, options, &mut progress)?;
+    let measurements = cleaned.as_slice();
     // 1. The baseline calibration, its residuals tested against the stated noise.
     let base = Baseline::fit(robot, measurements, options, &mut progress)?;
     let factor_tests = factor_tests(&base.graph.graph, base.components, base.dof);
     // 2. The residuals against the physical drivers.
-    let base_samples = samples(&base.result, &base.used, &base.graph)?;
+    let base_samples = samples(&base.result, &base.used, &base.options)?;
     let drivers = driver_tests(&base_samples);
     let baseline_cv = cross_validate(&base.result, &base.used, &base.options, options.folds, &mut |what| {
         progress.step(&format!("baseline: {what}"))
@@ -266,11 +271,7 @@ pub fn diagnose(
     let (drivers_after, series) = if model.hypotheses.is_empty() {
         (Vec::new(), driver_series(&drivers, &base_samples, None))
     } else {
-        let after_samples = samples(
-            &model.result,
-            &base.used,
-            &rebuild(&model.result, &base.used, &model.options),
-        )?;
+        let after_samples = samples(&model.result, &base.used, &model.options)?;
         let shown = first_effect(model).map(|kind| (kind, after_samples.as_slice()));
         let series = driver_series(&drivers, &base_samples, shown);
         (driver_tests(&after_samples), series)
@@ -302,5 +303,78 @@ pub fn diagnose(
         baseline_error_over_sigma: truth.map(|t| error_over_sigma(&base.result.robot, t, &base.result.uncertainty)),
         robot_after: model.result.robot.clone(),
         series,
+        excluded_readings,
+        mistakes,
     })
+}
+
+/// Step 0: the gross-error tests of `calibrate`
+/// ([`crate::calib::gross_errors::calibrate_checked`]) on the baseline. A
+/// sensor in the wrong unit is an error (the data must be fixed). Readings
+/// are left out when the baseline is then consistent, or when a specific
+/// mistake explains them (swapped cables, a re-homed drum); otherwise the
+/// failing readings are the model error this diagnosis is for, and every
+/// reading stays in (the mistakes found are still reported).
+fn screen_gross_errors(
+    robot: &Robot,
+    measurements: &[PoseMeasurement],
+    options: &DiagnoseOptions,
+    progress: &mut Progress<'_>,
+) -> Result<(Vec<PoseMeasurement>, Vec<ExcludedReading>, Vec<Mistake>)> {
+    progress.step("gross errors");
+    let check = GrossErrorOptions {
+        false_alarm: options.false_alarm,
+        ..GrossErrorOptions::default()
+    };
+    let base_options = CalibrationOptions {
+        free_effects: EffectSet::NONE,
+        ..options.calibration
+    };
+    let checked = calibrate_checked(robot, measurements, &base_options, &check)?;
+    if let Some(unit) = checked.mistakes.iter().find(|m| m.is_unit_mistake()) {
+        return Err(Error::InvalidInput(format!("diagnose: {}", unit.message)));
+    }
+    let consistent = checked.verdict == Verdict::Consistent;
+    let specific = |x: &ExcludedReading| {
+        checked.mistakes.iter().any(|m| {
+            matches!(m.kind, MistakeKind::SwappedCables | MistakeKind::Rehoming)
+                && x.explanation.as_deref() == Some(m.message.as_str())
+        })
+    };
+    let kept: Vec<ExcludedReading> = checked
+        .excluded
+        .iter()
+        .filter(|x| consistent || specific(x))
+        .cloned()
+        .collect();
+    let mut cleaned = measurements.to_vec();
+    for m in &mut cleaned {
+        m.excluded = ReadingSet::NONE;
+    }
+    for x in &kept {
+        cleaned[x.test.pose].excluded = cleaned[x.test.pose].excluded.with(x.test.sensor);
+    }
+    // Rows outside the frame go, the rest keep their order.
+    let outside: Vec<usize> = checked
+        .mistakes
+        .iter()
+        .filter(|m| m.kind == MistakeKind::OutsideFrame)
+        .flat_map(|m| m.rows.iter().copied())
+        .collect();
+    let cleaned = (0..cleaned.len())
+        .filter(|k| !outside.contains(k))
+        .map(|k| cleaned[k])
+        .collect();
+    // The mistakes acted on: rows left out, or readings left out that they explain.
+    let mistakes = checked
+        .mistakes
+        .into_iter()
+        .filter(|m| {
+            m.kind == MistakeKind::OutsideFrame
+                || kept
+                    .iter()
+                    .any(|x| x.explanation.as_deref() == Some(m.message.as_str()))
+        })
+        .collect();
+    Ok((cleaned, kept, mistakes))
 }

@@ -7,6 +7,8 @@ use super::drivers::{DriverSeries, DriverTest};
 use super::residual_tests::FactorTest;
 use super::selection::{Selection, SelectionStep};
 use super::{Baseline, DiagnoseOptions};
+use crate::calib::gross_errors::ExcludedReading;
+use crate::calib::mistakes::Mistake;
 use crate::calib::{CalibrationError, EffectEstimate, OrientationPrior, ParameterUncertainty};
 use crate::model::robot::{Robot, CABLE_COUNT};
 
@@ -87,6 +89,10 @@ pub struct Diagnosis {
     /// Residual against the winning driver (or the strongest, for `none`).
     #[serde(skip)]
     pub series: DriverSeries,
+    /// Readings left out as gross errors before the diagnosis (step 0).
+    pub excluded_readings: Vec<ExcludedReading>,
+    /// The common mistakes recognised in the data (step 0).
+    pub mistakes: Vec<Mistake>,
 }
 
 /// Mean over anchors of `|error| / sqrt(trace Sigma)` (NaN without a full-rank covariance).
