@@ -254,6 +254,27 @@ fn an_extension_written_by_diagnose_improves_verify_on_unseen_poses() {
             ],
         );
     }
+    // The baseline misses the stretch: `calibrate` refuses it (exit 1, nothing
+    // written) and names the failing sensors ...
+    let refused = std::process::Command::new(env!("CARGO_BIN_EXE_sagcal"))
+        .args([
+            "calibrate",
+            "--robot",
+            &large,
+            "--data",
+            "fit.csv",
+            "--noise",
+            "authors",
+            "--out",
+            "baseline.toml",
+        ])
+        .current_dir(d)
+        .output()
+        .unwrap();
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("sagcal diagnose"));
+    assert!(!d.join("baseline.toml").exists());
+    // ... and writes it only when told to, for this comparison.
     sagcal(
         d,
         &[
@@ -266,6 +287,7 @@ fn an_extension_written_by_diagnose_improves_verify_on_unseen_poses() {
             "authors",
             "--out",
             "baseline.toml",
+            "--accept-inconsistent",
             "--json",
         ],
     );

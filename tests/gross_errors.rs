@@ -271,7 +271,10 @@ fn diagnose_leaves_out_the_same_blunders_and_reports_them() {
     let d = diagnose(&guess, &data, None, &diagnose_options, &mut |_, _, _| {}).unwrap();
     println!("verdict {}: {}", d.verdict, d.reason);
     assert_eq!(d.excluded_readings.len(), 2, "{:#?}", d.excluded_readings);
-    assert!(d.mistakes.iter().any(|m| m.kind == MistakeKind::SwappedCables && m.rows == [12]));
+    assert!(d
+        .mistakes
+        .iter()
+        .any(|m| m.kind == MistakeKind::SwappedCables && m.rows == [12]));
     // The blunder is not mistaken for a model error.
     assert_eq!(d.verdict, "none");
 }

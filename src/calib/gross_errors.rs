@@ -195,7 +195,8 @@ pub struct CheckedCalibration {
 }
 
 /// Calibrate with gross-error detection (module docs): check the data for
-/// common mistakes, screen them with a robust fit, then calibrate, test,
+/// common mistakes; calibrate and test, which is all for data that pass;
+/// otherwise screen them with a robust fit, then calibrate, test,
 /// leave the most significant flagged reading out and calibrate again until
 /// nothing is flagged, take back what the final fit does not reject, name
 /// what the exclusions look like and give the verdict.
@@ -216,6 +217,14 @@ pub fn calibrate_checked(
     };
     let units = found.iter().any(Mistake::is_unit_mistake);
     if !units {
+        // Clean data pass at the cost of one fit and its test.
+        if let Ok(result) = calibrate(initial, &current, options) {
+            let test = test_fit(&result, &current, options, check)?;
+            if test.consistent() {
+                let at_fit = residuals_at_fit(&result, &current, options);
+                return Ok(finish(result, current, rows, state, found, test, &at_fit));
+            }
+        }
         robust_screen(initial, &mut current, options, check, &mut state);
     }
     let mut retried = false;
