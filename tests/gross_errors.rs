@@ -278,3 +278,20 @@ fn diagnose_leaves_out_the_same_blunders_and_reports_them() {
     // The blunder is not mistaken for a model error.
     assert_eq!(d.verdict, "none");
 }
+
+#[test]
+fn a_pose_outside_the_frame_is_named_and_its_row_left_out() {
+    let (truth, mut data, guess) = case(NoisePreset::Paper, 70);
+    // Beyond anchor 2's x (the large robot's frame is about +-60 m).
+    data[7].position_m[0] = 500.0;
+    let checked = check(&data, &guess, NoisePreset::Paper);
+    let outside: Vec<_> = checked.mistakes.iter().filter(|m| m.kind == MistakeKind::OutsideFrame).collect();
+    assert_eq!(outside.len(), 1, "{:#?}", checked.mistakes);
+    println!("{}", outside[0].message);
+    assert_eq!(outside[0].rows, [7]);
+    assert!(outside[0].message.starts_with("row 8") && outside[0].message.contains("outside the robot's frame"));
+    assert_eq!(checked.measurements.len(), 34);
+    assert!(!checked.rows.contains(&7));
+    assert_eq!(checked.verdict, Verdict::Consistent);
+    assert!(anchor_error(&checked, &truth) < 1.0);
+}
