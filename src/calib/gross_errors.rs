@@ -227,7 +227,7 @@ pub fn calibrate_checked(
         }
         robust_screen(initial, &mut current, options, check, &mut state);
     }
-    let mut retried = false;
+    let mut rounds = 0;
     loop {
         let result = calibrate(initial, &current, options)?;
         let test = test_fit(&result, &current, options, check)?;
@@ -240,7 +240,7 @@ pub fn calibrate_checked(
         }
         match test.flagged.first().copied() {
             Some(worst) if !units && state.counted() < state.limit => state.leave_out(&mut current, worst),
-            _ if !retried && take_back(&mut current, &at_fit, &test, &mut state) => retried = true,
+            _ if rounds < 3 && take_back(&result, &mut current, options, &test, &mut state) => rounds += 1,
             _ => {
                 return Ok(finish(result, current, rows, state, found, test, &at_fit));
             }
@@ -351,6 +351,7 @@ fn robust_screen(
         .map(|(&(k, sensor), &(e, sigma))| unweighed_test(k, current[k].line, sensor, e, sigma))
         .collect();
     suspects.sort_by(|a, b| b.w.abs().total_cmp(&a.w.abs()));
+    let suspects = localiser_first(suspects, current, &at_fit);
     if suspects.len() <= state.limit {
         for test in suspects {
             state.leave_out(current, test);
@@ -358,24 +359,81 @@ fn robust_screen(
     }
 }
 
-/// Give back every reading left out (other than an offset step's) whose
-/// residual against `at_fit`, the fit without it, is within the critical
-/// `|w|` of `test`: the screening is a first guess, the final fit decides.
-/// Returns whether any came back.
-fn take_back(
-    current: &mut [PoseMeasurement],
+/// Where three or more readings of one pose are suspect, one localiser
+/// blunder (which moves the pose and so every reading the statics tie to it)
+/// is the more parsimonious explanation: that pose's suspects are replaced by
+/// its localiser readings. They are set aside, not condemned: the
+/// least-squares loop flags the readings that are wrong after all, and
+/// [`take_back`] returns the localiser readings the final fit does not reject.
+fn localiser_first(
+    suspects: Vec<ReadingTest>,
+    current: &[PoseMeasurement],
     at_fit: &HashMap<(usize, Sensor), (f64, f64)>,
+) -> Vec<ReadingTest> {
+    let mut poses: Vec<usize> = suspects.iter().map(|t| t.pose).collect();
+    poses.sort_unstable();
+    let crowded: Vec<usize> = poses
+        .iter()
+        .copied()
+        .filter(|k| poses.iter().filter(|p| *p == k).count() >= 3)
+        .collect();
+    let mut out: Vec<ReadingTest> = suspects.into_iter().filter(|t| !crowded.contains(&t.pose)).collect();
+    let mut done = Vec::new();
+    for k in crowded {
+        if done.contains(&k) {
+            continue;
+        }
+        done.push(k);
+        let localiser = (0..3).map(Sensor::Position).chain((0..3).map(Sensor::Orientation));
+        for sensor in localiser {
+            if let Some(&(e, sigma)) = at_fit.get(&(k, sensor)) {
+                out.push(unweighed_test(k, current[k].line, sensor, e, sigma));
+            }
+        }
+    }
+    out
+}
+
+/// Give back every reading set aside by the screen whose residual against
+/// the fit without it is within the critical `|w|` of `test`: the screening
+/// is a first guess, the final fit decides. The residual of a reading the fit
+/// did not use has variance `sigma^2 + var(prediction)` (externally
+/// studentised); for a localiser reading the prediction's variance is the
+/// fitted pose's own (its marginal covariance), for the others it is taken
+/// as 0 (conservative: they stay out). Returns whether any came back.
+fn take_back(
+    result: &CalibrationResult,
+    current: &mut [PoseMeasurement],
+    options: &CalibrationOptions,
     test: &ConsistencyTest,
     state: &mut Exclusions,
 ) -> bool {
+    let at_fit = residuals_at_fit(result, current, options);
+    let (indices, used) = used_measurements(result, current);
+    let built = graph_at_solution(result, &used, options);
+    let prediction_variance = |k: usize, sensor: Sensor| -> f64 {
+        let (axis, offset) = match sensor {
+            Sensor::Orientation(a) => (a, 0),
+            Sensor::Position(a) => (a, 3),
+            _ => return 0.0,
+        };
+        let Some(slot) = indices.iter().position(|&i| i == k) else {
+            return 0.0;
+        };
+        match crate::solver::marginal_covariance(&built.graph, &[built.poses[slot].pose]) {
+            Ok(crate::solver::Covariance::Full(c)) => c[(offset + axis, offset + axis)].max(0.0),
+            _ => 0.0,
+        }
+    };
     let before = state.excluded.len();
     state.excluded.retain(|x| {
         let key = (x.test.pose, x.test.sensor);
         // Readings the least-squares loop left out (with a redundancy number) stay out.
         let keep_out = x.test.redundancy.is_finite()
-            || at_fit
-                .get(&key)
-                .is_none_or(|(e, sigma)| (e / sigma).abs() > test.critical_w);
+            || at_fit.get(&key).is_none_or(|(e, sigma)| {
+                let spread = (sigma * sigma + prediction_variance(key.0, key.1)).sqrt();
+                (e / spread).abs() > test.critical_w
+            });
         if !keep_out {
             current[x.test.pose].excluded = current[x.test.pose].excluded.without(x.test.sensor);
         }
@@ -397,9 +455,12 @@ fn finish(
 ) -> CheckedCalibration {
     // Each left-out reading's error against the final fit, which it did not pull.
     for x in &mut state.excluded {
-        if let Some(&(e, _)) = at_fit.get(&(x.test.pose, x.test.sensor)) {
+        if let Some(&(e, sigma)) = at_fit.get(&(x.test.pose, x.test.sensor)) {
             x.test.residual = e;
             x.test.estimated_error = -e;
+            if x.test.redundancy.is_nan() {
+                x.test.w = e / sigma; // set aside by the screen: its residual against the final fit
+            }
         }
     }
     if let Some(cable) = state.step_cable {
