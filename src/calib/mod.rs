@@ -48,6 +48,7 @@ mod orientation;
 mod predict;
 pub mod report;
 mod result;
+mod snooping;
 mod uncertainty;
 
 use crate::error::{Error, Result};
