@@ -175,17 +175,20 @@ impl CatenaryStart {
     }
 }
 
-/// The better of the `candidates` (the initial guess, and a rigid-cable
-/// calibration from it: close on robots whose cables barely sag, biased where
-/// they sag a lot). Each is warmed up (per-pose statics, closed-form offsets);
-/// the one with the lower relaxed catenary cost per feasible pose wins.
-/// `None` if no candidate has [`MIN_POSES`] poses with an equilibrium.
-pub(super) fn choose_start(
-    candidates: [Robot; 2],
+/// The warmed-up `candidates` (the initial guess, a rigid-cable calibration
+/// from it, or anchors mixed from both: [`mixed_anchors`]), best first. Each is warmed up (per-pose statics,
+/// closed-form offsets) and scored by its relaxed catenary cost per feasible
+/// pose (a start with fewer feasible poses is penalised); candidates with
+/// fewer than [`MIN_POSES`] feasible poses are dropped. The score only orders
+/// them: a start's cost says little about the basin it lies in (see
+/// [`super::calibrate_once`]), so every start is solved and the lowest final
+/// cost wins.
+pub(super) fn catenary_starts(
+    candidates: impl IntoIterator<Item = Robot>,
     measurements: &[PoseMeasurement],
     relaxed_options: &CalibrationOptions,
-) -> Option<CatenaryStart> {
-    let mut best: Option<(f64, CatenaryStart)> = None;
+) -> Vec<CatenaryStart> {
+    let mut scored: Vec<(f64, CatenaryStart)> = Vec::new();
     for candidate in candidates {
         let warm = warm_up(&candidate, measurements);
         let mut start = candidate;
@@ -212,17 +215,47 @@ pub(super) fn choose_start(
             continue;
         };
         let score = cost / feasible.len() as f64 * (1.0 + (measurements.len() - feasible.len()) as f64);
-        if best.as_ref().is_none_or(|(b, _)| score < *b) {
-            let start = CatenaryStart {
+        // The same anchors twice (a rigid stage that did not move) would only be solved twice.
+        let duplicate = scored
+            .iter()
+            .any(|(_, other)| (0..CABLE_COUNT).all(|i| (other.robot.anchors_m[i] - start.anchors_m[i]).norm() < 1e-6));
+        if duplicate {
+            continue;
+        }
+        scored.push((
+            score,
+            CatenaryStart {
                 robot: start,
                 poses: warm.poses,
                 tensions: warm.tensions,
                 feasible,
-            };
-            best = Some((score, start));
-        }
+            },
+        ));
     }
-    best.map(|(_, start)| start)
+    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    scored.into_iter().map(|(_, start)| start).collect()
+}
+
+/// Every mix of `initial`'s and `rigid`'s anchors other than the two
+/// themselves: cable `i`'s anchor from `rigid` where bit `i` of the mask is
+/// set. The rigid stage is, cable by cable, an independent fit of one anchor
+/// and one offset to that cable's lengths (the poses are held by their
+/// priors), so a wrong rigid minimum for one cable does not spoil the others:
+/// keeping the initial anchor for that cable alone is a start no better and
+/// no worse than the guess was for it.
+pub(super) fn mixed_anchors(initial: &Robot, rigid: &Robot) -> Vec<Robot> {
+    let full = (1usize << CABLE_COUNT) - 1;
+    (1..full)
+        .map(|mask| {
+            let mut mixed = initial.clone();
+            for i in 0..CABLE_COUNT {
+                if mask & (1 << i) != 0 {
+                    mixed.anchors_m[i] = rigid.anchors_m[i];
+                }
+            }
+            mixed
+        })
+        .collect()
 }
 
 /// The start of the final stage: every measurement, the feasible ones at the

@@ -29,6 +29,39 @@
 //! and tension, (3) the full catenary graph. Eq. (17)-(18) alone often start
 //! with negative tensions in other cables; this sequence does not.
 //!
+//! **Basins.** The rigid stage fits, cable by cable, one anchor and one
+//! offset to that cable's lengths (the poses are held by their priors): it
+//! knows nothing of the statics. Where the cables are nearly vertical and the
+//! poses form a narrow column under the anchors (the authors' small robot,
+//! `robots/small-authors.toml`: anchors 4.7 m apart in x, poses 9 to 24 m
+//! below them), the lengths barely change when an anchor slides along its
+//! mean cable direction (the offset takes up the difference) or turns about
+//! the column, so the rigid fit of a guess several metres off can leave one
+//! anchor tens of metres along that valley or on the wrong side of the
+//! column. The platform's force balance and orientation would tell, but only
+//! the catenary stages see them, and LM from such a start ends in a minimum
+//! whose cost is hundreds of times what the noise allows. Three remedies, none
+//! with a tuned constant:
+//! - both starts (the guess and the rigid fit) are solved to the end and the
+//!   lower final cost wins (a converged solve first, then the one leaving out
+//!   fewer poses): a start's warm-up cost says little about its basin;
+//! - if the two did not reach one minimum and the better fails the
+//!   chi-square test of its cost (99.9 % quantile at the redundancy), or no
+//!   start had an equilibrium at enough poses, the anchors mixed cable by
+//!   cable from the guess and the rigid fit are solved too (14 more starts):
+//!   a wrong rigid minimum for one cable then does not spoil the others;
+//! - with [`OrientationPrior::Auto`] a failed orientation test can be a wrong
+//!   basin of the fit with the prior rather than a localiser at odds with the
+//!   statics, so the fit with the prior is repeated from the fit without it
+//!   before the prior is dropped (`orientation.rs`).
+//!
+//! What stays lost: a guess whose anchors are on the wrong side of the pose
+//! column (a 10 m perturbation of a robot 4.7 m wide swaps anchors or puts
+//! them below the poses), so that neither the guess, the rigid fit, nor any
+//! mix of them holds the platform with positive tensions at enough poses; and
+//! with few poses and no orientation prior, minima of equal depth along a
+//! poorly observed direction.
+//!
 //! **Solving.** Each pose's variables (platform pose, reference tension) form
 //! a local group of the graph: after every trial step the solver re-fits each
 //! pose to its own factors with the anchors and offsets held, so a step of
@@ -54,7 +87,7 @@ mod uncertainty;
 use crate::error::{Error, Result};
 use crate::model::effects::{EffectKind, Effects};
 use crate::model::measurement::PoseMeasurement;
-use crate::model::robot::Robot;
+use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::solver::{optimize, LmParams};
 use uncertainty::effect_estimate;
 
@@ -72,11 +105,12 @@ pub use uncertainty::{anchor_rms_bound_m, cramer_rao_bound, parameter_uncertaint
 
 /// Calibrate anchors and length offsets from `measurements`, starting from `initial`.
 ///
-/// Stages (see the module docs): for the catenary model, (1) per-pose statics
-/// at the initial anchors and the closed-form offsets, (2) the full graph. If
-/// the initial anchors are so far off that most poses have no equilibrium, a
-/// rigid-cable calibration first moves them closer. For the rigid model, the
-/// rigid graph alone.
+/// Stages (see the module docs): for the catenary model, a rigid-cable
+/// calibration from `initial`, then from both `initial` and that calibration
+/// (and, if neither ends in a minimum consistent with the noise, from their
+/// anchors mixed cable by cable) per-pose statics with closed-form offsets,
+/// the relaxed-statics graph and the full graph; the lowest final cost wins.
+/// For the rigid model, the rigid graph alone.
 pub fn calibrate(
     initial: &Robot,
     measurements: &[PoseMeasurement],
@@ -102,16 +136,145 @@ fn calibrate_once(
     if options.model == CableModel::Rigid {
         return finish(initial, rigid, vec![rigid_stage], Vec::new());
     }
-    // (2) The better of two warmed-up starts: the initial guess and the rigid
-    // calibration, each with per-pose statics and closed-form offsets.
+    // (2) Two warmed-up starts: the initial guess and the rigid calibration,
+    // each with per-pose statics and closed-form offsets. Both are solved and
+    // the lower final cost wins (see the module docs, "Basins").
     let relaxed_options = init::relaxed_statics(options);
-    let candidates = [initial.clone(), robot_from_graph(initial, &rigid)];
-    let Some(start) = init::choose_start(candidates, measurements, &relaxed_options) else {
-        return Err(Error::NoEquilibrium(format!(
-            "fewer than {MIN_POSES} of {} poses have a positive-tension equilibrium at the initial anchors or at a rigid-cable calibration of them: the initial guess is too far off",
-            measurements.len()
-        )));
-    };
+    let rigid_robot = robot_from_graph(initial, &rigid);
+    let starts = init::catenary_starts([initial.clone(), rigid_robot.clone()], measurements, &relaxed_options);
+    let solves = solve_starts(initial, &starts, measurements, options, &relaxed_options);
+    let agree = solves.len() == 2 && CatenarySolve::same_minimum(&solves[0], &solves[1]);
+    let mut best = best_of(solves, measurements);
+    // (2') If the starts did not lead to one minimum and the best fits the data
+    // worse than the noise allows, the anchors mixed cable by cable from both.
+    if !agree && !best.as_ref().is_ok_and(|b| b.consistent_with_noise()) {
+        let mixed = init::catenary_starts(
+            init::mixed_anchors(initial, &rigid_robot),
+            measurements,
+            &relaxed_options,
+        );
+        let more = best_of(
+            solve_starts(initial, &mixed, measurements, options, &relaxed_options),
+            measurements,
+        );
+        best = match (best, more) {
+            (Ok(a), Ok(b)) => Ok(if b.better_than(&a) { b } else { a }),
+            (Ok(a), Err(_)) => Ok(a),
+            (Err(_), Ok(b)) => Ok(b),
+            (Err(e), Err(_)) => Err(e),
+        };
+    }
+    let solved = best?;
+    finish(
+        initial,
+        solved.full,
+        vec![rigid_stage, solved.relaxed_stage, solved.final_stage],
+        solved.excluded,
+    )
+}
+
+/// The catenary stages solved from every start that can be solved.
+fn solve_starts(
+    initial: &Robot,
+    starts: &[init::CatenaryStart],
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+    relaxed_options: &CalibrationOptions,
+) -> Vec<Result<CatenarySolve>> {
+    starts
+        .iter()
+        .map(|start| solve_catenary(initial, start, measurements, options, relaxed_options))
+        .collect()
+}
+
+/// The best of `solves` (by [`CatenarySolve::better_than`]); the first error
+/// if none succeeded, or the infeasible-start error if there were none.
+fn best_of(solves: Vec<Result<CatenarySolve>>, measurements: &[PoseMeasurement]) -> Result<CatenarySolve> {
+    let mut best: Option<CatenarySolve> = None;
+    let mut first_error = None;
+    for solved in solves {
+        match solved {
+            Ok(solved) => {
+                if best.as_ref().is_none_or(|b| solved.better_than(b)) {
+                    best = Some(solved);
+                }
+            }
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    best.ok_or_else(|| {
+        first_error.unwrap_or_else(|| {
+            Error::NoEquilibrium(format!(
+                "fewer than {MIN_POSES} of {} poses have a positive-tension equilibrium at the initial anchors or at a rigid-cable calibration of them: the initial guess is too far off",
+                measurements.len()
+            ))
+        })
+    })
+}
+
+/// The catenary stages solved from one start.
+struct CatenarySolve {
+    relaxed_stage: StageSummary,
+    final_stage: StageSummary,
+    full: CalibrationGraph,
+    excluded: Vec<usize>,
+}
+
+impl CatenarySolve {
+    /// Whether this solve is preferable to `other`: a converged solve beats
+    /// one that stopped at its iteration limit, then fewer poses left out
+    /// (costs of different pose sets do not compare), then the lower cost.
+    fn better_than(&self, other: &CatenarySolve) -> bool {
+        let key = |s: &CatenarySolve| (!s.final_stage.summary.termination.converged(), s.excluded.len());
+        match key(self).cmp(&key(other)) {
+            std::cmp::Ordering::Less => true,
+            std::cmp::Ordering::Greater => false,
+            std::cmp::Ordering::Equal => self.final_stage.summary.final_cost < other.final_stage.summary.final_cost,
+        }
+    }
+
+    /// Whether two solves (both `Ok`) reached the same minimum: the same poses,
+    /// anchors within 1 cm.
+    fn same_minimum(a: &Result<CatenarySolve>, b: &Result<CatenarySolve>) -> bool {
+        let (Ok(a), Ok(b)) = (a, b) else {
+            return false;
+        };
+        let anchors = |s: &CatenarySolve| s.full.globals.anchors.map(|id| s.full.graph.values.vector(id).clone());
+        let (pa, pb) = (anchors(a), anchors(b));
+        a.excluded == b.excluded && (0..CABLE_COUNT).all(|i| (&pa[i] - &pb[i]).norm() < 0.01)
+    }
+
+    /// Whether the final cost is consistent with the stated noise: twice the
+    /// cost (the whitened chi-square) within the 99.9 % quantile of
+    /// chi-square with the redundancy (residual components less the
+    /// variables' dimensions) as degrees of freedom. A minimum in a wrong
+    /// basin fits the data far worse than the noise allows (hundreds of times
+    /// the redundancy); model mismatch (finite-element data) can fail it too,
+    /// which only costs the extra starts.
+    fn consistent_with_noise(&self) -> bool {
+        let graph = &self.full.graph;
+        let components: usize = factor_statistics(graph).iter().map(|s| s.components).sum();
+        let unknowns: usize = graph
+            .values
+            .iter()
+            .filter(|(_, v)| !v.fixed)
+            .map(|(_, v)| v.value.tangent_dim())
+            .sum();
+        let redundancy = components.saturating_sub(unknowns).max(1);
+        2.0 * self.final_stage.summary.final_cost <= crate::stats::chi_square_quantile_999(redundancy)
+    }
+}
+
+/// Stages (3) and (4) of [`calibrate_once`] from one warmed-up start.
+fn solve_catenary(
+    initial: &Robot,
+    start: &init::CatenaryStart,
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+    relaxed_options: &CalibrationOptions,
+) -> Result<CatenarySolve> {
     // (3) Continuation on the statics constraint: a tight attachment-height
     // sigma makes the cost a narrow curved valley that Gauss-Newton follows in
     // tiny steps from far away; solving first with it relaxed to the encoder
@@ -124,7 +287,7 @@ fn calibrate_once(
         &poses,
         &tensions,
         CableModel::Catenary,
-        &relaxed_options,
+        relaxed_options,
     );
     let relaxed_stage = solve_stage("catenary (relaxed statics)", &mut relaxed, &options.lm)?;
     // (4) The full catenary graph: the relaxed solution, plus the poses that
@@ -141,12 +304,12 @@ fn calibrate_once(
         options,
     );
     let final_stage = solve_stage("catenary", &mut full, &options.lm)?;
-    finish(
-        initial,
+    Ok(CatenarySolve {
+        relaxed_stage,
+        final_stage,
         full,
-        vec![rigid_stage, relaxed_stage, final_stage],
-        last.excluded,
-    )
+        excluded: last.excluded,
+    })
 }
 
 /// The rigid-cable calibration from `initial` (the straight-cable offsets in

@@ -4,10 +4,10 @@
 
 use serde::Serialize;
 
-use super::calibrate_once;
-use super::graph::measured_pose;
-use super::options::{CalibrationOptions, OrientationPrior};
+use super::graph::{build_graph, measured_pose};
+use super::options::{CableModel, CalibrationOptions, OrientationPrior};
 use super::result::CalibrationResult;
+use super::{calibrate_once, finish, solve_stage};
 use crate::error::Result;
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::Robot;
@@ -55,6 +55,34 @@ fn orientation_check(result: &CalibrationResult, measurements: &[PoseMeasurement
     }
 }
 
+/// The full catenary graph under `options`, started from `result`'s solution
+/// (its poses left out stay out).
+fn refit_from(
+    result: &CalibrationResult,
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+) -> Result<CalibrationResult> {
+    let used: Vec<PoseMeasurement> = (0..measurements.len())
+        .filter(|k| !result.excluded_poses.contains(k))
+        .map(|k| measurements[k])
+        .collect();
+    let mut built = build_graph(
+        &result.robot,
+        &used,
+        &result.poses,
+        &result.reference_tensions(),
+        CableModel::Catenary,
+        options,
+    );
+    let mut stages = result.stages.clone();
+    stages.push(solve_stage(
+        "catenary (orientation prior, from the fit without it)",
+        &mut built,
+        &options.lm,
+    )?);
+    finish(&result.robot, built, stages, result.excluded_poses.clone())
+}
+
 impl CalibrationOptions {
     /// These options with [`OrientationPrior::Auto`] resolved to what `result`
     /// used (`On` if it kept the prior, else `Off`): the options under which
@@ -75,7 +103,9 @@ impl CalibrationOptions {
 /// [`OrientationPrior::Auto`]: calibrate with the orientation prior, test the
 /// localiser's orientations against the fitted statics ([`orientation_check`]),
 /// and calibrate again without the prior if they are inconsistent (or if the
-/// calibration with it fails). The test is recorded in the result.
+/// calibration with it fails), unless a second calibration with the prior,
+/// started from the anchors found without it, passes the test (the first one
+/// had ended in a wrong basin). The test is recorded in the result.
 pub(super) fn calibrate_testing_orientation(
     initial: &Robot,
     measurements: &[PoseMeasurement],
@@ -98,6 +128,20 @@ pub(super) fn calibrate_testing_orientation(
         return Ok(result);
     }
     let mut result = calibrate_once(initial, measurements, &without_prior)?;
+    // A failed test says the localiser disagrees with the statics *at the
+    // anchors found*: if the fit with the prior ended in a wrong basin (its
+    // statics orientations then disagree with every localiser reading), the
+    // test blames the localiser for the anchors. The fit without the prior
+    // does not depend on the orientations, so its solution (anchors, offsets,
+    // poses, tensions) is the start of a second fit with the prior, one stage
+    // from a minimum; if that one passes, the localiser was right.
+    if let Ok(mut again) = refit_from(&result, measurements, &with_prior) {
+        let second = orientation_check(&again, measurements, options.noise.orientation_sigma_rad);
+        if second.chi_square <= second.limit {
+            again.orientation_check = Some(second);
+            return Ok(again);
+        }
+    }
     check.prior_used = false;
     result.orientation_check = Some(check);
     Ok(result)
