@@ -42,9 +42,12 @@
 //! the catenary stages see them, and LM from such a start ends in a minimum
 //! whose cost is hundreds of times what the noise allows. Three remedies, none
 //! with a tuned constant:
-//! - both starts (the guess and the rigid fit) are solved to the end and the
-//!   lower final cost wins (a converged solve first, then the one leaving out
-//!   fewer poses): a start's warm-up cost says little about its basin;
+//! - the start with the lower warm-up cost is solved first and kept if its
+//!   minimum passes the chi-square test of its cost (99.9 % quantile at the
+//!   redundancy; the common case, one solve); otherwise both starts (the
+//!   guess and the rigid fit) are solved to the end and the lower final cost
+//!   wins (a converged solve first, then the one leaving out fewer poses): a
+//!   start's warm-up cost says little about its basin;
 //! - if the two did not reach one minimum and the better fails the
 //!   chi-square test of its cost (99.9 % quantile at the redundancy), or no
 //!   start had an equilibrium at enough poses, the anchors mixed cable by
@@ -142,6 +145,21 @@ fn calibrate_once(
     let relaxed_options = init::relaxed_statics(options);
     let rigid_robot = robot_from_graph(initial, &rigid);
     let starts = init::catenary_starts([initial.clone(), rigid_robot.clone()], measurements, &relaxed_options);
+    // The start with the lower warm-up cost first: a minimum that fits the
+    // data as well as the noise allows needs no other start (the common case,
+    // at the cost of one solve).
+    if let Some(first) = starts.first() {
+        if let Ok(solved) = solve_catenary(initial, first, measurements, options, &relaxed_options) {
+            if solved.final_stage.summary.termination.converged() && solved.consistent_with_noise() {
+                return finish(
+                    initial,
+                    solved.full,
+                    vec![rigid_stage, solved.relaxed_stage, solved.final_stage],
+                    solved.excluded,
+                );
+            }
+        }
+    }
     let solves = solve_starts(initial, &starts, measurements, options, &relaxed_options);
     let agree = solves.len() == 2 && CatenarySolve::same_minimum(&solves[0], &solves[1]);
     let mut best = best_of(solves, measurements);

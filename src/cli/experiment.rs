@@ -158,6 +158,7 @@ fn print_table(args: &Table2Args, truth: &Robot, report: &Table2Report) {
         "CRLB offset m",
         "paper anchor / offset m",
         "orientation prior kept",
+        "readings left out / inconsistent",
         "median ms",
     ]);
     for r in &report.results {
@@ -177,11 +178,12 @@ fn print_table(args: &Table2Args, truth: &Robot, report: &Table2Report) {
                 OrientationPrior::On => "all".into(),
                 OrientationPrior::Off => "none".into(),
             },
+            format!("{} / {}", r.readings_left_out, r.inconsistent),
             format!("{:.0}", r.median_solve_ms),
         ]);
     }
     print!("{table}");
-    println!("(CRLB: the error an unbiased estimator cannot beat on average, at the truth, for the same poses, noise and orientation prior;\n anchor errors are the mean Euclidean distance per anchor, as in the authors' program, +- the standard error of the mean over trials)");
+    println!("(CRLB: the error an unbiased estimator cannot beat on average, at the truth, for the same poses, noise and orientation prior;\n anchor errors are the mean Euclidean distance per anchor, as in the authors' program, +- the standard error of the mean over trials;\n readings left out: gross errors found over all trials by `calibrate`'s tests; inconsistent: trials whose fit fails them, which `calibrate` would refuse)");
 }
 
 /// Per pose count: whether the paper's anchor error is below the bound, and

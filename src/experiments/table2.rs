@@ -23,6 +23,7 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::calib::gross_errors::{calibrate_checked, GrossErrorOptions, Verdict};
 use crate::calib::{
     calibrate, cramer_rao_bound, refine_with_effects, CableModel, CalibrationError, CalibrationOptions,
     OrientationPrior, ParameterUncertainty,
@@ -141,6 +142,9 @@ pub struct TrialResult {
     pub offset_crlb_m: Option<f64>,
     /// With `--orientation-prior auto`: whether the calibration kept the orientation prior.
     pub orientation_prior_used: Option<bool>,
+    /// The gross-error tests ([`crate::calib::gross_errors`]): readings left
+    /// out, and whether the fit passed (`None` if the calibration failed).
+    pub gross_errors: Option<(usize, bool)>,
 }
 
 /// The summary for one pose count.
@@ -168,6 +172,10 @@ pub struct PoseCountResult {
     pub median_solve_ms: f64,
     /// Trials whose calibration kept the orientation prior (always all with `on`, none with `off`).
     pub orientation_prior_kept: usize,
+    /// Readings left out as gross errors, over all trials.
+    pub readings_left_out: usize,
+    /// Trials whose fit failed its consistency tests (`calibrate` would refuse it).
+    pub inconsistent: usize,
     /// The trials that did not converge, with the reason.
     pub not_converged: Vec<TrialResult>,
 }
@@ -309,7 +317,14 @@ pub fn run_trial(
     let equilibria: Vec<Equilibrium> = chosen.iter().map(|&k| pool[k].equilibrium.clone()).collect();
     let lines = chosen.iter().map(|&k| pool[k].line).collect();
     let started = std::time::Instant::now();
-    let result = calibrate(&guess, &data, &options).and_then(|baseline| {
+    // The gross-error tests of `sagcal calibrate` (clean data: one fit and its test).
+    let checked = calibrate_checked(&guess, &data, &options, &GrossErrorOptions::default());
+    let gross = checked
+        .as_ref()
+        .ok()
+        .map(|c| (c.excluded.len(), c.verdict == Verdict::Consistent));
+    let data = checked.as_ref().map_or(data, |c| c.measurements.clone());
+    let result = checked.map(|c| c.result).and_then(|baseline| {
         if protocol.estimate.is_empty() {
             return Ok(baseline);
         }
@@ -381,6 +396,7 @@ pub fn run_trial(
                 anchor_crlb_m,
                 offset_crlb_m,
                 orientation_prior_used,
+                gross_errors: gross,
             }
         }
         Err(e) => TrialResult {
@@ -393,6 +409,7 @@ pub fn run_trial(
             anchor_crlb_m,
             offset_crlb_m,
             orientation_prior_used,
+            gross_errors: gross,
         },
     }
 }
@@ -431,6 +448,8 @@ pub fn summarise(poses: usize, trials: Vec<TrialResult>) -> PoseCountResult {
         offset_crlb_m: mean(trials.iter().filter_map(|t| t.offset_crlb_m)),
         median_solve_ms: times.get(times.len() / 2).copied().unwrap_or(f64::NAN),
         orientation_prior_kept: trials.iter().filter(|t| t.orientation_prior_used == Some(true)).count(),
+        readings_left_out: trials.iter().filter_map(|t| t.gross_errors).map(|g| g.0).sum(),
+        inconsistent: trials.iter().filter(|t| t.gross_errors.is_some_and(|g| !g.1)).count(),
         not_converged: trials.into_iter().filter(|t| !t.converged).collect(),
     }
 }
