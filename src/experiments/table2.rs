@@ -26,7 +26,7 @@ use serde::Serialize;
 use crate::calib::gross_errors::{calibrate_checked, GrossErrorOptions, Verdict};
 use crate::calib::{
     calibrate, cramer_rao_bound, refine_with_effects, CableModel, CalibrationError, CalibrationOptions,
-    OrientationPrior, ParameterUncertainty,
+    CalibrationResult, OrientationPrior, ParameterUncertainty,
 };
 use crate::error::{Error, Result};
 use crate::model::effects::EffectSet;
@@ -353,28 +353,7 @@ pub fn run_trial(
     match result {
         Ok(result) => {
             let error = CalibrationError::between(&result.robot, truth);
-            let radius = protocol.basin_radius_m;
-            // Right basin: the solver stopped at a minimum, and it is the data's own
-            // minimum: within the radius of the truth, or, if farther (few poses make
-            // the bound itself large), the minimum a solve started at the truth finds
-            // (anchors within 1 cm) or a lower one. With few poses the cost can have
-            // several minima of nearly equal depth along a poorly observed direction;
-            // one at least as deep as the truth's is the data's answer, not a failure
-            // of the initialisation. Costs compare only under the same orientation prior.
-            let in_basin = error.anchor_max_euclidean_m < radius || {
-                let from_truth = truth.clone();
-                calibrate(&from_truth, &data, &options).is_ok_and(|reference| {
-                    let same_minimum = (0..CABLE_COUNT)
-                        .all(|i| (reference.robot.anchors_m[i] - result.robot.anchors_m[i]).norm() < 0.01);
-                    let same_prior = reference.orientation_check.map(|c| c.prior_used)
-                        == result.orientation_check.map(|c| c.prior_used);
-                    let reference_cost = reference.final_stage().final_cost;
-                    let deeper = same_prior
-                        && result.excluded_poses.len() <= reference.excluded_poses.len()
-                        && result.final_stage().final_cost <= reference_cost * (1.0 + 1e-9);
-                    same_minimum || deeper
-                })
-            };
+            let in_basin = in_right_basin(truth, &data, &options, &result, &error, protocol);
             let converged = result.converged() && in_basin;
             let failure = (!converged).then(|| {
                 if !result.converged() {
@@ -411,6 +390,36 @@ pub fn run_trial(
             orientation_prior_used,
             gross_errors: gross,
         },
+    }
+}
+
+/// Right basin: the solver stopped at a minimum, and it is the data's own
+/// minimum: within the radius of the truth, or, if farther (few poses make
+/// the bound itself large), the minimum a solve started at the truth finds
+/// (anchors within 1 cm) or a lower one. With few poses the cost can have
+/// several minima of nearly equal depth along a poorly observed direction;
+/// one at least as deep as the truth's is the data's answer, not a failure
+/// of the initialisation. Costs compare only under the same orientation prior.
+fn in_right_basin(
+    truth: &Robot,
+    data: &[PoseMeasurement],
+    options: &CalibrationOptions,
+    result: &CalibrationResult,
+    error: &CalibrationError,
+    protocol: &Protocol,
+) -> bool {
+    error.anchor_max_euclidean_m < protocol.basin_radius_m || {
+        calibrate(truth, data, options).is_ok_and(|reference| {
+            let same_minimum =
+                (0..CABLE_COUNT).all(|i| (reference.robot.anchors_m[i] - result.robot.anchors_m[i]).norm() < 0.01);
+            let same_prior =
+                reference.orientation_check.map(|c| c.prior_used) == result.orientation_check.map(|c| c.prior_used);
+            let reference_cost = reference.final_stage().final_cost;
+            let deeper = same_prior
+                && result.excluded_poses.len() <= reference.excluded_poses.len()
+                && result.final_stage().final_cost <= reference_cost * (1.0 + 1e-9);
+            same_minimum || deeper
+        })
     }
 }
 
