@@ -45,6 +45,7 @@ fn protocol(noise: NoisePreset, anchor_m: f64, offset_m: f64) -> Protocol {
         basin_radius_m: 0.3 * anchor_m,
         orientation_prior: OrientationPrior::Auto,
         estimate: EffectSet::NONE,
+        apply_gross_errors: false,
     }
 }
 

@@ -28,6 +28,7 @@ fn model_data_converge_at_the_cramer_rao_bound_and_reproduce_from_the_seed() {
         basin_radius_m: 3.0,
         orientation_prior: sagcal::calib::OrientationPrior::Auto,
         estimate: sagcal::model::effects::EffectSet::NONE,
+        apply_gross_errors: false,
     };
     let run = || run_protocol(&truth, &pool, &[25], 12, 5, &protocol, &|| {}).unwrap();
     let results = run();

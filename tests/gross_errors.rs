@@ -102,27 +102,22 @@ fn swapped_cables_are_named() {
 #[test]
 fn wrong_units_are_named_and_refused() {
     let (_, data, guess) = case(NoisePreset::Paper, 65);
+    let options = CalibrationOptions::new(NoisePreset::Paper.sigmas(guess.platform_weight_n));
     let mut millinewtons = data.clone();
     for m in &mut millinewtons {
         m.reference_tension_n *= 1000.0;
     }
-    let checked = check(&millinewtons, &guess, NoisePreset::Paper);
-    let Verdict::Inconsistent { reason } = &checked.verdict else {
-        panic!("mN load cell accepted")
-    };
-    println!("{reason}");
-    assert!(reason.contains("load cell") && reason.contains("mN"));
+    let error = calibrate_checked(&guess, &millinewtons, &options, &GrossErrorOptions::default()).unwrap_err();
+    println!("{error}");
+    assert!(error.to_string().contains("load cell") && error.to_string().contains("mN, not N"));
     let mut millimetres = data.clone();
     for m in &mut millimetres {
         m.encoder_lengths_m[2] *= 1000.0;
     }
-    let checked = check(&millimetres, &guess, NoisePreset::Paper);
-    let Verdict::Inconsistent { reason } = &checked.verdict else {
-        panic!("mm encoder accepted")
-    };
+    let error = calibrate_checked(&guess, &millimetres, &options, &GrossErrorOptions::default()).unwrap_err();
     assert!(
-        reason.contains("encoder of cable 3") && reason.contains("mm"),
-        "{reason}"
+        error.to_string().contains("encoder of cable 3") && error.to_string().contains("mm, not m"),
+        "{error}"
     );
 }
 
@@ -241,11 +236,50 @@ fn calibrate_refuses_an_inconsistent_fit_and_writes_nothing() {
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr.contains("mN.csv") && stderr.contains("mN, not N") && stderr.contains("no robot file is written"));
     assert!(!dir.path().join("c.toml").exists());
+    // A unit mistake is never accepted: no fit can mend it.
+    let mut accepted = args.to_vec();
+    accepted.push("--accept-inconsistent");
+    assert_eq!(sagcal(dir.path(), &accepted).status.code(), Some(1));
+    assert!(!dir.path().join("c.toml").exists());
+    // A model error (a stretch the model lacks, the authors' noise) is refused
+    // too, and written with its verdict when accepted.
+    let simulate = [
+        "simulate",
+        "--robot",
+        robots,
+        "--poses",
+        "30",
+        "--seed",
+        "71",
+        "--noise",
+        "authors",
+        "--effect",
+        "elastic:ea_n=2e6",
+        "--out",
+        "el.csv",
+    ];
+    let out = sagcal(dir.path(), &simulate);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let args = [
+        "calibrate",
+        "--robot",
+        robots,
+        "--data",
+        "el.csv",
+        "--noise",
+        "authors",
+        "--out",
+        "e.toml",
+    ];
+    let out = sagcal(dir.path(), &args);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stdout));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("sagcal diagnose"));
+    assert!(!dir.path().join("e.toml").exists());
     let mut accepted = args.to_vec();
     accepted.push("--accept-inconsistent");
     let out = sagcal(dir.path(), &accepted);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let written = std::fs::read_to_string(dir.path().join("c.toml")).unwrap();
+    let written = std::fs::read_to_string(dir.path().join("e.toml")).unwrap();
     assert!(written
         .lines()
         .nth(1)

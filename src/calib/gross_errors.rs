@@ -99,6 +99,10 @@ pub struct CheckedCalibration {
     pub rows: Vec<usize>,
     /// The readings left out, in the order found.
     pub excluded: Vec<ExcludedReading>,
+    /// For an inconsistent fit: the readings the search would have left out
+    /// before it gave up (the fit uses them all; the mistakes name what they
+    /// look like).
+    pub set_aside: Vec<ExcludedReading>,
     /// The common mistakes found before or after the fit.
     pub mistakes: Vec<Mistake>,
     /// The tests of the final fit.
@@ -128,8 +132,20 @@ pub fn calibrate_checked(
         limit: ((check.max_excluded_fraction * total_readings as f64).floor() as usize).max(1),
         step_cable: None,
     };
-    let units = found.iter().any(Mistake::is_unit_mistake);
-    if !units {
+    let units: Vec<&str> = found
+        .iter()
+        .filter(|m| m.is_unit_mistake())
+        .map(|m| m.message.as_str())
+        .collect();
+    if !units.is_empty() {
+        // No reading is to blame and no fit can mend it: the data must be fixed.
+        return Err(crate::error::Error::InvalidInput(format!(
+            "{}; fix the data and calibrate again",
+            units.join("; ")
+        )));
+    }
+    let mut plain = None;
+    {
         // Clean data pass at the cost of one fit and its test.
         if let Ok(result) = calibrate(initial, &current, options) {
             let test = test_fit(&result, &current, options, check)?;
@@ -137,28 +153,49 @@ pub fn calibrate_checked(
                 let at_fit = residuals_at_fit(&result, &current, options);
                 return Ok(finish(result, current, rows, state, found, test, &at_fit));
             }
+            plain = Some((result, test, current.clone()));
         }
         robust_screen(initial, &mut current, options, check, &mut state);
     }
     let mut rounds = 0;
-    loop {
+    let checked = loop {
         let result = calibrate(initial, &current, options)?;
         let test = test_fit(&result, &current, options, check)?;
         let at_fit = residuals_at_fit(&result, &current, options);
-        if !units && state.stepped == 0 && test.flagged.len() + state.counted() > state.limit {
+        let room = state.limit.saturating_sub(state.counted());
+        if state.stepped == 0 && test.flagged.len() > room {
             if let Some((cable, rows_off)) = mistakes::offset_step(&current, &at_fit, check.false_alarm) {
                 state.leave_out_step(&mut current, &at_fit, cable, &rows_off);
                 continue;
             }
         }
         match test.flagged.first().copied() {
-            Some(worst) if !units && state.counted() < state.limit => state.leave_out(&mut current, worst),
+            // Data snooping assumes a few blunders: more flagged readings than
+            // may still be left out reject that assumption, and the loop stops.
+            Some(worst) if test.flagged.len() <= room => state.leave_out(&mut current, worst),
             _ if rounds < 3 && take_back(&result, &mut current, options, &test, &mut state) => rounds += 1,
-            _ => {
-                return Ok(finish(result, current, rows, state, found, test, &at_fit));
-            }
+            _ => break finish(result, current, rows.clone(), state, found.clone(), test, &at_fit),
+        }
+    };
+    // An inconsistent fit is a model (or noise) error, not blunders: the
+    // readings left out go back (kept in `set_aside`, with the mistakes named,
+    // as hints), and the fit with every reading is the answer, with its verdict.
+    if checked.verdict != Verdict::Consistent {
+        if let Some((result, test, all)) = plain {
+            let at_fit = residuals_at_fit(&result, &all, options);
+            let none = Exclusions {
+                excluded: Vec::new(),
+                stepped: 0,
+                limit: 1,
+                step_cable: None,
+            };
+            let mut reverted = finish(result, all, rows, none, checked.mistakes.clone(), test, &at_fit);
+            reverted.verdict = checked.verdict;
+            reverted.set_aside = checked.excluded;
+            return Ok(reverted);
         }
     }
+    Ok(checked)
 }
 
 /// The readings left out so far.
@@ -398,6 +435,7 @@ fn finish(
         measurements: current,
         rows,
         excluded: state.excluded,
+        set_aside: Vec::new(),
         mistakes: found,
         test,
         verdict,

@@ -33,7 +33,8 @@ pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
         false_alarm: args.false_alarm,
         ..GrossErrorOptions::default()
     };
-    let checked = calibrate_checked(&nominal, &data.poses, &options, &check)?;
+    let checked = calibrate_checked(&nominal, &data.poses, &options, &check)
+        .map_err(|e| sagcal::Error::InvalidInput(format!("{}: no robot file is written: {e}", args.data.display())))?;
     let result = &checked.result;
     let lines: Vec<usize> = checked.measurements.iter().map(|p| p.line).collect();
     let report = CalibrationReport::new(result, &nominal, options.model, &lines, None);

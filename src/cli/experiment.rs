@@ -95,6 +95,7 @@ fn protocol(args: &Table2Args, truth: &Robot) -> sagcal::Result<Protocol> {
         basin_radius_m,
         orientation_prior: args.orientation_prior,
         estimate: args.estimate.as_deref().map_or(Ok(EffectSet::NONE), parse_effect_set)?,
+        apply_gross_errors: args.apply_gross_errors,
     })
 }
 
@@ -158,7 +159,7 @@ fn print_table(args: &Table2Args, truth: &Robot, report: &Table2Report) {
         "CRLB offset m",
         "paper anchor / offset m",
         "orientation prior kept",
-        "readings left out / inconsistent",
+        "readings flagged / inconsistent",
         "median ms",
     ]);
     for r in &report.results {
@@ -183,7 +184,7 @@ fn print_table(args: &Table2Args, truth: &Robot, report: &Table2Report) {
         ]);
     }
     print!("{table}");
-    println!("(CRLB: the error an unbiased estimator cannot beat on average, at the truth, for the same poses, noise and orientation prior;\n anchor errors are the mean Euclidean distance per anchor, as in the authors' program, +- the standard error of the mean over trials;\n readings left out: gross errors found over all trials by `calibrate`'s tests; inconsistent: trials whose fit fails them, which `calibrate` would refuse)");
+    println!("(CRLB: the error an unbiased estimator cannot beat on average, at the truth, for the same poses, noise and orientation prior;\n anchor errors are the mean Euclidean distance per anchor, as in the authors' program, +- the standard error of the mean over trials;\n readings flagged: by `calibrate`'s gross-error tests over all trials (left out only with --apply-gross-errors); inconsistent: trials whose fit fails them, which `calibrate` would refuse)");
 }
 
 /// Per pose count: whether the paper's anchor error is below the bound, and

@@ -149,6 +149,10 @@ struct Table2Args {
     /// verdict such as `encoder-gain,segments`); default: none.
     #[arg(long)]
     estimate: Option<String>,
+    /// Leave out the readings the gross-error tests flag, as `calibrate` does
+    /// (default: every trial is tested and the flags counted, the fit uses every reading).
+    #[arg(long)]
+    apply_gross_errors: bool,
     /// Print JSON.
     #[arg(long)]
     json: bool,

@@ -330,10 +330,8 @@ fn screen_gross_errors(
         free_effects: EffectSet::NONE,
         ..options.calibration
     };
-    let checked = calibrate_checked(robot, measurements, &base_options, &check)?;
-    if let Some(unit) = checked.mistakes.iter().find(|m| m.is_unit_mistake()) {
-        return Err(Error::InvalidInput(format!("diagnose: {}", unit.message)));
-    }
+    let checked = calibrate_checked(robot, measurements, &base_options, &check)
+        .map_err(|e| Error::InvalidInput(format!("diagnose: {e}")))?;
     let consistent = checked.verdict == Verdict::Consistent;
     let specific = |x: &ExcludedReading| {
         checked.mistakes.iter().any(|m| {
@@ -341,9 +339,11 @@ fn screen_gross_errors(
                 && x.explanation.as_deref() == Some(m.message.as_str())
         })
     };
+    // An inconsistent baseline's candidates are in `set_aside`.
     let kept: Vec<ExcludedReading> = checked
         .excluded
         .iter()
+        .chain(&checked.set_aside)
         .filter(|x| consistent || specific(x))
         .cloned()
         .collect();
