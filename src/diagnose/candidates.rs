@@ -7,9 +7,10 @@ use serde::Serialize;
 use super::residual_tests::total_chi_square;
 use super::selection::Search;
 use super::Baseline;
+use crate::calib::gross_errors::graph_at_solution;
 use crate::calib::{
-    build_graph, calibrate, refine_with_effects, set_effect_estimates, without_estimated, CableModel, CalibrationError,
-    CalibrationGraph, CalibrationOptions, CalibrationResult, EffectEstimate, OrientationPrior,
+    calibrate, refine_with_effects, CableModel, CalibrationError, CalibrationGraph, CalibrationOptions,
+    CalibrationResult, EffectEstimate, OrientationPrior,
 };
 use crate::error::Result;
 use crate::model::effect_ranges::smallest_plausible;
@@ -304,24 +305,17 @@ pub(super) fn parameters(estimate: &EffectEstimate) -> Vec<ParameterValue> {
 
 /// The graph of a fitted calibration (values at the fit), with the effect
 /// variables set from the estimates (the robot file's effects cannot hold a
-/// negative compliance).
+/// negative compliance): [`graph_at_solution`] with the catenary model.
 pub(super) fn rebuild(
     result: &CalibrationResult,
     used: &[PoseMeasurement],
     options: &CalibrationOptions,
 ) -> CalibrationGraph {
-    let mut robot = result.robot.clone();
-    robot.effects = without_estimated(&robot.effects, &result.effect_estimates);
-    let mut built = build_graph(
-        &robot,
-        used,
-        &result.poses,
-        &result.reference_tensions(),
-        CableModel::Catenary,
-        options,
-    );
-    set_effect_estimates(&mut built, &result.effect_estimates);
-    built
+    let catenary = CalibrationOptions {
+        model: CableModel::Catenary,
+        ..*options
+    };
+    graph_at_solution(result, used, &catenary)
 }
 
 /// The test of `hypothesis` against `model` at a step where `tested`
