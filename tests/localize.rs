@@ -264,3 +264,102 @@ fn localizer_sigma(robot: &Robot, eq: &Equilibrium) -> f64 {
         .position_sigma_m
         .norm()
 }
+
+fn sagcal(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_sagcal"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn cli_localizes_a_simulated_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (data, truth, out) = (
+        dir.path().join("m.csv"),
+        dir.path().join("truth.toml"),
+        dir.path().join("poses.csv"),
+    );
+    let robot_file = Path::new(env!("CARGO_MANIFEST_DIR")).join("robots/small.toml");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let simulated = sagcal(&[
+        "simulate",
+        "--robot",
+        &s(&robot_file),
+        "--poses",
+        "6",
+        "--seed",
+        "5",
+        "--noise",
+        "none",
+        "--out",
+        &s(&data),
+        "--truth",
+        &s(&truth),
+    ]);
+    assert!(
+        simulated.status.success(),
+        "{}",
+        String::from_utf8_lossy(&simulated.stderr)
+    );
+    let run = sagcal(&[
+        "localize",
+        "--robot",
+        &s(&truth),
+        "--data",
+        &s(&data),
+        "--json",
+        "--out",
+        &s(&out),
+    ]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let rows = report["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 6);
+    for row in rows {
+        for key in [
+            "row",
+            "position_m",
+            "roll_pitch_yaw_deg",
+            "tensions_n",
+            "position_sigma_m",
+            "consistent",
+        ] {
+            assert!(!row[key].is_null(), "{key} missing in {row}");
+        }
+        assert!(row["consistent"].as_bool().unwrap(), "{row}");
+        assert!(row["position_error_m"].as_f64().unwrap() < 1e-9, "{row}");
+    }
+    assert!(report["position_rms_error_m"].as_f64().unwrap() < 1e-9);
+    let csv = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(csv.lines().count(), 7, "{csv}");
+
+    // A readings-only file: a row no pose explains is flagged, a bad field an error naming it.
+    let readings = dir.path().join("readings.csv");
+    let first = std::fs::read_to_string(&data)
+        .unwrap()
+        .lines()
+        .find(|l| !l.starts_with('#') && !l.starts_with('x'))
+        .unwrap()
+        .to_string();
+    let lengths: Vec<&str> = first.split(',').skip(6).take(5).collect();
+    std::fs::write(
+        &readings,
+        format!("l1_m,l2_m,l3_m,l4_m,f_ref_n\n{}\n0.5,0.5,0.5,0.5,\n", lengths.join(",")),
+    )
+    .unwrap();
+    let run = sagcal(&["localize", "--robot", &s(&truth), "--data", &s(&readings), "--json"]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert!(report["rows"][0]["flag"].is_null(), "{}", report["rows"][0]);
+    assert!(report["rows"][1]["flag"]
+        .as_str()
+        .unwrap()
+        .contains("no static equilibrium"));
+    assert!(report["rows"][1]["position_m"].is_null());
+    std::fs::write(&readings, "l1_m,l2_m,l3_m,l4_m\n1,2,x,4\n").unwrap();
+    let run = sagcal(&["localize", "--robot", &s(&truth), "--data", &s(&readings)]);
+    assert!(!run.status.success());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("row 2") && stderr.contains("l3_m"), "{stderr}");
+}

@@ -154,8 +154,13 @@ pub fn solve(
             proposed = proposed.min(norm);
             let trial_pose = pose.retract(&Vector6::from_fn(|k, _| step[k]));
             let trial_reference = reference_n + Vector2::new(step[6], step[7]) * scale_n;
-            let trial = model_at_pose(robot, &trial_pose, &trial_reference)
-                .filter(|t| merit(t, &trial_pose, observation) <= current * (1.0 + 1e-12));
+            // Near the solution the merit's fixed height weight can refuse the
+            // Newton step that restores the heights (its Lagrange multiplier
+            // exceeds the weight): a short step that halves the heights is taken too.
+            let trial = model_at_pose(robot, &trial_pose, &trial_reference).filter(|t| {
+                merit(t, &trial_pose, observation) <= current * (1.0 + 1e-12)
+                    || (norm < 1e-2 && t.heights_m.amax() <= 0.5 * model.heights_m.amax() + 1e-13)
+            });
             if let Some(trial) = trial {
                 last_step = norm;
                 (pose, reference_n, model) = (trial_pose, trial_reference, trial);
