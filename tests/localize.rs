@@ -363,3 +363,69 @@ fn cli_localizes_a_simulated_file() {
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(stderr.contains("row 2") && stderr.contains("l3_m"), "{stderr}");
 }
+
+/// Accuracy on the RecurDyn log (finite-element cables, the paper's large
+/// robot): every kept row localised from its four lengths (offsets zero),
+/// with and without its load cell (`fc1`). Printed with `--nocapture`.
+#[test]
+fn recurdyn_log_accuracy() {
+    use sagcal::io::recurdyn::{read_recurdyn, LoadOptions};
+    let log_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/recurdyn-large/recurdyn_large.csv");
+    let log = read_recurdyn(&log_path, &LoadOptions::default()).unwrap();
+    let robot = Robot::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("robots/large.toml")).unwrap();
+    let localizer = localizer(&robot);
+    for load_cell in [false, true] {
+        let (mut sum_sq, mut max_position, mut sum_angle, mut max_angle) = (0.0, 0.0f64, 0.0, 0.0f64);
+        let (mut tension_errors, mut consistent) = (Vec::new(), 0);
+        for row in &log.rows {
+            let readings = Readings {
+                encoder_lengths_m: row.cable_lengths_m,
+                load_cell_n: load_cell.then(|| row.tensions[robot.reference_cable].unwrap().total_n),
+                localiser_pose: None,
+            };
+            let found = localizer
+                .localize(&readings, None)
+                .unwrap_or_else(|e| panic!("line {}: {e}", row.line));
+            let logged = sagcal::model::pose::PlatformPose::from_roll_pitch_yaw_deg(
+                row.position_m.into(),
+                row.roll_deg,
+                row.pitch_deg,
+                row.yaw_deg,
+            );
+            let error = (found.pose.position_m - logged.position_m).norm();
+            sum_sq += error * error;
+            max_position = max_position.max(error);
+            let angle = found.pose.angle_to_deg(&logged);
+            sum_angle += angle;
+            max_angle = max_angle.max(angle);
+            consistent += usize::from(found.consistent);
+            for (i, t) in row.tensions.iter().enumerate() {
+                if let Some(t) = t.filter(|_| !(load_cell && i == robot.reference_cable)) {
+                    tension_errors.push((found.tensions[i].magnitude_n() - t.total_n).abs() / t.total_n);
+                }
+            }
+        }
+        let n = log.rows.len() as f64;
+        let rms = (sum_sq / n).sqrt();
+        let mean_tension = tension_errors.iter().sum::<f64>() / tension_errors.len() as f64;
+        let max_tension = tension_errors.iter().copied().fold(0.0, f64::max);
+        println!(
+            "RecurDyn log, {} rows, {}: position RMS {:.1} mm, max {:.1} mm; orientation vs log mean {:.2} deg, max {:.2} deg; \
+             tension error mean {:.3} %, max {:.3} % ({} logged tensions); consistent at 1e-3 (paper sigmas): {consistent}",
+            log.rows.len(),
+            if load_cell { "lengths + load cell" } else { "lengths only" },
+            rms * 1e3,
+            max_position * 1e3,
+            sum_angle / n,
+            max_angle,
+            100.0 * mean_tension,
+            100.0 * max_tension,
+            tension_errors.len(),
+        );
+        assert!(
+            rms < 0.1 && max_position < 0.2,
+            "position RMS {rms} m, max {max_position} m"
+        );
+        assert!(max_tension < 0.05, "tension error {max_tension}");
+    }
+}
