@@ -429,3 +429,31 @@ fn recurdyn_log_accuracy() {
         assert!(max_tension < 0.05, "tension error {max_tension}");
     }
 }
+
+#[test]
+fn stiffness_is_symmetric_and_a_flipped_start_is_not_kept() {
+    use sagcal::localize::stiffness::{smallest_stiffness, stiffness};
+    let robot = robot("large");
+    let localizer = localizer(&robot);
+    for eq in equilibria(&robot, 4, 21) {
+        let t = eq.tensions[robot.reference_cable];
+        let model = model_at_pose(localizer.slots(), &eq.pose, &Vector2::new(t.horizontal_n, t.vertical_n)).unwrap();
+        let k = stiffness(&robot, localizer.slots(), &eq.pose, &model);
+        let asymmetry = (k - k.transpose()).amax() / k.amax();
+        println!(
+            "smallest stiffness {:.3e}, asymmetry {asymmetry:.1e}",
+            smallest_stiffness(&k)
+        );
+        assert!(asymmetry < 1e-4, "stiffness asymmetry {asymmetry:e}\n{k}");
+        assert!(smallest_stiffness(&k) > 0.0);
+        // Started upside down, the localiser still returns the stable, hanging equilibrium.
+        let flipped = eq
+            .pose
+            .retract(&Vector6::new(std::f64::consts::PI, 0.0, 0.0, 0.0, 0.0, 0.0));
+        let found = localizer
+            .localize(&readings(&robot, &eq, false), Some(&flipped))
+            .unwrap();
+        assert!(found.stable);
+        assert!((found.pose.position_m - eq.pose.position_m).norm() < 1e-9);
+    }
+}
