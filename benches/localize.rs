@@ -44,17 +44,20 @@ fn trajectory(robot: &Robot) -> Vec<(Equilibrium, Readings)> {
         .collect()
 }
 
-/// Localise the trajectory, warm-started or cold; the worst position error.
-fn pass(localizer: &Localizer, rows: &[(Equilibrium, Readings)], warm: bool) -> f64 {
+/// Localise the trajectory, warm-started or cold; the worst position error
+/// and the Gauss-Newton iterations.
+fn pass(localizer: &Localizer, rows: &[(Equilibrium, Readings)], warm: bool) -> (f64, usize) {
     let mut previous: Option<PlatformPose> = None;
     let mut worst = 0.0f64;
+    let mut iterations = 0;
     for (eq, readings) in rows {
         let start = if warm { previous.as_ref() } else { None };
         let found = localizer.localize(readings, start).expect("localised");
         worst = worst.max((found.pose.position_m - eq.pose.position_m).norm());
         previous = Some(found.pose);
+        iterations += found.iterations;
     }
-    worst
+    (worst, iterations)
 }
 
 fn localize(c: &mut Criterion) {
@@ -67,11 +70,12 @@ fn localize(c: &mut Criterion) {
     println!("localisation, large robot, {POSES} poses on a straight 10 m line, encoders + load cell, one thread");
     for (name, warm) in [("warm", true), ("cold", false)] {
         let started = Instant::now();
-        let worst = pass(&localizer, &rows, warm);
+        let (worst, iterations) = pass(&localizer, &rows, warm);
         let per_second = POSES as f64 / started.elapsed().as_secs_f64();
         println!(
-            "{name}: {per_second:>9.0} poses/s ({:.1} us/pose; target {TARGET_PER_SECOND:.0}/s: {}), worst position error {worst:.2e} m",
+            "{name}: {per_second:>9.0} poses/s ({:.1} us/pose, {:.1} Gauss-Newton iterations/pose; target {TARGET_PER_SECOND:.0}/s: {}), worst position error {worst:.2e} m",
             1e6 / per_second,
+            iterations as f64 / POSES as f64,
             if per_second >= TARGET_PER_SECOND { "met" } else { "NOT met" }
         );
     }

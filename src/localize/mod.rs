@@ -255,8 +255,12 @@ impl Localizer {
         }
         let mut best: Option<Localized> = None;
         let mut unstable = 0;
-        for start in self.cold_starts(&observation, readings) {
-            let Some(found) = self.try_start(&observation, start.0, Some(start.1), &mut iterations) else {
+        let level = self.level_start(readings);
+        for kind in [ColdStart::Prior, ColdStart::Level, ColdStart::Statics] {
+            let Some((pose, tension)) = self.cold_start(kind, &observation, &level) else {
+                continue;
+            };
+            let Some(found) = self.try_start(&observation, pose, tension, &mut iterations) else {
                 continue;
             };
             if !found.stable {
@@ -267,7 +271,9 @@ impl Localizer {
             if best.as_ref().is_none_or(|b| distance(&found) < distance(b) - 1e-9) {
                 best = Some(found);
             }
-            if reference.is_none() {
+            // Without a reference pose the first stable equilibrium is taken;
+            // one found from the prior is the one nearest the prior.
+            if reference.is_none() || kind == ColdStart::Prior {
                 break;
             }
         }
@@ -283,24 +289,34 @@ impl Localizer {
         })
     }
 
-    /// Starts after the warm one: the prior, the level trilateration with
-    /// the chord's tension, and `model::statics`' feasible start there.
-    fn cold_starts(&self, observation: &Observation, readings: &Readings) -> Vec<(PlatformPose, Vector2<f64>)> {
-        let mut starts = Vec::with_capacity(4);
+    /// The level platform at the straight-cable trilateration of the
+    /// lengths (offsets and encoder scale removed).
+    fn level_start(&self, readings: &Readings) -> PlatformPose {
         let true_lengths: [f64; CABLE_COUNT] = std::array::from_fn(|i| {
             (readings.encoder_lengths_m[i] - self.robot.length_offsets_m[i]) / self.robot.effects.encoder_gain[i]
         });
-        if let Some((prior, _, _)) = observation.prior {
-            starts.push((prior, self.chord_tension(&prior)));
+        PlatformPose::from_position(trilaterate(&self.robot, &true_lengths))
+    }
+
+    /// A start after the warm one (`None` where it does not exist); the
+    /// statics start (an exact closed-form equilibrium at the trilaterated
+    /// position, `model::statics::feasible_start`) is the costly one, taken last.
+    fn cold_start(
+        &self,
+        kind: ColdStart,
+        observation: &Observation,
+        level: &PlatformPose,
+    ) -> Option<(PlatformPose, Option<Vector2<f64>>)> {
+        match kind {
+            ColdStart::Prior => observation.prior.map(|(pose, _, _)| (pose, None)),
+            ColdStart::Level => Some((*level, None)),
+            ColdStart::Statics => {
+                let (_, eq) =
+                    statics::feasible_start(&self.robot, level.position_m, None, &StaticsOptions::default()).ok()?;
+                let t = eq.tensions[self.robot.reference_cable];
+                Some((eq.pose, Some(Vector2::new(t.horizontal_n, t.vertical_n))))
+            }
         }
-        let position = trilaterate(&self.robot, &true_lengths);
-        let level = PlatformPose::from_position(position);
-        starts.push((level, self.chord_tension(&level)));
-        if let Ok((_, eq)) = statics::feasible_start(&self.robot, position, None, &StaticsOptions::default()) {
-            let t = eq.tensions[self.robot.reference_cable];
-            starts.push((eq.pose, Vector2::new(t.horizontal_n, t.vertical_n)));
-        }
-        starts
     }
 
     /// A reference tension for a start pose: the straight-cable magnitude
@@ -320,7 +336,8 @@ impl Localizer {
         reference: Option<Vector2<f64>>,
         iterations: &mut usize,
     ) -> Option<Localized> {
-        let reference = reference.unwrap_or_else(|| self.chord_tension(&pose));
+        let reference =
+            reference.unwrap_or_else(|| newton::fit_reference_tension(&self.slots, &pose, self.chord_tension(&pose)));
         let solution = newton::solve(
             &self.slots,
             observation,
@@ -362,6 +379,17 @@ impl Localizer {
             iterations: solution.iterations,
         }
     }
+}
+
+/// The starts tried after the warm one, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum ColdStart {
+    /// The localiser prior (with `--pose-prior`).
+    Prior,
+    /// The level platform at the trilaterated position.
+    Level,
+    /// A closed-form equilibrium at the trilaterated position.
+    Statics,
 }
 
 /// Distance between poses for choosing among equilibria: position (m) plus

@@ -220,3 +220,32 @@ fn finish(
         converged: heights_hold,
     }
 }
+
+/// The reference tension that best meets the four attachment heights (eq. 15)
+/// at a fixed `pose`, by a few Gauss-Newton steps from `start` (the start is
+/// kept where the model is undefined): a warm start's pose is then matched
+/// by its tensions and the full iteration starts near the solution.
+pub fn fit_reference_tension(robot: &SlotRobot, pose: &PlatformPose, start: Vector2<f64>) -> Vector2<f64> {
+    let mut reference = start;
+    for _ in 0..4 {
+        let Some(model) = model_at_pose(robot, pose, &reference) else {
+            break;
+        };
+        let j = model.d_heights.fixed_columns::<2>(6).into_owned();
+        let Some(step) = (j.transpose() * j)
+            .try_inverse()
+            .map(|inverse| -(inverse * (j.transpose() * model.heights_m)))
+        else {
+            break;
+        };
+        let trial = reference + step;
+        match model_at_pose(robot, pose, &trial) {
+            Some(t) if t.heights_m.norm() < model.heights_m.norm() => reference = trial,
+            _ => break,
+        }
+        if step.norm() < 1e-9 * reference.norm() {
+            break;
+        }
+    }
+    reference
+}
