@@ -8,7 +8,7 @@
 //! **plan** the poses worth visiting (`plan`, to come), **calibrate** the
 //! anchors and encoder offsets ([`calib`]), **diagnose** what the model gets
 //! wrong ([`diagnose`]), and **localise** the calibrated robot from its cable
-//! readings (`localize`, to come).
+//! readings ([`localize`]).
 //!
 //! The layers, data flowing one way (no module names one above it; the
 //! test `tests/layout.rs` checks it):
@@ -21,7 +21,7 @@
 //! | [`sim`] | closed-form and discretised simulators (the truth of the experiments) |
 //! | [`graph`] | variables, the factor trait, noise, robust kernels ([`calib`]'s factors wrap [`generated`]) |
 //! | [`solver`] | sparse Levenberg-Marquardt: pattern, Schur / Cholesky, covariance |
-//! | [`calib`], [`diagnose`] | the jobs: staged calibration; residual tests, candidate effects, verdict |
+//! | [`calib`], [`diagnose`], [`localize`] | the jobs: staged calibration; residual tests, candidate effects, verdict; pose and tensions from the cable readings |
 //! | [`experiments`] | Table II protocol, hidden effects, the benchmark problem |
 //! | [`plot`] | figures (SVG) |
 //! | the `sagcal` binary | a thin clap layer, one file per command |
@@ -53,6 +53,7 @@ pub mod experiments;
 pub mod generated;
 pub mod graph;
 pub mod io;
+pub mod localize;
 pub mod model;
 pub mod plot;
 pub mod sim;

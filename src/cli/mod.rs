@@ -7,6 +7,7 @@ mod diagnose;
 mod experiment;
 mod gross_errors;
 mod hidden;
+mod localize;
 mod output;
 mod simulate;
 mod verify;
@@ -35,6 +36,8 @@ enum Command {
     Verify(VerifyArgs),
     /// Find what the model gets wrong: test residuals, fit the catalogue of effects, report the gain.
     Diagnose(DiagnoseArgs),
+    /// Localise the calibrated robot: pose and tensions from its cable readings.
+    Localize(LocalizeArgs),
     /// Reproduce the paper's experiments.
     #[command(subcommand)]
     Experiment(ExperimentCommand),
@@ -376,6 +379,31 @@ struct VerifyArgs {
     json: bool,
 }
 
+#[derive(Debug, clap::Args)]
+struct LocalizeArgs {
+    /// The calibrated robot (TOML): anchors, length offsets, `[effects]`.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Readings: `l1_m,l2_m,l3_m,l4_m[,f_ref_n]`, a sagcal measurement file or a RecurDyn log.
+    #[arg(long)]
+    data: PathBuf,
+    /// Use the input's localiser pose as a prior (by default it is only compared with).
+    #[arg(long)]
+    pose_prior: bool,
+    /// Sensor sigmas of the readings: paper or authors.
+    #[arg(long, default_value = "paper", value_parser = sagcal::model::sensors::NoisePreset::parse)]
+    noise: sagcal::model::sensors::NoisePreset,
+    /// False-alarm rate of each row's chi-square consistency test.
+    #[arg(long, default_value_t = 1e-3)]
+    false_alarm: f64,
+    /// Write the poses as CSV (atomically).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Print JSON instead of the table.
+    #[arg(long)]
+    json: bool,
+}
+
 /// Parse the command line, run the command, return the process exit code.
 pub fn run() -> i32 {
     let cli = match Cli::try_parse() {
@@ -398,6 +426,7 @@ pub fn run() -> i32 {
         Some(Command::Simulate(args)) => simulate::run(&args),
         Some(Command::Verify(args)) => verify::run(&args),
         Some(Command::Diagnose(args)) => diagnose::run(&args),
+        Some(Command::Localize(args)) => localize::run(&args),
         Some(Command::Experiment(ExperimentCommand::Table2(args))) => experiment::run(&args),
         Some(Command::Experiment(ExperimentCommand::HiddenEffects(args))) => hidden::run(&args),
     };

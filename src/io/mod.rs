@@ -3,6 +3,7 @@
 
 pub mod atomic;
 pub mod measurements;
+pub mod readings;
 pub mod recurdyn;
 pub mod robot_file;
 

@@ -1,0 +1,279 @@
+//! `sagcal localize`: the calibrated robot's pose and tensions from its cable readings.
+
+use serde::Serialize;
+
+use sagcal::io::readings::{read_readings, ReadingsFile, ReadingsFormat};
+use sagcal::io::recurdyn::RejectedRow;
+use sagcal::localize::{LocalizeOptions, Localized, Localizer, Readings};
+use sagcal::model::pose::PlatformPose;
+use sagcal::model::Robot;
+
+use super::output::{opt, print_json, Table};
+use super::LocalizeArgs;
+
+/// Why the position sigmas hold the reading noise only.
+const COVARIANCE_NOTE: &str = "the robot file records no covariance of the calibrated anchors and offsets: \
+     position_sigma_m is from the reading noise only";
+
+/// One row of the report.
+#[derive(Debug, Clone, Serialize)]
+struct RowReport {
+    /// 1-based line of the input.
+    row: usize,
+    position_m: Option<[f64; 3]>,
+    roll_pitch_yaw_deg: Option<[f64; 3]>,
+    tensions_n: Option<[f64; 4]>,
+    position_sigma_m: Option<[f64; 3]>,
+    chi_square: Option<f64>,
+    degrees_of_freedom: Option<usize>,
+    consistent: bool,
+    stable: Option<bool>,
+    /// Distance from the input's localiser position, when it has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    position_error_m: Option<f64>,
+    /// Why the row has no (trusted) equilibrium; `null` for a good row.
+    flag: Option<String>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+struct Report {
+    robot: String,
+    data: String,
+    format: ReadingsFormat,
+    pose_prior: bool,
+    covariance: &'static str,
+    rows: Vec<RowReport>,
+    rejected: Vec<RejectedRow>,
+    rows_flagged: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    position_rms_error_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    position_max_error_m: Option<f64>,
+}
+
+/// Localise every row and print the table (or JSON); `--out` gets the CSV.
+pub fn run(args: &LocalizeArgs) -> sagcal::Result<()> {
+    let robot = Robot::from_file(&args.robot)?;
+    let file = read_readings(&args.data, robot.reference_cable)?;
+    let noise = args.noise.sigmas(robot.platform_weight_n);
+    let options = LocalizeOptions {
+        pose_prior: args.pose_prior,
+        false_alarm: args.false_alarm,
+        ..LocalizeOptions::default()
+    };
+    let localizer = Localizer::with_options(&robot, &noise, options)?;
+    let report = localize_file(&args.robot.display().to_string(), &file, &localizer, args.pose_prior)?;
+    if let Some(out) = &args.out {
+        sagcal::io::write_atomically(out, render_csv(&report).as_bytes())?;
+    }
+    if args.json {
+        print_json(&report)
+    } else {
+        print!("{}", render(&report));
+        if let Some(out) = &args.out {
+            println!("wrote {}", out.display());
+        }
+        Ok(())
+    }
+}
+
+fn localize_file(robot: &str, file: &ReadingsFile, localizer: &Localizer, pose_prior: bool) -> sagcal::Result<Report> {
+    if pose_prior {
+        if let Some(row) = file.rows.iter().find(|r| r.localiser_pose.is_none()) {
+            return Err(sagcal::Error::Field {
+                path: file.path.clone(),
+                row: row.line,
+                field: "x_m".into(),
+                message: "--pose-prior needs a localiser pose on every row; this file has none".into(),
+            });
+        }
+    }
+    let mut warm: Option<PlatformPose> = None;
+    let mut rows = Vec::with_capacity(file.rows.len());
+    for row in &file.rows {
+        let readings = Readings {
+            encoder_lengths_m: row.encoder_lengths_m,
+            load_cell_n: row.load_cell_n,
+            localiser_pose: row.localiser_pose,
+        };
+        let result = localizer.localize(&readings, warm.as_ref());
+        let report = match result {
+            Ok(found) => {
+                if found.stable {
+                    warm = Some(found.pose);
+                }
+                row_report(row.line, &found, row.localiser_pose.as_ref())
+            }
+            Err(e) => flagged(row.line, e.to_string()),
+        };
+        rows.push(report);
+    }
+    let errors: Vec<f64> = rows
+        .iter()
+        .filter(|r| r.flag.is_none())
+        .filter_map(|r| r.position_error_m)
+        .collect();
+    let rms = (!errors.is_empty()).then(|| (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt());
+    Ok(Report {
+        robot: robot.to_string(),
+        data: file.path.display().to_string(),
+        format: file.format,
+        pose_prior,
+        covariance: COVARIANCE_NOTE,
+        rows_flagged: rows.iter().filter(|r| r.flag.is_some()).count(),
+        rows,
+        rejected: file.rejected.clone(),
+        position_rms_error_m: rms,
+        position_max_error_m: errors.iter().copied().reduce(f64::max),
+    })
+}
+
+fn row_report(line: usize, found: &Localized, localiser: Option<&PlatformPose>) -> RowReport {
+    let (roll, pitch, yaw) = found.pose.roll_pitch_yaw_deg();
+    let flag = match (found.consistent, found.stable) {
+        (_, false) => {
+            Some("unstable equilibrium (the stiffness at fixed cable lengths is not positive definite)".into())
+        }
+        (false, _) => Some(format!(
+            "inconsistent: chi-square {:.2} with {} degree(s) of freedom",
+            found.chi_square, found.degrees_of_freedom
+        )),
+        _ => None,
+    };
+    RowReport {
+        row: line,
+        position_m: Some(found.pose.position_m.into()),
+        roll_pitch_yaw_deg: Some([roll, pitch, yaw]),
+        tensions_n: Some(found.tension_magnitudes_n()),
+        position_sigma_m: Some(found.position_sigma_m.into()),
+        chi_square: Some(found.chi_square),
+        degrees_of_freedom: Some(found.degrees_of_freedom),
+        consistent: found.consistent,
+        stable: Some(found.stable),
+        position_error_m: localiser.map(|p| (p.position_m - found.pose.position_m).norm()),
+        flag,
+    }
+}
+
+fn flagged(line: usize, reason: String) -> RowReport {
+    RowReport {
+        row: line,
+        position_m: None,
+        roll_pitch_yaw_deg: None,
+        tensions_n: None,
+        position_sigma_m: None,
+        chi_square: None,
+        degrees_of_freedom: None,
+        consistent: false,
+        stable: None,
+        position_error_m: None,
+        flag: Some(reason),
+    }
+}
+
+fn render(report: &Report) -> String {
+    let mut out = format!(
+        "sagcal localize: robot {}, data {} ({:?}){}\nsigmas: {}\n\n",
+        report.robot,
+        report.data,
+        report.format,
+        if report.pose_prior {
+            ", localiser pose as a prior"
+        } else {
+            ""
+        },
+        COVARIANCE_NOTE
+    );
+    let mut table = Table::new([
+        "row",
+        "x m",
+        "y m",
+        "z m",
+        "roll deg",
+        "pitch deg",
+        "yaw deg",
+        "T1 N",
+        "T2 N",
+        "T3 N",
+        "T4 N",
+        "sx mm",
+        "sy mm",
+        "sz mm",
+        "chi2/dof",
+        "ok",
+        "err mm",
+    ]);
+    for r in &report.rows {
+        let Some(p) = r.position_m else {
+            continue;
+        };
+        let a = r.roll_pitch_yaw_deg.unwrap_or_default();
+        let t = r.tensions_n.unwrap_or_default();
+        let s = r.position_sigma_m.unwrap_or_default();
+        let mut cells = vec![r.row.to_string()];
+        cells.extend(p.iter().map(|v| format!("{v:.4}")));
+        cells.extend(a.iter().map(|v| format!("{v:.3}")));
+        cells.extend(t.iter().map(|v| format!("{v:.2}")));
+        cells.extend(s.iter().map(|v| format!("{:.2}", v * 1e3)));
+        cells.push(format!(
+            "{:.2}/{}",
+            r.chi_square.unwrap_or(f64::NAN),
+            r.degrees_of_freedom.unwrap_or(0)
+        ));
+        cells.push(if r.flag.is_none() { "yes" } else { "FLAG" }.into());
+        cells.push(opt(r.position_error_m.map(|e| e * 1e3), 2));
+        table.row(cells);
+    }
+    out += &table.to_string();
+    for r in report.rows.iter().filter(|r| r.flag.is_some()) {
+        out += &format!("row {}: {}\n", r.row, r.flag.as_deref().unwrap_or(""));
+    }
+    for r in &report.rejected {
+        out += &format!("row {} left out by the loader: {}\n", r.line, r.reason);
+    }
+    out += &format!(
+        "\nrows localised: {}, flagged: {}\n",
+        report.rows.len(),
+        report.rows_flagged
+    );
+    if let (Some(rms), Some(max)) = (report.position_rms_error_m, report.position_max_error_m) {
+        out += &format!(
+            "position against the input's poses (unflagged rows): RMS {:.3} mm, max {:.3} mm\n",
+            rms * 1e3,
+            max * 1e3
+        );
+    }
+    out
+}
+
+/// The poses as CSV (one line per input row; a flagged row's values empty).
+fn render_csv(report: &Report) -> String {
+    let mut out = String::from(
+        "row,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,t1_n,t2_n,t3_n,t4_n,sigma_x_m,sigma_y_m,sigma_z_m,chi_square,dof,consistent,stable,position_error_m,flag\n",
+    );
+    let join = |v: Option<&[f64]>, n: usize| -> String {
+        v.map_or_else(
+            || vec![""; n].join(","),
+            |v| v.iter().map(|x| format!("{x:e}")).collect::<Vec<_>>().join(","),
+        )
+    };
+    for r in &report.rows {
+        out += &format!(
+            "{},{},{},{},{},{},{},{},{},{},{}\n",
+            r.row,
+            join(r.position_m.as_ref().map(|v| &v[..]), 3),
+            join(r.roll_pitch_yaw_deg.as_ref().map(|v| &v[..]), 3),
+            join(r.tensions_n.as_ref().map(|v| &v[..]), 4),
+            join(r.position_sigma_m.as_ref().map(|v| &v[..]), 3),
+            r.chi_square.map_or(String::new(), |c| format!("{c:e}")),
+            r.degrees_of_freedom.map_or(String::new(), |d| d.to_string()),
+            r.consistent,
+            r.stable.map_or(String::new(), |s| s.to_string()),
+            r.position_error_m.map_or(String::new(), |e| format!("{e:e}")),
+            r.flag
+                .as_deref()
+                .map_or(String::new(), |f| format!("\"{}\"", f.replace('"', "'"))),
+        );
+    }
+    out
+}

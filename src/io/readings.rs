@@ -1,0 +1,194 @@
+//! The input of `sagcal localize`: rows of cable readings, from a
+//! readings-only CSV, sagcal's measurement file or a RecurDyn log
+//! ([`read_readings`] tells them apart by the header).
+//!
+//! # Readings-only format
+//!
+//! ```text
+//! # encoder readings of the calibrated robot
+//! l1_m,l2_m,l3_m,l4_m,f_ref_n
+//! 183.324069126233,169.162981532604,155.642263929178,170.927219368362,698.72
+//! ```
+//!
+//! The header is `l1_m,l2_m,l3_m,l4_m` with an optional fifth column
+//! `f_ref_n` (the load cell, N, positive; an empty field: not read on that
+//! row). Encoder readings are any finite numbers (cable length plus the
+//! calibrated offset). Comments (`#`) and blank lines are ignored, as in the
+//! measurement file ([`crate::io::measurements`]). Errors name the file, the
+//! line and the column.
+//!
+//! Measurement files and RecurDyn logs are read by
+//! [`read_measurements`]: their localiser pose is kept (for comparison, or a
+//! prior) and their load cell is the reference cable's tension.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result};
+use crate::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
+use crate::io::recurdyn::RejectedRow;
+use crate::model::pose::PlatformPose;
+use crate::model::robot::CABLE_COUNT;
+
+/// The readings-only header (the fifth column optional).
+pub const READINGS_HEADER: [&str; 5] = ["l1_m", "l2_m", "l3_m", "l4_m", "f_ref_n"];
+
+/// One row of readings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReadingRow {
+    /// 1-based line in the file.
+    pub line: usize,
+    /// Encoder readings of cables 1..4, metres.
+    pub encoder_lengths_m: [f64; CABLE_COUNT],
+    /// The load cell, newtons, if read.
+    pub load_cell_n: Option<f64>,
+    /// The localiser's pose, if the file has one.
+    pub localiser_pose: Option<PlatformPose>,
+}
+
+/// The format a readings file was in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ReadingsFormat {
+    /// `l1_m,l2_m,l3_m,l4_m[,f_ref_n]`.
+    ReadingsOnly,
+    /// sagcal's measurement file.
+    Sagcal,
+    /// A RecurDyn log.
+    RecurDyn,
+}
+
+/// The rows of one file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReadingsFile {
+    /// The file.
+    pub path: PathBuf,
+    /// Its format.
+    pub format: ReadingsFormat,
+    /// The rows, in file order; never empty.
+    pub rows: Vec<ReadingRow>,
+    /// Rows the RecurDyn loader left out, with the reason.
+    pub rejected: Vec<RejectedRow>,
+}
+
+fn field_error(path: &Path, row: usize, field: &str, message: String) -> Error {
+    Error::Field {
+        path: path.to_path_buf(),
+        row,
+        field: field.into(),
+        message,
+    }
+}
+
+/// Read the rows of `path` in any of the three formats (module docs);
+/// `reference_cable` (0-based) picks a RecurDyn log's load-cell column.
+pub fn read_readings(path: &Path, reference_cable: usize) -> Result<ReadingsFile> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let header = lines.next().map(|(_, l)| l).unwrap_or("");
+    let fields: Vec<&str> = header.split(',').map(str::trim).collect();
+    let with_load_cell = fields == READINGS_HEADER;
+    if !(with_load_cell || fields == READINGS_HEADER[..CABLE_COUNT]) {
+        return read_measurement_rows(path, reference_cable);
+    }
+    let mut rows = Vec::new();
+    for (line, text) in lines {
+        let values: Vec<&str> = text.split(',').map(str::trim).collect();
+        if values.len() != fields.len() {
+            return Err(field_error(
+                path,
+                line,
+                fields.last().copied().unwrap_or(""),
+                format!("expected {} fields, found {}", fields.len(), values.len()),
+            ));
+        }
+        let number =
+            |k: usize| -> Result<f64> {
+                values[k].parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
+                    field_error(path, line, fields[k], format!("`{}` is not a finite number", values[k]))
+                })
+            };
+        let mut encoder_lengths_m = [0.0; CABLE_COUNT];
+        for (k, value) in encoder_lengths_m.iter_mut().enumerate() {
+            *value = number(k)?;
+        }
+        let load_cell_n = match with_load_cell && !values[CABLE_COUNT].is_empty() {
+            true => {
+                let f = number(CABLE_COUNT)?;
+                if f <= 0.0 {
+                    return Err(field_error(
+                        path,
+                        line,
+                        "f_ref_n",
+                        format!("tension {f} N must be positive"),
+                    ));
+                }
+                Some(f)
+            }
+            false => None,
+        };
+        rows.push(ReadingRow {
+            line,
+            encoder_lengths_m,
+            load_cell_n,
+            localiser_pose: None,
+        });
+    }
+    if rows.is_empty() {
+        return Err(Error::Format {
+            path: path.to_path_buf(),
+            message: "no rows after the header".into(),
+        });
+    }
+    Ok(ReadingsFile {
+        path: path.to_path_buf(),
+        format: ReadingsFormat::ReadingsOnly,
+        rows,
+        rejected: Vec::new(),
+    })
+}
+
+fn read_measurement_rows(path: &Path, reference_cable: usize) -> Result<ReadingsFile> {
+    let set = read_measurements(
+        path,
+        &ReadOptions {
+            reference_cable,
+            keep_rounded: false,
+        },
+    )
+    .map_err(|e| match e {
+        Error::Format { path, message } => Error::Format {
+            path,
+            message: format!("{message}; or the readings-only header `l1_m,l2_m,l3_m,l4_m[,f_ref_n]`"),
+        },
+        other => other,
+    })?;
+    let rows = set
+        .poses
+        .iter()
+        .map(|m| ReadingRow {
+            line: m.line,
+            encoder_lengths_m: m.encoder_lengths_m,
+            load_cell_n: Some(m.reference_tension_n),
+            localiser_pose: Some(PlatformPose::from_roll_pitch_yaw_deg(
+                m.position_m.into(),
+                m.roll_deg,
+                m.pitch_deg,
+                m.yaw_deg,
+            )),
+        })
+        .collect();
+    Ok(ReadingsFile {
+        path: set.path,
+        format: match set.format {
+            MeasurementFormat::Sagcal => ReadingsFormat::Sagcal,
+            MeasurementFormat::RecurDyn => ReadingsFormat::RecurDyn,
+        },
+        rows,
+        rejected: set.rejected,
+    })
+}

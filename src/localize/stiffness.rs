@@ -1,0 +1,84 @@
+//! Stability of an equilibrium: the platform's stiffness at fixed cable lengths.
+//!
+//! Hold every cable's paid-out length and move the platform by a tangent
+//! `xi = [dtheta, dp]`: each cable's end tensions then follow from its two
+//! equations alone (paid-out length fixed, eq. 4; end height, eq. 15), so
+//! `d f_i / d xi = -(d[paid, drop]/d[f_h, f_v])^-1 d[paid, drop - h]/d xi`.
+//! The generalised force on the platform conjugate to `xi` is
+//! `Q = [R^T tau; F]` with `[F; tau] = J^T(pose) f - w(pose)` (eq. 5-8: the
+//! cables' pull and the weight), and the stiffness is `K = -dQ/dxi`. The
+//! equilibrium is stable when `K`'s symmetric part is positive definite (the
+//! Hessian of the potential energy at fixed cable lengths; `K` itself is
+//! symmetric at an equilibrium up to the finite differences taken of `J^T`
+//! and `w` at fixed tensions).
+
+use nalgebra::{Matrix6, SMatrix, Vector3, Vector6};
+
+use super::equations::{ModelAtPose, SlotRobot};
+use crate::model::pose::PlatformPose;
+use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::statics::{gravity_wrench, structure_matrix};
+
+/// Step of the finite differences of `J^T` and `w` at fixed tensions.
+const STEP: f64 = 1e-6;
+
+/// `Q = [R^T tau; F]` at `pose` with tensions `f` (robot order, `(f_h, f_v)` per cable).
+fn generalised_force(robot: &Robot, pose: &PlatformPose, f: &SMatrix<f64, 8, 1>) -> Vector6<f64> {
+    let wrench = structure_matrix(robot, pose) * f - gravity_wrench(robot, pose);
+    let torque = pose.rotation.inverse() * Vector3::new(wrench[3], wrench[4], wrench[5]);
+    Vector6::new(torque.x, torque.y, torque.z, wrench[0], wrench[1], wrench[2])
+}
+
+/// The stiffness `K = -dQ/dxi` at fixed cable lengths (module docs); `robot`
+/// is the calibrated robot with the `[effects]` centre of mass.
+pub fn stiffness(robot: &Robot, slots: &SlotRobot, pose: &PlatformPose, model: &ModelAtPose) -> Matrix6<f64> {
+    let mut f = SMatrix::<f64, 8, 1>::zeros();
+    for (slot, &cable) in slots.cables.iter().enumerate() {
+        f[2 * cable] = model.tensions_n[slot][0];
+        f[2 * cable + 1] = model.tensions_n[slot][1];
+    }
+    // At fixed tensions: central differences of J^T f - w.
+    let mut d_q = Matrix6::<f64>::zeros();
+    for k in 0..6 {
+        let mut xi = Vector6::zeros();
+        xi[k] = STEP;
+        let plus = generalised_force(robot, &pose.retract(&xi), &f);
+        let minus = generalised_force(robot, &pose.retract(&-xi), &f);
+        d_q.set_column(k, &((plus - minus) / (2.0 * STEP)));
+    }
+    // Through the tensions: dQ/df df/dxi, each cable on its own.
+    let jt = structure_matrix(robot, pose);
+    let inverse_rotation = pose.rotation.inverse().to_rotation_matrix();
+    let mut d_q_d_f = SMatrix::<f64, 6, 8>::zeros();
+    for c in 0..8 {
+        let column = jt.column(c);
+        let torque = inverse_rotation * Vector3::new(column[3], column[4], column[5]);
+        d_q_d_f.set_column(
+            c,
+            &Vector6::new(torque.x, torque.y, torque.z, column[0], column[1], column[2]),
+        );
+    }
+    let mut d_f = SMatrix::<f64, 8, 6>::zeros();
+    for (slot, &cable) in slots.cables.iter().enumerate().take(CABLE_COUNT) {
+        let partials = &model.cables[slot];
+        let mut b = SMatrix::<f64, 2, 6>::zeros();
+        b.set_row(0, &(partials.span_pose * partials.d_span[0]));
+        b.set_row(1, &(partials.span_pose * partials.d_span[1] - partials.height_pose));
+        let Some(inverse) = partials.d_tension.try_inverse() else {
+            return Matrix6::from_element(f64::NAN);
+        };
+        let block = -(inverse * b);
+        d_f.fixed_view_mut::<2, 6>(2 * cable, 0).copy_from(&block);
+    }
+    -(d_q + d_q_d_f * d_f)
+}
+
+/// The smallest eigenvalue of `K`'s symmetric part (NaN if `K` is not finite);
+/// units mixed (N m/rad and N/m), only its sign is meaningful.
+pub fn smallest_stiffness(k: &Matrix6<f64>) -> f64 {
+    if !k.iter().all(|v| v.is_finite()) {
+        return f64::NAN;
+    }
+    let symmetric = (k + k.transpose()) * 0.5;
+    symmetric.symmetric_eigenvalues().min()
+}
