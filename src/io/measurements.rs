@@ -52,6 +52,13 @@
 //! ([`ReadOptions::reference_cable`]). Rows the RecurDyn loader rejects, and
 //! rows without a tension for the reference cable, are listed in
 //! [`MeasurementSet::rejected`] with the reason.
+//!
+//! # The authors' dataset folder
+//!
+//! When `path` is a folder, [`read_measurements`] reads it as the dataset
+//! folder of the paper's published program (`pos_i_cpp_test.csv`,
+//! `R_i_cpp_test.csv`, `lc_meas_cpp_test.csv`, `forces_cpp_test.csv`; see
+//! [`crate::io::authors`] for the columns and the mapping).
 
 use std::path::{Path, PathBuf};
 
@@ -59,6 +66,7 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::io::atomic::write_atomically;
+use crate::io::authors::{is_authors_folder, read_authors_folder};
 use crate::io::recurdyn::{looks_like_recurdyn, read_recurdyn, LoadOptions, RecurDynRow, RejectedRow};
 pub use crate::model::measurement::PoseMeasurement;
 
@@ -95,6 +103,8 @@ pub enum MeasurementFormat {
     Sagcal,
     /// A RecurDyn finite-element log ([`crate::io::recurdyn`]).
     RecurDyn,
+    /// The dataset folder of the paper's published program ([`crate::io::authors`]).
+    Authors,
 }
 
 /// The measurements of one file.
@@ -123,7 +133,8 @@ pub struct ReadOptions {
 }
 
 /// Read a measurement file, sagcal's own format or a RecurDyn log, told apart
-/// by the header (the first line that is neither blank nor a comment).
+/// by the header (the first line that is neither blank nor a comment); or,
+/// when `path` is a folder, the authors' dataset folder ([`crate::io::authors`]).
 ///
 /// Malformed input is an error naming the file (and the line and column when
 /// the problem is in one value): [`Error::Io`] when the file cannot be read,
@@ -138,6 +149,14 @@ pub fn read_measurements(path: &Path, options: &ReadOptions) -> Result<Measureme
             options.reference_cable,
             N_CABLES - 1
         )));
+    }
+    if is_authors_folder(path) {
+        return Ok(MeasurementSet {
+            path: path.to_path_buf(),
+            format: MeasurementFormat::Authors,
+            poses: read_authors_folder(path)?,
+            rejected: Vec::new(),
+        });
     }
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let bytes = bytes.strip_prefix(b"\xef\xbb\xbf".as_slice()).unwrap_or(&bytes);

@@ -2,6 +2,7 @@
 //! formats and validation of single values, no physics.
 
 pub mod atomic;
+pub mod authors;
 pub mod measurements;
 pub mod readings;
 pub mod recurdyn;

@@ -1,6 +1,7 @@
 //! The input of `sagcal localize`: rows of cable readings, from a
-//! readings-only CSV, sagcal's measurement file or a RecurDyn log
-//! ([`read_readings`] tells them apart by the header).
+//! readings-only CSV, sagcal's measurement file, a RecurDyn log
+//! ([`read_readings`] tells them apart by the header) or the authors' dataset
+//! folder ([`crate::io::authors`], when the path is a folder).
 //!
 //! # Readings-only format
 //!
@@ -55,6 +56,8 @@ pub enum ReadingsFormat {
     Sagcal,
     /// A RecurDyn log.
     RecurDyn,
+    /// The authors' dataset folder.
+    Authors,
 }
 
 /// The rows of one file.
@@ -79,9 +82,12 @@ fn field_error(path: &Path, row: usize, field: &str, message: String) -> Error {
     }
 }
 
-/// Read the rows of `path` in any of the three formats (module docs);
+/// Read the rows of `path` in any of the four formats (module docs);
 /// `reference_cable` (0-based) picks a RecurDyn log's load-cell column.
 pub fn read_readings(path: &Path, reference_cable: usize) -> Result<ReadingsFile> {
+    if crate::io::authors::is_authors_folder(path) {
+        return read_measurement_rows(path, reference_cable);
+    }
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let mut lines = text
@@ -187,6 +193,7 @@ fn read_measurement_rows(path: &Path, reference_cable: usize) -> Result<Readings
         format: match set.format {
             MeasurementFormat::Sagcal => ReadingsFormat::Sagcal,
             MeasurementFormat::RecurDyn => ReadingsFormat::RecurDyn,
+            MeasurementFormat::Authors => ReadingsFormat::Authors,
         },
         rows,
         rejected: set.rejected,
