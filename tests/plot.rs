@@ -1,9 +1,10 @@
-//! Tests of the dependency-free SVG anchor plot (`sagcal::plot`).
+//! Tests of the hand-drawn anchor plot (`sagcal::plot`) and of writing figures as SVG or PNG.
 
 use std::collections::HashMap;
 use std::path::Path;
 
-use sagcal::plot::{anchor_plot_svg, write_svg, AnchorPlot, AnchorPlotEntry};
+use sagcal::plot::residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
+use sagcal::plot::{anchor_plot_svg, svg_to_png, write_figure, AnchorPlot, AnchorPlotEntry, PNG_SCALE};
 
 // ---------------------------------------------------------------------------
 // A minimal XML reader: checks well-formedness (balanced, properly nested tags,
@@ -321,7 +322,7 @@ fn example_is_well_formed_and_complete() {
     }
     assert!(svg.contains(">initial<"));
     let path = std::env::temp_dir().join("anchor_plot_example.svg");
-    write_svg(&path, &svg).unwrap();
+    write_figure(&path, &svg).unwrap();
     assert_eq!(std::fs::read_to_string(&path).unwrap(), svg);
 }
 
@@ -471,10 +472,10 @@ fn dir_entries(dir: &Path) -> Vec<String> {
 }
 
 #[test]
-fn write_svg_to_missing_directory_fails_naming_the_path_and_leaves_nothing() {
+fn write_figure_to_missing_directory_fails_naming_the_path_and_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("no-such-dir").join("plot.svg");
-    let err = write_svg(&path, "<svg/>").unwrap_err();
+    let err = write_figure(&path, "<svg/>").unwrap_err();
     assert!(matches!(err, sagcal::Error::Io { .. }), "{err:?}");
     assert!(err.to_string().contains(&path.display().to_string()), "{err}");
     assert!(!path.exists());
@@ -483,17 +484,136 @@ fn write_svg_to_missing_directory_fails_naming_the_path_and_leaves_nothing() {
 }
 
 #[test]
-fn write_svg_replaces_atomically() {
+fn write_figure_replaces_atomically() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("plot.svg");
-    write_svg(&path, "first").unwrap();
-    write_svg(&path, "second").unwrap();
+    write_figure(&path, "first").unwrap();
+    write_figure(&path, "second").unwrap();
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "second");
     assert_eq!(dir_entries(dir.path()), vec!["plot.svg".to_owned()]);
     // A directory in the way is an error naming the path, and leaves no temp file.
     let sub = dir.path().join("sub");
     std::fs::create_dir(&sub).unwrap();
-    let err = write_svg(&sub, "x").unwrap_err();
+    let err = write_figure(&sub, "x").unwrap_err();
     assert!(err.to_string().contains(&sub.display().to_string()));
     assert_eq!(dir_entries(dir.path()), vec!["plot.svg".to_owned(), "sub".to_owned()]);
+}
+
+// ---------------------------------------------------------------------------
+// PNG.
+
+/// Width and height of a PNG, from its IHDR chunk.
+fn png_size(png: &[u8]) -> (u32, u32) {
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
+    assert_eq!(&png[12..16], b"IHDR");
+    let be = |b: &[u8]| u32::from_be_bytes([b[0], b[1], b[2], b[3]]);
+    (be(&png[16..20]), be(&png[20..24]))
+}
+
+/// Pixels darker than mid grey in a rendered PNG.
+fn ink(png: &[u8]) -> usize {
+    let pixmap = resvg::tiny_skia::Pixmap::decode_png(png).expect("decodes");
+    pixmap
+        .pixels()
+        .iter()
+        .filter(|p| u32::from(p.red()) + u32::from(p.green()) + u32::from(p.blue()) < 3 * 128)
+        .count()
+}
+
+/// The `width="..."` and `height="..."` of an SVG's root element.
+fn svg_size(svg: &str) -> (f64, f64) {
+    let root = &svg[svg.find("<svg").unwrap()..];
+    let attr = |name: &str| -> f64 {
+        let at = root.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+        root[at..at + root[at..].find('"').unwrap()].parse().unwrap()
+    };
+    (attr("width"), attr("height"))
+}
+
+#[test]
+fn text_is_drawn_with_the_bundled_regular_and_bold_fonts() {
+    // Without a font resvg draws no text at all: the ink is the glyphs'.
+    let svg = |weight: &str| {
+        format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="300" height="40"><text x="4" y="28" font-family="Helvetica, sans-serif" font-size="24" font-weight="{weight}">Anchor 1 sigma</text></svg>"#
+        )
+    };
+    let regular = ink(&svg_to_png(&svg("normal"), 1.0, "regular").unwrap());
+    let bold = ink(&svg_to_png(&svg("bold"), 1.0, "bold").unwrap());
+    assert!(regular > 300, "regular text ink {regular} px");
+    // DejaVu Sans Bold's strokes are thicker: the bold face is loaded, not the regular one again.
+    assert!(
+        bold as f64 > 1.25 * regular as f64,
+        "bold {bold} vs regular {regular} px"
+    );
+    let empty = r#"<svg xmlns="http://www.w3.org/2000/svg" width="300" height="40"></svg>"#;
+    assert_eq!(ink(&svg_to_png(empty, 1.0, "empty").unwrap()), 0);
+}
+
+#[test]
+fn png_figures_are_the_svg_at_twice_the_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = anchor_plot_svg(&example_plot());
+    let path = dir.path().join("anchors.PNG");
+    write_figure(&path, &svg).unwrap();
+    let png = std::fs::read(&path).unwrap();
+    let (w, h) = svg_size(&svg);
+    assert_eq!(
+        png_size(&png),
+        ((PNG_SCALE as f64 * w) as u32, (PNG_SCALE as f64 * h) as u32)
+    );
+    assert!(ink(&png) > 10_000, "the figure is drawn");
+    // Any other name is the SVG text itself.
+    let other = dir.path().join("anchors.png.svg");
+    write_figure(&other, &svg).unwrap();
+    assert_eq!(std::fs::read_to_string(&other).unwrap(), svg);
+    // A broken SVG is an error naming the file, and nothing is written.
+    let bad = dir.path().join("bad.png");
+    let err = write_figure(&bad, "<svg").unwrap_err();
+    assert!(err.to_string().contains("bad.png"), "{err}");
+    assert!(!bad.exists());
+}
+
+#[test]
+fn long_titles_and_captions_wrap_inside_the_residual_figure() {
+    let title = "sagcal diagnose `large`: load_cell residual vs mid-span sag (m) (verdict: none)".to_string();
+    let caption = "m.csv; held-out residual RMS 0.801 -> 0.801 (no hypothesis is significant at false-alarm rate \
+                   1e-3: the baseline model stands)"
+        .to_string();
+    let plot = ResidualPlot {
+        title: title.clone(),
+        driver_label: "mid-span sag (m)".into(),
+        residual_label: "load_cell residual / sigma".into(),
+        before: ResidualSeries {
+            label: "baseline model".into(),
+            points: (0..20).map(|i| (i as f64, 0.1 * i as f64)).collect(),
+        },
+        after: None,
+        caption: caption.clone(),
+    };
+    let svg = residual_plot_svg(&plot);
+    let (width, height) = svg_size(&svg);
+    // Every line of the title (20 px, bold) and caption (12 px) fits the width at
+    // DejaVu's widest average advance, 0.62 em; all their words are there.
+    let lines = |class: &str| -> Vec<String> {
+        let at = svg.find(&format!(r#"class="{class}""#)).unwrap();
+        let end = at + svg[at..].find("</text>").unwrap();
+        svg[at..end]
+            .split("<tspan")
+            .skip(1)
+            .map(|t| t[t.find('>').unwrap() + 1..t.find("</tspan>").unwrap()].to_string())
+            .collect()
+    };
+    for (class, font, text) in [("title", 20.0, &title), ("caption", 12.0, &caption)] {
+        let got = lines(class);
+        assert!(got.len() >= 2, "{class}: {got:?}");
+        for line in &got {
+            assert!(
+                20.0 + line.chars().count() as f64 * 0.62 * font <= width,
+                "{class} line {line:?}"
+            );
+        }
+        assert_eq!(got.join(" ").replace("&gt;", ">"), *text);
+    }
+    assert!(height > 520.0, "the figure grows with the extra lines: {height}");
 }

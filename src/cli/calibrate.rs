@@ -7,7 +7,7 @@ use sagcal::calib::report::CalibrationReport;
 use sagcal::calib::{CableModel, CalibrationOptions, CalibrationResult, OrientationPrior, ParameterUncertainty};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::model::Robot;
-use sagcal::plot::{anchor_plot_svg, write_svg, AnchorPlot, AnchorPlotEntry};
+use sagcal::plot::{anchor_plot_svg, write_figure, AnchorPlot, AnchorPlotEntry};
 
 use super::gross_errors::{self, GrossErrorReport};
 use super::output::{print_json, Table};
@@ -113,7 +113,7 @@ struct CheckedReport {
     gross_errors: GrossErrorReport,
 }
 
-/// The anchor plot of a calibration.
+/// The anchor plot of a calibration: PNG when `path` ends in `.png`, SVG otherwise.
 pub fn write_plot(
     path: &Path,
     nominal: &Robot,
@@ -147,7 +147,7 @@ pub fn write_plot(
             .collect(),
         platform_positions_m: positions.to_vec(),
     };
-    write_svg(path, &anchor_plot_svg(&plot))
+    write_figure(path, &anchor_plot_svg(&plot))
 }
 
 fn sigma(value: Option<f64>) -> String {

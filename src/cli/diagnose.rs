@@ -48,7 +48,7 @@ pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
     bar.finish_and_clear();
     // Files only after everything succeeded, each atomically.
     let plot_path = match &args.plots {
-        Some(dir) => Some(write_plots(dir, &diagnosis, &args.data)?),
+        Some(dir) => Some(write_plots(dir, args.plot_format.extension(), &diagnosis, &args.data)?),
         None => None,
     };
     if let Some(out) = &args.out {
@@ -95,13 +95,14 @@ fn file_name(text: &str) -> String {
         .join("_")
 }
 
-/// Write the residual plot against the winning driver (before and after) into `dir`; its path.
-fn write_plots(dir: &Path, diagnosis: &Diagnosis, data: &Path) -> sagcal::Result<std::path::PathBuf> {
+/// Write the residual plot against the winning driver (before and after) into
+/// `dir` as `extension` (`svg` or `png`); its path.
+fn write_plots(dir: &Path, extension: &str, diagnosis: &Diagnosis, data: &Path) -> sagcal::Result<std::path::PathBuf> {
     std::fs::create_dir_all(dir).map_err(|e| {
         sagcal::Error::InvalidInput(format!("--plots {}: cannot create the folder: {e}", dir.display()))
     })?;
     let s = &diagnosis.series;
-    let path = dir.join(format!("{}_vs_{}.svg", s.residual, file_name(&s.driver)));
+    let path = dir.join(format!("{}_vs_{}.{extension}", s.residual, file_name(&s.driver)));
     let plot = ResidualPlot {
         title: format!(
             "sagcal diagnose `{}`: {} residual vs {} (verdict: {})",
@@ -125,7 +126,7 @@ fn write_plots(dir: &Path, diagnosis: &Diagnosis, data: &Path) -> sagcal::Result
             diagnosis.reason
         ),
     };
-    sagcal::plot::write_svg(&path, &residual_plot_svg(&plot))?;
+    sagcal::plot::write_figure(&path, &residual_plot_svg(&plot))?;
     Ok(path)
 }
 

@@ -14,7 +14,7 @@ mod verify;
 
 use std::path::PathBuf;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 
 /// Self-calibration of suspended cable-driven parallel robots with sagging cables.
 #[derive(Debug, Parser)]
@@ -41,6 +41,15 @@ enum Command {
     /// Reproduce the paper's experiments.
     #[command(subcommand)]
     Experiment(ExperimentCommand),
+    /// Print a shell completion script (e.g. `sagcal completions bash > ~/.local/share/bash-completion/completions/sagcal`).
+    Completions(CompletionsArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct CompletionsArgs {
+    /// The shell: bash, zsh, fish (also elvish, powershell).
+    #[arg(value_enum)]
+    shell: clap_complete::Shell,
 }
 
 #[derive(Debug, Subcommand)]
@@ -114,7 +123,7 @@ struct Table2Args {
     /// The true robot (TOML).
     #[arg(long)]
     robot: PathBuf,
-    /// The log whose poses are sampled (RecurDyn or sagcal CSV).
+    /// The log whose poses are sampled (RecurDyn or sagcal CSV, or the authors' dataset folder).
     #[arg(long)]
     data: PathBuf,
     /// Pose counts, comma separated.
@@ -240,13 +249,14 @@ struct CalibrateArgs {
     /// Nominal robot description (TOML): the initial guess of anchors and offsets.
     #[arg(long)]
     robot: PathBuf,
-    /// Measurements: sagcal CSV (see README) or a RecurDyn log.
+    /// Measurements: sagcal CSV (see README), a RecurDyn log, or the authors' dataset folder
+    /// (`pos_i_cpp_test.csv`, `R_i_cpp_test.csv`, `lc_meas_cpp_test.csv`, `forces_cpp_test.csv`).
     #[arg(long)]
     data: PathBuf,
     /// Write the calibrated robot (TOML) here.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Write an SVG plot of nominal and calibrated anchors with error ellipses here.
+    /// Write a plot of nominal and calibrated anchors with error ellipses here (PNG if the name ends in `.png`, SVG otherwise).
     #[arg(long)]
     plot: Option<PathBuf>,
     /// Print the report as JSON.
@@ -269,7 +279,7 @@ struct DiagnoseArgs {
     /// Nominal robot description (TOML): the initial guess; its `[effects]` are known inputs.
     #[arg(long)]
     robot: PathBuf,
-    /// Measurements: sagcal CSV or a RecurDyn log.
+    /// Measurements: sagcal CSV, a RecurDyn log, or the authors' dataset folder.
     #[arg(long)]
     data: PathBuf,
     /// The true robot (TOML, e.g. from `sagcal simulate --truth`): report anchor and offset errors.
@@ -278,6 +288,9 @@ struct DiagnoseArgs {
     /// Write the plot of the residual against the winning driver (before and after) into this folder.
     #[arg(long)]
     plots: Option<PathBuf>,
+    /// Format of the `--plots` figures: svg or png.
+    #[arg(long, value_enum, default_value = "svg")]
+    plot_format: PlotFormat,
     /// Candidate effects, comma separated (default: elastic,pulley,encoder-scale,loadcell,com,encoder-gain,segments).
     #[arg(long)]
     candidates: Option<String>,
@@ -351,6 +364,25 @@ struct DemoArgs {
     json: bool,
 }
 
+/// The file format of figures written into a folder.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum PlotFormat {
+    /// Scalable vector graphics (the figure as drawn).
+    Svg,
+    /// The same figure rendered to a PNG image (2x pixel density, bundled font).
+    Png,
+}
+
+impl PlotFormat {
+    /// The file-name extension.
+    fn extension(self) -> &'static str {
+        match self {
+            PlotFormat::Svg => "svg",
+            PlotFormat::Png => "png",
+        }
+    }
+}
+
 /// Which measurement closes the statics in `verify`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum ClosureArg {
@@ -365,7 +397,7 @@ struct VerifyArgs {
     /// Robot description (TOML), e.g. robots/large.toml.
     #[arg(long)]
     robot: PathBuf,
-    /// Measurement log (RecurDyn CSV).
+    /// Measurement log: RecurDyn CSV, sagcal CSV or the authors' dataset folder.
     #[arg(long)]
     data: PathBuf,
     /// The measurement that closes the one-parameter family of equilibria.
@@ -384,7 +416,8 @@ struct LocalizeArgs {
     /// The calibrated robot (TOML): anchors, length offsets, `[effects]`.
     #[arg(long)]
     robot: PathBuf,
-    /// Readings: `l1_m,l2_m,l3_m,l4_m[,f_ref_n]`, a sagcal measurement file or a RecurDyn log.
+    /// Readings: `l1_m,l2_m,l3_m,l4_m[,f_ref_n]`, a sagcal measurement file, a RecurDyn log or
+    /// the authors' dataset folder.
     #[arg(long)]
     data: PathBuf,
     /// Use the input's localiser pose as a prior (by default it is only compared with).
@@ -429,6 +462,10 @@ pub fn run() -> i32 {
         Some(Command::Localize(args)) => localize::run(&args),
         Some(Command::Experiment(ExperimentCommand::Table2(args))) => experiment::run(&args),
         Some(Command::Experiment(ExperimentCommand::HiddenEffects(args))) => hidden::run(&args),
+        Some(Command::Completions(args)) => {
+            clap_complete::generate(args.shell, &mut Cli::command(), "sagcal", &mut std::io::stdout());
+            Ok(())
+        }
     };
     match result {
         Ok(()) => 0,

@@ -45,7 +45,7 @@
 
 use std::fmt::Write as _;
 
-use super::svg::{esc, halo_text, n2, shorten, text_w, C_FRAME, C_GRID, C_MUTED, C_TEXT, FONT};
+use super::svg::{esc, halo_text, n2, shorten, text_lines, text_w, wrap, C_FRAME, C_GRID, C_MUTED, C_TEXT, FONT};
 
 /// One anchor (pulley) to draw: its nominal, initial, estimated and true position.
 #[derive(Debug, Clone, PartialEq)]
@@ -114,7 +114,11 @@ pub fn anchor_plot_svg(plot: &AnchorPlot) -> String {
     let rows = n.div_ceil(2).max(1);
     let strip_h = STRIP_MIN_H.max(44.0 + 20.0 * n as f64);
     let cells_top = TITLE_H + strip_h + 8.0;
-    let height = (cells_top + rows as f64 * ROW_PITCH + CAPTION_H).round();
+    // The caption wraps to the figure's width; the title is cut to one line.
+    let caption = wrap(&plot.caption, WIDTH - 2.0 * MARGIN, 12.0);
+    let title = shorten(&plot.title, ((WIDTH - 2.0 * MARGIN) / (0.62 * 20.0)) as usize);
+    let caption_extra = 16.0 * (caption.len() - 1) as f64;
+    let height = (cells_top + rows as f64 * ROW_PITCH + CAPTION_H + caption_extra).round();
 
     let mut s = String::with_capacity(64 * 1024);
     let _ = writeln!(s, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
@@ -134,7 +138,7 @@ pub fn anchor_plot_svg(plot: &AnchorPlot) -> String {
     let _ = writeln!(
         s,
         r#"<text class="title" x="{MARGIN}" y="30" font-size="20" font-weight="bold">{}</text>"#,
-        esc(&plot.title)
+        esc(&title)
     );
 
     // Top strip: overview, legend, summary table.
@@ -159,11 +163,13 @@ pub fn anchor_plot_svg(plot: &AnchorPlot) -> String {
     }
 
     // Caption.
-    let _ = writeln!(
-        s,
-        r#"<text class="caption" x="{MARGIN}" y="{}" font-size="12" fill="{C_MUTED}">{}</text>"#,
-        n2(height - 12.0),
-        esc(&plot.caption)
+    text_lines(
+        &mut s,
+        MARGIN,
+        height - 12.0 - caption_extra,
+        16.0,
+        &format!(r#"class="caption" font-size="12" fill="{C_MUTED}""#),
+        &caption,
     );
     s.push_str("</svg>\n");
     s

@@ -17,7 +17,7 @@
 //!   finite points sorted by driver and split into 10 equal-count bins, each
 //!   drawn at (mean driver, mean residual). It shows structure that a dense
 //!   scatter hides and is drawn when the series has at least 10 finite points;
-//! * a title, a legend and a one-line caption.
+//! * a title, a legend and a caption, both wrapped to the figure's width.
 //!
 //! Points with a non-finite coordinate are skipped and counted in a note in
 //! the panel; a series without finite points shows `no data`; when all driver
@@ -49,7 +49,7 @@
 //! assert_eq!(svg.matches(r#"class="after""#).count(), 50);
 //! ```
 
-use super::svg::{esc, halo_text, n2, shorten, text_w, C_FRAME, C_GRID, C_MUTED, C_TEXT, FONT};
+use super::svg::{esc, halo_text, n2, shorten, text_lines, text_w, wrap, C_FRAME, C_GRID, C_MUTED, C_TEXT, FONT};
 use std::fmt::Write as _;
 
 /// One series of points: `(driver value, residual)` pairs and a name.
@@ -128,7 +128,12 @@ pub fn residual_plot_svg(plot: &ResidualPlot) -> String {
     let yaxis = Axis::nice(ylo, yhi);
 
     let width = 2.0 * MARGIN + series.len() as f64 * CELL_W;
-    let height = PANEL_TOP + PANEL_H + BELOW_PANEL + CAPTION_H;
+    // Title and caption wrap to the figure's width; the body moves down by the title's extra lines.
+    let title = wrap(&plot.title, width - 2.0 * MARGIN, 20.0);
+    let caption = wrap(&plot.caption, width - 2.0 * MARGIN, 12.0);
+    let title_extra = 24.0 * (title.len() - 1) as f64;
+    let caption_extra = 16.0 * (caption.len() - 1) as f64;
+    let height = PANEL_TOP + PANEL_H + BELOW_PANEL + CAPTION_H + title_extra + caption_extra;
 
     let mut s = String::with_capacity(16 * 1024 + 160 * series.iter().map(|p| p.points.len()).sum::<usize>());
     let _ = writeln!(s, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
@@ -143,23 +148,30 @@ pub fn residual_plot_svg(plot: &ResidualPlot) -> String {
         s,
         r#"<rect x="0" y="0" width="{width}" height="{height}" fill="white" stroke="none"/>"#
     );
-    let _ = writeln!(
-        s,
-        r#"<text class="title" x="{MARGIN}" y="30" font-size="20" font-weight="bold">{}</text>"#,
-        esc(&plot.title)
+    text_lines(
+        &mut s,
+        MARGIN,
+        30.0,
+        24.0,
+        r#"class="title" font-size="20" font-weight="bold""#,
+        &title,
     );
+    let _ = writeln!(s, r#"<g transform="translate(0 {})">"#, n2(title_extra));
     render_legend(&mut s, &series, MARGIN, width - MARGIN, LEGEND_Y);
 
     for (i, p) in series.iter().enumerate() {
         let left = MARGIN + i as f64 * CELL_W + PANEL_LEFT;
         render_panel(&mut s, plot, p, &xaxis, &yaxis, left, PANEL_TOP);
     }
+    let _ = writeln!(s, "</g>");
 
-    let _ = writeln!(
-        s,
-        r#"<text class="caption" x="{MARGIN}" y="{}" font-size="12" fill="{C_MUTED}">{}</text>"#,
-        n2(height - 12.0),
-        esc(&plot.caption)
+    text_lines(
+        &mut s,
+        MARGIN,
+        height - 12.0 - caption_extra,
+        16.0,
+        &format!(r#"class="caption" font-size="12" fill="{C_MUTED}""#),
+        &caption,
     );
     s.push_str("</svg>\n");
     s

@@ -1,5 +1,5 @@
 //! Drawing helpers shared by every figure: text escaping, pixel coordinates,
-//! haloed labels, the font and the common colours, and atomic file writing.
+//! haloed labels, the font and the common colours.
 
 use std::fmt::Write as _;
 
@@ -13,14 +13,6 @@ pub(crate) const C_MUTED: &str = "#666666";
 pub(crate) const C_GRID: &str = "#e6e6e6";
 /// Panel frames.
 pub(crate) const C_FRAME: &str = "#9a9a9a";
-
-/// Write `svg` to `path` atomically: the text goes to a temporary file in the
-/// same directory, which is then renamed over `path`.
-///
-/// Errors are [`crate::Error::Io`] naming `path`; on error no file is left behind.
-pub fn write_svg(path: &std::path::Path, svg: &str) -> crate::Result<()> {
-    crate::io::write_atomically(path, svg.as_bytes())
-}
 
 /// A pixel coordinate for an attribute (always a finite number).
 pub(crate) fn n2(x: f64) -> String {
@@ -74,4 +66,57 @@ pub(crate) fn halo_text(s: &mut String, x: f64, y: f64, anchor: &str, fill: &str
         n2(y),
         esc(text)
     );
+}
+
+/// `text` broken at spaces into lines that fit `max_w` pixels at `font` px
+/// (a rough width of 0.62 em per character, bold included); a word longer
+/// than a line is shortened with an ellipsis. Always at least one line.
+pub(crate) fn wrap(text: &str, max_w: f64, font: f64) -> Vec<String> {
+    let max_chars = ((max_w / (0.62 * font)).floor() as usize).max(8);
+    let mut lines = Vec::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        let word = shorten(word, max_chars);
+        let used = line.chars().count();
+        if used > 0 && used + 1 + word.chars().count() > max_chars {
+            lines.push(std::mem::take(&mut line));
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(&word);
+    }
+    if !line.is_empty() || lines.is_empty() {
+        lines.push(line);
+    }
+    lines
+}
+
+/// One `<text>` of several lines (`<tspan>`s `line_h` apart), the first on baseline `y`.
+pub(crate) fn text_lines(s: &mut String, x: f64, y: f64, line_h: f64, attrs: &str, lines: &[String]) {
+    let _ = write!(s, r#"<text x="{}" y="{}" {attrs}>"#, n2(x), n2(y));
+    for (i, line) in lines.iter().enumerate() {
+        let dy = if i == 0 { 0.0 } else { line_h };
+        let _ = write!(s, r#"<tspan x="{}" dy="{}">{}</tspan>"#, n2(x), n2(dy), esc(line));
+    }
+    let _ = writeln!(s, "</text>");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wrap;
+
+    #[test]
+    fn wrap_keeps_every_word_within_the_width() {
+        let text = "sagcal diagnose `large`: load_cell residual vs mid-span sag (m) (verdict: none)";
+        let lines = wrap(text, 300.0, 20.0);
+        // 300 px / (0.62 * 20 px) = 24 characters per line.
+        assert!(lines.iter().all(|l| l.chars().count() <= 24), "{lines:?}");
+        assert_eq!(lines.join(" "), text);
+        assert_eq!(wrap("", 100.0, 12.0), vec![String::new()]);
+        assert_eq!(
+            wrap("abcdefghijklmnop", 62.0, 10.0),
+            vec!["abcdefghij\u{2026}".to_string()]
+        );
+    }
 }
