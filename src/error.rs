@@ -2,6 +2,15 @@
 //!
 //! Every variant names *where* the problem is (file, row, field) so the CLI can
 //! print it as is and exit non-zero. Library code never panics on user input.
+//!
+//! ```
+//! use sagcal::io::measurements::{read_measurements, ReadOptions};
+//! let missing = std::path::Path::new("no-such-measurements.csv");
+//! let err = read_measurements(missing, &ReadOptions::default()).unwrap_err();
+//! assert!(matches!(err, sagcal::Error::Io { .. }));
+//! // The message starts with the file, as the CLI prints it.
+//! assert!(err.to_string().starts_with("no-such-measurements.csv: "));
+//! ```
 
 use std::path::PathBuf;
 

@@ -17,17 +17,21 @@
 //! |---|---|
 //! | [`error`], [`stats`] | the error type; chi-square quantiles, correlation, BIC |
 //! | [`model`] | cable physics (catenary, elastic, pulley), robot, statics, effects, measurements |
-//! | [`io`] | files -> plain serde structs -> `model` types (`model` never sees a file) |
+//! | [`io`] | files (robot TOML; sagcal CSV, RecurDyn logs, the authors' dataset folder) -> `model` types (`model` never sees a file) |
 //! | [`sim`] | closed-form and discretised simulators (the truth of the experiments) |
 //! | [`graph`] | variables, the factor trait, noise, robust kernels ([`calib`]'s factors wrap [`generated`]) |
 //! | [`solver`] | sparse Levenberg-Marquardt: pattern, Schur / Cholesky, covariance |
 //! | [`calib`], [`diagnose`], [`localize`] | the jobs: staged calibration; residual tests, candidate effects, verdict; pose and tensions from the cable readings |
 //! | [`experiments`] | Table II protocol, hidden effects, the benchmark problem |
-//! | [`plot`] | figures (SVG) |
+//! | [`plot`] | figures, SVG or PNG (rendered with a bundled font) |
 //! | the `sagcal` binary | a thin clap layer, one file per command |
 //!
 //! The residuals and their analytic Jacobians are derived with SymForce in
 //! `codegen/` and emitted into [`generated`].
+//!
+//! Each job has a short program in `examples/` on the built-in robot:
+//! `cargo run --release --example calibrate` (also `diagnose`, `localize`,
+//! `simulate`).
 //!
 //! ```
 //! use sagcal::model::{Catenary, Robot};
@@ -43,6 +47,7 @@
 //! ```
 
 #![warn(missing_docs)]
+#![deny(rustdoc::broken_intra_doc_links)]
 
 pub mod calib;
 pub mod diagnose;

@@ -72,6 +72,27 @@
 //! 0.1 mm attachment-height constraint bends the valley so sharply that LM
 //! creeps along it (the small robot, with its nearly vertical cables, hit
 //! 500 iterations in most trials).
+//!
+//! ```
+//! use rand::SeedableRng;
+//! use sagcal::calib::{calibrate, CalibrationOptions};
+//! use sagcal::model::sensors::NoisePreset;
+//! use sagcal::model::Robot;
+//! use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
+//! let truth = Robot::builtin("large")?;
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+//! let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), 15, &mut rng)?;
+//! let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
+//! let data = measure(&truth, &equilibria, &noise, &mut rng);
+//! // The operator's guess: anchor 2 measured 3 m off, every encoder offset 1 m off.
+//! let mut guess = truth.clone();
+//! guess.anchors_m[1].x += 3.0;
+//! guess.length_offsets_m = [1.0; 4];
+//! let result = calibrate(&guess, &data, &CalibrationOptions::new(noise))?;
+//! let error_m = (result.robot.anchors_m[1] - truth.anchors_m[1]).norm();
+//! assert!(error_m < 1.0, "anchor 2 is {error_m} m off after calibration");
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 pub mod effect_factors;
 pub mod factors;

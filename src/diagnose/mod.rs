@@ -31,6 +31,33 @@
 //! parameters held, and its whitened measurement residuals (encoders, load
 //! cell, localiser) are collected. `cv_rms` is their root mean square (about 1
 //! when the model and the stated noise are right).
+//!
+//! ```
+//! use rand::SeedableRng;
+//! use sagcal::calib::CalibrationOptions;
+//! use sagcal::diagnose::{diagnose, DiagnoseOptions};
+//! use sagcal::model::effects::EffectKind;
+//! use sagcal::model::sensors::NoisePreset;
+//! use sagcal::model::Robot;
+//! use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
+//! // Encoders that read 0.3 % long: each reading is gain x length (+ offset).
+//! let nominal = Robot::builtin("large")?;
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+//! let equilibria = sample_equilibria(&nominal, &Workspace::default_for(&nominal), 20, &mut rng)?;
+//! let noise = NoisePreset::Paper.sigmas(nominal.platform_weight_n);
+//! let mut data = measure(&nominal, &equilibria, &noise, &mut rng);
+//! for (m, e) in data.iter_mut().zip(&equilibria) {
+//!     for i in 0..4 {
+//!         m.encoder_lengths_m[i] += 0.003 * e.cable_lengths_m[i];
+//!     }
+//! }
+//! let mut options = DiagnoseOptions::new(CalibrationOptions::new(noise));
+//! options.candidates = vec![EffectKind::parse("encoder-gain").unwrap()];
+//! options.folds = 2;
+//! let diagnosis = diagnose(&nominal, &data, None, &options, &mut |_, _, _| {})?;
+//! assert_eq!(diagnosis.verdict, "encoder-gain");
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 mod candidates;
 mod drivers;

@@ -7,6 +7,16 @@
 //!   scored (`sagcal experiment hidden-effects`);
 //! - [`benchmark`]: the reproducible calibration graph the solver benches and
 //!   the peer comparison share.
+//!
+//! ```
+//! use sagcal::experiments::benchmark::{BenchmarkProblem, ANCHOR_PERTURBATION_M};
+//! // The same (poses, seed) gives the same problem, for every solver that is compared on it.
+//! let problem = BenchmarkProblem::new(6, 42)?;
+//! assert_eq!(problem.measurements, BenchmarkProblem::new(6, 42)?.measurements);
+//! let moved = (problem.initial.anchors_m[0] - problem.truth.anchors_m[0]).norm();
+//! assert!((moved - ANCHOR_PERTURBATION_M).abs() < 1e-12);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 pub mod benchmark;
 pub mod hidden_effects;

@@ -1,4 +1,17 @@
 //! Atomic file writes: a command that fails leaves nothing half-written.
+//!
+//! ```
+//! use sagcal::io::write_atomically;
+//! let path = std::env::temp_dir().join(format!("sagcal-atomic-doc-{}.txt", std::process::id()));
+//! write_atomically(&path, b"first")?;
+//! write_atomically(&path, b"second")?; // replaces the file whole
+//! assert_eq!(std::fs::read(&path).unwrap(), b"second");
+//! // A folder that does not exist is an error naming the file; nothing is created.
+//! let nowhere = path.with_extension("d").join("x.txt");
+//! assert!(write_atomically(&nowhere, b"x").unwrap_err().to_string().contains("x.txt"));
+//! # std::fs::remove_file(&path).unwrap();
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use std::ffi::OsString;
 use std::fs::{File, OpenOptions};
