@@ -2,15 +2,10 @@
 //! as PNG for a `.png` name.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn sagcal(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sagcal"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("sagcal runs")
-}
+#[path = "common/cli.rs"]
+mod cli;
+use cli::{robot, sagcal};
 
 #[test]
 fn version_prints_the_crate_version() {
@@ -57,7 +52,7 @@ fn completions_for_bash_zsh_and_fish_name_every_command() {
 #[test]
 fn calibrate_plot_with_a_png_name_writes_a_png() {
     let dir = tempfile::tempdir().unwrap();
-    let robot = format!("{}/robots/small.toml", env!("CARGO_MANIFEST_DIR"));
+    let robot = robot("small");
     let out = sagcal(
         dir.path(),
         &[

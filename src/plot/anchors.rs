@@ -45,7 +45,7 @@
 
 use std::fmt::Write as _;
 
-use super::svg::{esc, halo_text, n2, shorten, text_lines, text_w, wrap, C_FRAME, C_GRID, C_MUTED, C_TEXT, FONT};
+use super::svg::{caption_text, esc, halo_text, n2, shorten, text_w, wrap, C_FRAME, C_GRID, C_MUTED, C_TEXT, FONT};
 
 /// One anchor (pulley) to draw: its nominal, initial, estimated and true position.
 #[derive(Debug, Clone, PartialEq)]
@@ -163,14 +163,7 @@ pub fn anchor_plot_svg(plot: &AnchorPlot) -> String {
     }
 
     // Caption.
-    text_lines(
-        &mut s,
-        MARGIN,
-        height - 12.0 - caption_extra,
-        16.0,
-        &format!(r#"class="caption" font-size="12" fill="{C_MUTED}""#),
-        &caption,
-    );
+    caption_text(&mut s, MARGIN, height, &caption);
     s.push_str("</svg>\n");
     s
 }

@@ -49,7 +49,9 @@
 //! assert_eq!(svg.matches(r#"class="after""#).count(), 50);
 //! ```
 
-use super::svg::{esc, halo_text, n2, shorten, text_lines, text_w, wrap, C_FRAME, C_GRID, C_MUTED, C_TEXT, FONT};
+use super::svg::{
+    caption_text, esc, halo_text, n2, shorten, text_lines, text_w, wrap, C_FRAME, C_GRID, C_MUTED, C_TEXT, FONT,
+};
 use std::fmt::Write as _;
 
 /// One series of points: `(driver value, residual)` pairs and a name.
@@ -165,14 +167,7 @@ pub fn residual_plot_svg(plot: &ResidualPlot) -> String {
     }
     let _ = writeln!(s, "</g>");
 
-    text_lines(
-        &mut s,
-        MARGIN,
-        height - 12.0 - caption_extra,
-        16.0,
-        &format!(r#"class="caption" font-size="12" fill="{C_MUTED}""#),
-        &caption,
-    );
+    caption_text(&mut s, MARGIN, height, &caption);
     s.push_str("</svg>\n");
     s
 }

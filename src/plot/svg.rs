@@ -102,6 +102,13 @@ pub(crate) fn text_lines(s: &mut String, x: f64, y: f64, line_h: f64, attrs: &st
     let _ = writeln!(s, "</text>");
 }
 
+/// A figure's caption: `lines` (12 px, muted), the last one 12 px above `bottom`.
+pub(crate) fn caption_text(s: &mut String, x: f64, bottom: f64, lines: &[String]) {
+    let first = bottom - 12.0 - 16.0 * lines.len().saturating_sub(1) as f64;
+    let attrs = format!(r#"class="caption" font-size="12" fill="{C_MUTED}""#);
+    text_lines(s, x, first, 16.0, &attrs, lines);
+}
+
 #[cfg(test)]
 mod tests {
     use super::wrap;
@@ -116,7 +123,8 @@ mod tests {
         assert_eq!(wrap("", 100.0, 12.0), vec![String::new()]);
         assert_eq!(
             wrap("abcdefghijklmnop", 62.0, 10.0),
-            vec!["abcdefghij\u{2026}".to_string()]
+            vec!["abcdefghi\u{2026}".to_string()],
+            "10 characters with the ellipsis"
         );
     }
 }
