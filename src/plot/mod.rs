@@ -4,10 +4,12 @@
 //!   (`sagcal calibrate --plot`, the demo);
 //! - [`residuals`]: normalised residuals against a physical driver, before and
 //!   after a model extension (`sagcal diagnose --plots`);
+//! - [`localize`]: localised poses with their error ellipses (`sagcal localize --plot`);
 //! - `svg`: the drawing helpers both share (escaping, coordinates, labels,
 //!   the font and colours) and [`write_svg`].
 
 pub mod anchors;
+pub mod localize;
 pub mod residuals;
 mod svg;
 
