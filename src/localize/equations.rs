@@ -135,6 +135,34 @@ pub struct ModelAtPose {
     pub cables: [CablePartials; CABLE_COUNT],
 }
 
+/// One cable's `[paid_out, drop]` (eq. 1-4 with the `[effects]`) and its
+/// derivatives in the span, `f_h` and `f_v` (`generated::extended_cable`).
+fn extended_cable(
+    robot: &SlotRobot,
+    span: f64,
+    f_h: f64,
+    f_v: f64,
+) -> (Vector2<f64>, Vector2<f64>, Vector2<f64>, Vector2<f64>) {
+    let (mut d_span, mut d_fh, mut d_fv) = (Vector2::zeros(), Vector2::zeros(), Vector2::zeros());
+    let cable = generated::extended_cable(
+        span,
+        f_h,
+        f_v,
+        robot.cable_weight_n_per_m,
+        robot.compliance_per_mn,
+        robot.pulley_radius_m,
+        robot.inverse_segments_squared,
+        EPSILON,
+        Some(&mut d_span),
+        Some(&mut d_fh),
+        Some(&mut d_fv),
+        None,
+        None,
+        None,
+    );
+    (cable, d_span, d_fh, d_fv)
+}
+
 /// Pose as the generated functions take it: position and `[x, y, z, w]`.
 pub fn pose_arguments(pose: &PlatformPose) -> (Vector3<f64>, Vector4<f64>) {
     (pose.position_m, pose.rotation_xyzw())
@@ -188,23 +216,7 @@ pub fn model_at_pose(robot: &SlotRobot, pose: &PlatformPose, reference_n: &Vecto
         if !(f_h > 0.0 && span.is_finite() && f_v.is_finite() && h.is_finite()) {
             return None;
         }
-        let (mut d_span, mut d_fh, mut d_fv) = (Vector2::zeros(), Vector2::zeros(), Vector2::zeros());
-        let cable = generated::extended_cable(
-            span,
-            f_h,
-            f_v,
-            robot.cable_weight_n_per_m,
-            robot.compliance_per_mn,
-            robot.pulley_radius_m,
-            robot.inverse_segments_squared,
-            EPSILON,
-            Some(&mut d_span),
-            Some(&mut d_fh),
-            Some(&mut d_fv),
-            None,
-            None,
-            None,
-        );
+        let (cable, d_span, d_fh, d_fv) = extended_cable(robot, span, f_h, f_v);
         let gain = robot.encoder_gains[slot];
         out.encoders_m[slot] = gain * cable[0] + robot.length_offsets_m[slot];
         out.heights_m[slot] = cable[1] - h;
@@ -308,23 +320,7 @@ pub fn parameter_partials(
         if !(f_h > 0.0 && span.is_finite() && f_v.is_finite()) {
             return None;
         }
-        let (mut d_span, mut d_fh, mut d_fv) = (Vector2::zeros(), Vector2::zeros(), Vector2::zeros());
-        generated::extended_cable(
-            span,
-            f_h,
-            f_v,
-            robot.cable_weight_n_per_m,
-            robot.compliance_per_mn,
-            robot.pulley_radius_m,
-            robot.inverse_segments_squared,
-            EPSILON,
-            Some(&mut d_span),
-            Some(&mut d_fh),
-            Some(&mut d_fv),
-            None,
-            None,
-            None,
-        );
+        let (_, d_span, d_fh, d_fv) = extended_cable(robot, span, f_h, f_v);
         let (g_span, g_fh, g_fv, g_h) = (row(k), row(k + 1), row(k + 2), row(k + 3));
         let mut encoder = (g_span * d_span[0] + g_fh * d_fh[0] + g_fv * d_fv[0]) * robot.encoder_gains[slot];
         encoder[12 + slot] = 1.0;
