@@ -57,6 +57,11 @@ def test_setting_values_and_the_toml_round_trip(tmp_path):
     assert effects["axial_stiffness_n"] == 3e6 and effects["cable_segments"] is None
     np.testing.assert_array_equal(effects["encoder_gain"], [1.0, 1.001, 1.0, 1.0])
     assert path.read_text() == robot.toml()
+    # The dict the getter returns is accepted back as it is.
+    again = sagcal.Robot.builtin("large")
+    again.effects = robot.effects
+    assert again.effects["axial_stiffness_n"] == 3e6
+    np.testing.assert_array_equal(again.effects["encoder_gain"], robot.effects["encoder_gain"])
     copied = copy.deepcopy(robot)
     copied.name = "other"
     assert robot.name != "other"
