@@ -291,7 +291,7 @@ def simulate(
     seed: int = 1,
     noise: str = "paper",
     *,
-    effects: Sequence[str] = (),
+    effects: Optional[Sequence[str]] = None,
     segments: int = 100,
     closure: str = "level",
 ) -> Simulation:
@@ -300,7 +300,7 @@ def simulate(
 def read_measurements(path: PathLike, reference_cable: int = 1) -> FloatArray:
     """A measurement file (sagcal CSV or RecurDyn log) as an (N, 11) array."""
 
-def write_measurements(path: PathLike, measurements: ArrayLike, comments: Sequence[str] = ()) -> None:
+def write_measurements(path: PathLike, measurements: ArrayLike, comments: Optional[Sequence[str]] = None) -> None:
     """Write an (N, 11) array as a sagcal measurement file (atomically)."""
 
 # --- sagcal.plan (issue 19): the stub of `plan` goes here after src/plan/ is merged. ---

@@ -50,14 +50,20 @@ pub fn measurements(value: &Bound<'_, PyAny>, reference_cable: usize) -> PyResul
             label: path,
         });
     }
+    Ok(Data {
+        poses: from_rows(&rows::<11>(value, ARRAY_LABEL)?)?,
+        label: PathBuf::from(ARRAY_LABEL),
+    })
+}
+
+/// Measurements from array rows, each checked as a file's row is (`row` in messages is 1-based).
+fn from_rows(rows: &[[f64; 11]]) -> PyResult<Vec<PoseMeasurement>> {
     let label = PathBuf::from(ARRAY_LABEL);
-    let poses = rows::<11>(value, ARRAY_LABEL)?
-        .iter()
+    rows.iter()
         .enumerate()
         .map(|(i, row)| measurement_from_values(&label, i + 1, row))
         .collect::<sagcal::Result<Vec<_>>>()
-        .map_err(to_py)?;
-    Ok(Data { poses, label })
+        .map_err(to_py)
 }
 
 /// `value` as a path if it is a `str` or an `os.PathLike`.
@@ -109,26 +115,19 @@ pub fn read_measurements<'py>(py: Python<'py>, path: PathBuf, reference_cable: u
 /// ``comments`` as a ``# ...`` line before the header.
 ///
 /// Values are written with full round-trip precision, so
-/// :func:`read_measurements` gives back the same array bit for bit. A
-/// non-finite value or a reference tension that is not positive raises
-/// :class:`SagcalError` naming the row and the column, and nothing is written.
+/// :func:`read_measurements` gives back the same array bit for bit. The rows
+/// are checked as :func:`calibrate` checks an array: a non-finite value or a
+/// reference tension that is not positive raises :class:`SagcalError` naming
+/// the row (1-based) and the column, and nothing is written.
 #[pyfunction]
-#[pyo3(signature = (path, measurements, comments = Vec::new()))]
-pub fn write_measurements(path: PathBuf, measurements: &Bound<'_, PyAny>, comments: Vec<String>) -> PyResult<()> {
-    let poses: Vec<PoseMeasurement> = rows::<11>(measurements, ARRAY_LABEL)?
-        .iter()
-        .map(|r| PoseMeasurement {
-            line: 0,
-            position_m: [r[0], r[1], r[2]],
-            roll_deg: r[3],
-            pitch_deg: r[4],
-            yaw_deg: r[5],
-            encoder_lengths_m: [r[6], r[7], r[8], r[9]],
-            reference_tension_n: r[10],
-            excluded: Default::default(),
-        })
-        .collect();
-    sagcal::io::measurements::write_measurements(&path, &comments, &poses).map_err(to_py)
+#[pyo3(signature = (path, measurements, comments = None))]
+pub fn write_measurements(
+    path: PathBuf,
+    measurements: &Bound<'_, PyAny>,
+    comments: Option<Vec<String>>,
+) -> PyResult<()> {
+    let poses = from_rows(&rows::<11>(measurements, ARRAY_LABEL)?)?;
+    sagcal::io::measurements::write_measurements(&path, &comments.unwrap_or_default(), &poses).map_err(to_py)
 }
 
 /// The column names of a measurement array, in order.

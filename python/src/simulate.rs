@@ -61,7 +61,7 @@ impl Simulation {
 /// ``"authors"``, ``"none"``). The robot's ``length_offsets_m`` are the
 /// encoders' true offsets.
 ///
-/// ``effects`` lists physical effects the closed-form model lacks, each
+/// ``effects`` (optional) lists physical effects the closed-form model lacks, each
 /// ``"NAME:PARAM=VALUE[,PARAM=VALUE...]"`` as ``--effect`` takes them
 /// (``"elastic:ea_n=3e6"``, ``"pulley:radius_m=0.1"``, ...); with effects
 /// (or a robot whose ``effects`` are set) the readings come from the
@@ -70,7 +70,7 @@ impl Simulation {
 ///
 /// Raises :class:`SagcalError` with the message the command prints.
 #[pyfunction]
-#[pyo3(signature = (robot, poses, seed = 1, noise = "paper", *, effects = Vec::new(), segments = 100, closure = "level"))]
+#[pyo3(signature = (robot, poses, seed = 1, noise = "paper", *, effects = None, segments = 100, closure = "level"))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate(
     py: Python<'_>,
@@ -78,7 +78,7 @@ pub fn simulate(
     poses: usize,
     seed: u64,
     noise: &str,
-    effects: Vec<String>,
+    effects: Option<Vec<String>>,
     segments: usize,
     closure: &str,
 ) -> PyResult<Simulation> {
@@ -86,7 +86,7 @@ pub fn simulate(
     if poses == 0 {
         return Err(invalid("--poses must be at least 1"));
     }
-    for spec in &effects {
+    for spec in effects.iter().flatten() {
         truth
             .effects
             .apply_spec(spec)

@@ -459,17 +459,7 @@ fn parse_row(text: &[u8], line: usize, path: &Path) -> Result<PoseMeasurement> {
         }
         *slot = value;
     }
-    let [x, y, z, roll, pitch, yaw, l1, l2, l3, l4, f_ref] = values;
-    Ok(PoseMeasurement {
-        line,
-        position_m: [x, y, z],
-        roll_deg: roll,
-        pitch_deg: pitch,
-        yaw_deg: yaw,
-        encoder_lengths_m: [l1, l2, l3, l4],
-        reference_tension_n: f_ref,
-        excluded: Default::default(),
-    })
+    Ok(pose_from_values(line, &values))
 }
 
 /// A line holding only whitespace.
@@ -515,9 +505,15 @@ pub fn measurement_from_values(source: &Path, row: usize, values: &[f64; N_COLUM
             });
         }
     }
+    Ok(pose_from_values(0, values))
+}
+
+/// The pose of line `line` from its 11 values in [`MEASUREMENT_HEADER`] order
+/// (the inverse of [`pose_values`]; no checks).
+fn pose_from_values(line: usize, values: &[f64; N_COLUMNS]) -> PoseMeasurement {
     let [x, y, z, roll, pitch, yaw, l1, l2, l3, l4, f_ref] = *values;
-    Ok(PoseMeasurement {
-        line: 0,
+    PoseMeasurement {
+        line,
         position_m: [x, y, z],
         roll_deg: roll,
         pitch_deg: pitch,
@@ -525,5 +521,5 @@ pub fn measurement_from_values(source: &Path, row: usize, values: &[f64; N_COLUM
         encoder_lengths_m: [l1, l2, l3, l4],
         reference_tension_n: f_ref,
         excluded: Default::default(),
-    })
+    }
 }
