@@ -37,6 +37,14 @@ fn float_array(value: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<usize>, Ve
     Ok((view.shape().to_vec(), view.iter().copied().collect()))
 }
 
+/// Row-major values as rows of `C`.
+fn split_rows<const C: usize>(values: &[f64]) -> Vec<[f64; C]> {
+    values
+        .chunks_exact(C)
+        .map(|row| std::array::from_fn(|k| row[k]))
+        .collect()
+}
+
 /// The rows of an `(N, C)` array with `N >= 1`.
 pub fn rows<const C: usize>(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f64; C]>> {
     let (shape, values) = float_array(value, what)?;
@@ -46,10 +54,19 @@ pub fn rows<const C: usize>(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Ve
             shape_text(&shape)
         )));
     }
-    Ok(values
-        .chunks_exact(C)
-        .map(|row| std::array::from_fn(|k| row[k]))
-        .collect())
+    Ok(split_rows(&values))
+}
+
+/// The rows of an `(R, C)` array (`R` given).
+pub fn exact_rows<const C: usize>(value: &Bound<'_, PyAny>, count: usize, what: &str) -> PyResult<Vec<[f64; C]>> {
+    let (shape, values) = float_array(value, what)?;
+    if shape != [count, C] {
+        return Err(invalid(format!(
+            "{what} must be an array of shape ({count}, {C}), got shape {}",
+            shape_text(&shape)
+        )));
+    }
+    Ok(split_rows(&values))
 }
 
 /// The values of an `(N,)` array (`N` given).

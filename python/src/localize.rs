@@ -9,7 +9,7 @@ use sagcal::io::readings::{read_readings, ReadingRow};
 use sagcal::localize::{LocalizeOptions, Localized, Localizer, Readings};
 use sagcal::model::pose::PlatformPose;
 
-use crate::arrays::{out1, out2, out3, rows, vector};
+use crate::arrays::{exact_rows, out1, out2, out3, rows, vector};
 use crate::data::as_path;
 use crate::options::{false_alarm as check_false_alarm, noise_preset};
 use crate::robot::Robot;
@@ -275,15 +275,7 @@ fn rows_from_arrays(
     let lengths = rows::<4>(lengths, "readings")?;
     let n = lengths.len();
     let load_cell = load_cell.map(|l| vector(l, n, "load_cell")).transpose()?;
-    let poses = poses.map(|p| rows::<6>(p, "localiser_poses")).transpose()?;
-    if let Some(p) = &poses {
-        if p.len() != n {
-            return Err(invalid(format!(
-                "localiser_poses must be an array of shape ({n}, 6) like the readings, got shape ({}, 6)",
-                p.len()
-            )));
-        }
-    }
+    let poses = poses.map(|p| exact_rows::<6>(p, n, "localiser_poses")).transpose()?;
     let field = |source: &str, row: usize, field: &str, message: String| {
         to_py(sagcal::Error::Field {
             path: PathBuf::from(source),

@@ -9,8 +9,8 @@ use sagcal::io::robot_file::{RobotFile, WorkspaceEntry};
 use sagcal::model::effects::Effects;
 use sagcal::model::robot::{PaperRobot, CABLE_COUNT};
 
-use crate::arrays::{fixed, out1, out2, rows};
-use crate::{invalid, to_py};
+use crate::arrays::{exact_rows, fixed, out1, out2};
+use crate::to_py;
 
 /// A suspended four-cable robot: anchors, attachment points, weights, the
 /// reference cable with the load cell, encoder length offsets and the effects
@@ -259,14 +259,7 @@ impl Robot {
 
 /// Four points as a (4, 3) array.
 fn four_points(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f64; 3]>> {
-    let points = rows::<3>(value, what)?;
-    if points.len() != CABLE_COUNT {
-        return Err(invalid(format!(
-            "{what} must be an array of shape ({CABLE_COUNT}, 3), got shape ({}, 3)",
-            points.len()
-        )));
-    }
-    Ok(points)
+    exact_rows::<3>(value, CABLE_COUNT, what)
 }
 
 /// Effects from a dict of the robot file's `[effects]` keys (numbers, arrays or `None`).

@@ -81,6 +81,8 @@ def test_invalid_values_raise_the_loaders_message_and_change_nothing():
         robot.reference_cable = 5
     with pytest.raises(sagcal.SagcalError, match="unknown field `spring`"):
         robot.effects = {"spring": 1.0}
+    with pytest.raises(sagcal.SagcalError, match=r"^invalid input: anchors_m must be an array of shape \(4, 3\), got shape \(4, 2\)$"):
+        robot.anchors_m = np.zeros((4, 2))
     with pytest.raises(sagcal.SagcalError, match="field `anchor_m` is not finite"):
         robot.anchors_m = np.full((4, 3), np.nan)
     assert robot == before

@@ -87,5 +87,7 @@ def test_localize_input_errors(problem):
         sagcal.localize(problem["truth"], lengths)
     with pytest.raises(sagcal.SagcalError, match=r"load_cell must be an array of shape \(30,\), got shape \(29,\)"):
         sagcal.localize(problem["truth"], data[:, 6:10], load_cell=data[:29, 10])
+    with pytest.raises(sagcal.SagcalError, match=r"localiser_poses must be an array of shape \(30, 6\), got shape \(30, 3\)"):
+        sagcal.localize(problem["truth"], data[:, 6:10], localiser_poses=data[:, :3])
     with pytest.raises(sagcal.SagcalError, match="needs a localiser pose on every row"):
         sagcal.localize(problem["truth"], data[:, 6:10], pose_prior=True)
