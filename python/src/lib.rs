@@ -20,7 +20,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 pyo3::create_exception!(
-    _sagcal,
+    sagcal,
     SagcalError,
     PyValueError,
     "A sagcal error: bad input (file, row, field), an invalid robot, no static equilibrium, ...\n\n\

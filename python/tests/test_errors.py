@@ -12,6 +12,7 @@ def message(call):
     with pytest.raises(sagcal.SagcalError) as caught:
         call()
     assert isinstance(caught.value, ValueError)
+    assert type(caught.value).__module__ == "sagcal"  # tracebacks say `sagcal.SagcalError`
     return str(caught.value)
 
 
