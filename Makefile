@@ -4,7 +4,13 @@ VENV := codegen/.venv
 PYTHON := $(VENV)/bin/python
 PYTHON3 ?= python3
 
-.PHONY: all codegen codegen-check test lint bench bench-peers demo verify clean-venv
+.PHONY: all codegen codegen-check test lint bench bench-peers demo verify clean-venv python-venv python-test
+
+# The Python package (python/): a virtualenv with maturin, numpy and pytest and
+# the package built from this tree; ignored by git.
+PY_VENV := python/.venv
+PY_SOURCES := $(shell find python/src python/sagcal src generated -type f -not -name '*.pyc' -not -name '*.so' 2>/dev/null) \
+	python/Cargo.toml python/Cargo.lock python/pyproject.toml python/README.md Cargo.toml $(wildcard robots/*.toml)
 
 all: test
 
@@ -14,6 +20,23 @@ $(VENV)/.installed: codegen/requirements.txt
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r codegen/requirements.txt
 	touch $@
 
+# `pip install ./python` with the dev profile of python/Cargo.toml (opt-level 1,
+# faer and nalgebra at 3: the root crate's test profile) into target/, where
+# `cargo test` left the crates both builds share; rebuilt when a source changes.
+$(PY_VENV)/.installed: python/requirements-dev.txt $(PY_SOURCES)
+	$(PYTHON3) -m venv $(PY_VENV)
+	$(PY_VENV)/bin/pip install --quiet --disable-pip-version-check -r python/requirements-dev.txt
+	PATH="$(CURDIR)/$(PY_VENV)/bin:$$PATH" CARGO_TARGET_DIR=$(CURDIR)/target MATURIN_PEP517_ARGS="--profile dev --strip" \
+		$(PY_VENV)/bin/pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps --force-reinstall ./python
+	touch $@
+
+## The virtualenv python/.venv with the Python package `sagcal` built from this tree.
+python-venv: $(PY_VENV)/.installed
+
+## The Python package's tests, against the `sagcal` binary `cargo test` built.
+python-test: $(PY_VENV)/.installed
+	SAGCAL_BIN=$(CURDIR)/target/debug/sagcal $(PY_VENV)/bin/python -m pytest python/tests -q
+
 ## Regenerate generated/ from the symbolic model in codegen/.
 codegen: $(VENV)/.installed
 	$(PYTHON) codegen/generate.py --out generated
@@ -22,10 +45,12 @@ codegen: $(VENV)/.installed
 codegen-check: $(VENV)/.installed
 	$(PYTHON) codegen/generate.py --check generated
 
-## The README's test command: generated code up to date, then every test of the crate.
+## The README's test command: generated code up to date, every test of the crate,
+## then the Python package's tests.
 test: codegen-check
 	cargo test --all-targets
 	cargo test --doc
+	$(MAKE) python-test
 
 lint:
 	cargo fmt --all -- --check

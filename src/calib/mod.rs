@@ -388,8 +388,9 @@ fn finish(
     stages: Vec<StageSummary>,
     excluded_poses: Vec<usize>,
 ) -> Result<CalibrationResult> {
-    let robot = robot_from_graph(template, &built);
+    let mut robot = robot_from_graph(template, &built);
     let uncertainty = parameter_uncertainty(&built)?;
+    robot.calibration_covariance_m2 = uncertainty.covariance();
     let factor_statistics = factor_statistics(&built.graph);
     let poses = built.poses.iter().map(|p| *built.graph.values.pose(p.pose)).collect();
     let reference_tensions_n = built

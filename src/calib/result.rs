@@ -7,7 +7,7 @@ use super::orientation::OrientationCheck;
 use crate::graph::{whitened_squared_norm, FactorGraph};
 use crate::model::effects::EffectKind;
 use crate::model::pose::PlatformPose;
-use crate::model::robot::Robot;
+use crate::model::robot::{ParameterCovariance, Robot};
 use crate::model::statics::CableTension;
 use crate::solver::{SolveSummary, UnobservableDirection};
 
@@ -49,12 +49,25 @@ pub enum ParameterUncertainty {
         anchor_sigma_m: Vec<[f64; 3]>,
         /// Per offset, its 1-sigma, metres.
         offset_sigma_m: Vec<f64>,
+        /// The joint covariance, m^2, 16 rows of 16: anchors 1..4 (x, y, z
+        /// each), then offsets 1..4 (what `localize` propagates).
+        covariance_m2: Vec<Vec<f64>>,
     },
     /// Some directions of parameter space are not observable from these poses.
     RankDeficient {
         /// The unobservable directions.
         directions: Vec<UnobservableDirection>,
     },
+}
+
+impl ParameterUncertainty {
+    /// The joint covariance of anchors and offsets, when full rank.
+    pub fn covariance(&self) -> Option<ParameterCovariance> {
+        match self {
+            Self::Full { covariance_m2, .. } => Some(ParameterCovariance::from_fn(|r, k| covariance_m2[r][k])),
+            Self::RankDeficient { .. } => None,
+        }
+    }
 }
 
 /// The result of a calibration.

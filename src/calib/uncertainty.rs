@@ -70,6 +70,9 @@ fn uncertainty_from_covariance(c: &DMatrix<f64>) -> ParameterUncertainty {
         anchor_covariance_m2,
         anchor_sigma_m,
         offset_sigma_m,
+        covariance_m2: (0..c.nrows())
+            .map(|r| (0..c.ncols()).map(|k| c[(r, k)]).collect())
+            .collect(),
     }
 }
 

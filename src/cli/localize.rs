@@ -7,13 +7,19 @@ use sagcal::io::recurdyn::RejectedRow;
 use sagcal::localize::{LocalizeOptions, Localized, Localizer, Readings};
 use sagcal::model::pose::PlatformPose;
 use sagcal::model::Robot;
+use sagcal::plot::localize::{localize_plot_svg, LocalizePlot, PlottedPose};
 
 use super::output::{opt, print_json, Table};
 use super::LocalizeArgs;
 
-/// Why the position sigmas hold the reading noise only.
-const COVARIANCE_NOTE: &str = "the robot file records no covariance of the calibrated anchors and offsets: \
-     position_sigma_m is from the reading noise only";
+/// What the position sigmas hold, by whether the robot records its calibration's covariance.
+fn covariance_note(robot: &Robot, used: bool) -> &'static str {
+    match (robot.calibration_covariance_m2.is_some(), used) {
+        (true, true) => "position_sigma_m combines the reading noise and the calibration's recorded anchor/offset covariance ([calibration] of the robot file)",
+        (true, false) => "--no-calibration-uncertainty: position_sigma_m is from the reading noise only",
+        (false, _) => "the robot file records no covariance of the calibrated anchors and offsets (no [calibration]; `calibrate --out` writes it): position_sigma_m is from the reading noise only",
+    }
+}
 
 /// One row of the report.
 #[derive(Debug, Clone, Serialize)]
@@ -23,7 +29,13 @@ struct RowReport {
     position_m: Option<[f64; 3]>,
     roll_pitch_yaw_deg: Option<[f64; 3]>,
     tensions_n: Option<[f64; 4]>,
+    /// 1-sigma per axis from both sources (reading noise and calibration).
     position_sigma_m: Option<[f64; 3]>,
+    /// 1-sigma per axis from the reading noise only.
+    position_sigma_reading_m: Option<[f64; 3]>,
+    /// 1-sigma per axis from the calibration's uncertainty only (`null`
+    /// when the robot records no covariance).
+    position_sigma_calibration_m: Option<[f64; 3]>,
     chi_square: Option<f64>,
     degrees_of_freedom: Option<usize>,
     consistent: bool,
@@ -33,6 +45,14 @@ struct RowReport {
     position_error_m: Option<f64>,
     /// Why the row has no (trusted) equilibrium; `null` for a good row.
     flag: Option<String>,
+    /// Equilibria the multistart found (`null` with `--fast`).
+    equilibria: Option<usize>,
+    /// Of those, the stable ones.
+    stable_equilibria: Option<usize>,
+    /// Distance (position, metres) from the chosen pose to the farthest other
+    /// stable equilibrium: the readings cannot tell them apart by more than
+    /// their chi-square; `null` when the chosen one is the only stable one.
+    ambiguity_m: Option<f64>,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -42,7 +62,13 @@ struct Report {
     format: ReadingsFormat,
     pose_prior: bool,
     covariance: &'static str,
+    /// RMS over unflagged rows of the total position 1-sigma (norm of the three axes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    position_rms_sigma_m: Option<f64>,
     rows: Vec<RowReport>,
+    /// What the figure draws per localised row.
+    #[serde(skip)]
+    plotted: Vec<PlottedPose>,
     rejected: Vec<RejectedRow>,
     rows_flagged: usize,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -59,25 +85,49 @@ pub fn run(args: &LocalizeArgs) -> sagcal::Result<()> {
     let options = LocalizeOptions {
         pose_prior: args.pose_prior,
         false_alarm: args.false_alarm,
+        calibration_uncertainty: !args.no_calibration_uncertainty,
         ..LocalizeOptions::default()
     };
     let localizer = Localizer::with_options(&robot, &noise, options)?;
-    let report = localize_file(&args.robot.display().to_string(), &file, &localizer, args.pose_prior)?;
+    let mut report = localize_file(
+        &args.robot.display().to_string(),
+        &file,
+        &localizer,
+        args.pose_prior,
+        !args.fast,
+    )?;
+    report.covariance = covariance_note(&robot, !args.no_calibration_uncertainty);
     if let Some(out) = &args.out {
         sagcal::io::write_atomically(out, render_csv(&report).as_bytes())?;
+    }
+    if let Some(path) = &args.plot {
+        let plot = LocalizePlot {
+            title: format!("sagcal localize: {} rows of {}", report.rows.len(), report.data),
+            caption: format!("robot {}; {}", report.robot, report.covariance),
+            anchors_m: robot.anchors_m.map(Into::into),
+            reference_label: if args.pose_prior { "prior" } else { "logged" }.into(),
+            poses: report.plotted.clone(),
+        };
+        sagcal::plot::write_figure(path, &localize_plot_svg(&plot))?;
     }
     if args.json {
         print_json(&report)
     } else {
         print!("{}", render(&report));
-        if let Some(out) = &args.out {
-            println!("wrote {}", out.display());
+        for path in args.out.iter().chain(&args.plot) {
+            println!("wrote {}", path.display());
         }
         Ok(())
     }
 }
 
-fn localize_file(robot: &str, file: &ReadingsFile, localizer: &Localizer, pose_prior: bool) -> sagcal::Result<Report> {
+fn localize_file(
+    robot: &str,
+    file: &ReadingsFile,
+    localizer: &Localizer,
+    pose_prior: bool,
+    search: bool,
+) -> sagcal::Result<Report> {
     if pose_prior {
         if let Some(row) = file.rows.iter().find(|r| r.localiser_pose.is_none()) {
             return Err(sagcal::Error::Field {
@@ -90,6 +140,7 @@ fn localize_file(robot: &str, file: &ReadingsFile, localizer: &Localizer, pose_p
     }
     let mut warm: Option<PlatformPose> = None;
     let mut rows = Vec::with_capacity(file.rows.len());
+    let mut plotted = Vec::new();
     for row in &file.rows {
         let readings = Readings {
             encoder_lengths_m: row.encoder_lengths_m,
@@ -99,10 +150,31 @@ fn localize_file(robot: &str, file: &ReadingsFile, localizer: &Localizer, pose_p
         let result = localizer.localize(&readings, warm.as_ref());
         let report = match result {
             Ok(found) => {
+                let mut report = row_report(row.line, &found, row.localiser_pose.as_ref());
+                if search {
+                    let reference = warm.or(readings.localiser_pose.filter(|_| pose_prior));
+                    let all = localizer.equilibria(&readings, reference.as_ref())?;
+                    let stable: Vec<_> = all.iter().filter(|l| l.stable).collect();
+                    report.equilibria = Some(all.len());
+                    report.stable_equilibria = Some(stable.len());
+                    report.ambiguity_m = stable
+                        .iter()
+                        .map(|l| (l.pose.position_m - found.pose.position_m).norm())
+                        .filter(|d| *d > 1e-6)
+                        .reduce(f64::max);
+                }
+                let total = found.covariance + found.calibration_covariance.unwrap_or_default();
+                plotted.push(PlottedPose {
+                    row: row.line,
+                    position_m: found.pose.position_m.into(),
+                    covariance_m2: Some(std::array::from_fn(|r| std::array::from_fn(|c| total[(3 + r, 3 + c)]))),
+                    reference_m: row.localiser_pose.map(|p| p.position_m.into()),
+                    flagged: report.flag.is_some(),
+                });
                 if found.stable {
                     warm = Some(found.pose);
                 }
-                row_report(row.line, &found, row.localiser_pose.as_ref())
+                report
             }
             Err(e) => flagged(row.line, e.to_string()),
         };
@@ -113,19 +185,30 @@ fn localize_file(robot: &str, file: &ReadingsFile, localizer: &Localizer, pose_p
         .filter(|r| r.flag.is_none())
         .filter_map(|r| r.position_error_m)
         .collect();
-    let rms = (!errors.is_empty()).then(|| (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt());
+    let rms = rms_of(errors.iter().copied());
     Ok(Report {
         robot: robot.to_string(),
         data: file.path.display().to_string(),
         format: file.format,
         pose_prior,
-        covariance: COVARIANCE_NOTE,
+        covariance: "",
+        position_rms_sigma_m: rms_of(rows.iter().filter(|r| r.flag.is_none()).filter_map(|r| {
+            r.position_sigma_m
+                .map(|s| (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt())
+        })),
         rows_flagged: rows.iter().filter(|r| r.flag.is_some()).count(),
         rows,
+        plotted,
         rejected: file.rejected.clone(),
         position_rms_error_m: rms,
         position_max_error_m: errors.iter().copied().reduce(f64::max),
     })
+}
+
+/// Root mean square, `None` when empty.
+fn rms_of(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
+    (n > 0).then(|| (sum / n as f64).sqrt())
 }
 
 fn row_report(line: usize, found: &Localized, localiser: Option<&PlatformPose>) -> RowReport {
@@ -146,12 +229,19 @@ fn row_report(line: usize, found: &Localized, localiser: Option<&PlatformPose>) 
         roll_pitch_yaw_deg: Some([roll, pitch, yaw]),
         tensions_n: Some(found.tension_magnitudes_n()),
         position_sigma_m: Some(found.position_sigma_m.into()),
+        position_sigma_reading_m: Some(found.reading_position_sigma_m.into()),
+        position_sigma_calibration_m: found
+            .calibration_covariance
+            .map(|c| std::array::from_fn(|a| c[(3 + a, 3 + a)].max(0.0).sqrt())),
         chi_square: Some(found.chi_square),
         degrees_of_freedom: Some(found.degrees_of_freedom),
         consistent: found.consistent,
         stable: Some(found.stable),
         position_error_m: localiser.map(|p| (p.position_m - found.pose.position_m).norm()),
         flag,
+        equilibria: None,
+        stable_equilibria: None,
+        ambiguity_m: None,
     }
 }
 
@@ -162,12 +252,17 @@ fn flagged(line: usize, reason: String) -> RowReport {
         roll_pitch_yaw_deg: None,
         tensions_n: None,
         position_sigma_m: None,
+        position_sigma_reading_m: None,
+        position_sigma_calibration_m: None,
         chi_square: None,
         degrees_of_freedom: None,
         consistent: false,
         stable: None,
         position_error_m: None,
         flag: Some(reason),
+        equilibria: None,
+        stable_equilibria: None,
+        ambiguity_m: None,
     }
 }
 
@@ -182,7 +277,7 @@ fn render(report: &Report) -> String {
         } else {
             ""
         },
-        COVARIANCE_NOTE
+        report.covariance
     );
     let mut table = Table::new([
         "row",
@@ -202,6 +297,8 @@ fn render(report: &Report) -> String {
         "chi2/dof",
         "ok",
         "err mm",
+        "stable eq",
+        "other at m",
     ]);
     for r in &report.rows {
         let Some(p) = r.position_m else {
@@ -222,6 +319,8 @@ fn render(report: &Report) -> String {
         ));
         cells.push(if r.flag.is_none() { "yes" } else { "FLAG" }.into());
         cells.push(opt(r.position_error_m.map(|e| e * 1e3), 2));
+        cells.push(r.stable_equilibria.map_or("-".into(), |n| n.to_string()));
+        cells.push(opt(r.ambiguity_m, 3));
         table.row(cells);
     }
     out += &table.to_string();
@@ -236,6 +335,12 @@ fn render(report: &Report) -> String {
         report.rows.len(),
         report.rows_flagged
     );
+    let ambiguous = report.rows.iter().filter(|r| r.ambiguity_m.is_some()).count();
+    if ambiguous > 0 {
+        out += &format!(
+            "{ambiguous} row(s) have another stable equilibrium with the same readings (`other at m`): the chosen one is the stable solution nearest the previous row's pose (or the prior; the first row: the level start). Four lengths cannot tell them apart; a prior or a warm start along a trajectory can.\n"
+        );
+    }
     if let (Some(rms), Some(max)) = (report.position_rms_error_m, report.position_max_error_m) {
         out += &format!(
             "position against the input's poses (unflagged rows): RMS {:.3} mm, max {:.3} mm\n",

@@ -8,6 +8,7 @@ mod experiment;
 mod gross_errors;
 mod hidden;
 mod localize;
+mod localize_experiment;
 mod output;
 mod simulate;
 mod verify;
@@ -58,6 +59,46 @@ enum ExperimentCommand {
     Table2(Table2Args),
     /// Hide effects in simulated data and score `sagcal diagnose` (issue 4's sweep).
     HiddenEffects(HiddenEffectsArgs),
+    /// Calibrate by the Table II protocol, then localise the held-out poses.
+    Localize(LocalizeExperimentArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct LocalizeExperimentArgs {
+    /// The robot the data were logged on (truth: its anchors, zero offsets).
+    #[arg(long)]
+    robot: PathBuf,
+    /// A RecurDyn log or sagcal measurement file: the pool of poses.
+    #[arg(long)]
+    data: PathBuf,
+    /// Calibration poses per trial; the rest of the pool is localised.
+    #[arg(long, default_value_t = 35)]
+    poses: usize,
+    /// Trials per case.
+    #[arg(long, default_value_t = 50)]
+    trials: usize,
+    /// Base random seed (printed; each trial's streams derive from it).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Noise: paper, authors, or both.
+    #[arg(long, default_value = "both", value_parser = parse_noises)]
+    noise: std::vec::Vec<sagcal::model::sensors::NoisePreset>,
+    /// Data: log, model, or both (`model`: the closed-form equilibria at the logged poses).
+    #[arg(long, default_value = "both", value_parser = parse_sources)]
+    source: std::vec::Vec<sagcal::experiments::table2::Source>,
+    /// Print JSON instead of the table.
+    #[arg(long)]
+    json: bool,
+}
+
+fn parse_sources(text: &str) -> Result<Vec<sagcal::experiments::table2::Source>, String> {
+    match text {
+        "both" => Ok(vec![
+            sagcal::experiments::table2::Source::Log,
+            sagcal::experiments::table2::Source::Model,
+        ]),
+        other => parse_source(other).map(|s| vec![s]),
+    }
 }
 
 #[derive(Debug, clap::Args)]
@@ -429,9 +470,21 @@ struct LocalizeArgs {
     /// False-alarm rate of each row's chi-square consistency test.
     #[arg(long, default_value_t = 1e-3)]
     false_alarm: f64,
+    /// Leave the robot file's recorded calibration covariance out of the sigmas.
+    #[arg(long)]
+    no_calibration_uncertainty: bool,
+    /// Skip the multistart search for every equilibrium of each row (about
+    /// 1000 starts per row): for long trajectories, each row warm-started
+    /// from the previous one.
+    #[arg(long)]
+    fast: bool,
     /// Write the poses as CSV (atomically).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Draw the localised poses with their 1-sigma ellipses (top and side
+    /// views), beside the input's poses when it has them (PNG if the name ends in `.png`, SVG otherwise).
+    #[arg(long)]
+    plot: Option<PathBuf>,
     /// Print JSON instead of the table.
     #[arg(long)]
     json: bool,
@@ -462,6 +515,7 @@ pub fn run() -> i32 {
         Some(Command::Localize(args)) => localize::run(&args),
         Some(Command::Experiment(ExperimentCommand::Table2(args))) => experiment::run(&args),
         Some(Command::Experiment(ExperimentCommand::HiddenEffects(args))) => hidden::run(&args),
+        Some(Command::Experiment(ExperimentCommand::Localize(args))) => localize_experiment::run_experiment(&args),
         Some(Command::Completions(args)) => {
             clap_complete::generate(args.shell, &mut Cli::command(), "sagcal", &mut std::io::stdout());
             Ok(())

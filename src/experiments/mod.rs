@@ -5,6 +5,8 @@
 //!   (`sagcal experiment table2`);
 //! - [`hidden_effects`]: effects hidden in simulated data, diagnosed blind and
 //!   scored (`sagcal experiment hidden-effects`);
+//! - [`localize_after_calibration`]: calibrate by the Table II protocol, then
+//!   localise the held-out poses (`sagcal experiment localize`);
 //! - [`benchmark`]: the reproducible calibration graph the solver benches and
 //!   the peer comparison share.
 //!
@@ -20,4 +22,5 @@
 
 pub mod benchmark;
 pub mod hidden_effects;
+pub mod localize_after_calibration;
 pub mod table2;

@@ -274,8 +274,8 @@ pub fn write_measurements(path: &Path, comments: &[String], poses: &[PoseMeasure
     write_atomically(path, text.as_bytes())
 }
 
-/// The 11 values of a pose, in column order.
-fn pose_values(pose: &PoseMeasurement) -> [f64; N_COLUMNS] {
+/// The 11 values of a pose, in [`MEASUREMENT_HEADER`] order (as a file row holds them).
+pub fn pose_values(pose: &PoseMeasurement) -> [f64; N_COLUMNS] {
     let [x, y, z] = pose.position_m;
     let [l1, l2, l3, l4] = pose.encoder_lengths_m;
     [
@@ -478,17 +478,7 @@ fn parse_row(text: &[u8], line: usize, path: &Path) -> Result<PoseMeasurement> {
         }
         *slot = value;
     }
-    let [x, y, z, roll, pitch, yaw, l1, l2, l3, l4, f_ref] = values;
-    Ok(PoseMeasurement {
-        line,
-        position_m: [x, y, z],
-        roll_deg: roll,
-        pitch_deg: pitch,
-        yaw_deg: yaw,
-        encoder_lengths_m: [l1, l2, l3, l4],
-        reference_tension_n: f_ref,
-        excluded: Default::default(),
-    })
+    Ok(pose_from_values(line, &values))
 }
 
 /// A line holding only whitespace.
@@ -506,5 +496,49 @@ fn format_error(path: &Path, message: String) -> Error {
     Error::Format {
         path: path.to_path_buf(),
         message,
+    }
+}
+
+/// A measurement from the 11 values of one row in [`MEASUREMENT_HEADER`]
+/// order, for data that never were a file (the Python binding's arrays).
+///
+/// The checks and messages are those of [`read_measurements`] for a row of a
+/// file: every value finite, the reference tension positive. `source` names
+/// the data in the error ([`Error::Field`]) and `row` is its 1-based row;
+/// [`PoseMeasurement::line`] is set to 0 (in-memory data).
+pub fn measurement_from_values(source: &Path, row: usize, values: &[f64; N_COLUMNS]) -> Result<PoseMeasurement> {
+    for (index, value) in values.iter().enumerate() {
+        let problem = if !value.is_finite() {
+            Some(format!("not a finite number: `{value}`"))
+        } else if index == F_REF {
+            tension_problem(*value)
+        } else {
+            None
+        };
+        if let Some(message) = problem {
+            return Err(Error::Field {
+                path: source.to_path_buf(),
+                row,
+                field: MEASUREMENT_HEADER[index].to_string(),
+                message,
+            });
+        }
+    }
+    Ok(pose_from_values(0, values))
+}
+
+/// The pose of line `line` from its 11 values in [`MEASUREMENT_HEADER`] order
+/// (the inverse of [`pose_values`]; no checks).
+fn pose_from_values(line: usize, values: &[f64; N_COLUMNS]) -> PoseMeasurement {
+    let [x, y, z, roll, pitch, yaw, l1, l2, l3, l4, f_ref] = *values;
+    PoseMeasurement {
+        line,
+        position_m: [x, y, z],
+        roll_deg: roll,
+        pitch_deg: pitch,
+        yaw_deg: yaw,
+        encoder_lengths_m: [l1, l2, l3, l4],
+        reference_tension_n: f_ref,
+        excluded: Default::default(),
     }
 }

@@ -17,6 +17,9 @@
 //!
 //! [effects]                        # optional: effects beyond the closed-form model
 //! axial_stiffness_n = 3e6          # (written by `simulate --truth`; the calibration ignores it)
+//!
+//! [calibration]                    # optional: written by `calibrate --out`
+//! covariance_m2 = [[...], ...]     # 16 x 16: a1x, a1y, a1z, ..., a4z, l1^0, ..., l4^0
 //! ```
 //!
 //! An optional top-level `paper_robot = "large"` (or `"small"`) says the file
@@ -33,7 +36,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::model::effects::Effects;
-use crate::model::robot::{PaperRobot, Robot, Workspace, CABLE_COUNT};
+use crate::model::robot::{PaperRobot, ParameterCovariance, Robot, Workspace, CABLE_COUNT, CALIBRATED_PARAMETERS};
 
 /// One cable of a robot file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -76,6 +79,64 @@ pub struct RobotFile {
     /// (optional; written by `simulate --truth`; the calibration ignores it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub effects: Option<Effects>,
+    /// What the calibration that produced the anchors and offsets knows of
+    /// them (optional; written by `calibrate --out`, read by `localize`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<CalibrationEntry>,
+}
+
+/// The `[calibration]` table of a robot file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrationEntry {
+    /// Marginal covariance of the calibrated parameters, m^2, 16 rows of 16:
+    /// anchors 1..4 (x, y, z each), then length offsets 1..4.
+    pub covariance_m2: Vec<Vec<f64>>,
+}
+
+impl CalibrationEntry {
+    /// The entry of a covariance matrix.
+    pub fn from_covariance(c: &ParameterCovariance) -> Self {
+        Self {
+            covariance_m2: (0..CALIBRATED_PARAMETERS)
+                .map(|r| (0..CALIBRATED_PARAMETERS).map(|k| c[(r, k)]).collect())
+                .collect(),
+        }
+    }
+
+    /// The covariance matrix, validated: 16 x 16, finite, symmetric (to
+    /// 1e-9 of its largest entry) and positive semi-definite (no eigenvalue
+    /// below -1e-9 of the largest); the error says which.
+    pub fn covariance(&self) -> std::result::Result<ParameterCovariance, String> {
+        let n = CALIBRATED_PARAMETERS;
+        if self.covariance_m2.len() != n || self.covariance_m2.iter().any(|r| r.len() != n) {
+            return Err(format!(
+                "field `calibration.covariance_m2`: must be {n} rows of {n} numbers (anchors x, y, z of cables 1..4, then offsets 1..4)"
+            ));
+        }
+        let c = ParameterCovariance::from_fn(|r, k| self.covariance_m2[r][k]);
+        if let Some((r, k)) = (0..n)
+            .flat_map(|r| (0..n).map(move |k| (r, k)))
+            .find(|&(r, k)| !c[(r, k)].is_finite())
+        {
+            return Err(format!(
+                "field `calibration.covariance_m2`: row {} column {} is not a finite number",
+                r + 1,
+                k + 1
+            ));
+        }
+        let scale = c.amax().max(f64::MIN_POSITIVE);
+        if (c - c.transpose()).amax() > 1e-9 * scale {
+            return Err("field `calibration.covariance_m2`: the matrix is not symmetric".into());
+        }
+        let smallest = c.symmetric_eigenvalues().min();
+        if smallest < -1e-9 * scale {
+            return Err(format!(
+                "field `calibration.covariance_m2`: not a covariance (an eigenvalue is {smallest:e} m^2 < 0)"
+            ));
+        }
+        Ok(c)
+    }
 }
 
 /// The `[workspace]` table of a robot file: an axis-aligned box of platform positions.
@@ -88,6 +149,19 @@ pub struct WorkspaceEntry {
     pub max_m: [f64; 3],
 }
 
+impl WorkspaceEntry {
+    /// The box, validated: finite corners, `min_m <= max_m` on every axis.
+    fn validated(self) -> std::result::Result<Workspace, String> {
+        let WorkspaceEntry { min_m, max_m } = self;
+        if !(0..3).all(|k| min_m[k].is_finite() && max_m[k].is_finite() && min_m[k] <= max_m[k]) {
+            return Err(format!(
+                "field `workspace`: `min_m` {min_m:?} must be finite and <= `max_m` {max_m:?} on every axis"
+            ));
+        }
+        Ok(Workspace { min_m, max_m })
+    }
+}
+
 impl RobotFile {
     /// Read and parse a robot file (no physical validation: see `model::Robot`).
     pub fn read(path: &Path) -> Result<Self> {
@@ -98,9 +172,23 @@ impl RobotFile {
         })
     }
 
-    /// Serialise to TOML text.
+    /// Serialise to TOML text (the `[calibration]` covariance one row per line).
     pub fn to_toml(&self) -> Result<String> {
-        toml::to_string_pretty(self).map_err(|e| Error::InvalidInput(format!("cannot serialise robot: {e}")))
+        let without = Self {
+            calibration: None,
+            ..self.clone()
+        };
+        let mut text =
+            toml::to_string(&without).map_err(|e| Error::InvalidInput(format!("cannot serialise robot: {e}")))?;
+        if let Some(calibration) = &self.calibration {
+            text += "\n[calibration]\n# Covariance of the calibrated parameters, m^2: anchors 1..4 (x, y, z), then offsets 1..4.\ncovariance_m2 = [\n";
+            for row in &calibration.covariance_m2 {
+                let cells: Vec<String> = row.iter().map(|v| format!("{v:e}")).collect();
+                text += &format!("    [{}],\n", cells.join(", "));
+            }
+            text += "]\n";
+        }
+        Ok(text)
     }
 }
 
@@ -185,19 +273,19 @@ impl Robot {
                 )))
             }
         };
-        let workspace = match file.workspace {
-            None => None,
-            Some(WorkspaceEntry { min_m, max_m }) => {
-                if !(0..3).all(|k| min_m[k].is_finite() && max_m[k].is_finite() && min_m[k] <= max_m[k]) {
-                    return Err(fail(format!(
-                        "field `workspace`: `min_m` {min_m:?} must be finite and <= `max_m` {max_m:?} on every axis"
-                    )));
-                }
-                Some(Workspace { min_m, max_m })
-            }
-        };
+        let workspace = file
+            .workspace
+            .map(WorkspaceEntry::validated)
+            .transpose()
+            .map_err(fail)?;
         let effects = file.effects.unwrap_or_default();
         effects.validate().map_err(|e| fail(format!("table `effects`: {e}")))?;
+        let calibration_covariance_m2 = file
+            .calibration
+            .as_ref()
+            .map(CalibrationEntry::covariance)
+            .transpose()
+            .map_err(fail)?;
         Ok(Robot {
             name: file.name,
             anchors_m,
@@ -210,6 +298,7 @@ impl Robot {
             workspace,
             effects,
             paper_robot: file.paper_robot,
+            calibration_covariance_m2,
         })
     }
 
@@ -238,6 +327,10 @@ impl Robot {
                 max_m: w.max_m,
             }),
             effects: (!self.effects.is_none()).then_some(self.effects),
+            calibration: self
+                .calibration_covariance_m2
+                .as_ref()
+                .map(CalibrationEntry::from_covariance),
         }
     }
 

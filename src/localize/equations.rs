@@ -135,6 +135,34 @@ pub struct ModelAtPose {
     pub cables: [CablePartials; CABLE_COUNT],
 }
 
+/// One cable's `[paid_out, drop]` (eq. 1-4 with the `[effects]`) and its
+/// derivatives in the span, `f_h` and `f_v` (`generated::extended_cable`).
+fn extended_cable(
+    robot: &SlotRobot,
+    span: f64,
+    f_h: f64,
+    f_v: f64,
+) -> (Vector2<f64>, Vector2<f64>, Vector2<f64>, Vector2<f64>) {
+    let (mut d_span, mut d_fh, mut d_fv) = (Vector2::zeros(), Vector2::zeros(), Vector2::zeros());
+    let cable = generated::extended_cable(
+        span,
+        f_h,
+        f_v,
+        robot.cable_weight_n_per_m,
+        robot.compliance_per_mn,
+        robot.pulley_radius_m,
+        robot.inverse_segments_squared,
+        EPSILON,
+        Some(&mut d_span),
+        Some(&mut d_fh),
+        Some(&mut d_fv),
+        None,
+        None,
+        None,
+    );
+    (cable, d_span, d_fh, d_fv)
+}
+
 /// Pose as the generated functions take it: position and `[x, y, z, w]`.
 pub fn pose_arguments(pose: &PlatformPose) -> (Vector3<f64>, Vector4<f64>) {
     (pose.position_m, pose.rotation_xyzw())
@@ -188,23 +216,7 @@ pub fn model_at_pose(robot: &SlotRobot, pose: &PlatformPose, reference_n: &Vecto
         if !(f_h > 0.0 && span.is_finite() && f_v.is_finite() && h.is_finite()) {
             return None;
         }
-        let (mut d_span, mut d_fh, mut d_fv) = (Vector2::zeros(), Vector2::zeros(), Vector2::zeros());
-        let cable = generated::extended_cable(
-            span,
-            f_h,
-            f_v,
-            robot.cable_weight_n_per_m,
-            robot.compliance_per_mn,
-            robot.pulley_radius_m,
-            robot.inverse_segments_squared,
-            EPSILON,
-            Some(&mut d_span),
-            Some(&mut d_fh),
-            Some(&mut d_fv),
-            None,
-            None,
-            None,
-        );
+        let (cable, d_span, d_fh, d_fv) = extended_cable(robot, span, f_h, f_v);
         let gain = robot.encoder_gains[slot];
         out.encoders_m[slot] = gain * cable[0] + robot.length_offsets_m[slot];
         out.heights_m[slot] = cable[1] - h;
@@ -247,4 +259,77 @@ pub fn prior_residual(pose: &PlatformPose, prior: &PlatformPose) -> (Vector6<f64
         Some(&mut jacobian),
     );
     (r, jacobian)
+}
+
+/// Number of calibrated parameters in slot order: the anchors of slots
+/// 0..3 (x, y, z each), then the offsets of slots 0..3.
+pub const PARAMETERS: usize = 16;
+
+/// How the equations move with the calibrated parameters (slot order, see
+/// [`PARAMETERS`]) at one pose: what carries the calibration's uncertainty
+/// into the localised pose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParameterPartials {
+    /// `d encoders / d parameters`.
+    pub d_encoders: SMatrix<f64, 4, PARAMETERS>,
+    /// `d heights / d parameters` (the offsets do not enter the heights).
+    pub d_heights: SMatrix<f64, 4, PARAMETERS>,
+    /// `d load_cell / d parameters`.
+    pub d_load_cell: RowSVector<f64, PARAMETERS>,
+}
+
+/// The equations' partial derivatives in the anchors and offsets at `pose`
+/// and `reference_n`, chained as in [`model_at_pose`] through
+/// `generated::cable_geometry`'s anchor Jacobian: `encoder_j = gain_j
+/// paid_out_j(span, f_h, f_v) + l0_j` (eq. 14), `drop_j - h_j` (eq. 15),
+/// `|f_ref|` (eq. 16). `None` where the model is undefined.
+pub fn parameter_partials(
+    robot: &SlotRobot,
+    pose: &PlatformPose,
+    reference_n: &Vector2<f64>,
+) -> Option<ParameterPartials> {
+    let (position, rotation) = pose_arguments(pose);
+    let mut j_anchors = SMatrix::<f64, 16, 12>::zeros();
+    let geometry = generated::cable_geometry(
+        &position,
+        &rotation,
+        reference_n,
+        &robot.anchors_m,
+        &robot.attachments_m,
+        &robot.com_offset_m,
+        robot.platform_weight_n,
+        EPSILON,
+        None,
+        None,
+        Some(&mut j_anchors),
+        None,
+    );
+    let mut out = ParameterPartials {
+        d_encoders: SMatrix::zeros(),
+        d_heights: SMatrix::zeros(),
+        d_load_cell: RowSVector::zeros(),
+    };
+    let row = |k: usize| -> RowSVector<f64, PARAMETERS> {
+        let mut r = RowSVector::<f64, PARAMETERS>::zeros();
+        r.fixed_columns_mut::<12>(0).copy_from(&j_anchors.row(k));
+        r
+    };
+    for slot in 0..CABLE_COUNT {
+        let k = 4 * slot;
+        let (span, f_h, f_v) = (geometry[k], geometry[k + 1], geometry[k + 2]);
+        if !(f_h > 0.0 && span.is_finite() && f_v.is_finite()) {
+            return None;
+        }
+        let (_, d_span, d_fh, d_fv) = extended_cable(robot, span, f_h, f_v);
+        let (g_span, g_fh, g_fv, g_h) = (row(k), row(k + 1), row(k + 2), row(k + 3));
+        let mut encoder = (g_span * d_span[0] + g_fh * d_fh[0] + g_fv * d_fv[0]) * robot.encoder_gains[slot];
+        encoder[12 + slot] = 1.0;
+        out.d_encoders.set_row(slot, &encoder);
+        out.d_heights
+            .set_row(slot, &(g_span * d_span[1] + g_fh * d_fh[1] + g_fv * d_fv[1] - g_h));
+    }
+    let (f_h, f_v) = (geometry[1], geometry[2]);
+    let magnitude = f_h.hypot(f_v);
+    out.d_load_cell = (row(1) * (f_h / magnitude) + row(2) * (f_v / magnitude)) * robot.load_cell_gain;
+    Some(out)
 }

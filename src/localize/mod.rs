@@ -23,17 +23,22 @@
 //! allocates nothing: every matrix is fixed-size.
 
 mod equations;
+mod equilibria;
 mod newton;
 pub mod stiffness;
 
-use nalgebra::{Matrix6, UnitQuaternion, Vector2, Vector3, Vector6};
+use nalgebra::{Matrix6, SMatrix, UnitQuaternion, Vector2, Vector3, Vector6};
 
-pub use equations::{model_at_pose, ModelAtPose, SlotRobot, EPSILON, MEASUREMENT_ROWS, UNKNOWNS};
+pub use equations::{
+    model_at_pose, parameter_partials, ModelAtPose, ParameterPartials, SlotRobot, EPSILON, MEASUREMENT_ROWS,
+    PARAMETERS, UNKNOWNS,
+};
+pub use equilibria::tilt_deg;
 use newton::{Observation, Solution};
 
 use crate::error::{Error, Result};
 use crate::model::pose::PlatformPose;
-use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::robot::{ParameterCovariance, Robot, CABLE_COUNT};
 use crate::model::sensors::SensorNoise;
 use crate::model::statics::{self, CableTension, StaticsOptions};
 use crate::stats;
@@ -62,16 +67,21 @@ pub struct LocalizeOptions {
     pub max_iterations: usize,
     /// Largest attachment-height residual (eq. 15) accepted, metres.
     pub height_tolerance_m: f64,
+    /// Propagate the robot's recorded calibration covariance
+    /// ([`Robot::calibration_covariance_m2`]) into the pose uncertainty.
+    pub calibration_uncertainty: bool,
 }
 
 impl Default for LocalizeOptions {
-    /// No prior, false alarms 1e-3, 50 iterations, 1e-9 m.
+    /// No prior, false alarms 1e-3, 50 iterations, 1e-9 m, the calibration's
+    /// uncertainty propagated.
     fn default() -> Self {
         Self {
             pose_prior: false,
             false_alarm: 1e-3,
             max_iterations: 50,
             height_tolerance_m: 1e-9,
+            calibration_uncertainty: true,
         }
     }
 }
@@ -86,8 +96,15 @@ pub struct Localized {
     /// Covariance of the pose tangent `[dtheta (rad), dp (m)]` from the
     /// reading noise, `(J^T W J)^-1` with the model equations tight.
     pub covariance: Matrix6<f64>,
-    /// 1-sigma of the position per world axis, metres (from `covariance`).
+    /// Covariance of the pose tangent from the calibration's own uncertainty
+    /// (the robot's recorded anchor/offset covariance carried through the
+    /// equilibrium, `S Sigma_theta S^T`); `None` when the robot records none.
+    pub calibration_covariance: Option<Matrix6<f64>>,
+    /// 1-sigma of the position per world axis, metres, from both sources
+    /// (`covariance + calibration_covariance`).
     pub position_sigma_m: Vector3<f64>,
+    /// 1-sigma of the position per world axis from the reading noise only, metres.
+    pub reading_position_sigma_m: Vector3<f64>,
     /// Chi-square of the whitened readings at the solution.
     pub chi_square: f64,
     /// Its degrees of freedom: readings minus 4 (0 with the encoders only).
@@ -122,6 +139,21 @@ pub struct Localizer {
     /// The localiser's mounting rotation `M` (`[effects]`): it reads `R M`.
     mount: UnitQuaternion<f64>,
     critical: [f64; MEASUREMENT_ROWS],
+    /// The calibration covariance in slot order ([`PARAMETERS`]), if used.
+    calibration: Option<SMatrix<f64, PARAMETERS, PARAMETERS>>,
+}
+
+/// The robot-order covariance (anchors of cables 1..4, then offsets) in
+/// slot order.
+fn to_slot_order(slots: &SlotRobot, covariance: &ParameterCovariance) -> SMatrix<f64, PARAMETERS, PARAMETERS> {
+    let index = |k: usize| {
+        if k < 12 {
+            3 * slots.cables[k / 3] + k % 3
+        } else {
+            12 + slots.cables[k - 12]
+        }
+    };
+    SMatrix::from_fn(|r, c| covariance[(index(r), index(c))])
 }
 
 impl Localizer {
@@ -157,10 +189,16 @@ impl Localizer {
         shifted.com_offset_m += Vector3::from(robot.effects.com_shift_m);
         let mount =
             UnitQuaternion::from_scaled_axis(Vector3::from(robot.effects.localiser_mount_deg).map(f64::to_radians));
+        let slots = SlotRobot::new(robot);
+        let calibration = robot
+            .calibration_covariance_m2
+            .filter(|_| options.calibration_uncertainty)
+            .map(|c| to_slot_order(&slots, &c));
         Ok(Self {
             robot: robot.clone(),
             shifted,
-            slots: SlotRobot::new(robot),
+            calibration,
+            slots,
             noise: *noise,
             options,
             mount,
@@ -354,6 +392,14 @@ impl Localizer {
         let k = stiffness::stiffness(&self.shifted, &self.slots, &solution.pose, &solution.model);
         let smallest = stiffness::smallest_stiffness(&k);
         let covariance: Matrix6<f64> = solution.covariance.fixed_view::<6, 6>(0, 0).into_owned();
+        let calibration_covariance = self.calibration.and_then(|sigma| {
+            let reference = solution.model.tensions_n[0];
+            let partials = equations::parameter_partials(&self.slots, &solution.pose, &reference)?;
+            let s = newton::parameter_sensitivity(&self.slots, observation, solution, &partials);
+            Some(s * sigma * s.transpose())
+        });
+        let position_sigma = |c: &Matrix6<f64>| Vector3::from_fn(|a, _| c[(3 + a, 3 + a)].max(0.0).sqrt());
+        let total = covariance + calibration_covariance.unwrap_or_else(Matrix6::zeros);
         let chi_square = solution.whitened.norm_squared();
         let degrees_of_freedom = observation.rows() - 4;
         let mut tensions = [CableTension {
@@ -370,7 +416,9 @@ impl Localizer {
             pose: solution.pose,
             tensions,
             covariance,
-            position_sigma_m: Vector3::from_fn(|a, _| covariance[(3 + a, 3 + a)].max(0.0).sqrt()),
+            calibration_covariance,
+            position_sigma_m: position_sigma(&total),
+            reading_position_sigma_m: position_sigma(&covariance),
             chi_square,
             degrees_of_freedom,
             consistent: degrees_of_freedom == 0 || chi_square <= self.critical[degrees_of_freedom],

@@ -17,7 +17,9 @@
 
 use nalgebra::{SMatrix, SVector, Vector2, Vector6};
 
-use super::equations::{model_at_pose, prior_residual, ModelAtPose, SlotRobot, MEASUREMENT_ROWS, UNKNOWNS};
+use super::equations::{
+    model_at_pose, prior_residual, ModelAtPose, ParameterPartials, SlotRobot, MEASUREMENT_ROWS, PARAMETERS, UNKNOWNS,
+};
 use crate::model::pose::PlatformPose;
 
 const KKT: usize = UNKNOWNS + 4;
@@ -53,6 +55,9 @@ pub struct Solution {
     pub whitened: SVector<f64, MEASUREMENT_ROWS>,
     /// Covariance of `[pose tangent (6), f_ref (2)]` from the reading noise.
     pub covariance: SMatrix<f64, UNKNOWNS, UNKNOWNS>,
+    /// The inverse of the KKT matrix at the solution (tension unknowns in
+    /// units of the platform weight; NaN where singular).
+    pub kkt_inverse: SMatrix<f64, KKT, KKT>,
     /// Iterations used.
     pub iterations: usize,
     /// Whether the heights hold and the last step was negligible.
@@ -200,7 +205,9 @@ fn finish(
     j.column_mut(7).scale_mut(scale_n);
     let h = scaled(model.d_heights, scale_n);
     let mut covariance = SMatrix::<f64, UNKNOWNS, UNKNOWNS>::from_element(f64::NAN);
+    let mut kkt_inverse = SMatrix::<f64, KKT, KKT>::from_element(f64::NAN);
     if let Some(inverse) = kkt_matrix(&j, &h, 0.0).try_inverse() {
+        kkt_inverse = inverse;
         covariance = inverse.fixed_view::<UNKNOWNS, UNKNOWNS>(0, 0).into_owned();
         for a in 0..UNKNOWNS {
             for b in 0..UNKNOWNS {
@@ -216,9 +223,38 @@ fn finish(
         model,
         whitened: r,
         covariance,
+        kkt_inverse,
         iterations: 0,
         converged: heights_hold,
     }
+}
+
+/// `d pose tangent / d parameters` at the solution (implicit function
+/// theorem on the KKT conditions): a parameter change `dtheta` moves the
+/// whitened readings by `J_theta dtheta` and the heights by `H_theta dtheta`,
+/// so `[dx; dlambda] = -K^-1 [J^T J_theta; H_theta] dtheta`. Exact for the
+/// square system (encoders only), first order in the residuals otherwise.
+pub fn parameter_sensitivity(
+    robot: &SlotRobot,
+    observation: &Observation,
+    solution: &Solution,
+    partials: &ParameterPartials,
+) -> SMatrix<f64, 6, PARAMETERS> {
+    let scale_n = robot.platform_weight_n;
+    let (_, mut j) = whitened(&solution.model, &solution.pose, observation);
+    j.column_mut(6).scale_mut(scale_n);
+    j.column_mut(7).scale_mut(scale_n);
+    let mut j_theta = SMatrix::<f64, MEASUREMENT_ROWS, PARAMETERS>::zeros();
+    j_theta
+        .fixed_rows_mut::<4>(0)
+        .copy_from(&(partials.d_encoders / observation.encoder_sigma_m));
+    if let Some((_, sigma)) = observation.load_cell {
+        j_theta.set_row(4, &(partials.d_load_cell / sigma));
+    }
+    let mut rhs = SMatrix::<f64, KKT, PARAMETERS>::zeros();
+    rhs.fixed_rows_mut::<UNKNOWNS>(0).copy_from(&(j.transpose() * j_theta));
+    rhs.fixed_rows_mut::<4>(UNKNOWNS).copy_from(&partials.d_heights);
+    -(solution.kkt_inverse.fixed_rows::<6>(0) * rhs)
 }
 
 /// The reference tension that best meets the four attachment heights (eq. 15)

@@ -1,13 +1,21 @@
 //! The robot's geometry and masses. Files are read and validated into a
 //! [`Robot`] by `io::robot_file`; the physics never sees a file.
 
-use nalgebra::Vector3;
+use nalgebra::{SMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::model::effects::Effects;
 
 /// Number of cables of the suspended robot modelled by sagcal.
 pub const CABLE_COUNT: usize = 4;
+
+/// Number of calibrated parameters: the anchors' 12 coordinates, then the 4
+/// encoder length offsets.
+pub const CALIBRATED_PARAMETERS: usize = 3 * CABLE_COUNT + CABLE_COUNT;
+
+/// Covariance of the calibrated parameters, m^2, in the order
+/// `[a1x, a1y, a1z, ..., a4z, l1^0, ..., l4^0]` (cable order).
+pub type ParameterCovariance = SMatrix<f64, CALIBRATED_PARAMETERS, CALIBRATED_PARAMETERS>;
 
 /// A suspended 4-cable robot (paper Sec. III-A).
 #[derive(Debug, Clone, PartialEq)]
@@ -38,6 +46,11 @@ pub struct Robot {
     /// Which of the paper's robots this is, if the robot file says so (its
     /// optional `paper_robot`); only used to print the paper's numbers beside sagcal's.
     pub paper_robot: Option<PaperRobot>,
+    /// The marginal covariance of the anchors and offsets from the
+    /// calibration that produced them (the robot file's optional
+    /// `[calibration]`, written by `calibrate --out`); `None` for a nominal
+    /// robot. `localize` propagates it into its pose uncertainty.
+    pub calibration_covariance_m2: Option<ParameterCovariance>,
 }
 
 /// The two robots of the paper's Sec. V (Table I): a robot file names one with

@@ -174,15 +174,15 @@ pub fn anchor_plot_svg(plot: &AnchorPlot) -> String {
 /// 1-sigma ellipse of a 2x2 covariance: semi-axes [m] and major-axis angle
 /// [deg, counter-clockwise from the first axis, in (-90, 90]].
 #[derive(Debug, Clone, Copy)]
-struct SigmaEllipse {
-    major: f64,
-    minor: f64,
-    angle_deg: f64,
+pub(super) struct SigmaEllipse {
+    pub(super) major: f64,
+    pub(super) minor: f64,
+    pub(super) angle_deg: f64,
 }
 
 /// Closed-form eigen-decomposition of the symmetric matrix [[a, b], [b, d]].
 /// `None` unless finite and positive definite.
-fn sigma_ellipse(a: f64, b: f64, d: f64) -> Option<SigmaEllipse> {
+pub(super) fn sigma_ellipse(a: f64, b: f64, d: f64) -> Option<SigmaEllipse> {
     if !(a.is_finite() && b.is_finite() && d.is_finite()) {
         return None;
     }
@@ -245,7 +245,7 @@ fn finite3(p: &[f64; 3]) -> bool {
 }
 
 /// Largest of 1, 2, 5 x 10^k not above `raw` (or 1 for nonsense input).
-fn nice_step_below(raw: f64) -> f64 {
+pub(super) fn nice_step_below(raw: f64) -> f64 {
     if !(raw.is_finite() && raw > 0.0) {
         return 1.0;
     }
@@ -262,7 +262,7 @@ fn nice_step_below(raw: f64) -> f64 {
 }
 
 /// Decimals needed to print multiples of `step`.
-fn decimals_for(step: f64) -> usize {
+pub(super) fn decimals_for(step: f64) -> usize {
     if !(step.is_finite() && step > 0.0) {
         return 0;
     }
@@ -270,7 +270,7 @@ fn decimals_for(step: f64) -> usize {
 }
 
 /// Tick value `i * step` as text, with a typographic minus sign.
-fn tick_label(i: i64, step: f64, decimals: usize) -> String {
+pub(super) fn tick_label(i: i64, step: f64, decimals: usize) -> String {
     if i == 0 {
         return "0".to_owned();
     }

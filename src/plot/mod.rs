@@ -5,7 +5,8 @@
 //!   (`sagcal calibrate --plot`, the demo);
 //! - [`residuals`]: normalised residuals against a physical driver, before and
 //!   after a model extension (`sagcal diagnose --plots`);
-//! - `svg`: the drawing helpers both share (escaping, coordinates, labels,
+//! - [`localize`]: localised poses with their error ellipses (`sagcal localize --plot`);
+//! - `svg`: the drawing helpers they share (escaping, coordinates, labels,
 //!   the font and colours);
 //! - `png`: [`write_figure`] and [`svg_to_png`], the SVG rendered with `resvg`
 //!   and a bundled font (DejaVu Sans), so PNG needs no system fonts.
@@ -34,6 +35,7 @@
 //! ```
 
 pub mod anchors;
+pub mod localize;
 mod png;
 pub mod residuals;
 mod svg;

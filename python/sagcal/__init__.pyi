@@ -1,0 +1,306 @@
+"""Type stubs of sagcal (the extension module `sagcal._sagcal`, re-exported)."""
+
+import os
+from typing import Any, Callable, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+#: The columns of a measurement array, in order (sagcal's CSV header).
+MEASUREMENT_COLUMNS: Tuple[str, ...]
+
+#: Anything numpy turns into a float64 array.
+ArrayLike = npt.ArrayLike
+#: A file path.
+PathLike = Union[str, "os.PathLike[str]"]
+#: A float64 array.
+FloatArray = npt.NDArray[np.float64]
+
+class SagcalError(ValueError):
+    """A sagcal error; the message is what the ``sagcal`` command prints after ``error: ``."""
+
+class Robot:
+    """A suspended four-cable robot (a robot TOML file). Array attributes
+    return new read-only float64 arrays: copy, edit, assign back."""
+
+    @staticmethod
+    def from_toml(path: PathLike) -> "Robot":
+        """Read and validate a robot TOML file."""
+    @staticmethod
+    def builtin(name: str) -> "Robot":
+        """A built-in robot: ``"large"`` or ``"small"``."""
+    def to_toml(self, path: PathLike) -> None:
+        """Write the robot as a TOML file (atomically)."""
+    def toml(self) -> str:
+        """The robot file's text (TOML)."""
+    def copy(self) -> "Robot":
+        """An independent copy."""
+    def __copy__(self) -> "Robot": ...
+    def __deepcopy__(self, memo: Any) -> "Robot": ...
+    def __eq__(self, other: object) -> bool: ...
+    name: str
+    """Human-readable name."""
+    @property
+    def anchors_m(self) -> FloatArray:
+        """Anchors of cables 1..4, world frame, metres: (4, 3)."""
+    @anchors_m.setter
+    def anchors_m(self, value: ArrayLike) -> None: ...
+    @property
+    def attachments_m(self) -> FloatArray:
+        """Attachment points of cables 1..4, platform frame, metres: (4, 3)."""
+    @attachments_m.setter
+    def attachments_m(self, value: ArrayLike) -> None: ...
+    @property
+    def com_offset_m(self) -> FloatArray:
+        """Centre of mass, platform frame, metres: (3,)."""
+    @com_offset_m.setter
+    def com_offset_m(self, value: ArrayLike) -> None: ...
+    platform_weight_n: float
+    """Platform weight, newtons."""
+    cable_weight_n_per_m: float
+    """Cable weight per metre, newtons per metre."""
+    reference_cable: int
+    """The cable with the load cell, 1..4 (as in the robot file)."""
+    @property
+    def length_offsets_m(self) -> FloatArray:
+        """Encoder length offsets of cables 1..4, metres: (4,)."""
+    @length_offsets_m.setter
+    def length_offsets_m(self, value: ArrayLike) -> None: ...
+    @property
+    def workspace(self) -> Optional[Tuple[FloatArray, FloatArray]]:
+        """``(min_m, max_m)`` of the pose box, or ``None``."""
+    @workspace.setter
+    def workspace(self, value: Optional[Tuple[ArrayLike, ArrayLike]]) -> None: ...
+    @property
+    def paper_robot(self) -> Optional[str]:
+        """``"large"``, ``"small"`` or ``None``."""
+    @property
+    def effects(self) -> dict[str, Any]:
+        """The effects beyond the closed-form model (every key)."""
+    @effects.setter
+    def effects(self, value: dict[str, Any]) -> None: ...
+
+class Calibration:
+    """The result of :func:`calibrate`."""
+
+    @property
+    def robot(self) -> Robot:
+        """The calibrated robot."""
+    @property
+    def anchors_m(self) -> FloatArray:
+        """Calibrated anchors, metres: (4, 3)."""
+    @property
+    def length_offsets_m(self) -> FloatArray:
+        """Calibrated length offsets, metres: (4,)."""
+    @property
+    def anchor_covariance_m2(self) -> Optional[FloatArray]:
+        """Per anchor its 3x3 covariance, m^2: (4, 3, 3); ``None`` if not observable."""
+    @property
+    def anchor_sigma_m(self) -> Optional[FloatArray]:
+        """1-sigma per anchor coordinate, metres: (4, 3); ``None`` if not observable."""
+    @property
+    def offset_sigma_m(self) -> Optional[FloatArray]:
+        """1-sigma per offset, metres: (4,); ``None`` if not observable."""
+    @property
+    def factor_statistics(self) -> list[dict[str, Any]]:
+        """Normalised residual statistics per factor type."""
+    @property
+    def stages(self) -> list[dict[str, Any]]:
+        """The solver stages in order."""
+    @property
+    def termination(self) -> str:
+        """Why the final stage stopped, in words."""
+    @property
+    def converged(self) -> bool:
+        """Whether the final stage stopped at a minimum."""
+    @property
+    def iterations(self) -> int:
+        """Solver iterations over all stages."""
+    @property
+    def final_cost(self) -> float:
+        """Cost of the final stage."""
+    @property
+    def poses_used(self) -> int:
+        """Poses in the final solve."""
+    @property
+    def excluded_poses(self) -> list[int]:
+        """Poses without an equilibrium near them (file lines or 1-based rows)."""
+    @property
+    def excluded_readings(self) -> list[dict[str, Any]]:
+        """Readings left out as gross errors."""
+    @property
+    def mistakes(self) -> list[dict[str, Any]]:
+        """Common mistakes recognised in the data."""
+    @property
+    def consistent(self) -> bool:
+        """Whether the fit passes its consistency tests."""
+    @property
+    def inconsistency(self) -> Optional[str]:
+        """Why the fit fails its consistency tests, or ``None``."""
+    @property
+    def rows(self) -> list[int]:
+        """0-based row of each pose the fit used."""
+    @property
+    def positions_m(self) -> FloatArray:
+        """Estimated platform positions, metres: (M, 3)."""
+    @property
+    def roll_pitch_yaw_deg(self) -> FloatArray:
+        """Estimated orientations, degrees: (M, 3)."""
+    @property
+    def reference_tensions_n(self) -> FloatArray:
+        """Estimated reference tension ``(f_h, f_v)``, newtons: (M, 2)."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The report as ``sagcal calibrate --json`` prints it."""
+
+class Diagnosis:
+    """The result of :func:`diagnose`."""
+
+    @property
+    def verdict(self) -> str:
+        """The effects selected, joined by ``+``, or ``"none"``."""
+    @property
+    def reason(self) -> str:
+        """Why, in one sentence."""
+    @property
+    def effects(self) -> list[dict[str, Any]]:
+        """The selected effects with their parameters and 1-sigma."""
+    @property
+    def robot(self) -> Robot:
+        """The selected model's calibrated robot."""
+    @property
+    def baseline_consistent(self) -> bool:
+        """Whether the baseline model passes its chi-square test."""
+    @property
+    def series(self) -> dict[str, Any]:
+        """Residual against its strongest driver, before and after."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The diagnosis as ``sagcal diagnose --json`` prints it."""
+
+class Localization:
+    """The result of :func:`localize` (one row per input row)."""
+
+    @property
+    def rows(self) -> list[int]:
+        """File lines, or 1-based rows of an array."""
+    @property
+    def positions_m(self) -> FloatArray:
+        """Platform positions, metres: (N, 3)."""
+    @property
+    def roll_pitch_yaw_deg(self) -> FloatArray:
+        """Orientations, degrees: (N, 3)."""
+    @property
+    def tensions_n(self) -> FloatArray:
+        """Cable tensions, newtons: (N, 4)."""
+    @property
+    def position_sigma_m(self) -> FloatArray:
+        """1-sigma of the position from the reading noise, metres: (N, 3)."""
+    @property
+    def covariance(self) -> FloatArray:
+        """Covariance of the pose tangent ``[dtheta, dp]``: (N, 6, 6)."""
+    @property
+    def chi_square(self) -> FloatArray:
+        """Chi-square of each row: (N,)."""
+    @property
+    def degrees_of_freedom(self) -> list[int]:
+        """Degrees of freedom of each row's test (-1: no solution)."""
+    @property
+    def consistent(self) -> list[bool]:
+        """Whether each row passes its chi-square test."""
+    @property
+    def stable(self) -> list[bool]:
+        """Whether each row's equilibrium is stable."""
+    @property
+    def flags(self) -> list[Optional[str]]:
+        """Why a row is not trusted, or ``None``."""
+    @property
+    def position_error_m(self) -> Optional[FloatArray]:
+        """Distance from the input's localiser positions, metres: (N,), or ``None``."""
+
+class Simulation:
+    """The result of :func:`simulate`."""
+
+    @property
+    def measurements(self) -> FloatArray:
+        """The simulated measurements: (N, 11)."""
+    @property
+    def truth(self) -> Robot:
+        """The true robot."""
+    @property
+    def seed(self) -> int:
+        """The random seed."""
+
+def calibrate(
+    robot: Robot,
+    measurements: Union[ArrayLike, PathLike],
+    noise: str = "paper",
+    *,
+    model: str = "catenary",
+    encoder_sigma_m: Optional[float] = None,
+    load_cell_sigma_n: Optional[float] = None,
+    position_sigma_m: Optional[float] = None,
+    orientation_prior: str = "auto",
+    robust_encoder: str = "none",
+    robust_load_cell: str = "none",
+    robust_pose: str = "none",
+    false_alarm: float = 1e-3,
+    accept_inconsistent: bool = False,
+) -> Calibration:
+    """Calibrate anchors and encoder offsets, as ``sagcal calibrate`` does."""
+
+def diagnose(
+    robot: Robot,
+    measurements: Union[ArrayLike, PathLike],
+    noise: str = "paper",
+    *,
+    truth: Optional[Robot] = None,
+    candidates: Optional[Sequence[str]] = None,
+    orientation_hypothesis: bool = True,
+    folds: int = 5,
+    false_alarm: float = 1e-3,
+    progress: Optional[Callable[[int, int, str], Any]] = None,
+    model: str = "catenary",
+    encoder_sigma_m: Optional[float] = None,
+    load_cell_sigma_n: Optional[float] = None,
+    position_sigma_m: Optional[float] = None,
+    orientation_prior: str = "auto",
+    robust_encoder: str = "none",
+    robust_load_cell: str = "none",
+    robust_pose: str = "none",
+) -> Diagnosis:
+    """Find what the calibration model gets wrong, as ``sagcal diagnose`` does."""
+
+def localize(
+    robot: Robot,
+    readings: Union[ArrayLike, PathLike],
+    load_cell: Optional[ArrayLike] = None,
+    localiser_poses: Optional[ArrayLike] = None,
+    *,
+    pose_prior: bool = False,
+    noise: str = "paper",
+    false_alarm: float = 1e-3,
+) -> Localization:
+    """Pose and tensions from the cable readings, as ``sagcal localize`` does."""
+
+def simulate(
+    robot: Robot,
+    poses: int,
+    seed: int = 1,
+    noise: str = "paper",
+    *,
+    effects: Optional[Sequence[str]] = None,
+    segments: int = 100,
+    closure: str = "level",
+) -> Simulation:
+    """Simulated measurements, as ``sagcal simulate`` draws them."""
+
+def read_measurements(path: PathLike, reference_cable: int = 1) -> FloatArray:
+    """A measurement file (sagcal CSV or RecurDyn log) as an (N, 11) array."""
+
+def write_measurements(path: PathLike, measurements: ArrayLike, comments: Optional[Sequence[str]] = None) -> None:
+    """Write an (N, 11) array as a sagcal measurement file (atomically)."""
+
+# --- sagcal.plan (issue 19): the stub of `plan` goes here after src/plan/ is merged. ---

@@ -1,0 +1,199 @@
+//! `sagcal.diagnose`: what the calibration model gets wrong (`sagcal
+//! diagnose`, `src/cli/diagnose.rs`), with the same options and report.
+
+use std::sync::Mutex;
+
+use pyo3::prelude::*;
+use sagcal::diagnose::DiagnoseOptions;
+use sagcal::model::effects::EffectKind;
+
+use crate::arrays::out2;
+use crate::json::to_python;
+use crate::options::SolverArgs;
+use crate::robot::Robot;
+use crate::{invalid, to_py};
+
+/// The result of :func:`diagnose`: the verdict (which effects the data show),
+/// the selected model's calibrated robot, and the whole report.
+#[pyclass(module = "sagcal", name = "Diagnosis", frozen)]
+pub struct Diagnosis {
+    inner: sagcal::diagnose::Diagnosis,
+    json: serde_json::Value,
+}
+
+#[pymethods]
+impl Diagnosis {
+    /// The hypotheses selected, in the order added, joined by ``+`` (``"elastic+segments"``), or ``"none"``.
+    #[getter]
+    fn verdict(&self) -> String {
+        self.inner.verdict.clone()
+    }
+
+    /// Why, in one sentence.
+    #[getter]
+    fn reason(&self) -> String {
+        self.inner.reason.clone()
+    }
+
+    /// The selected effects: a list of dicts with ``effect`` and ``params``
+    /// (each ``name``, ``value``, ``sigma``).
+    #[getter]
+    fn effects<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.inner.effects)
+    }
+
+    /// The selected model's calibrated robot (anchors, offsets and the
+    /// estimated effects); the baseline calibration's for ``"none"``.
+    #[getter]
+    fn robot(&self) -> Robot {
+        Robot::new(self.inner.robot_after.clone())
+    }
+
+    /// Whether the baseline model's chi-square is within its 99.9 % quantile.
+    #[getter]
+    fn baseline_consistent(&self) -> bool {
+        self.inner.baseline_consistent
+    }
+
+    /// The residual plotted against its strongest driver: a dict with
+    /// ``residual``, ``driver`` (names), ``before`` and ``after`` ((K, 2)
+    /// arrays of ``(driver, residual / sigma)``; ``after`` is ``None`` for the verdict ``"none"``).
+    #[getter]
+    fn series<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let s = &self.inner.series;
+        let points = |p: &[(f64, f64)]| -> Vec<[f64; 2]> { p.iter().map(|&(d, r)| [d, r]).collect() };
+        let dict = pyo3::types::PyDict::new(py);
+        dict.set_item("residual", &s.residual)?;
+        dict.set_item("driver", &s.driver)?;
+        dict.set_item("before", out2(py, &points(&s.before))?)?;
+        dict.set_item("after", s.after.as_ref().map(|a| out2(py, &points(a))).transpose()?)?;
+        Ok(dict.into_any())
+    }
+
+    /// The whole diagnosis as ``sagcal diagnose --json`` prints it (a dict).
+    #[getter]
+    fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.json)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Diagnosis(robot={:?}, verdict={:?}, poses_used={})",
+            self.inner.robot, self.inner.verdict, self.inner.poses_used
+        )
+    }
+}
+
+/// Find what the calibration model gets wrong, as ``sagcal diagnose`` does:
+/// calibrate with the baseline model, test the normalised residuals against
+/// the stated noise, correlate them with physical drivers, and search the
+/// catalogue of effects by forward selection with likelihood-ratio tests at
+/// ``false_alarm``, with ``folds``-fold cross-validation of the gain.
+///
+/// ``robot`` is the initial guess (its ``effects`` are known inputs);
+/// ``measurements`` an (N, 11) array or a path, as for :func:`calibrate`;
+/// ``truth`` an optional true robot (simulations) for anchor and offset
+/// errors before and after; ``candidates`` a list of effect names (default:
+/// the whole catalogue: ``elastic``, ``pulley``, ``encoder-scale``,
+/// ``loadcell``, ``com``, ``encoder-gain``, ``segments``); ``progress`` an
+/// optional ``callable(done, total, what)`` called before each fit. The
+/// solver keywords are those of :func:`calibrate`.
+///
+/// Raises :class:`SagcalError` with the message the command prints.
+#[pyfunction]
+#[pyo3(signature = (
+    robot,
+    measurements,
+    noise = "paper",
+    *,
+    truth = None,
+    candidates = None,
+    orientation_hypothesis = true,
+    folds = 5,
+    false_alarm = 1e-3,
+    progress = None,
+    model = "catenary",
+    encoder_sigma_m = None,
+    load_cell_sigma_n = None,
+    position_sigma_m = None,
+    orientation_prior = "auto",
+    robust_encoder = "none",
+    robust_load_cell = "none",
+    robust_pose = "none",
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn diagnose(
+    py: Python<'_>,
+    robot: &Robot,
+    measurements: &Bound<'_, PyAny>,
+    noise: &str,
+    truth: Option<&Robot>,
+    candidates: Option<Vec<String>>,
+    orientation_hypothesis: bool,
+    folds: usize,
+    false_alarm: f64,
+    progress: Option<Py<PyAny>>,
+    model: &str,
+    encoder_sigma_m: Option<f64>,
+    load_cell_sigma_n: Option<f64>,
+    position_sigma_m: Option<f64>,
+    orientation_prior: &str,
+    robust_encoder: &str,
+    robust_load_cell: &str,
+    robust_pose: &str,
+) -> PyResult<Diagnosis> {
+    let nominal = robot.inner.clone();
+    let truth = truth.map(|t| t.inner.clone());
+    let data = crate::data::measurements(measurements, nominal.reference_cable)?;
+    let mut options = DiagnoseOptions::new(
+        SolverArgs {
+            model,
+            noise,
+            encoder_sigma_m,
+            load_cell_sigma_n,
+            position_sigma_m,
+            orientation_prior,
+            robust_encoder,
+            robust_load_cell,
+            robust_pose,
+        }
+        .options(&nominal)?,
+    );
+    options.folds = folds;
+    options.false_alarm = false_alarm;
+    options.orientation_hypothesis = orientation_hypothesis;
+    if let Some(list) = candidates {
+        options.candidates = list
+            .iter()
+            .map(|c| EffectKind::parse(c))
+            .collect::<Result<_, _>>()
+            .map_err(|e| invalid(format!("candidates: {e}")))?;
+    }
+    // The first exception the progress callback raised, re-raised after the run.
+    let callback_error: Mutex<Option<PyErr>> = Mutex::new(None);
+    let diagnosis = py
+        .detach(|| {
+            sagcal::diagnose::diagnose(
+                &nominal,
+                &data.poses,
+                truth.as_ref(),
+                &options,
+                &mut |done, total, what| {
+                    if let Some(callback) = &progress {
+                        Python::attach(|py| {
+                            if let Err(e) = callback.call1(py, (done, total, what)) {
+                                callback_error.lock().expect("not poisoned").get_or_insert(e);
+                            }
+                        });
+                    }
+                },
+            )
+        })
+        .map_err(to_py)?;
+    if let Some(e) = callback_error.into_inner().expect("not poisoned") {
+        return Err(e);
+    }
+    let json =
+        serde_json::to_value(&diagnosis).map_err(|e| invalid(format!("cannot serialise the report as JSON: {e}")))?;
+    Ok(Diagnosis { inner: diagnosis, json })
+}

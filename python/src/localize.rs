@@ -1,0 +1,328 @@
+//! `sagcal.localize`: the calibrated robot's pose and tensions from its cable
+//! readings, row by row as `sagcal localize` does (`src/cli/localize.rs`).
+
+use std::path::PathBuf;
+
+use nalgebra::Vector3;
+use pyo3::prelude::*;
+use sagcal::io::readings::{read_readings, ReadingRow};
+use sagcal::localize::{LocalizeOptions, Localized, Localizer, Readings};
+use sagcal::model::pose::PlatformPose;
+
+use crate::arrays::{exact_rows, out1, out2, out3, rows, vector};
+use crate::data::as_path;
+use crate::options::{false_alarm as check_false_alarm, noise_preset};
+use crate::robot::Robot;
+use crate::{invalid, to_py};
+
+/// The result of :func:`localize`: per row of readings, the equilibrium
+/// pose, the cable tensions, the pose's uncertainty from the reading noise
+/// and the row's consistency test. Arrays have one row per input row; a row
+/// without a trusted equilibrium has NaN values and its reason in :attr:`flags`.
+#[pyclass(module = "sagcal", name = "Localization", frozen)]
+pub struct Localization {
+    lines: Vec<usize>,
+    found: Vec<Option<Localized>>,
+    flags: Vec<Option<String>>,
+    position_error_m: Option<Vec<f64>>,
+}
+
+impl Localization {
+    /// Per row, `value(found)` or NaNs.
+    fn per_row<const C: usize>(&self, value: impl Fn(&Localized) -> [f64; C]) -> Vec<[f64; C]> {
+        self.found
+            .iter()
+            .map(|f| f.as_ref().map_or([f64::NAN; C], &value))
+            .collect()
+    }
+}
+
+#[pymethods]
+impl Localization {
+    /// Per row, the number that names it: its file line, or its 1-based row in an array.
+    #[getter]
+    fn rows(&self) -> Vec<usize> {
+        self.lines.clone()
+    }
+
+    /// Platform positions, world frame, metres: an (N, 3) array.
+    #[getter]
+    fn positions_m<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        out2(py, &self.per_row(|f| f.pose.position_m.into()))
+    }
+
+    /// Platform orientations ``(roll, pitch, yaw)``, degrees, ``R = Rz(yaw) Ry(pitch) Rx(roll)``: an (N, 3) array.
+    #[getter]
+    fn roll_pitch_yaw_deg<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        out2(
+            py,
+            &self.per_row(|f| {
+                let (r, p, y) = f.pose.roll_pitch_yaw_deg();
+                [r, p, y]
+            }),
+        )
+    }
+
+    /// Cable tension magnitudes at the attachments, cables 1..4, newtons: an (N, 4) array.
+    #[getter]
+    fn tensions_n<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        out2(py, &self.per_row(Localized::tension_magnitudes_n))
+    }
+
+    /// 1-sigma of the position per world axis from the reading noise, metres: an (N, 3) array.
+    #[getter]
+    fn position_sigma_m<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        out2(py, &self.per_row(|f| f.position_sigma_m.into()))
+    }
+
+    /// Covariance of the pose tangent ``[dtheta (rad), dp (m)]`` from the
+    /// reading noise: an (N, 6, 6) array.
+    #[getter]
+    fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let matrices: Vec<[[f64; 6]; 6]> = self
+            .found
+            .iter()
+            .map(|f| {
+                f.as_ref().map_or([[f64::NAN; 6]; 6], |f| {
+                    std::array::from_fn(|r| std::array::from_fn(|c| f.covariance[(r, c)]))
+                })
+            })
+            .collect();
+        out3(py, &matrices)
+    }
+
+    /// Chi-square of the whitened readings at the solution: an (N,) array.
+    #[getter]
+    fn chi_square<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let values: Vec<f64> = self.per_row(|f| [f.chi_square]).into_iter().map(|[v]| v).collect();
+        out1(py, &values)
+    }
+
+    /// Degrees of freedom of each row's test (readings minus 4; 0 with the encoders only; -1 for a row without a solution).
+    #[getter]
+    fn degrees_of_freedom(&self) -> Vec<i64> {
+        self.found
+            .iter()
+            .map(|f| f.as_ref().map_or(-1, |f| f.degrees_of_freedom as i64))
+            .collect()
+    }
+
+    /// Whether each row passes its chi-square test (``False`` for a row without a solution).
+    #[getter]
+    fn consistent(&self) -> Vec<bool> {
+        self.found.iter().map(|f| f.is_some_and(|f| f.consistent)).collect()
+    }
+
+    /// Whether each row's equilibrium is stable at fixed cable lengths (``False`` for a row without a solution).
+    #[getter]
+    fn stable(&self) -> Vec<bool> {
+        self.found.iter().map(|f| f.is_some_and(|f| f.stable)).collect()
+    }
+
+    /// Per row, why it has no trusted equilibrium (unstable, inconsistent, no
+    /// equilibrium), in the command's words; ``None`` for a good row.
+    #[getter]
+    fn flags(&self) -> Vec<Option<String>> {
+        self.flags.clone()
+    }
+
+    /// Distance of each position from the input's localiser position, metres
+    /// (an (N,) array; ``None`` when the input has no localiser poses).
+    #[getter]
+    fn position_error_m<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.position_error_m.as_ref().map(|e| out1(py, e)).transpose()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Localization(rows={}, flagged={})",
+            self.lines.len(),
+            self.flags.iter().filter(|f| f.is_some()).count()
+        )
+    }
+}
+
+/// Localise the calibrated ``robot`` from its cable readings, as ``sagcal
+/// localize`` does: per row, the static equilibrium (pose and the four cable
+/// tensions) that the four encoder readings (and the load cell, if read)
+/// imply through the catenary statics and the robot's ``effects``, warm-started
+/// from the previous row's stable pose.
+///
+/// ``readings`` is an (N, 4) array of encoder readings ``l1_m .. l4_m``
+/// (cable length plus the calibrated offset), or the path of a file the
+/// command reads (``l1_m,l2_m,l3_m,l4_m[,f_ref_n]``, a sagcal measurement
+/// file, a RecurDyn log). With an array, ``load_cell`` is an optional (N,)
+/// array of the reference cable's tension (N) and ``localiser_poses`` an
+/// optional (N, 6) array ``x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg``,
+/// compared with (or, with ``pose_prior=True``, used as a prior). ``noise``
+/// (``"paper"``, ``"authors"``) gives the reading sigmas; ``false_alarm`` the
+/// rate of each row's chi-square test.
+///
+/// A row no stable equilibrium explains is flagged, not an error; bad input
+/// raises :class:`SagcalError` with the command's message.
+#[pyfunction]
+#[pyo3(signature = (robot, readings, load_cell = None, localiser_poses = None, *, pose_prior = false, noise = "paper", false_alarm = 1e-3))]
+#[allow(clippy::too_many_arguments)]
+pub fn localize(
+    py: Python<'_>,
+    robot: &Robot,
+    readings: &Bound<'_, PyAny>,
+    load_cell: Option<&Bound<'_, PyAny>>,
+    localiser_poses: Option<&Bound<'_, PyAny>>,
+    pose_prior: bool,
+    noise: &str,
+    false_alarm: f64,
+) -> PyResult<Localization> {
+    let robot = &robot.inner;
+    let (label, input) = match as_path(readings) {
+        Some(path) => {
+            if load_cell.is_some() || localiser_poses.is_some() {
+                return Err(invalid(
+                    "load_cell and localiser_poses go with an array of readings; a file brings its own",
+                ));
+            }
+            let file = read_readings(&path, robot.reference_cable).map_err(to_py)?;
+            (file.path, file.rows)
+        }
+        None => (
+            PathBuf::from("readings"),
+            rows_from_arrays(readings, load_cell, localiser_poses)?,
+        ),
+    };
+    if pose_prior {
+        if let Some(row) = input.iter().find(|r| r.localiser_pose.is_none()) {
+            return Err(to_py(sagcal::Error::Field {
+                path: label,
+                row: row.line,
+                field: "x_m".into(),
+                message: "--pose-prior needs a localiser pose on every row; this file has none".into(),
+            }));
+        }
+    }
+    let noise = noise_preset(noise)?.sigmas(robot.platform_weight_n);
+    let options = LocalizeOptions {
+        pose_prior,
+        false_alarm: check_false_alarm(false_alarm, "false_alarm")?,
+        ..LocalizeOptions::default()
+    };
+    let localizer = Localizer::with_options(robot, &noise, options).map_err(to_py)?;
+    Ok(py.detach(|| localize_rows(&localizer, &input)))
+}
+
+/// Every row, warm-started from the last stable pose (as the command does).
+fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> Localization {
+    let mut warm: Option<PlatformPose> = None;
+    let mut found = Vec::with_capacity(input.len());
+    let mut flags = Vec::with_capacity(input.len());
+    for row in input {
+        let readings = Readings {
+            encoder_lengths_m: row.encoder_lengths_m,
+            load_cell_n: row.load_cell_n,
+            localiser_pose: row.localiser_pose,
+        };
+        match localizer.localize(&readings, warm.as_ref()) {
+            Ok(f) => {
+                if f.stable {
+                    warm = Some(f.pose);
+                }
+                flags.push(flag(&f));
+                found.push(Some(f));
+            }
+            Err(e) => {
+                flags.push(Some(e.to_string()));
+                found.push(None);
+            }
+        }
+    }
+    let position_error_m = input.iter().all(|r| r.localiser_pose.is_some()).then(|| {
+        input
+            .iter()
+            .zip(&found)
+            .map(|(r, f)| match (r.localiser_pose, f) {
+                (Some(p), Some(f)) => (p.position_m - f.pose.position_m).norm(),
+                _ => f64::NAN,
+            })
+            .collect()
+    });
+    Localization {
+        lines: input.iter().map(|r| r.line).collect(),
+        found,
+        flags,
+        position_error_m,
+    }
+}
+
+/// Why a solved row is not trusted, in the command's words.
+fn flag(found: &Localized) -> Option<String> {
+    match (found.consistent, found.stable) {
+        (_, false) => {
+            Some("unstable equilibrium (the stiffness at fixed cable lengths is not positive definite)".into())
+        }
+        (false, _) => Some(format!(
+            "inconsistent: chi-square {:.2} with {} degree(s) of freedom",
+            found.chi_square, found.degrees_of_freedom
+        )),
+        _ => None,
+    }
+}
+
+/// Rows of readings from arrays, every value checked (finite; load cell positive).
+fn rows_from_arrays(
+    lengths: &Bound<'_, PyAny>,
+    load_cell: Option<&Bound<'_, PyAny>>,
+    poses: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Vec<ReadingRow>> {
+    let lengths = rows::<4>(lengths, "readings")?;
+    let n = lengths.len();
+    let load_cell = load_cell.map(|l| vector(l, n, "load_cell")).transpose()?;
+    let poses = poses.map(|p| exact_rows::<6>(p, n, "localiser_poses")).transpose()?;
+    let field = |source: &str, row: usize, field: &str, message: String| {
+        to_py(sagcal::Error::Field {
+            path: PathBuf::from(source),
+            row,
+            field: field.into(),
+            message,
+        })
+    };
+    let mut out = Vec::with_capacity(n);
+    for (i, l) in lengths.iter().enumerate() {
+        for (k, v) in l.iter().enumerate() {
+            if !v.is_finite() {
+                let name = format!("l{}_m", k + 1);
+                return Err(field("readings", i + 1, &name, format!("not a finite number: `{v}`")));
+            }
+        }
+        let f = load_cell.as_ref().map(|f| f[i]);
+        if let Some(f) = f.filter(|f| !(f.is_finite() && *f > 0.0)) {
+            let message = format!("not a positive number of newtons: `{f}`");
+            return Err(field("load_cell", i + 1, "f_ref_n", message));
+        }
+        let pose = match &poses {
+            None => None,
+            Some(p) => {
+                let [x, y, z, roll, pitch, yaw] = p[i];
+                if let Some(v) = p[i].iter().find(|v| !v.is_finite()) {
+                    return Err(field(
+                        "localiser_poses",
+                        i + 1,
+                        "pose",
+                        format!("not a finite number: `{v}`"),
+                    ));
+                }
+                Some(PlatformPose::from_roll_pitch_yaw_deg(
+                    Vector3::new(x, y, z),
+                    roll,
+                    pitch,
+                    yaw,
+                ))
+            }
+        };
+        out.push(ReadingRow {
+            line: i + 1,
+            encoder_lengths_m: *l,
+            load_cell_n: f,
+            localiser_pose: pose,
+        });
+    }
+    Ok(out)
+}

@@ -1,0 +1,114 @@
+"""Errors raise `sagcal.SagcalError` (a ValueError) with the message the
+`sagcal` command prints after `error: `."""
+
+import numpy as np
+import pytest
+
+import sagcal
+from conftest import ROOT, cli_error
+
+
+def message(call):
+    with pytest.raises(sagcal.SagcalError) as caught:
+        call()
+    assert isinstance(caught.value, ValueError)
+    assert type(caught.value).__module__ == "sagcal"  # tracebacks say `sagcal.SagcalError`
+    return str(caught.value)
+
+
+def test_a_missing_measurement_file(cli, problem, tmp_path):
+    missing = tmp_path / "missing.csv"
+    guess = problem["folder"] / "guess.toml"
+    expected = cli_error(cli("calibrate", "--robot", guess, "--data", missing, check=False))
+    assert message(lambda: sagcal.calibrate(problem["guess"], missing)) == expected
+    assert message(lambda: sagcal.calibrate(problem["guess"], str(missing))) == expected
+    assert expected.startswith(str(missing)) and "No such file" in expected
+
+
+def test_a_missing_or_invalid_robot_file(cli, tmp_path):
+    missing = tmp_path / "missing.toml"
+    data = ROOT / "robots" / "large.toml"  # any path: the robot is read first
+    expected = cli_error(cli("calibrate", "--robot", missing, "--data", data, check=False))
+    assert message(lambda: sagcal.Robot.from_toml(missing)) == expected
+    bad = tmp_path / "bad.toml"
+    text = (ROOT / "robots" / "large.toml").read_text().replace("reference_cable = 1", "reference_cable = 7")
+    bad.write_text(text)
+    expected = cli_error(cli("calibrate", "--robot", bad, "--data", data, check=False))
+    assert message(lambda: sagcal.Robot.from_toml(bad)) == expected
+    assert "field `reference_cable`: cable 7 does not exist" in expected
+
+
+def test_nan_in_a_file_and_in_an_array(cli, problem, tmp_path):
+    lines = (problem["folder"] / "data.csv").read_text().splitlines()
+    header = next(i for i, line in enumerate(lines) if line.startswith("x_m"))
+    row = lines[header + 3].split(",")
+    row[0] = "NaN"
+    lines[header + 3] = ",".join(row)
+    path = tmp_path / "nan.csv"
+    path.write_text("\n".join(lines) + "\n")
+    guess = problem["folder"] / "guess.toml"
+    expected = cli_error(cli("calibrate", "--robot", guess, "--data", path, check=False))
+    line = header + 4  # 1-based line of the fourth data row
+    assert expected == f"{path}: row {line}, field `x_m`: not a finite number: `NaN`"
+    assert message(lambda: sagcal.calibrate(problem["guess"], path)) == expected
+    # The same value in an array: the same check and words; the row is the array's (1-based).
+    data = problem["measurements"].copy()
+    data[3, 0] = np.nan
+    assert message(lambda: sagcal.calibrate(problem["guess"], data)) == (
+        "measurements: row 4, field `x_m`: not a finite number: `NaN`"
+    )
+
+
+def test_a_negative_tension_in_a_file_and_in_an_array(cli, problem, tmp_path):
+    data = problem["measurements"].copy()
+    data[0, 10] = -5.0
+    path = tmp_path / "negative.csv"
+    # The file writer refuses it, so write the CSV by hand.
+    header = ",".join(sagcal.MEASUREMENT_COLUMNS)
+    path.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in r) for r in data) + "\n")
+    expected = cli_error(cli("calibrate", "--robot", problem["folder"] / "guess.toml", "--data", path, check=False))
+    assert expected == f"{path}: row 2, field `f_ref_n`: negative tension: the reference tension must be positive, got -5 N"
+    assert message(lambda: sagcal.calibrate(problem["guess"], data)) == expected.replace(f"{path}: row 2", "measurements: row 1")
+
+
+def test_bad_shapes_and_values_name_the_argument(problem):
+    guess = problem["guess"]
+    assert message(lambda: sagcal.calibrate(guess, np.zeros((5, 10)))) == (
+        "invalid input: measurements must be an (N, 11) array with N >= 1, got shape (5, 10)"
+    )
+    assert message(lambda: sagcal.calibrate(guess, np.zeros(11))) == (
+        "invalid input: measurements must be an (N, 11) array with N >= 1, got shape (11,)"
+    )
+    assert message(lambda: sagcal.calibrate(guess, [["a"] * 11])).startswith(
+        "invalid input: measurements: not an array of numbers: could not convert string to float"
+    )
+    with pytest.raises(sagcal.SagcalError, match="must be an array of shape \\(4, 3\\), got shape \\(3, 3\\)"):
+        guess.anchors_m = np.zeros((3, 3))
+    assert message(lambda: sagcal.calibrate(guess, problem["measurements"], noise="loud")) == (
+        "invalid input: noise: unknown noise setting `loud` (paper, authors, none)"
+    )
+    assert message(lambda: sagcal.calibrate(guess, problem["measurements"], false_alarm=2.0)) == (
+        "invalid input: false_alarm must be between 0 and 1, got 2"
+    )
+
+
+def test_too_few_poses_is_the_commands_error(cli, problem, tmp_path):
+    few = problem["measurements"][:3]
+    path = tmp_path / "few.csv"
+    sagcal.write_measurements(path, few)
+    expected = cli_error(cli("calibrate", "--robot", problem["folder"] / "guess.toml", "--data", path, check=False))
+    assert message(lambda: sagcal.calibrate(problem["guess"], path)) == expected
+    assert message(lambda: sagcal.calibrate(problem["guess"], few)) == expected.replace(str(path), "measurements", 1)
+
+
+def test_simulate_errors_are_the_commands(cli, tmp_path):
+    robot = ROOT / "robots" / "large.toml"
+    out = tmp_path / "x.csv"
+    large = sagcal.Robot.from_toml(robot)
+    expected = cli_error(cli("simulate", "--robot", robot, "--poses", "0", "--out", out, check=False))
+    assert message(lambda: sagcal.simulate(large, 0)) == expected
+    expected = cli_error(
+        cli("simulate", "--robot", robot, "--poses", "3", "--out", out, "--effect", "elastic:ea_n=-1", check=False)
+    )
+    assert message(lambda: sagcal.simulate(large, 3, effects=["elastic:ea_n=-1"])) == expected
+    assert not out.exists()
