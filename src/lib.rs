@@ -55,6 +55,7 @@ pub mod graph;
 pub mod io;
 pub mod localize;
 pub mod model;
+pub mod plan;
 pub mod plot;
 pub mod sim;
 pub mod solver;

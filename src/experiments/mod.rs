@@ -5,9 +5,11 @@
 //!   (`sagcal experiment table2`);
 //! - [`hidden_effects`]: effects hidden in simulated data, diagnosed blind and
 //!   scored (`sagcal experiment hidden-effects`);
+//! - [`plan_candidates`]: candidate poses for `sagcal plan`;
 //! - [`benchmark`]: the reproducible calibration graph the solver benches and
 //!   the peer comparison share.
 
 pub mod benchmark;
 pub mod hidden_effects;
+pub mod plan_candidates;
 pub mod table2;
