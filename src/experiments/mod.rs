@@ -12,4 +12,5 @@
 pub mod benchmark;
 pub mod hidden_effects;
 pub mod plan_candidates;
+pub mod selection;
 pub mod table2;

@@ -102,7 +102,10 @@ pub fn filter_candidates(robot: &Robot, equilibria: Vec<Equilibrium>, margins: &
 /// Draw `count` candidates in `workspace`: candidate `k` draws level
 /// equilibria ([`sample_equilibria`]) from its own stream `(seed, k)` until
 /// one keeps the margins and is stable, so the set does not depend on the
-/// number of threads.
+/// number of threads. Level equilibria: a robot commanded to a position
+/// with a level platform hangs near the most level member of the family (the
+/// member of the straight-cable tension estimate, one solve instead of the
+/// scan, tilts up to 25 degrees at the frame's edges on the large robot).
 pub fn draw_candidates(
     robot: &Robot,
     workspace: &Workspace,

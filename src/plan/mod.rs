@@ -50,6 +50,9 @@ pub struct RandomBounds {
     pub anchor_rms_m: f64,
     /// Mean over the determined sets of the RMS offset error bound, metres.
     pub offset_rms_m: f64,
+    /// Per anchor, the mean over the determined sets of its 3x3 covariance, m^2 (for the figure).
+    #[serde(skip)]
+    pub anchor_covariance_m2: Vec<[[f64; 3]; 3]>,
 }
 
 /// The information of every candidate (in parallel), at the nominal robot.
@@ -69,6 +72,7 @@ pub fn random_bounds(information: &[PoseInformation], poses: usize, draws: usize
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut anchor = Vec::with_capacity(draws);
     let mut offset = Vec::with_capacity(draws);
+    let mut covariance = vec![[[0.0; 3]; 3]; crate::model::robot::CABLE_COUNT];
     let mut indices: Vec<usize> = (0..information.len()).collect();
     let poses = poses.min(information.len());
     for _ in 0..draws {
@@ -79,10 +83,22 @@ pub fn random_bounds(information: &[PoseInformation], poses: usize, draws: usize
         if let Some(b) = plan_bound(information, &indices[..poses]) {
             anchor.push(b.anchor_rms_m);
             offset.push(b.offset_rms_m);
+            for (sum, c) in covariance.iter_mut().zip(&b.anchor_covariance_m2) {
+                for r in 0..3 {
+                    for k in 0..3 {
+                        sum[r][k] += c[r][k];
+                    }
+                }
+            }
         }
     }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let determined = anchor.len().max(1) as f64;
+    for c in covariance.iter_mut().flatten().flatten() {
+        *c /= determined;
+    }
     RandomBounds {
+        anchor_covariance_m2: covariance,
         poses,
         draws,
         undetermined: draws - anchor.len(),

@@ -8,6 +8,7 @@
 //!   the font and colours) and [`write_svg`].
 
 pub mod anchors;
+pub mod plan;
 pub mod residuals;
 mod svg;
 
