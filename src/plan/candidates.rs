@@ -29,7 +29,7 @@ impl Margins {
     /// Why `equilibrium` breaks a margin, or `None` if it keeps them all.
     pub fn violation(&self, robot: &Robot, equilibrium: &Equilibrium) -> Option<String> {
         for (i, t) in equilibrium.tensions.iter().enumerate() {
-            if !(t.horizontal_n >= self.min_horizontal_tension_n) {
+            if t.horizontal_n.is_nan() || t.horizontal_n < self.min_horizontal_tension_n {
                 return Some(format!(
                     "cable {}: horizontal tension {:.1} N below the {:.1} N margin",
                     i + 1,
@@ -42,7 +42,7 @@ impl Margins {
         for (i, cable) in cables.iter().enumerate() {
             let anchor_z = robot.anchors_m[i].z;
             let lowest = anchor_z + lowest_height_above_anchor_m(cable);
-            if !(lowest >= self.min_cable_height_m) {
+            if lowest.is_nan() || lowest < self.min_cable_height_m {
                 return Some(format!(
                     "cable {}: sags to {lowest:.2} m, below the {:.2} m clearance",
                     i + 1,

@@ -72,15 +72,19 @@ pub struct DesignOptions {
     pub criterion: Criterion,
     /// Largest number of exchange passes (each tries to swap every chosen pose once).
     pub max_exchange_passes: usize,
+    /// Stop the exchanges when a pass improves the criterion by less than
+    /// this fraction (of its value for A, in absolute `log det` for D).
+    pub exchange_tolerance: f64,
 }
 
 impl DesignOptions {
-    /// A-optimal, up to 5 exchange passes.
+    /// A-optimal, up to 5 exchange passes, stopping below a 0.1 % gain per pass.
     pub fn new(poses: usize) -> Self {
         Self {
             poses,
             criterion: Criterion::A,
             max_exchange_passes: 5,
+            exchange_tolerance: 1e-3,
         }
     }
 }
@@ -279,6 +283,7 @@ pub fn choose_more_poses(poses: &[PoseInformation], fixed: &[usize], options: &D
     };
     let greedy_value = value_of(&chosen)?;
     let (mut exchanges, mut passes) = (0, 0);
+    let mut value = greedy_value;
     while passes < options.max_exchange_passes {
         passes += 1;
         let mut swapped = false;
@@ -301,9 +306,18 @@ pub fn choose_more_poses(poses: &[PoseInformation], fixed: &[usize], options: &D
         if !swapped {
             break;
         }
+        let before = value;
+        value = value_of(&chosen)?;
+        let gain = match options.criterion {
+            Criterion::A => (before - value) / before.abs(),
+            Criterion::D => before - value,
+        };
+        if gain < options.exchange_tolerance {
+            break;
+        }
     }
     Ok(Design {
-        value: value_of(&chosen)?,
+        value,
         chosen: chosen.split_off(fixed.len()),
         ridge,
         greedy_value,
