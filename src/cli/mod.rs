@@ -430,7 +430,7 @@ struct PlanArgs {
     noise: sagcal::model::sensors::NoisePreset,
     /// The box candidates are drawn in, `x0,x1,y0,y1,z0,z1` metres (default: the
     /// robot file's `[workspace]`, else the frame below the anchors with a 10 % margin).
-    #[arg(long, value_parser = plan::parse_workspace)]
+    #[arg(long, allow_hyphen_values = true, value_parser = plan::parse_workspace)]
     workspace: Option<sagcal::model::robot::Workspace>,
     /// Candidate poses from a file (sagcal CSV or RecurDyn log, e.g. poses already logged) instead of drawing them.
     #[arg(long)]

@@ -165,6 +165,8 @@ fn overview(s: &mut String, plot: &PlanPlot, axes: [usize; 2], left: f64, top: f
             );
         }
     }
+    // Anchors that project onto one point (the side view) share one label.
+    let mut labelled: Vec<((f64, f64), Vec<String>)> = Vec::new();
     for (i, a) in plot.anchors_m.iter().enumerate() {
         let (x, y) = f.px(pick(a));
         let _ = writeln!(
@@ -173,7 +175,16 @@ fn overview(s: &mut String, plot: &PlanPlot, axes: [usize; 2], left: f64, top: f
             n2(x - 4.0),
             n2(y - 4.0)
         );
-        plain_text(s, x + 7.0, y - 6.0, "start", &format!("A{}", i + 1));
+        match labelled
+            .iter_mut()
+            .find(|(p, _)| (p.0 - x).abs() < 8.0 && (p.1 - y).abs() < 8.0)
+        {
+            Some((_, names)) => names.push(format!("A{}", i + 1)),
+            None => labelled.push(((x, y), vec![format!("A{}", i + 1)])),
+        }
+    }
+    for ((x, y), names) in labelled {
+        plain_text(s, x + 7.0, y - 6.0, "start", &names.join(", "));
     }
 }
 
