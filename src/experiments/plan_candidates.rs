@@ -4,7 +4,7 @@
 //! equilibrium (the stiffness at fixed cable lengths is positive definite,
 //! [`crate::localize::stiffness`]).
 
-use nalgebra::{Vector2, Vector3};
+use nalgebra::Vector2;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -40,14 +40,8 @@ pub struct CandidateSet {
 /// of the lowest anchor's height (the default box of `sagcal plan` when
 /// neither `--workspace` nor the robot file's `[workspace]` gives one).
 pub fn frame_workspace(robot: &Robot) -> Workspace {
-    let min = robot
-        .anchors_m
-        .iter()
-        .fold(Vector3::repeat(f64::INFINITY), |m, a| m.inf(a));
-    let max = robot
-        .anchors_m
-        .iter()
-        .fold(Vector3::repeat(f64::NEG_INFINITY), |m, a| m.sup(a));
+    let first = robot.anchors_m[0];
+    let (min, max) = robot.anchors_m.iter().fold((first, first), |(lo, hi), a| (lo.inf(a), hi.sup(a)));
     let margin = 0.1 * (max - min);
     Workspace {
         min_m: [min.x + margin.x, min.y + margin.y, 0.05 * min.z],
