@@ -149,3 +149,104 @@ fn planned_nine_beat_random_nine_on_both_robots() {
         }
     }
 }
+
+/// `sagcal plan` end to end on the small robot: the JSON has the issue's
+/// keys, the CSV reads back in visiting order with the plan's positions, and
+/// bad input fails with a message and writes nothing.
+#[test]
+fn plan_command_writes_the_plan_and_refuses_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("plan.csv");
+    let sagcal = env!("CARGO_BIN_EXE_sagcal");
+    let ok = std::process::Command::new(sagcal)
+        .args([
+            "plan",
+            "--robot",
+            "robots/small.toml",
+            "--poses",
+            "5",
+            "--candidates",
+            "40",
+            "--seed",
+            "2",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&ok.stdout).unwrap();
+    for key in [
+        "poses",
+        "anchor_bound_m",
+        "offset_bound_m",
+        "random_anchor_bound_m",
+        "random35_anchor_bound_m",
+        "path_length_m",
+        "plan",
+    ] {
+        assert!(json.get(key).is_some(), "JSON lacks {key}");
+    }
+    assert!(json["anchor_bound_m"].as_f64().unwrap() < json["random_anchor_bound_m"].as_f64().unwrap());
+    let read = sagcal::io::measurements::read_measurements(
+        &out,
+        &sagcal::io::measurements::ReadOptions {
+            reference_cable: 0,
+            keep_rounded: true,
+        },
+    )
+    .unwrap();
+    assert_eq!(read.poses.len(), 5);
+    let plan = json["plan"].as_array().unwrap();
+    let mut path = 0.0;
+    for (k, row) in read.poses.iter().enumerate() {
+        let p: Vec<f64> = plan[k]["position_m"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        // serde_json's default float parsing may differ in the last bit.
+        let gap = (0..3).map(|i| (row.position_m[i] - p[i]).abs()).fold(0.0, f64::max);
+        assert!(gap < 1e-12, "row {k} is visit {}: {:?} vs {p:?}", k + 1, row.position_m);
+        if k > 0 {
+            let q = read.poses[k - 1].position_m;
+            path += (0..3).map(|i| (row.position_m[i] - q[i]).powi(2)).sum::<f64>().sqrt();
+        }
+    }
+    assert!((path - json["path_length_m"].as_f64().unwrap()).abs() < 1e-9);
+    // More poses than candidates: an error naming both counts, no file.
+    let refused = dir.path().join("refused.csv");
+    let bad = std::process::Command::new(sagcal)
+        .args([
+            "plan",
+            "--robot",
+            "robots/small.toml",
+            "--poses",
+            "50",
+            "--candidates",
+            "10",
+        ])
+        .arg("--out")
+        .arg(&refused)
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("50 poses requested but only 10 candidates"));
+    assert!(!refused.exists());
+    let box_error = std::process::Command::new(sagcal)
+        .args([
+            "plan",
+            "--robot",
+            "robots/small.toml",
+            "--poses",
+            "5",
+            "--workspace",
+            "1,2,3",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(box_error.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&box_error.stderr).contains("x0,x1,y0,y1,z0,z1"));
+}
