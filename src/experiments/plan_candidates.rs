@@ -41,7 +41,10 @@ pub struct CandidateSet {
 /// neither `--workspace` nor the robot file's `[workspace]` gives one).
 pub fn frame_workspace(robot: &Robot) -> Workspace {
     let first = robot.anchors_m[0];
-    let (min, max) = robot.anchors_m.iter().fold((first, first), |(lo, hi), a| (lo.inf(a), hi.sup(a)));
+    let (min, max) = robot
+        .anchors_m
+        .iter()
+        .fold((first, first), |(lo, hi), a| (lo.inf(a), hi.sup(a)));
     let margin = 0.1 * (max - min);
     Workspace {
         min_m: [min.x + margin.x, min.y + margin.y, 0.05 * min.z],
