@@ -10,6 +10,7 @@
 
 pub mod anchors;
 pub mod localize;
+pub mod plan;
 pub mod residuals;
 mod svg;
 
