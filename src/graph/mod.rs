@@ -10,10 +10,12 @@
 
 pub mod masked;
 pub mod robust;
+pub mod shared;
 pub mod values;
 
 pub use masked::MaskedFactor;
 pub use robust::RobustKernel;
+pub use shared::SharedEvaluation;
 pub use values::{Values, VariableId, VariableValue};
 
 use nalgebra::{DMatrix, DVector};
