@@ -142,7 +142,7 @@ impl LinearizationBuffers {
         let index = match self.by_shape.iter().position(same_shape) {
             Some(index) => {
                 for jacobian in &mut self.by_shape[index].jacobians {
-                    jacobian.fill(0.0);
+                    jacobian.as_mut_slice().fill(0.0);
                 }
                 index
             }
@@ -191,7 +191,11 @@ fn linearize_into(factor: &dyn Factor, values: &Values, out: &mut WhitenedLinear
             }
         }
     }
-    if out.jacobians.iter().any(|j| j.iter().any(|v| !v.is_finite())) {
+    if out
+        .jacobians
+        .iter()
+        .any(|j| !j.as_slice().iter().all(|v| v.is_finite()))
+    {
         return Err("non-finite Jacobian");
     }
     out.cost = 0.5 * kernel.rho(s);
