@@ -8,7 +8,7 @@
 #   peers/count_instructions.sh floor         # the evaluation floor (floor-fused: one call per pose)
 #
 # Four runs of `sagcal-peers --count SOLVER` (poses N1, N2; linearisation
-# budgets K1, K2), each counting only `counted_solve`; the double difference
+# budgets K1, K2), each counting only `counted_solve` (apex: its `optimize`); the double difference
 #   [C(N2,K2) - C(N2,K1) - C(N1,K2) + C(N1,K1)] / ((N2 - N1)(K2 - K1))
 # leaves one pose's share of one iteration (graph building, pattern analysis,
 # the first linearisation and the dense 16 x 16 work cancel). The floor needs
@@ -28,8 +28,11 @@ case $solver in
   factrs) evaluation='*factrs_peer*residual*' ;;
   *) evaluation='sagcal::generated::*' ;;
 esac
+# apex-solver solves inside a one-thread rayon pool, on another thread than
+# `counted_solve`: its region is its `optimize`.
 case $solver in
   floor*) region='*counted_floor*' ;;
+  apex-solver) region='apex_solver::optimizer::levenberg_marquardt::LevenbergMarquardt::optimize' ;;
   *) region='*counted_solve*' ;;
 esac
 
