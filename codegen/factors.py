@@ -118,6 +118,42 @@ def _catenaries(
     return attachments, spans, tensions
 
 
+def _length_rows(
+    spans: list[sf.Scalar],
+    tensions: list[tuple[sf.Scalar, sf.Scalar]],
+    cable_weight_n_per_m: sf.Scalar,
+    length_offsets_m: sf.V4,
+    encoder_lengths_m: sf.V4,
+    epsilon: sf.Scalar,
+) -> list[sf.Scalar]:
+    """Eq. (14) per slot: ``l_C,j + l0_j - z_enc,j``."""
+    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
+    return [
+        cable_model.catenary_length(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
+        + length_offsets_m[j]
+        - encoder_lengths_m[j]
+        for j in range(CABLE_COUNT)
+    ]
+
+
+def _height_rows(
+    attachments: list[sf.V3],
+    spans: list[sf.Scalar],
+    tensions: list[tuple[sf.Scalar, sf.Scalar]],
+    anchors_m: sf.Matrix34,
+    cable_weight_n_per_m: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> list[sf.Scalar]:
+    """Eq. (15) per slot: ``(p + R b_j)_z - a_j,z + drop_j``."""
+    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
+    return [
+        attachments[j][2]
+        - anchors_m[2, j]
+        + cable_model.catenary_drop(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
+        for j in range(CABLE_COUNT)
+    ]
+
+
 def catenary_length_residual(
     position_m: sf.V3,
     rotation_xyzw: sf.V4,
@@ -163,15 +199,7 @@ def catenary_length_residual(
         platform_weight_n,
         epsilon,
     )
-    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
-    return sf.V4(
-        [
-            cable_model.catenary_length(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
-            + length_offsets_m[j]
-            - encoder_lengths_m[j]
-            for j in range(CABLE_COUNT)
-        ]
-    )
+    return sf.V4(_length_rows(spans, tensions, cable_weight_n_per_m, length_offsets_m, encoder_lengths_m, epsilon))
 
 
 def attachment_height_residual(
@@ -214,15 +242,7 @@ def attachment_height_residual(
         platform_weight_n,
         epsilon,
     )
-    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
-    return sf.V4(
-        [
-            attachments[j][2]
-            - anchors_m[2, j]
-            + cable_model.catenary_drop(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
-            for j in range(CABLE_COUNT)
-        ]
-    )
+    return sf.V4(_height_rows(attachments, spans, tensions, anchors_m, cable_weight_n_per_m, epsilon))
 
 
 def catenary_cable_residuals(
@@ -274,19 +294,8 @@ def catenary_cable_residuals(
         platform_weight_n,
         epsilon,
     )
-    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
-    lengths = [
-        cable_model.catenary_length(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
-        + length_offsets_m[j]
-        - encoder_lengths_m[j]
-        for j in range(CABLE_COUNT)
-    ]
-    heights = [
-        attachments[j][2]
-        - anchors_m[2, j]
-        + cable_model.catenary_drop(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
-        for j in range(CABLE_COUNT)
-    ]
+    lengths = _length_rows(spans, tensions, cable_weight_n_per_m, length_offsets_m, encoder_lengths_m, epsilon)
+    heights = _height_rows(attachments, spans, tensions, anchors_m, cable_weight_n_per_m, epsilon)
     return sf.Matrix(lengths + heights + [component for pair in tensions for component in pair])
 
 
