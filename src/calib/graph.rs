@@ -6,7 +6,7 @@ use std::sync::Arc;
 use nalgebra::{DVector, Vector3};
 
 use super::effect_factors::{
-    EffectVariables, ExtendedHeightFactor, ExtendedLengthFactor, LoadCellFactor, MountedPosePriorFactor,
+    EffectVariables, ExtendedHeightFactor, ExtendedLengthFactor, ExtendedMemo, LoadCellFactor, MountedPosePriorFactor,
 };
 use super::factors::{
     AttachmentHeightFactor, CalibrationVariables, CatenaryCall, CatenaryLengthFactor, CatenaryMemo, PosePriorFactor,
@@ -109,6 +109,7 @@ pub fn build_graph(
         options,
         tension_floor_n: 0.01 * robot.platform_weight_n / CABLE_COUNT as f64,
         catenary_memo: Arc::new(CatenaryMemo::default()),
+        extended_memo: Arc::new(ExtendedMemo::default()),
     };
     let mut pose_variables = Vec::with_capacity(measurements.len());
     for (k, m) in measurements.iter().enumerate() {
@@ -172,6 +173,8 @@ struct PoseFactors<'a> {
     /// The last catenary call, read by the length, height and guard factors
     /// of the pose it was made for (the paper's model; see [`CatenaryCall`]).
     catenary_memo: Arc<CatenaryMemo>,
+    /// The same for the extended model's length and height factors.
+    extended_memo: Arc<ExtendedMemo>,
 }
 
 impl PoseFactors<'_> {
@@ -287,6 +290,7 @@ impl PoseFactors<'_> {
             &m.encoder_lengths_m,
             noise.encoder_sigma_m,
             self.options.robust.encoder,
+            self.extended_memo.clone(),
         );
         push_masked(graph, Box::new(lengths), &encoder_rows(m));
         graph.add(ExtendedHeightFactor::new(
@@ -295,6 +299,7 @@ impl PoseFactors<'_> {
             effects,
             vars,
             self.options.height_sigma_m,
+            self.extended_memo.clone(),
         ));
         let cell = LoadCellFactor::new(
             vars.reference_tension,
