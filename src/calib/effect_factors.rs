@@ -98,6 +98,7 @@ const CHAIN_COLUMNS: usize = 26;
 /// through `generated::cable_geometry` and `generated::extended_cable`.
 /// Computed once per point for the pose's length and height factors
 /// ([`ExtendedMemo`]).
+#[derive(Default)]
 pub struct ExtendedCables {
     /// Paid-out length per slot, metres.
     paid_out_m: Vector4<f64>,
@@ -107,17 +108,6 @@ pub struct ExtendedCables {
     d_paid_out: SMatrix<f64, 4, CHAIN_COLUMNS>,
     /// `d height_residual / d [...]`, same columns.
     d_height: SMatrix<f64, 4, CHAIN_COLUMNS>,
-}
-
-impl Default for ExtendedCables {
-    fn default() -> Self {
-        Self {
-            paid_out_m: Vector4::zeros(),
-            height_residual_m: Vector4::zeros(),
-            d_paid_out: SMatrix::zeros(),
-            d_height: SMatrix::zeros(),
-        }
-    }
 }
 
 /// Inputs of [`extended_cables`] that change with the variables: pose 7,

@@ -18,24 +18,13 @@ use crate::model::robot::CABLE_COUNT;
 /// The outputs of [`generated::catenary_cable_residuals`] at one point, slot
 /// order: rows 0..4 the length errors (eq. 14), 4..8 the height errors
 /// (eq. 15), 8..16 the tensions `[f_h0, f_v0, ...]` (eq. 11).
+#[derive(Default)]
 pub struct CatenaryRows {
     pub(super) rows: SVector<f64, 16>,
     pub(super) pose: SMatrix<f64, 16, 6>,
     pub(super) tension: SMatrix<f64, 16, 2>,
     pub(super) anchors: SMatrix<f64, 16, 12>,
     pub(super) offsets: SMatrix<f64, 16, 4>,
-}
-
-impl Default for CatenaryRows {
-    fn default() -> Self {
-        Self {
-            rows: SVector::zeros(),
-            pose: SMatrix::zeros(),
-            tension: SMatrix::zeros(),
-            anchors: SMatrix::zeros(),
-            offsets: SMatrix::zeros(),
-        }
-    }
 }
 
 /// Inputs of the call that change with the variables (pose 7, reference
