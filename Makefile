@@ -61,9 +61,10 @@ bench:
 	cargo bench
 
 ## sagcal against apex-solver and factrs on the same problem (peers/, its own lock file;
-## not part of `make test`). Writes target/bench-peers/peers.json and peers.svg.
+## not part of `make test`): solvers interleaved in every round, min / median / max.
+## Writes target/bench-peers/peers.json and peers.svg. `make bench-peers ARGS=--quick`: under a minute.
 bench-peers:
-	cargo run --release --manifest-path peers/Cargo.toml -- --out target/bench-peers
+	cargo run --release --manifest-path peers/Cargo.toml -- --out target/bench-peers $(ARGS)
 
 demo:
 	cargo run --release

@@ -39,8 +39,8 @@ use sagcal::model::{PlatformPose, Robot};
 mod generated_calls;
 
 use generated_calls::{
-    attachment_height, catenary_length, dynamic, extended, extended_blocks, geometry, load_cell, mounted_pose_prior,
-    pose_prior, reference_tension, rigid_length, tensions, Point,
+    attachment_height, catenary_cable, catenary_length, dynamic, extended, extended_blocks, geometry, load_cell,
+    mounted_pose_prior, pose_prior, reference_tension, rigid_length, tensions, Point,
 };
 
 /// A large-robot operating point where all four cables pull.
@@ -253,6 +253,14 @@ fn jacobians(c: &mut Criterion) {
     group(c, "attachment_height_residual", &p, &statics, attachment_height, |j| {
         vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)]
     });
+    group(
+        c,
+        "catenary_cable_residuals",
+        &p,
+        &[Pose, reference, anchors, offsets],
+        catenary_cable,
+        |j| vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2), dynamic(&j.3)],
+    );
     group(
         c,
         "reference_tension_residual",

@@ -118,6 +118,42 @@ def _catenaries(
     return attachments, spans, tensions
 
 
+def _length_rows(
+    spans: list[sf.Scalar],
+    tensions: list[tuple[sf.Scalar, sf.Scalar]],
+    cable_weight_n_per_m: sf.Scalar,
+    length_offsets_m: sf.V4,
+    encoder_lengths_m: sf.V4,
+    epsilon: sf.Scalar,
+) -> list[sf.Scalar]:
+    """Eq. (14) per slot: ``l_C,j + l0_j - z_enc,j``."""
+    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
+    return [
+        cable_model.catenary_length(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
+        + length_offsets_m[j]
+        - encoder_lengths_m[j]
+        for j in range(CABLE_COUNT)
+    ]
+
+
+def _height_rows(
+    attachments: list[sf.V3],
+    spans: list[sf.Scalar],
+    tensions: list[tuple[sf.Scalar, sf.Scalar]],
+    anchors_m: sf.Matrix34,
+    cable_weight_n_per_m: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> list[sf.Scalar]:
+    """Eq. (15) per slot: ``(p + R b_j)_z - a_j,z + drop_j``."""
+    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
+    return [
+        attachments[j][2]
+        - anchors_m[2, j]
+        + cable_model.catenary_drop(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
+        for j in range(CABLE_COUNT)
+    ]
+
+
 def catenary_length_residual(
     position_m: sf.V3,
     rotation_xyzw: sf.V4,
@@ -163,15 +199,7 @@ def catenary_length_residual(
         platform_weight_n,
         epsilon,
     )
-    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
-    return sf.V4(
-        [
-            cable_model.catenary_length(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
-            + length_offsets_m[j]
-            - encoder_lengths_m[j]
-            for j in range(CABLE_COUNT)
-        ]
-    )
+    return sf.V4(_length_rows(spans, tensions, cable_weight_n_per_m, length_offsets_m, encoder_lengths_m, epsilon))
 
 
 def attachment_height_residual(
@@ -214,15 +242,61 @@ def attachment_height_residual(
         platform_weight_n,
         epsilon,
     )
-    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
-    return sf.V4(
-        [
-            attachments[j][2]
-            - anchors_m[2, j]
-            + cable_model.catenary_drop(spans[j], tensions[j][0], tensions[j][1], cable, epsilon)
-            for j in range(CABLE_COUNT)
-        ]
+    return sf.V4(_height_rows(attachments, spans, tensions, anchors_m, cable_weight_n_per_m, epsilon))
+
+
+def catenary_cable_residuals(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    reference_tension_n: sf.V2,
+    anchors_m: sf.Matrix34,
+    attachments_m: sf.Matrix34,
+    com_offset_m: sf.V3,
+    platform_weight_n: sf.Scalar,
+    cable_weight_n_per_m: sf.Scalar,
+    length_offsets_m: sf.V4,
+    encoder_lengths_m: sf.V4,
+    epsilon: sf.Scalar,
+) -> sf.Matrix:
+    """Both catenary factors of one pose, eq. (14) and (15), and its tensions, from one statics solve.
+
+    The rows are exactly ``catenary_length_residual`` (0..4),
+    ``attachment_height_residual`` (4..8) and
+    ``cable_tensions_from_reference`` (8..16, read by the tension guard); the
+    attachment points, spans and the tensions of eq. (11) they share are
+    derived once, so one call costs little more than one of the three did.
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        reference_tension_n: ``[f_h, f_v]`` of the reference cable (slot 0), newtons.
+        anchors_m: Column ``j`` = anchor of slot ``j``, world frame, metres.
+        attachments_m: Column ``j`` = attachment of slot ``j``, platform frame, metres.
+        com_offset_m: Centre of mass, platform frame, metres.
+        platform_weight_n: Platform weight ``m_e g``, newtons.
+        cable_weight_n_per_m: Cable weight per metre ``g_c``, N/m (0: massless cable).
+        length_offsets_m: Encoder length offsets ``l0_j``, metres, slot order.
+        encoder_lengths_m: Encoder readings ``z_enc,j``, metres, slot order.
+        epsilon: Small positive number (safe divisions, ``sinhc`` at ``g_c = 0``).
+
+    Returns:
+        The 16-vector: the length errors (eq. 14, metres), the height errors
+        (eq. 15, metres), each in slot order, then
+        ``[f_h0, f_v0, ..., f_h3, f_v3]`` (eq. 11, newtons, slot order).
+    """
+    attachments, spans, tensions = _catenaries(
+        position_m,
+        rotation_xyzw,
+        reference_tension_n,
+        anchors_m,
+        attachments_m,
+        com_offset_m,
+        platform_weight_n,
+        epsilon,
     )
+    lengths = _length_rows(spans, tensions, cable_weight_n_per_m, length_offsets_m, encoder_lengths_m, epsilon)
+    heights = _height_rows(attachments, spans, tensions, anchors_m, cable_weight_n_per_m, epsilon)
+    return sf.Matrix(lengths + heights + [component for pair in tensions for component in pair])
 
 
 def reference_tension_residual(

@@ -315,6 +315,11 @@ FUNCTIONS = (
         ("pose", "reference_tension_n", "anchors_m", "length_offsets_m"),
     ),
     FunctionSpec(factors.attachment_height_residual, "residual", ("pose", "reference_tension_n", "anchors_m")),
+    FunctionSpec(
+        factors.catenary_cable_residuals,
+        "rows",
+        ("pose", "reference_tension_n", "anchors_m", "length_offsets_m"),
+    ),
     FunctionSpec(factors.reference_tension_residual, "residual", ("reference_tension_n",)),
     FunctionSpec(factors.pose_prior_residual, "residual", ("pose",)),
     FunctionSpec(factors.mounted_pose_prior_residual, "residual", ("pose", "localiser_mount_rad")),

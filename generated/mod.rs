@@ -7,6 +7,7 @@
 mod attachment_height_residual;
 mod cable_geometry;
 mod cable_tensions_from_reference;
+mod catenary_cable_residuals;
 mod catenary_length_residual;
 mod extended_cable;
 mod load_cell_residual;
@@ -18,6 +19,7 @@ mod rigid_length_residual;
 pub use attachment_height_residual::attachment_height_residual;
 pub use cable_geometry::cable_geometry;
 pub use cable_tensions_from_reference::cable_tensions_from_reference;
+pub use catenary_cable_residuals::catenary_cable_residuals;
 pub use catenary_length_residual::catenary_length_residual;
 pub use extended_cable::extended_cable;
 pub use load_cell_residual::load_cell_residual;

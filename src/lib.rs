@@ -5,7 +5,7 @@
 //! Cable-Driven Robots with Sagging Cable*.
 //!
 //! sagcal does four jobs for an operator, in the order they meet them:
-//! **plan** the poses worth visiting (`plan`, to come), **calibrate** the
+//! **plan** the poses worth visiting ([`plan`]), **calibrate** the
 //! anchors and encoder offsets ([`calib`]), **diagnose** what the model gets
 //! wrong ([`diagnose`]), and **localise** the calibrated robot from its cable
 //! readings ([`localize`]).
@@ -21,7 +21,7 @@
 //! | [`sim`] | closed-form and discretised simulators (the truth of the experiments) |
 //! | [`graph`] | variables, the factor trait, noise, robust kernels ([`calib`]'s factors wrap [`generated`]) |
 //! | [`solver`] | sparse Levenberg-Marquardt: pattern, Schur / Cholesky, covariance |
-//! | [`calib`], [`diagnose`], [`localize`] | the jobs: staged calibration; residual tests, candidate effects, verdict; pose and tensions from the cable readings |
+//! | [`calib`], [`diagnose`], [`localize`], [`plan`] | the jobs: staged calibration; residual tests, candidate effects, verdict; pose and tensions from the cable readings; the poses to visit (optimal design on the Cramer-Rao bound) |
 //! | [`experiments`] | Table II protocol, hidden effects, the benchmark problem |
 //! | [`plot`] | figures, SVG or PNG (rendered with a bundled font) |
 //! | the `sagcal` binary | a thin clap layer, one file per command |
@@ -60,6 +60,7 @@ pub mod graph;
 pub mod io;
 pub mod localize;
 pub mod model;
+pub mod plan;
 pub mod plot;
 pub mod sim;
 pub mod solver;

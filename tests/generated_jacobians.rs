@@ -306,6 +306,15 @@ fn catenary_length(p: &Point) -> Evaluation {
     )
 }
 
+fn catenary_cable(p: &Point) -> Evaluation {
+    let mut j = (nan(), nan(), nan(), nan());
+    let value = calls::catenary_cable(p, Some(&mut j));
+    (
+        column(value),
+        vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2), dynamic(&j.3)],
+    )
+}
+
 fn attachment_height(p: &Point) -> Evaluation {
     let mut j = (nan(), nan(), nan());
     let value = calls::attachment_height(p, Some(&mut j));
@@ -361,7 +370,7 @@ fn load_cell(p: &Point) -> Evaluation {
     (column(value), vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2)])
 }
 
-const FUNCTIONS: [Function; 10] = [
+const FUNCTIONS: [Function; 11] = [
     Function {
         name: "cable_tensions_from_reference",
         blocks: &[Block::Pose, Block::ReferenceTension, Block::Anchors],
@@ -381,6 +390,16 @@ const FUNCTIONS: [Function; 10] = [
         name: "attachment_height_residual",
         blocks: &[Block::Pose, Block::ReferenceTension, Block::Anchors],
         evaluate: attachment_height,
+    },
+    Function {
+        name: "catenary_cable_residuals",
+        blocks: &[
+            Block::Pose,
+            Block::ReferenceTension,
+            Block::Anchors,
+            Block::LengthOffsets,
+        ],
+        evaluate: catenary_cable,
     },
     Function {
         name: "reference_tension_residual",
@@ -584,6 +603,56 @@ fn jacobians_match_finite_differences_massless_cable() {
             );
         }
     }
+}
+
+/// `catenary_cable_residuals` is the three functions it replaces in the
+/// solver, stacked: its rows 0..4, 4..8 and 8..16 and their Jacobians equal
+/// `catenary_length_residual`, `attachment_height_residual` and
+/// `cable_tensions_from_reference` (the offsets' block of the height and
+/// tension rows zero) to 1e-12 of each block's largest entry: the same
+/// expressions, only shared.
+#[test]
+fn catenary_cable_rows_are_the_length_height_and_tension_functions() {
+    let mut worst: f64 = 0.0;
+    for (regime, seed) in [(large(), 21), (small(), 22)] {
+        for p in physical_points(&regime, seed, 30) {
+            let (rows, blocks) = catenary_cable(&p);
+            let (length, length_blocks) = catenary_length(&p);
+            let (height, height_blocks) = attachment_height(&p);
+            let (tensions, tension_blocks) = tensions(&p);
+            let parts = [
+                (0, length, length_blocks),
+                (4, height, height_blocks),
+                (8, tensions, tension_blocks),
+            ];
+            for (first, value, part_blocks) in parts {
+                let n = value.len();
+                let scale = value.amax().max(1.0);
+                let difference = (rows.rows(first, n) - &value).amax() / scale;
+                worst = worst.max(difference);
+                assert!(
+                    difference <= 1e-12,
+                    "{}: rows {first}.. differ by {difference:.1e}",
+                    regime.name
+                );
+                for (k, block) in blocks.iter().enumerate() {
+                    let expected = part_blocks
+                        .get(k)
+                        .cloned()
+                        .unwrap_or_else(|| DMatrix::zeros(n, block.ncols()));
+                    let scale = expected.amax().max(1.0);
+                    let difference = (block.rows(first, n) - &expected).amax() / scale;
+                    worst = worst.max(difference);
+                    assert!(
+                        difference <= 1e-12,
+                        "{}: rows {first}.. block {k} differ by {difference:.1e}",
+                        regime.name
+                    );
+                }
+            }
+        }
+    }
+    println!("catenary_cable_residuals against the three functions: worst relative difference {worst:.1e}");
 }
 
 // -------------------------------------------------------------------------------------------------

@@ -33,6 +33,10 @@ fn generated_sources() {
             include_str!("../generated/attachment_height_residual.rs"),
         ),
         (
+            "catenary_cable_residuals",
+            include_str!("../generated/catenary_cable_residuals.rs"),
+        ),
+        (
             "reference_tension_residual",
             include_str!("../generated/reference_tension_residual.rs"),
         ),
@@ -149,6 +153,37 @@ fn cable_tensions_from_reference_outputs() {
     format_block(&mut out, "jacobian_pose", &pose);
     format_block(&mut out, "jacobian_reference_tension", &reference);
     format_block(&mut out, "jacobian_anchors", &anchors);
+    insta::assert_snapshot!(out);
+}
+
+#[test]
+fn catenary_cable_residuals_outputs() {
+    let x = inputs();
+    let (mut pose, mut reference, mut anchors, mut offsets) =
+        (nan::<16, 6>(), nan::<16, 2>(), nan::<16, 12>(), nan::<16, 4>());
+    let value = generated::catenary_cable_residuals(
+        &x.pose.position_m,
+        &x.pose.rotation_xyzw(),
+        &x.reference_tension_n,
+        &x.anchors_m,
+        &x.attachments_m,
+        &x.com_offset_m,
+        x.platform_weight_n,
+        x.cable_weight_n_per_m,
+        &x.length_offsets_m,
+        &x.encoder_lengths_m,
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut reference),
+        Some(&mut anchors),
+        Some(&mut offsets),
+    );
+    let mut out = String::new();
+    format_block(&mut out, "rows", &value);
+    format_block(&mut out, "jacobian_pose", &pose);
+    format_block(&mut out, "jacobian_reference_tension", &reference);
+    format_block(&mut out, "jacobian_anchors", &anchors);
+    format_block(&mut out, "jacobian_length_offsets", &offsets);
     insta::assert_snapshot!(out);
 }
 

@@ -92,8 +92,10 @@ use sagcal::model::robot::CABLE_COUNT;
 use crate::common::{PeerRun, Solution};
 
 /// Solve `problem` with apex-solver's Levenberg-Marquardt (see the module docs).
-pub fn solve(problem: &BenchmarkProblem) -> Result<PeerRun, String> {
-    run(problem).map(|(run, _)| run)
+/// `max_iterations`: sagcal's linearisation budget (the benchmark's is
+/// [`BenchmarkProblem::stopping`]'s; a smaller one for the instruction counts).
+pub fn solve(problem: &BenchmarkProblem, max_iterations: usize) -> Result<PeerRun, String> {
+    run(problem, max_iterations).map(|(run, _)| run)
 }
 
 /// What apex reports besides the [`PeerRun`] (read by the tests).
@@ -106,12 +108,12 @@ struct ApexReport {
     status: String,
 }
 
-fn run(problem: &BenchmarkProblem) -> Result<(PeerRun, ApexReport), String> {
+fn run(problem: &BenchmarkProblem, max_iterations: usize) -> Result<(PeerRun, ApexReport), String> {
     let setup_start = Instant::now();
     let built = problem.graph();
     let apex = ApexProblem::new(problem, &built)?;
     let mut apex_problem = apex.problem;
-    let mut lm = LevenbergMarquardt::with_config(lm_config());
+    let mut lm = LevenbergMarquardt::with_config(lm_config(max_iterations));
     let setup_seconds = setup_start.elapsed().as_secs_f64();
 
     let pool = rayon::ThreadPoolBuilder::new()
@@ -179,11 +181,11 @@ fn run(problem: &BenchmarkProblem) -> Result<(PeerRun, ApexReport), String> {
 }
 
 /// The stopping rule of [`BenchmarkProblem::stopping`] as apex's LM options (table in the module docs).
-fn lm_config() -> LevenbergMarquardtConfig {
+fn lm_config(max_iterations: usize) -> LevenbergMarquardtConfig {
     let stopping = BenchmarkProblem::stopping();
     let mut config = LevenbergMarquardtConfig::new()
         .with_linear_solver_type(LinearSolverType::SparseCholesky)
-        .with_max_iterations(stopping.max_iterations - 1)
+        .with_max_iterations(max_iterations.max(1) - 1)
         .with_cost_tolerance(stopping.relative_cost_tolerance)
         .with_gradient_tolerance(stopping.gradient_tolerance)
         .with_parameter_tolerance(stopping.relative_step_tolerance)
@@ -834,7 +836,7 @@ mod tests {
         let built = p.graph();
         let initial_sagcal = built.graph.cost(&built.graph.values).unwrap();
         let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
-        let (run, report) = run(&p).unwrap();
+        let (run, report) = run(&p, BenchmarkProblem::stopping().max_iterations).unwrap();
         eprintln!(
             "initial cost: apex {:.15e}, sagcal {initial_sagcal:.15e} (relative difference {:.1e}); apex stopped: {}",
             report.initial_cost,
@@ -878,7 +880,7 @@ mod tests {
     fn apex_at_1000_poses() {
         let p = problem(1000);
         let built = p.graph();
-        let (run, report) = run(&p).unwrap();
+        let (run, report) = run(&p, BenchmarkProblem::stopping().max_iterations).unwrap();
         let at_solution = built.graph.cost(&solution_values(&built, &run.solution)).unwrap();
         let mut graph = p.graph();
         let start = Instant::now();

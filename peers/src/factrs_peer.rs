@@ -108,6 +108,7 @@ use sagcal::graph::RobustKernel;
 use sagcal::io::measurements::PoseMeasurement;
 use sagcal::model::pose::PlatformPose;
 use sagcal::model::robot::{Robot, CABLE_COUNT};
+use sagcal::solver::LmParams;
 
 use crate::common::{PeerRun, Solution};
 
@@ -647,10 +648,16 @@ fn solution_from(values: &Values, poses: usize, normalize: bool) -> Result<Solut
     Ok(solution)
 }
 
-fn solve_detailed(problem: &BenchmarkProblem) -> Result<Detailed, String> {
+fn solve_detailed(problem: &BenchmarkProblem, max_iterations: usize) -> Result<Detailed, String> {
     let setup_start = Instant::now();
     let (graph, values) = build(problem)?;
-    let mut optimizer = LevenMarquardt::new(params(&BenchmarkProblem::stopping()), graph);
+    let mut optimizer = LevenMarquardt::new(
+        params(&LmParams {
+            max_iterations,
+            ..BenchmarkProblem::stopping()
+        }),
+        graph,
+    );
     let iterations = Rc::new(Cell::new(0));
     let latest = Rc::new(RefCell::new(None));
     optimizer.add_observer(Progress {
@@ -703,8 +710,9 @@ fn solve_detailed(problem: &BenchmarkProblem) -> Result<Detailed, String> {
 }
 
 /// Solve the benchmark problem with factrs's Levenberg-Marquardt (see the module docs).
-pub fn solve(problem: &BenchmarkProblem) -> Result<PeerRun, String> {
-    solve_detailed(problem).map(|d| d.run)
+/// `max_iterations`: the linearisation budget (see `apex::solve`).
+pub fn solve(problem: &BenchmarkProblem, max_iterations: usize) -> Result<PeerRun, String> {
+    solve_detailed(problem, max_iterations).map(|d| d.run)
 }
 
 #[cfg(test)]
@@ -879,7 +887,7 @@ mod tests {
 
     fn compare(poses: usize, seed: u64) {
         let problem = BenchmarkProblem::new(poses, seed).unwrap();
-        let detailed = solve_detailed(&problem).unwrap();
+        let detailed = solve_detailed(&problem, BenchmarkProblem::stopping().max_iterations).unwrap();
         let run = &detailed.run;
 
         // (2) factrs's reported cost equals sagcal's cost at factrs's solution.

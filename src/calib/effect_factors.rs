@@ -19,7 +19,7 @@ use super::factors::{
     tension_argument, variable_list, CalibrationVariables, PoseVariables, SlotOrder, EPSILON,
 };
 use crate::generated;
-use crate::graph::{Factor, RobustKernel, Values, VariableId};
+use crate::graph::{Factor, RobustKernel, SharedEvaluation, Values, VariableId};
 use crate::model::effects::EffectKind;
 use crate::model::robot::CABLE_COUNT;
 
@@ -96,7 +96,10 @@ const CHAIN_COLUMNS: usize = 26;
 /// The extended cable model of one pose: per slot the paid-out length and
 /// `drop - h` (the attachment residual), with Jacobians by the chain rule
 /// through `generated::cable_geometry` and `generated::extended_cable`.
-struct ExtendedCables {
+/// Computed once per point for the pose's length and height factors
+/// ([`ExtendedMemo`]).
+#[derive(Default)]
+pub struct ExtendedCables {
     /// Paid-out length per slot, metres.
     paid_out_m: Vector4<f64>,
     /// Attachment residual `drop - h` per slot, metres.
@@ -105,6 +108,45 @@ struct ExtendedCables {
     d_paid_out: SMatrix<f64, 4, CHAIN_COLUMNS>,
     /// `d height_residual / d [...]`, same columns.
     d_height: SMatrix<f64, 4, CHAIN_COLUMNS>,
+}
+
+/// Inputs of [`extended_cables`] that change with the variables: pose 7,
+/// reference tension 2, anchors 12, compliance, pulley radius, centre of mass 3, `1/n^2`.
+const EXTENDED_INPUTS: usize = 27;
+
+/// The last [`ExtendedCables`] of a graph, read by the length and height
+/// factors of the pose it was computed for (one call per pose and point
+/// instead of one per factor; see [`crate::graph::SharedEvaluation`]).
+pub type ExtendedMemo = SharedEvaluation<EXTENDED_INPUTS, ExtendedCables>;
+
+/// `read` of [`extended_cables`] at `values`, through `memo`.
+#[allow(clippy::too_many_arguments)]
+fn shared_extended_cables<R>(
+    memo: &ExtendedMemo,
+    values: &Values,
+    slots: &SlotOrder,
+    globals: &CalibrationVariables,
+    pose: &PoseVariables,
+    effects: &EffectArguments,
+    want_jacobians: bool,
+    read: impl FnOnce(&ExtendedCables) -> R,
+) -> R {
+    let (position, rotation) = pose_arguments(values, pose.pose);
+    let tension = tension_argument(values, pose.reference_tension);
+    let anchors = gather_anchors(values, slots, globals);
+    let mut inputs = [0.0; EXTENDED_INPUTS];
+    inputs[..3].copy_from_slice(position.as_slice());
+    inputs[3..7].copy_from_slice(rotation.as_slice());
+    inputs[7..9].copy_from_slice(tension.as_slice());
+    inputs[9..21].copy_from_slice(anchors.as_slice());
+    inputs[21] = effects.compliance_per_mn;
+    inputs[22] = effects.pulley_radius_m;
+    inputs[23..26].copy_from_slice(effects.com_offset_m.as_slice());
+    inputs[26] = effects.inverse_segments_squared;
+    let evaluate = |out: &mut ExtendedCables, want: bool| {
+        *out = extended_cables(values, slots, globals, pose, effects, want);
+    };
+    memo.read(&inputs, want_jacobians, evaluate, read)
 }
 
 fn extended_cables(
@@ -231,10 +273,12 @@ pub struct ExtendedLengthFactor {
     encoder_lengths_m: Vector4<f64>,
     sigmas: DVector<f64>,
     kernel: RobustKernel,
+    memo: Arc<ExtendedMemo>,
 }
 
 impl ExtendedLengthFactor {
-    /// `encoder_lengths_m` in the robot's cable order.
+    /// `encoder_lengths_m` in the robot's cable order; `memo` shared with the pose's height factor.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         slots: Arc<SlotOrder>,
         globals: CalibrationVariables,
@@ -243,6 +287,7 @@ impl ExtendedLengthFactor {
         encoder_lengths_m: &[f64; CABLE_COUNT],
         sigma_m: f64,
         kernel: RobustKernel,
+        memo: Arc<ExtendedMemo>,
     ) -> Self {
         let mut variables = variable_list(&pose, &globals, true, true);
         variables.extend([
@@ -262,6 +307,7 @@ impl ExtendedLengthFactor {
             effects,
             sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
             kernel,
+            memo,
         }
     }
 }
@@ -277,7 +323,31 @@ impl Factor for ExtendedLengthFactor {
         let s = &self.slots;
         let e = effect_arguments(values, s, &self.effects);
         let offsets = gather_offsets(values, s, &self.globals);
-        let cables = extended_cables(values, s, &self.globals, &self.pose, &e, jacobians.is_some());
+        let want = jacobians.is_some();
+        let read = |cables: &ExtendedCables| self.rows(cables, &e, &offsets, jacobians);
+        shared_extended_cables(&self.memo, values, s, &self.globals, &self.pose, &e, want, read)
+    }
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.sigmas
+    }
+    fn robust_kernel(&self) -> RobustKernel {
+        self.kernel
+    }
+    fn kind(&self) -> &'static str {
+        "catenary_length"
+    }
+}
+
+impl ExtendedLengthFactor {
+    /// The residual (and blocks) from the pose's extended cables.
+    fn rows(
+        &self,
+        cables: &ExtendedCables,
+        e: &EffectArguments,
+        offsets: &Vector4<f64>,
+        jacobians: Option<&mut [DMatrix<f64>]>,
+    ) -> Option<DVector<f64>> {
+        let s = &self.slots;
         let scale = Vector4::from_fn(|slot, _| 1.0 + e.gain_errors[slot]);
         let residual = cables.paid_out_m.component_mul(&scale) + offsets - self.encoder_lengths_m;
         if let Some(blocks) = jacobians {
@@ -303,15 +373,6 @@ impl Factor for ExtendedLengthFactor {
         }
         Some(slots_to_cables(s, &residual))
     }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.kernel
-    }
-    fn kind(&self) -> &'static str {
-        "catenary_length"
-    }
 }
 
 /// Extended attachment factor: eq. (15) with the elastic catenary leaving the
@@ -323,16 +384,19 @@ pub struct ExtendedHeightFactor {
     pose: PoseVariables,
     effects: EffectVariables,
     sigmas: DVector<f64>,
+    memo: Arc<ExtendedMemo>,
 }
 
 impl ExtendedHeightFactor {
-    /// A height factor with standard deviation `sigma_m` (a model constraint: small).
+    /// A height factor with standard deviation `sigma_m` (a model constraint:
+    /// small); `memo` shared with the pose's length factor.
     pub fn new(
         slots: Arc<SlotOrder>,
         globals: CalibrationVariables,
         effects: EffectVariables,
         pose: PoseVariables,
         sigma_m: f64,
+        memo: Arc<ExtendedMemo>,
     ) -> Self {
         let mut variables = variable_list(&pose, &globals, true, false);
         variables.extend([
@@ -348,6 +412,7 @@ impl ExtendedHeightFactor {
             pose,
             effects,
             sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
+            memo,
         }
     }
 }
@@ -362,18 +427,21 @@ impl Factor for ExtendedHeightFactor {
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
         let s = &self.slots;
         let e = effect_arguments(values, s, &self.effects);
-        let cables = extended_cables(values, s, &self.globals, &self.pose, &e, jacobians.is_some());
-        if let Some(blocks) = jacobians {
-            let at = EffectBlocks {
-                compliance: 6,
-                radius: 7,
-                com: 8,
-                segments: 9,
-            };
-            split_chain(&cables.d_height, s, blocks, at);
-            rows_to_cables(s, blocks);
-        }
-        Some(slots_to_cables(s, &cables.height_residual_m))
+        let want = jacobians.is_some();
+        let read = |cables: &ExtendedCables| {
+            if let Some(blocks) = jacobians {
+                let at = EffectBlocks {
+                    compliance: 6,
+                    radius: 7,
+                    com: 8,
+                    segments: 9,
+                };
+                split_chain(&cables.d_height, s, blocks, at);
+                rows_to_cables(s, blocks);
+            }
+            Some(slots_to_cables(s, &cables.height_residual_m))
+        };
+        shared_extended_cables(&self.memo, values, s, &self.globals, &self.pose, &e, want, read)
     }
     fn sigmas(&self) -> &DVector<f64> {
         &self.sigmas

@@ -8,11 +8,15 @@
 
 use std::sync::Arc;
 
-use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, Vector2, Vector3, Vector4};
+use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, SVector, Vector2, Vector3, Vector4};
 
 use crate::generated;
 use crate::graph::{Factor, RobustKernel, Values, VariableId};
 use crate::model::robot::{Robot, CABLE_COUNT};
+
+mod catenary_call;
+
+pub use catenary_call::{CatenaryCall, CatenaryMemo, CatenaryRows};
 
 /// The `epsilon` passed to the generated code (SymForce's default for f64).
 pub const EPSILON: f64 = 10.0 * f64::EPSILON;
@@ -161,33 +165,20 @@ pub(super) fn rows_to_cables(slots: &SlotOrder, blocks: &mut [DMatrix<f64>]) {
 
 /// Catenary length factor (paper eq. 14): `l_C,i + l_i^0 - z_i^enc` for the four
 /// cables of one pose, the tensions of the non-reference cables from eq. (11).
+/// Rows 0..4 of the pose's shared [`CatenaryCall`].
 pub struct CatenaryLengthFactor {
     variables: Vec<VariableId>,
-    slots: Arc<SlotOrder>,
-    globals: CalibrationVariables,
-    pose: PoseVariables,
-    /// Encoder readings, slot order, metres.
-    encoder_lengths_m: Vector4<f64>,
+    call: CatenaryCall,
     sigmas: DVector<f64>,
     kernel: RobustKernel,
 }
 
 impl CatenaryLengthFactor {
-    /// `encoder_lengths_m` in the robot's cable order.
-    pub fn new(
-        slots: Arc<SlotOrder>,
-        globals: CalibrationVariables,
-        pose: PoseVariables,
-        encoder_lengths_m: &[f64; CABLE_COUNT],
-        sigma_m: f64,
-        kernel: RobustKernel,
-    ) -> Self {
+    /// The length rows of `call` (which holds the pose's encoder readings).
+    pub fn new(call: CatenaryCall, sigma_m: f64, kernel: RobustKernel) -> Self {
         Self {
-            variables: variable_list(&pose, &globals, true, true),
-            encoder_lengths_m: slots.to_slots(encoder_lengths_m),
-            slots,
-            globals,
-            pose,
+            variables: variable_list(&call.pose, &call.globals, true, true),
+            call,
             sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
             kernel,
         }
@@ -202,41 +193,7 @@ impl Factor for CatenaryLengthFactor {
         CABLE_COUNT
     }
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
-        let (position, rotation) = pose_arguments(values, self.pose.pose);
-        let tension = tension_argument(values, self.pose.reference_tension);
-        let anchors = gather_anchors(values, &self.slots, &self.globals);
-        let offsets = gather_offsets(values, &self.slots, &self.globals);
-        let s = &self.slots;
-        let mut j_pose = SMatrix::<f64, 4, 6>::zeros();
-        let mut j_tension = SMatrix::<f64, 4, 2>::zeros();
-        let mut j_anchors = SMatrix::<f64, 4, 12>::zeros();
-        let mut j_offsets = SMatrix::<f64, 4, 4>::zeros();
-        let want = jacobians.is_some();
-        let residual = generated::catenary_length_residual(
-            &position,
-            &rotation,
-            &tension,
-            &anchors,
-            &s.attachments_m,
-            &s.com_offset_m,
-            s.platform_weight_n,
-            s.cable_weight_n_per_m,
-            &offsets,
-            &self.encoder_lengths_m,
-            EPSILON,
-            want.then_some(&mut j_pose),
-            want.then_some(&mut j_tension),
-            want.then_some(&mut j_anchors),
-            want.then_some(&mut j_offsets),
-        );
-        if let Some(blocks) = jacobians {
-            blocks[0].copy_from(&j_pose);
-            blocks[1].copy_from(&j_tension);
-            split_anchor_jacobian(&j_anchors, s, &mut blocks[2..6]);
-            split_offset_jacobian(&j_offsets, s, &mut blocks[6..10]);
-            rows_to_cables(s, blocks);
-        }
-        Some(slots_to_cables(s, &residual))
+        Some(self.call.four_rows(values, 0, jacobians))
     }
     fn sigmas(&self) -> &DVector<f64> {
         &self.sigmas
@@ -250,23 +207,20 @@ impl Factor for CatenaryLengthFactor {
 }
 
 /// Cable attachment factor (paper eq. 15): the attachment height minus the
-/// height the catenary from each anchor reaches, for the four cables of one pose.
+/// height the catenary from each anchor reaches, for the four cables of one
+/// pose. Rows 4..8 of the pose's shared [`CatenaryCall`].
 pub struct AttachmentHeightFactor {
     variables: Vec<VariableId>,
-    slots: Arc<SlotOrder>,
-    globals: CalibrationVariables,
-    pose: PoseVariables,
+    call: CatenaryCall,
     sigmas: DVector<f64>,
 }
 
 impl AttachmentHeightFactor {
     /// A height factor with standard deviation `sigma_m` (a model constraint: small).
-    pub fn new(slots: Arc<SlotOrder>, globals: CalibrationVariables, pose: PoseVariables, sigma_m: f64) -> Self {
+    pub fn new(call: CatenaryCall, sigma_m: f64) -> Self {
         Self {
-            variables: variable_list(&pose, &globals, true, false),
-            slots,
-            globals,
-            pose,
+            variables: variable_list(&call.pose, &call.globals, true, false),
+            call,
             sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
         }
     }
@@ -280,35 +234,7 @@ impl Factor for AttachmentHeightFactor {
         CABLE_COUNT
     }
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
-        let (position, rotation) = pose_arguments(values, self.pose.pose);
-        let tension = tension_argument(values, self.pose.reference_tension);
-        let anchors = gather_anchors(values, &self.slots, &self.globals);
-        let s = &self.slots;
-        let mut j_pose = SMatrix::<f64, 4, 6>::zeros();
-        let mut j_tension = SMatrix::<f64, 4, 2>::zeros();
-        let mut j_anchors = SMatrix::<f64, 4, 12>::zeros();
-        let want = jacobians.is_some();
-        let residual = generated::attachment_height_residual(
-            &position,
-            &rotation,
-            &tension,
-            &anchors,
-            &s.attachments_m,
-            &s.com_offset_m,
-            s.platform_weight_n,
-            s.cable_weight_n_per_m,
-            EPSILON,
-            want.then_some(&mut j_pose),
-            want.then_some(&mut j_tension),
-            want.then_some(&mut j_anchors),
-        );
-        if let Some(blocks) = jacobians {
-            blocks[0].copy_from(&j_pose);
-            blocks[1].copy_from(&j_tension);
-            split_anchor_jacobian(&j_anchors, s, &mut blocks[2..6]);
-            rows_to_cables(s, blocks);
-        }
-        Some(slots_to_cables(s, &residual))
+        Some(self.call.four_rows(values, 4, jacobians))
     }
     fn sigmas(&self) -> &DVector<f64> {
         &self.sigmas
@@ -318,33 +244,99 @@ impl Factor for AttachmentHeightFactor {
     }
 }
 
+/// Where a tension guard takes the tensions of eq. (11) from.
+pub enum TensionSource {
+    /// Rows 8..16 of the pose's shared catenary call (the paper's model).
+    Shared(CatenaryCall),
+    /// Its own call of [`generated::cable_tensions_from_reference`] (the extended model).
+    Own {
+        /// Robot constants in slot order.
+        slots: Arc<SlotOrder>,
+        /// Anchors and offsets.
+        globals: CalibrationVariables,
+        /// The pose's variables.
+        pose: PoseVariables,
+    },
+}
+
+impl TensionSource {
+    fn pose(&self) -> (&PoseVariables, &CalibrationVariables, &SlotOrder) {
+        match self {
+            TensionSource::Shared(call) => (&call.pose, &call.globals, &call.slots),
+            TensionSource::Own { slots, globals, pose } => (pose, globals, slots),
+        }
+    }
+
+    /// The tensions (slot order) and, if `jacobians`, their pose, tension and
+    /// anchor Jacobians (8 x 20, columns `[pose 6, tension 2, anchors 12]`).
+    fn tensions(&self, values: &Values, jacobians: bool) -> (SVector<f64, 8>, SMatrix<f64, 8, 20>) {
+        let mut jacobian = SMatrix::<f64, 8, 20>::zeros();
+        match self {
+            TensionSource::Shared(call) => call.read(values, jacobians, |out| {
+                if jacobians {
+                    jacobian
+                        .fixed_columns_mut::<6>(0)
+                        .copy_from(&out.pose.fixed_rows::<8>(8));
+                    jacobian
+                        .fixed_columns_mut::<2>(6)
+                        .copy_from(&out.tension.fixed_rows::<8>(8));
+                    jacobian
+                        .fixed_columns_mut::<12>(8)
+                        .copy_from(&out.anchors.fixed_rows::<8>(8));
+                }
+                (out.rows.fixed_rows::<8>(8).into_owned(), jacobian)
+            }),
+            TensionSource::Own {
+                slots: s,
+                globals,
+                pose,
+            } => {
+                let (position, rotation) = pose_arguments(values, pose.pose);
+                let tension = tension_argument(values, pose.reference_tension);
+                let anchors = gather_anchors(values, s, globals);
+                let mut j_pose = SMatrix::<f64, 8, 6>::zeros();
+                let mut j_tension = SMatrix::<f64, 8, 2>::zeros();
+                let mut j_anchors = SMatrix::<f64, 8, 12>::zeros();
+                let tensions = generated::cable_tensions_from_reference(
+                    &position,
+                    &rotation,
+                    &tension,
+                    &anchors,
+                    &s.attachments_m,
+                    &s.com_offset_m,
+                    s.platform_weight_n,
+                    EPSILON,
+                    jacobians.then_some(&mut j_pose),
+                    jacobians.then_some(&mut j_tension),
+                    jacobians.then_some(&mut j_anchors),
+                );
+                jacobian.fixed_columns_mut::<6>(0).copy_from(&j_pose);
+                jacobian.fixed_columns_mut::<2>(6).copy_from(&j_tension);
+                jacobian.fixed_columns_mut::<12>(8).copy_from(&j_anchors);
+                (tensions, jacobian)
+            }
+        }
+    }
+}
+
 /// Positivity guard: `min(0, f_h,i - f_min)` for every cable of one pose,
 /// with the tensions of eq. (11). Zero (inactive) while all cables are taut;
 /// it only shapes the path of the solver. Undefined (`None`) once a cable
 /// would push, so the solver never steps into a slack configuration.
 pub struct TensionGuardFactor {
     variables: Vec<VariableId>,
-    slots: Arc<SlotOrder>,
-    globals: CalibrationVariables,
-    pose: PoseVariables,
+    source: TensionSource,
     minimum_horizontal_tension_n: f64,
     sigmas: DVector<f64>,
 }
 
 impl TensionGuardFactor {
-    /// A guard keeping every `f_h` above `minimum_horizontal_tension_n`, stiffness `sigma_n`.
-    pub fn new(
-        slots: Arc<SlotOrder>,
-        globals: CalibrationVariables,
-        pose: PoseVariables,
-        minimum_horizontal_tension_n: f64,
-        sigma_n: f64,
-    ) -> Self {
+    /// A guard keeping every `f_h` from `source` above `minimum_horizontal_tension_n`, stiffness `sigma_n`.
+    pub fn new(source: TensionSource, minimum_horizontal_tension_n: f64, sigma_n: f64) -> Self {
+        let (pose, globals, _) = source.pose();
         Self {
-            variables: variable_list(&pose, &globals, true, false),
-            slots,
-            globals,
-            pose,
+            variables: variable_list(pose, globals, true, false),
+            source,
             minimum_horizontal_tension_n,
             sigmas: DVector::from_element(CABLE_COUNT, sigma_n),
         }
@@ -359,27 +351,8 @@ impl Factor for TensionGuardFactor {
         CABLE_COUNT
     }
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
-        let (position, rotation) = pose_arguments(values, self.pose.pose);
-        let tension = tension_argument(values, self.pose.reference_tension);
-        let anchors = gather_anchors(values, &self.slots, &self.globals);
-        let s = &self.slots;
-        let mut j_pose = SMatrix::<f64, 8, 6>::zeros();
-        let mut j_tension = SMatrix::<f64, 8, 2>::zeros();
-        let mut j_anchors = SMatrix::<f64, 8, 12>::zeros();
-        let want = jacobians.is_some();
-        let tensions = generated::cable_tensions_from_reference(
-            &position,
-            &rotation,
-            &tension,
-            &anchors,
-            &s.attachments_m,
-            &s.com_offset_m,
-            s.platform_weight_n,
-            EPSILON,
-            want.then_some(&mut j_pose),
-            want.then_some(&mut j_tension),
-            want.then_some(&mut j_anchors),
-        );
+        let (tensions, jacobian) = self.source.tensions(values, jacobians.is_some());
+        let (_, _, s) = self.source.pose();
         let mut residual = Vector4::zeros();
         let mut active = [false; CABLE_COUNT];
         for slot in 0..CABLE_COUNT {
@@ -399,14 +372,14 @@ impl Factor for TensionGuardFactor {
             for slot in (0..CABLE_COUNT).filter(|&k| active[k]) {
                 let row = 2 * slot;
                 for c in 0..6 {
-                    blocks[0][(slot, c)] = j_pose[(row, c)];
+                    blocks[0][(slot, c)] = jacobian[(row, c)];
                 }
                 for c in 0..2 {
-                    blocks[1][(slot, c)] = j_tension[(row, c)];
+                    blocks[1][(slot, c)] = jacobian[(row, 6 + c)];
                 }
                 for (anchor_slot, &cable) in s.cables.iter().enumerate() {
                     for c in 0..3 {
-                        blocks[2 + cable][(slot, c)] = j_anchors[(row, 3 * anchor_slot + c)];
+                        blocks[2 + cable][(slot, c)] = jacobian[(row, 8 + 3 * anchor_slot + c)];
                     }
                 }
             }

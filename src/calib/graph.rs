@@ -6,11 +6,11 @@ use std::sync::Arc;
 use nalgebra::{DVector, Vector3};
 
 use super::effect_factors::{
-    EffectVariables, ExtendedHeightFactor, ExtendedLengthFactor, LoadCellFactor, MountedPosePriorFactor,
+    EffectVariables, ExtendedHeightFactor, ExtendedLengthFactor, ExtendedMemo, LoadCellFactor, MountedPosePriorFactor,
 };
 use super::factors::{
-    AttachmentHeightFactor, CalibrationVariables, CatenaryLengthFactor, PosePriorFactor, PoseVariables,
-    ReferenceTensionFactor, RigidLengthFactor, SlotOrder, TensionGuardFactor,
+    AttachmentHeightFactor, CalibrationVariables, CatenaryCall, CatenaryLengthFactor, CatenaryMemo, PosePriorFactor,
+    PoseVariables, ReferenceTensionFactor, RigidLengthFactor, SlotOrder, TensionGuardFactor, TensionSource,
 };
 use super::options::{CableModel, CalibrationOptions, OrientationPrior};
 use crate::error::{Error, Result};
@@ -108,6 +108,8 @@ pub fn build_graph(
         model,
         options,
         tension_floor_n: 0.01 * robot.platform_weight_n / CABLE_COUNT as f64,
+        catenary_memo: Arc::new(CatenaryMemo::default()),
+        extended_memo: Arc::new(ExtendedMemo::default()),
     };
     let mut pose_variables = Vec::with_capacity(measurements.len());
     for (k, m) in measurements.iter().enumerate() {
@@ -168,6 +170,11 @@ struct PoseFactors<'a> {
     /// The positivity guard's minimum horizontal tension, and its sigma: 1 %
     /// of the platform's weight share per cable, newtons.
     tension_floor_n: f64,
+    /// The last catenary call, read by the length, height and guard factors
+    /// of the pose it was made for (the paper's model; see [`CatenaryCall`]).
+    catenary_memo: Arc<CatenaryMemo>,
+    /// The same for the extended model's length and height factors.
+    extended_memo: Arc<ExtendedMemo>,
 }
 
 impl PoseFactors<'_> {
@@ -212,11 +219,25 @@ impl PoseFactors<'_> {
             (CableModel::Rigid, _) => self.add_rigid(graph, vars, m),
             (CableModel::Catenary, Some(effects)) => {
                 self.add_extended(graph, vars, m, effects);
-                self.add_tension_guard(graph, vars);
+                self.add_tension_guard(
+                    graph,
+                    TensionSource::Own {
+                        slots: self.slots.clone(),
+                        globals: self.globals,
+                        pose: vars,
+                    },
+                );
             }
             (CableModel::Catenary, None) => {
-                self.add_catenary(graph, vars, m);
-                self.add_tension_guard(graph, vars);
+                let call = CatenaryCall::new(
+                    self.slots.clone(),
+                    self.globals,
+                    vars,
+                    &m.encoder_lengths_m,
+                    self.catenary_memo.clone(),
+                );
+                self.add_catenary(graph, &call, m);
+                self.add_tension_guard(graph, TensionSource::Shared(call));
             }
         }
     }
@@ -235,27 +256,15 @@ impl PoseFactors<'_> {
         push_masked(graph, Box::new(lengths), &encoder_rows(m));
     }
 
-    /// The paper's factors: catenary length (eq. 14), attachment height
-    /// (eq. 15), reference tension (eq. 16).
-    fn add_catenary(&self, graph: &mut FactorGraph, vars: PoseVariables, m: &PoseMeasurement) {
+    /// The paper's factors: catenary length (eq. 14) and attachment height
+    /// (eq. 15), both from the pose's one catenary `call`, and reference tension (eq. 16).
+    fn add_catenary(&self, graph: &mut FactorGraph, call: &CatenaryCall, m: &PoseMeasurement) {
         let noise = &self.options.noise;
-        let lengths = CatenaryLengthFactor::new(
-            self.slots.clone(),
-            self.globals,
-            vars,
-            &m.encoder_lengths_m,
-            noise.encoder_sigma_m,
-            self.options.robust.encoder,
-        );
+        let lengths = CatenaryLengthFactor::new(call.clone(), noise.encoder_sigma_m, self.options.robust.encoder);
         push_masked(graph, Box::new(lengths), &encoder_rows(m));
-        graph.add(AttachmentHeightFactor::new(
-            self.slots.clone(),
-            self.globals,
-            vars,
-            self.options.height_sigma_m,
-        ));
+        graph.add(AttachmentHeightFactor::new(call.clone(), self.options.height_sigma_m));
         let cell = ReferenceTensionFactor::new(
-            vars.reference_tension,
+            call.reference_tension(),
             m.reference_tension_n,
             noise.load_cell_sigma_n,
             self.options.robust.load_cell,
@@ -281,6 +290,7 @@ impl PoseFactors<'_> {
             &m.encoder_lengths_m,
             noise.encoder_sigma_m,
             self.options.robust.encoder,
+            self.extended_memo.clone(),
         );
         push_masked(graph, Box::new(lengths), &encoder_rows(m));
         graph.add(ExtendedHeightFactor::new(
@@ -289,6 +299,7 @@ impl PoseFactors<'_> {
             effects,
             vars,
             self.options.height_sigma_m,
+            self.extended_memo.clone(),
         ));
         let cell = LoadCellFactor::new(
             vars.reference_tension,
@@ -301,11 +312,9 @@ impl PoseFactors<'_> {
     }
 
     /// Every cable's tension kept positive (inactive at the optimum).
-    fn add_tension_guard(&self, graph: &mut FactorGraph, vars: PoseVariables) {
+    fn add_tension_guard(&self, graph: &mut FactorGraph, source: TensionSource) {
         graph.add(TensionGuardFactor::new(
-            self.slots.clone(),
-            self.globals,
-            vars,
+            source,
             self.tension_floor_n,
             self.tension_floor_n,
         ));

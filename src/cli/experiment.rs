@@ -1,7 +1,8 @@
 //! `sagcal experiment table2`: the paper's calibration protocol.
 
 use sagcal::calib::{CableModel, OrientationPrior};
-use sagcal::experiments::table2::{pose_pool, run_protocol, PoolPose, PoseCountResult, Protocol, Source};
+use sagcal::experiments::selection::{PlanSettings, Selection};
+use sagcal::experiments::table2::{pose_pool, run_selected_protocol, PoolPose, PoseCountResult, Protocol, Source};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
@@ -29,6 +30,9 @@ struct Table2Report {
     basin_radius_m: f64,
     orientation_prior: sagcal::calib::OrientationPrior,
     pool_size: usize,
+    /// `--select` when not random: the selection and the planner's anchor error, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    select: Option<(String, f64)>,
     results: Vec<PoseCountResult>,
 }
 
@@ -67,6 +71,7 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         basin_radius_m: protocol.basin_radius_m,
         orientation_prior: args.orientation_prior,
         pool_size: pool.len(),
+        select: (args.select != "random").then(|| (args.select.clone(), args.plan_anchor_error_m)),
         results,
     };
     if args.json {
@@ -122,16 +127,62 @@ fn run_trials(
         },
         pool.len()
     );
-    let results = run_protocol(truth, pool, &args.poses, args.trials, args.seed, protocol, &|| {
-        bar.inc(1)
-    })?;
+    let selection = selection(args)?;
+    if selection != Selection::Random {
+        eprintln!(
+            "poses chosen: {} ({:?}-optimal on the bound, planner's anchors {} m off the truth)",
+            args.select, args.plan_criterion, args.plan_anchor_error_m
+        );
+    }
+    let results = run_selected_protocol(
+        truth,
+        pool,
+        &args.poses,
+        args.trials,
+        args.seed,
+        protocol,
+        &selection,
+        &|| bar.inc(1),
+    )?;
     bar.finish_and_clear();
     Ok(results)
+}
+
+/// `--select`: the plan's bound uses the orientation prior where the
+/// calibration keeps it (`auto`: on model data, not on the RecurDyn log).
+fn selection(args: &Table2Args) -> sagcal::Result<Selection> {
+    if !(args.plan_anchor_error_m.is_finite() && args.plan_anchor_error_m >= 0.0) {
+        return Err(sagcal::Error::InvalidInput(format!(
+            "--plan-anchor-error-m must be a non-negative distance in metres, got {}",
+            args.plan_anchor_error_m
+        )));
+    }
+    let orientation_prior = match (args.orientation_prior, args.source) {
+        (OrientationPrior::Auto, Source::Model) => OrientationPrior::On,
+        (OrientationPrior::Auto, Source::Log) => OrientationPrior::Off,
+        (other, _) => other,
+    };
+    let settings = PlanSettings {
+        criterion: args.plan_criterion,
+        orientation_prior,
+        anchor_error_m: args.plan_anchor_error_m,
+    };
+    Ok(match args.select.as_str() {
+        "planned" => Selection::Planned(settings),
+        "sequential" => Selection::Sequential(settings),
+        _ => Selection::Random,
+    })
 }
 
 /// The readable Table II: the protocol's heading, then per pose count the
 /// errors beside the bound and the paper, with the bound's legend.
 fn print_table(args: &Table2Args, truth: &Robot, report: &Table2Report) {
+    if args.select != "random" {
+        println!(
+            "poses: {} ({:?}-optimal; planner's anchors {} m off the truth)",
+            args.select, args.plan_criterion, args.plan_anchor_error_m
+        );
+    }
     println!(
         "Table II protocol: robot `{}`, {} data, {} noise, {:?} cable model, orientation prior {}, seed {}, initial guess {} m / {} m off",
         report.robot,

@@ -10,6 +10,7 @@ mod hidden;
 mod localize;
 mod localize_experiment;
 mod output;
+mod plan;
 mod simulate;
 mod verify;
 
@@ -39,6 +40,8 @@ enum Command {
     Diagnose(DiagnoseArgs),
     /// Localise the calibrated robot: pose and tensions from its cable readings.
     Localize(LocalizeArgs),
+    /// Choose the calibration poses that make the anchors observable (optimal design on the Cramer-Rao bound).
+    Plan(PlanArgs),
     /// Reproduce the paper's experiments.
     #[command(subcommand)]
     Experiment(ExperimentCommand),
@@ -206,6 +209,16 @@ struct Table2Args {
     /// (default: every trial is tested and the flags counted, the fit uses every reading).
     #[arg(long)]
     apply_gross_errors: bool,
+    /// How each trial's poses are chosen from the pool: random (the paper), planned
+    /// (`sagcal plan` over the pool) or sequential (plan half, calibrate, re-plan the rest at the estimate).
+    #[arg(long, default_value = "random", value_parser = ["random", "planned", "sequential"])]
+    select: String,
+    /// The plan's criterion (with --select planned|sequential): a or d.
+    #[arg(long, default_value = "a", value_parser = sagcal::plan::Criterion::parse)]
+    plan_criterion: sagcal::plan::Criterion,
+    /// The planner's nominal anchors are this far from the truth, each in a random direction, m.
+    #[arg(long, default_value_t = 0.0)]
+    plan_anchor_error_m: f64,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -490,6 +503,49 @@ struct LocalizeArgs {
     json: bool,
 }
 
+#[derive(Debug, clap::Args)]
+struct PlanArgs {
+    /// The nominal robot (TOML): the plan is computed at its anchors.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Poses to choose.
+    #[arg(long)]
+    poses: usize,
+    /// Sensor noise the bound assumes: paper or authors.
+    #[arg(long, default_value = "paper", value_parser = sagcal::model::sensors::NoisePreset::parse)]
+    noise: sagcal::model::sensors::NoisePreset,
+    /// The box candidates are drawn in, `x0,x1,y0,y1,z0,z1` metres (default: the
+    /// robot file's `[workspace]`, else the frame below the anchors with a 10 % margin).
+    #[arg(long, allow_hyphen_values = true, value_parser = plan::parse_workspace)]
+    workspace: Option<sagcal::model::robot::Workspace>,
+    /// Candidate poses from a file (sagcal CSV or RecurDyn log, e.g. poses already logged) instead of drawing them.
+    #[arg(long)]
+    from: Option<PathBuf>,
+    /// Candidates to draw (without `--from`; each a level equilibrium, ~30 ms of CPU).
+    #[arg(long, default_value_t = 1000)]
+    candidates: usize,
+    /// Random seed of the candidates and of the random sets compared with.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Design criterion: a (trace of the anchors' covariance) or d (log-determinant of the information).
+    #[arg(long, default_value = "a", value_parser = sagcal::plan::Criterion::parse)]
+    criterion: sagcal::plan::Criterion,
+    /// The localiser's orientation as a prior in the bound: `on`, or `off`/`auto`
+    /// (the statics alone decide the orientation, as `cramer_rao_bound` reads `auto`).
+    #[arg(long, default_value = "off", value_parser = sagcal::calib::OrientationPrior::parse)]
+    orientation_prior: sagcal::calib::OrientationPrior,
+    /// Write the plan (visiting order) as a sagcal measurement CSV (atomically).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Write the figure (PNG if the name ends in `.png`, SVG otherwise): frame, anchors, candidates,
+    /// path, error ellipses plan vs random.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Print JSON instead of the tables.
+    #[arg(long)]
+    json: bool,
+}
+
 /// Parse the command line, run the command, return the process exit code.
 pub fn run() -> i32 {
     let cli = match Cli::try_parse() {
@@ -513,6 +569,7 @@ pub fn run() -> i32 {
         Some(Command::Verify(args)) => verify::run(&args),
         Some(Command::Diagnose(args)) => diagnose::run(&args),
         Some(Command::Localize(args)) => localize::run(&args),
+        Some(Command::Plan(args)) => plan::run(&args),
         Some(Command::Experiment(ExperimentCommand::Table2(args))) => experiment::run(&args),
         Some(Command::Experiment(ExperimentCommand::HiddenEffects(args))) => hidden::run(&args),
         Some(Command::Experiment(ExperimentCommand::Localize(args))) => localize_experiment::run_experiment(&args),

@@ -7,6 +7,7 @@
 //!   scored (`sagcal experiment hidden-effects`);
 //! - [`localize_after_calibration`]: calibrate by the Table II protocol, then
 //!   localise the held-out poses (`sagcal experiment localize`);
+//! - [`plan_candidates`]: candidate poses for `sagcal plan`;
 //! - [`benchmark`]: the reproducible calibration graph the solver benches and
 //!   the peer comparison share.
 //!
@@ -23,4 +24,6 @@
 pub mod benchmark;
 pub mod hidden_effects;
 pub mod localize_after_calibration;
+pub mod plan_candidates;
+pub mod selection;
 pub mod table2;

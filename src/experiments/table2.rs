@@ -36,6 +36,9 @@ use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::{NoisePreset, SensorNoise};
 use crate::model::statics::{self, Equilibrium, StaticsOptions};
 
+pub use super::selection::Selection;
+use super::selection::{failed_selection, selection_inputs};
+
 /// Where the measured quantities come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -226,7 +229,7 @@ fn bound_summary(bound: &ParameterUncertainty) -> (Option<f64>, Option<f64>) {
 }
 
 /// Measurements of `chosen` pool poses with `noise`.
-fn noisy_measurements(
+pub(crate) fn noisy_measurements(
     pool: &[PoolPose],
     chosen: &[usize],
     noise: &SensorNoise,
@@ -266,7 +269,7 @@ fn noisy_measurements(
         .collect()
 }
 
-fn perturbed_guess(truth: &Robot, protocol: &Protocol, rng: &mut impl Rng) -> Robot {
+pub(crate) fn perturbed_guess(truth: &Robot, protocol: &Protocol, rng: &mut impl Rng) -> Robot {
     let mut guess = truth.clone();
     for i in 0..CABLE_COUNT {
         let direction = loop {
@@ -296,6 +299,16 @@ pub fn trial_inputs(
     seed: u64,
     protocol: &Protocol,
 ) -> (Vec<usize>, Vec<PoseMeasurement>, Robot, CalibrationOptions) {
+    let (mut rng, indices) = trial_stream(pool, poses, trial, seed);
+    let noise = protocol.noise.sigmas(truth.platform_weight_n);
+    let data = noisy_measurements(pool, &indices, &noise, &mut rng);
+    let guess = perturbed_guess(truth, protocol, &mut rng);
+    (indices, data, guess, trial_options(truth, protocol))
+}
+
+/// A trial's random stream, seeded from `(seed, poses, trial)`, after it drew
+/// the trial's random pose subset (returned).
+pub(crate) fn trial_stream(pool: &[PoolPose], poses: usize, trial: usize, seed: u64) -> (ChaCha8Rng, Vec<usize>) {
     let stream = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ ((poses as u64) << 32) ^ trial as u64;
     let mut rng = ChaCha8Rng::seed_from_u64(stream);
     let mut indices: Vec<usize> = (0..pool.len()).collect();
@@ -304,13 +317,15 @@ pub fn trial_inputs(
         indices.swap(i, j);
     }
     indices.truncate(poses);
-    let noise = protocol.noise.sigmas(truth.platform_weight_n);
-    let data = noisy_measurements(pool, &indices, &noise, &mut rng);
-    let guess = perturbed_guess(truth, protocol, &mut rng);
-    let mut options = CalibrationOptions::new(noise);
+    (rng, indices)
+}
+
+/// The calibration options of the protocol.
+pub(crate) fn trial_options(truth: &Robot, protocol: &Protocol) -> CalibrationOptions {
+    let mut options = CalibrationOptions::new(protocol.noise.sigmas(truth.platform_weight_n));
     options.model = protocol.model;
     options.orientation_prior = protocol.orientation_prior;
-    (indices, data, guess, options)
+    options
 }
 
 /// Run one trial.
@@ -322,7 +337,23 @@ pub fn run_trial(
     seed: u64,
     protocol: &Protocol,
 ) -> TrialResult {
-    let (chosen, data, guess, options) = trial_inputs(truth, pool, poses, trial, seed, protocol);
+    run_selected_trial(truth, pool, poses, trial, seed, protocol, &Selection::Random)
+}
+
+/// Run one trial with the poses chosen by `selection` ([`Selection::Random`]: [`run_trial`]).
+pub fn run_selected_trial(
+    truth: &Robot,
+    pool: &[PoolPose],
+    poses: usize,
+    trial: usize,
+    seed: u64,
+    protocol: &Protocol,
+    selection: &Selection,
+) -> TrialResult {
+    let (chosen, data, guess, options) = match selection_inputs(truth, pool, poses, trial, seed, protocol, selection) {
+        Ok(inputs) => inputs,
+        Err(e) => return failed_selection(poses, trial, e),
+    };
     let equilibria: Vec<Equilibrium> = chosen.iter().map(|&k| pool[k].equilibrium.clone()).collect();
     let lines = chosen.iter().map(|&k| pool[k].line).collect();
     let started = std::time::Instant::now();
@@ -505,6 +536,30 @@ pub fn run_protocol(
     protocol: &Protocol,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<PoseCountResult>> {
+    run_selected_protocol(
+        truth,
+        pool,
+        pose_counts,
+        trials,
+        seed,
+        protocol,
+        &Selection::Random,
+        progress,
+    )
+}
+
+/// [`run_protocol`] with the poses of every trial chosen by `selection`.
+#[allow(clippy::too_many_arguments)]
+pub fn run_selected_protocol(
+    truth: &Robot,
+    pool: &[PoolPose],
+    pose_counts: &[usize],
+    trials: usize,
+    seed: u64,
+    protocol: &Protocol,
+    selection: &Selection,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<PoseCountResult>> {
     for &n in pose_counts {
         if n > pool.len() {
             return Err(Error::InvalidInput(format!(
@@ -526,7 +581,7 @@ pub fn run_protocol(
     let results: Vec<(usize, TrialResult)> = jobs
         .par_iter()
         .map(|&(n, t)| {
-            let r = run_trial(truth, pool, n, t, seed, protocol);
+            let r = run_selected_trial(truth, pool, n, t, seed, protocol, selection);
             progress();
             (n, r)
         })

@@ -10,10 +10,12 @@
 
 pub mod masked;
 pub mod robust;
+pub mod shared;
 pub mod values;
 
 pub use masked::MaskedFactor;
 pub use robust::RobustKernel;
+pub use shared::SharedEvaluation;
 pub use values::{Values, VariableId, VariableValue};
 
 use nalgebra::{DMatrix, DVector};
@@ -95,6 +97,8 @@ pub struct WhitenedLinearization {
     pub jacobians: Vec<DMatrix<f64>>,
     /// The factor's cost `1/2 rho(|r / sigma|^2)`.
     pub cost: f64,
+    /// Scratch: `sqrt(w) / sigma_r` per row.
+    row_weights: Vec<f64>,
 }
 
 /// Linearise one factor at `values`; `Err` names what went wrong (the model is
@@ -109,6 +113,7 @@ pub fn linearize_factor(factor: &dyn Factor, values: &Values) -> Result<Whitened
             .map(|&v| DMatrix::zeros(rows, values.tangent_dim(v)))
             .collect(),
         cost: 0.0,
+        row_weights: Vec::with_capacity(rows),
     };
     linearize_into(factor, values, &mut linearized)?;
     Ok(linearized)
@@ -137,7 +142,7 @@ impl LinearizationBuffers {
         let index = match self.by_shape.iter().position(same_shape) {
             Some(index) => {
                 for jacobian in &mut self.by_shape[index].jacobians {
-                    jacobian.fill(0.0);
+                    jacobian.as_mut_slice().fill(0.0);
                 }
                 index
             }
@@ -149,6 +154,7 @@ impl LinearizationBuffers {
                         .map(|&v| DMatrix::zeros(rows, values.tangent_dim(v)))
                         .collect(),
                     cost: 0.0,
+                    row_weights: Vec::with_capacity(rows),
                 });
                 self.by_shape.len() - 1
             }
@@ -175,16 +181,21 @@ fn linearize_into(factor: &dyn Factor, values: &Values, out: &mut WhitenedLinear
     let scale = kernel.weight(s).sqrt();
     out.residual.clear();
     out.residual.extend((0..rows).map(|r| residual[r] / sigmas[r] * scale));
+    // The row weights `scale / sigma_r` once per row, not per entry (the same quotients).
+    out.row_weights.clear();
+    out.row_weights.extend(sigmas.iter().map(|sigma| scale / sigma));
     for jac in &mut out.jacobians {
-        let columns = jac.ncols();
-        let data = jac.as_mut_slice();
-        for c in 0..columns {
-            for r in 0..rows {
-                data[c * rows + r] *= scale / sigmas[r];
+        for column in jac.as_mut_slice().chunks_exact_mut(rows) {
+            for (entry, weight) in column.iter_mut().zip(&out.row_weights) {
+                *entry *= weight;
             }
         }
     }
-    if out.jacobians.iter().any(|j| j.iter().any(|v| !v.is_finite())) {
+    if out
+        .jacobians
+        .iter()
+        .any(|j| !j.as_slice().iter().all(|v| v.is_finite()))
+    {
         return Err("non-finite Jacobian");
     }
     out.cost = 0.5 * kernel.rho(s);

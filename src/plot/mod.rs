@@ -6,6 +6,7 @@
 //! - [`residuals`]: normalised residuals against a physical driver, before and
 //!   after a model extension (`sagcal diagnose --plots`);
 //! - [`localize`]: localised poses with their error ellipses (`sagcal localize --plot`);
+//! - [`plan`]: a planned pose set (`sagcal plan --plot`);
 //! - `svg`: the drawing helpers they share (escaping, coordinates, labels,
 //!   the font and colours);
 //! - `png`: [`write_figure`] and [`svg_to_png`], the SVG rendered with `resvg`
@@ -36,6 +37,7 @@
 
 pub mod anchors;
 pub mod localize;
+pub mod plan;
 mod png;
 pub mod residuals;
 mod svg;

@@ -381,12 +381,18 @@ impl LinearSystem {
             let (ja, jb) = (jacobians[slot_a].as_slice(), jacobians[slot_b].as_slice());
             let same = variables[slot_a] == variables[slot_b];
             let (columns_a, columns_b) = (ja.len() / rows, jb.len() / rows);
-            let mut k = start;
-            for j in 0..columns_b {
-                let column_b = &jb[j * rows..(j + 1) * rows];
-                for i in (if same { j } else { 0 })..columns_a {
-                    hessian[k] += dot::<R>(&ja[i * rows..(i + 1) * rows], column_b);
-                    k += 1;
+            // The block's entries, column-major (the lower triangle of a diagonal block).
+            let size = if same {
+                columns_a * (columns_a + 1) / 2
+            } else {
+                columns_a * columns_b
+            };
+            let mut block = hessian[start..start + size].iter_mut();
+            for (j, column_b) in jb.chunks_exact(rows).enumerate() {
+                for column_a in ja.chunks_exact(rows).skip(if same { j } else { 0 }) {
+                    if let Some(entry) = block.next() {
+                        *entry += dot::<R>(column_a, column_b);
+                    }
                 }
             }
         }

@@ -248,7 +248,7 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
         let Some(Accepted {
             step,
             candidate,
-            cost: new_cost,
+            linearization: next,
             gain_ratio,
         }) = accepted
         else {
@@ -263,6 +263,7 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
             });
             break;
         };
+        let new_cost = next.cost;
         let step_norm = step.iter().map(|x| x * x).sum::<f64>().sqrt();
         let relative_decrease = (cost - new_cost) / cost.max(f64::MIN_POSITIVE);
         let step_scale = 1.0 + variables_scale(&values);
@@ -275,11 +276,6 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
             trials,
         });
         values = candidate;
-        let Ok(next) = linearize(graph, &values, &system) else {
-            // The accepted point had a finite cost, so this cannot happen; stop safely if it does.
-            termination = Termination::DampingExhausted;
-            break;
-        };
         linearization = next;
         if relative_decrease < params.relative_cost_tolerance {
             termination = Termination::CostConverged;
@@ -324,11 +320,12 @@ impl Damping {
     }
 }
 
-/// A step that lowered the cost.
+/// A step that lowered the cost, with the linearisation at its end point
+/// (the next iteration's).
 struct Accepted {
     step: Vec<f64>,
     candidate: Values,
-    cost: f64,
+    linearization: Linearization,
     gain_ratio: f64,
 }
 
@@ -372,14 +369,18 @@ fn damped_step(
         if !groups.is_empty() {
             groups.refine(graph, &mut candidate);
         }
-        match graph.cost(&candidate) {
-            Some(new_cost) if new_cost < cost && predicted > 0.0 => {
-                let gain_ratio = (cost - new_cost) / predicted;
+        // The trial point is linearised whole, not only costed: its cost is
+        // the same sum, and an accepted step (nearly every trial) then needs no
+        // second pass over the factors. A point where the model is undefined
+        // or a Jacobian is not finite is rejected.
+        match linearize(graph, &candidate, system) {
+            Ok(next) if next.cost < cost && predicted > 0.0 => {
+                let gain_ratio = (cost - next.cost) / predicted;
                 damping.accept(gain_ratio);
                 let accepted = Accepted {
                     step,
                     candidate,
-                    cost: new_cost,
+                    linearization: next,
                     gain_ratio,
                 };
                 return (Some(accepted), trials);

@@ -93,6 +93,33 @@ pub fn catenary_length(p: &Point, j: Option<&mut (M<4, 6>, M<4, 2>, M<4, 12>, M<
     )
 }
 
+/// The Jacobian blocks of `catenary_cable_residuals`: pose, reference tension, anchors, offsets.
+pub type CatenaryCableJacobians = (M<16, 6>, M<16, 2>, M<16, 12>, M<16, 4>);
+
+pub fn catenary_cable(p: &Point, j: Option<&mut CatenaryCableJacobians>) -> SVector<f64, 16> {
+    let (pose, reference, anchors, offsets) = match j {
+        Some((a, b, c, d)) => (Some(a), Some(b), Some(c), Some(d)),
+        None => (None, None, None, None),
+    };
+    generated::catenary_cable_residuals(
+        &p.pose.position_m,
+        &p.pose.rotation_xyzw(),
+        &p.reference_tension_n,
+        &p.anchors_m,
+        &p.attachments_m,
+        &p.com_offset_m,
+        p.platform_weight_n,
+        p.cable_weight_n_per_m,
+        &p.length_offsets_m,
+        &p.encoder_lengths_m,
+        EPSILON,
+        pose,
+        reference,
+        anchors,
+        offsets,
+    )
+}
+
 pub fn attachment_height(p: &Point, j: Option<&mut (M<4, 6>, M<4, 2>, M<4, 12>)>) -> SVector<f64, 4> {
     let (pose, reference, anchors) = match j {
         Some((a, b, c)) => (Some(a), Some(b), Some(c)),

@@ -1,0 +1,91 @@
+//! One evaluation read by several factors: the last result of an expensive
+//! call, kept with the inputs it was computed at.
+//!
+//! The length and height factors of a pose (paper eq. 14 and 15) and its
+//! tension guard read different rows of one generated call
+//! (`generated::catenary_cable_residuals`). Each factor is still its own
+//! [`super::Factor`] (its own sigmas, robust kernel, masked rows and
+//! per-type statistics); the first one evaluated at a point makes the call,
+//! the others find its result here. Solvers evaluate a pose's factors one
+//! after the other, so one remembered result per graph is enough.
+
+use std::sync::{Mutex, PoisonError};
+
+/// The last result `T` of a call on `N` scalar inputs, compared bit for bit
+/// (so a hit returns exactly what a new call would).
+pub struct SharedEvaluation<const N: usize, T> {
+    last: Mutex<Memo<N, T>>,
+}
+
+struct Memo<const N: usize, T> {
+    /// The inputs' bits; `None`: nothing evaluated yet.
+    key: Option<[u64; N]>,
+    /// Whether `result` holds the Jacobians too.
+    jacobians: bool,
+    result: T,
+}
+
+impl<const N: usize, T: Default> Default for SharedEvaluation<N, T> {
+    fn default() -> Self {
+        Self {
+            last: Mutex::new(Memo {
+                key: None,
+                jacobians: false,
+                result: T::default(),
+            }),
+        }
+    }
+}
+
+impl<const N: usize, T: Default> SharedEvaluation<N, T> {
+    /// `read` of the result at `inputs`, with Jacobians if `jacobians`: the
+    /// remembered one when it was computed at these inputs (with Jacobians,
+    /// if asked for), else `evaluate(result, jacobians)` into the buffer,
+    /// remembered for the next reader.
+    pub fn read<R>(
+        &self,
+        inputs: &[f64; N],
+        jacobians: bool,
+        evaluate: impl FnOnce(&mut T, bool),
+        read: impl FnOnce(&T) -> R,
+    ) -> R {
+        let key = inputs.map(f64::to_bits);
+        let mut memo = self.last.lock().unwrap_or_else(PoisonError::into_inner);
+        if memo.key != Some(key) || (jacobians && !memo.jacobians) {
+            // Invalid until the call returns (a panic inside leaves no stale key).
+            memo.key = None;
+            evaluate(&mut memo.result, jacobians);
+            memo.key = Some(key);
+            memo.jacobians = jacobians;
+        }
+        read(&memo.result)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::cell::Cell;
+
+    #[test]
+    fn a_second_reader_at_the_same_inputs_does_not_call_again() {
+        let shared = SharedEvaluation::<2, f64>::default();
+        let calls = Cell::new(0);
+        let call = |out: &mut f64, _: bool, x: [f64; 2]| {
+            calls.set(calls.get() + 1);
+            *out = x[0] * x[1];
+        };
+        let x = [3.0, 4.0];
+        assert_eq!(shared.read(&x, false, |o, j| call(o, j, x), |r| *r), 12.0);
+        assert_eq!(shared.read(&x, false, |o, j| call(o, j, x), |r| *r), 12.0);
+        assert_eq!(calls.get(), 1);
+        // Jacobians asked for after a value-only call: evaluated again, then kept.
+        shared.read(&x, true, |o, j| call(o, j, x), |r| *r);
+        shared.read(&x, false, |o, j| call(o, j, x), |r| *r);
+        assert_eq!(calls.get(), 2);
+        // Other inputs (-0.0 differs from 0.0 in its bits): a new call.
+        let y = [3.0, -0.0];
+        assert_eq!(shared.read(&y, false, |o, j| call(o, j, y), |r| *r), -0.0);
+        assert_eq!(calls.get(), 3);
+    }
+}

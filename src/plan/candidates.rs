@@ -1,0 +1,65 @@
+//! Which static poses a plan may use: positive cable tensions with a margin
+//! and every cable inside the frame. (Stability at fixed cable lengths is the
+//! third condition; it needs the localiser's stiffness and is checked where
+//! candidates are drawn, `experiments::plan_candidates`.)
+
+use serde::Serialize;
+
+use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::statics::{catenaries, Equilibrium};
+
+/// The margins a candidate must keep.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Margins {
+    /// Every cable's horizontal tension `f_h` (paper eq. 7) at least this, newtons.
+    pub min_horizontal_tension_n: f64,
+    /// Every cable's lowest point at least this height, metres (the floor of the frame is `z = 0`).
+    pub min_cable_height_m: f64,
+}
+
+impl Margins {
+    /// 10 % of the platform's weight share per cable (`m_e g / 4`), and cables at least 0.5 m above the floor.
+    pub fn for_robot(robot: &Robot) -> Self {
+        Self {
+            min_horizontal_tension_n: 0.1 * robot.platform_weight_n / CABLE_COUNT as f64,
+            min_cable_height_m: 0.5,
+        }
+    }
+
+    /// Why `equilibrium` breaks a margin, or `None` if it keeps them all.
+    pub fn violation(&self, robot: &Robot, equilibrium: &Equilibrium) -> Option<String> {
+        for (i, t) in equilibrium.tensions.iter().enumerate() {
+            if t.horizontal_n.is_nan() || t.horizontal_n < self.min_horizontal_tension_n {
+                return Some(format!(
+                    "cable {}: horizontal tension {:.1} N below the {:.1} N margin",
+                    i + 1,
+                    t.horizontal_n,
+                    self.min_horizontal_tension_n
+                ));
+            }
+        }
+        let cables = catenaries(robot, &equilibrium.pose, &equilibrium.tensions);
+        for (i, cable) in cables.iter().enumerate() {
+            let anchor_z = robot.anchors_m[i].z;
+            let lowest = anchor_z + lowest_height_above_anchor_m(cable);
+            if lowest.is_nan() || lowest < self.min_cable_height_m {
+                return Some(format!(
+                    "cable {}: sags to {lowest:.2} m, below the {:.2} m clearance",
+                    i + 1,
+                    self.min_cable_height_m
+                ));
+            }
+        }
+        None
+    }
+}
+
+/// The lowest point of a catenary relative to its anchor, metres (`<= 0`):
+/// its vertex if that lies within the span, else the attachment end.
+fn lowest_height_above_anchor_m(cable: &crate::model::Catenary) -> f64 {
+    // Sampled at 64 points: the vertex is interior only for nearly
+    // horizontal cables, where the curve is flat and sampling is exact to mm.
+    (0..=64)
+        .map(|k| cable.height_above_anchor_m(cable.span_m * k as f64 / 64.0))
+        .fold(0.0, f64::min)
+}
