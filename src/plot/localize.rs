@@ -263,6 +263,9 @@ fn draw_panel(s: &mut String, view: &View, name: &str) {
 /// along the direction from the view's centre.
 fn draw_anchors(s: &mut String, view: &View, anchors: &[[f64; 3]; 4]) {
     let c = [view.left + 0.5 * PANEL, TOP + 0.5 * PANEL];
+    // Markers that land within 12 px of each other (anchors one behind the
+    // other in this view) share one marker and one label, e.g. "A1, A4".
+    let mut markers: Vec<([f64; 2], bool, Vec<usize>)> = Vec::new();
     for (i, a) in anchors.iter().enumerate() {
         let q = view.px(a);
         if !(q[0].is_finite() && q[1].is_finite()) {
@@ -275,6 +278,15 @@ fn draw_anchors(s: &mut String, view: &View, anchors: &[[f64; 3]; 4]) {
             (0.5 * PANEL - 8.0) / d[0].abs().max(d[1].abs())
         };
         let m = [c[0] + t * d[0], c[1] + t * d[1]];
+        match markers
+            .iter_mut()
+            .find(|(p, _, _)| (p[0] - m[0]).hypot(p[1] - m[1]) < 12.0)
+        {
+            Some(marker) => marker.2.push(i),
+            None => markers.push((m, inside, vec![i])),
+        }
+    }
+    for (m, inside, cables) in markers {
         let _ = writeln!(
             s,
             r#"<path d="M{} {}l-6 10h12z" fill="{}" stroke="{C_ANCHOR}"/>"#,
@@ -282,14 +294,10 @@ fn draw_anchors(s: &mut String, view: &View, anchors: &[[f64; 3]; 4]) {
             n2(m[1] - 6.0),
             if inside { C_ANCHOR } else { "white" }
         );
-        let label = if inside {
-            format!("A{}", i + 1)
-        } else {
-            format!("A{} (outside)", i + 1)
-        };
+        let label: Vec<String> = cables.iter().map(|i| format!("A{}", i + 1)).collect();
         let anchor = if m[0] > c[0] { "end" } else { "start" };
         let dx = if m[0] > c[0] { -9.0 } else { 9.0 };
-        halo_text(s, m[0] + dx, m[1] + 4.0, anchor, C_ANCHOR, &label);
+        halo_text(s, m[0] + dx, m[1] + 4.0, anchor, C_ANCHOR, &label.join(", "));
     }
 }
 
