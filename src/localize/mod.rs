@@ -21,6 +21,28 @@
 //!
 //! The hot path (a warm start that converges to a stable equilibrium)
 //! allocates nothing: every matrix is fixed-size.
+//!
+//! ```
+//! use nalgebra::Vector3;
+//! use sagcal::localize::{Localizer, Readings};
+//! use sagcal::model::sensors::NoisePreset;
+//! use sagcal::model::statics::{solve_level, StaticsOptions};
+//! use sagcal::model::Robot;
+//!
+//! let robot = Robot::builtin("large")?;
+//! // Where the platform hangs, and what its encoders and load cell read there.
+//! let truth = solve_level(&robot, Vector3::new(2.0, -3.0, 15.0), &StaticsOptions::default())?;
+//! let readings = Readings {
+//!     encoder_lengths_m: truth.cable_lengths_m,
+//!     load_cell_n: Some(truth.tensions[robot.reference_cable].magnitude_n()),
+//!     localiser_pose: None,
+//! };
+//! let localizer = Localizer::new(&robot, &NoisePreset::Paper.sigmas(robot.platform_weight_n))?;
+//! let found = localizer.localize(&readings, None)?;
+//! assert!((found.pose.position_m - truth.pose.position_m).norm() < 1e-9);
+//! assert!(found.stable && found.consistent);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 mod equations;
 mod equilibria;

@@ -13,6 +13,27 @@
 //!
 //! [`plan_poses`] runs 1-4 and compares the plan with random pose sets of
 //! the same candidates.
+//!
+//! ```
+//! use rand::SeedableRng;
+//! use sagcal::calib::CalibrationOptions;
+//! use sagcal::model::sensors::NoisePreset;
+//! use sagcal::model::Robot;
+//! use sagcal::plan::{candidate_information, choose_poses, plan_bound, DesignOptions};
+//! use sagcal::sim::closed_form::{sample_equilibria, Workspace};
+//!
+//! let robot = Robot::builtin("small")?;
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+//! let candidates = sample_equilibria(&robot, &Workspace::default_for(&robot), 40, &mut rng)?;
+//! let options = CalibrationOptions::new(NoisePreset::Paper.sigmas(robot.platform_weight_n));
+//! let information = candidate_information(&robot, &candidates, &options)?;
+//! let design = choose_poses(&information, &DesignOptions::new(9))?;
+//! let planned = plan_bound(&information, &design.chosen).expect("9 poses determine the anchors");
+//! let first_nine: Vec<usize> = (0..9).collect();
+//! let arbitrary = plan_bound(&information, &first_nine).expect("determined");
+//! assert!(planned.anchor_rms_m < arbitrary.anchor_rms_m);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 pub mod bound;
 pub mod candidates;

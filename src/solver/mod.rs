@@ -19,6 +19,20 @@
 //! re-minimised with the rest held before its cost is judged (nonlinear
 //! elimination, see the `local` module), which keeps long steps of the global
 //! variables on the curved valley of a tight model constraint.
+//!
+//! The calibration builds its graph and calls [`optimize`]; the benchmark
+//! problem shows the loop on its own:
+//!
+//! ```
+//! use sagcal::experiments::benchmark::BenchmarkProblem;
+//! use sagcal::solver::optimize;
+//!
+//! let problem = BenchmarkProblem::new(9, 1)?;
+//! let mut built = problem.graph();
+//! let summary = optimize(&mut built.graph, &BenchmarkProblem::stopping()).map_err(sagcal::Error::InvalidInput)?;
+//! assert!(summary.final_cost < 1e-3 * summary.initial_cost);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 mod covariance;
 mod linear_system;
