@@ -351,7 +351,9 @@ impl Factor for TensionGuardFactor {
         CABLE_COUNT
     }
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
-        let (tensions, jacobian) = self.source.tensions(values, jacobians.is_some());
+        // Values first: the Jacobian is needed only where a row is active
+        // (rarely: the guard is zero while every cable is taut).
+        let (tensions, _) = self.source.tensions(values, false);
         let (_, _, s) = self.source.pose();
         let mut residual = Vector4::zeros();
         let mut active = [false; CABLE_COUNT];
@@ -369,6 +371,10 @@ impl Factor for TensionGuardFactor {
             for block in blocks.iter_mut() {
                 block.fill(0.0);
             }
+            if !active.contains(&true) {
+                return Some(slots_to_cables(s, &residual));
+            }
+            let (_, jacobian) = self.source.tensions(values, true);
             for slot in (0..CABLE_COUNT).filter(|&k| active[k]) {
                 let row = 2 * slot;
                 for c in 0..6 {

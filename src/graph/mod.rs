@@ -97,6 +97,9 @@ pub struct WhitenedLinearization {
     pub jacobians: Vec<DMatrix<f64>>,
     /// The factor's cost `1/2 rho(|r / sigma|^2)`.
     pub cost: f64,
+    /// Whether the residual and every Jacobian entry are zero (an inactive
+    /// guard): the factor then adds nothing to `J^T J` or `J^T r`.
+    pub is_zero: bool,
     /// Scratch: `sqrt(w) / sigma_r` per row.
     row_weights: Vec<f64>,
 }
@@ -113,6 +116,7 @@ pub fn linearize_factor(factor: &dyn Factor, values: &Values) -> Result<Whitened
             .map(|&v| DMatrix::zeros(rows, values.tangent_dim(v)))
             .collect(),
         cost: 0.0,
+        is_zero: false,
         row_weights: Vec::with_capacity(rows),
     };
     linearize_into(factor, values, &mut linearized)?;
@@ -154,6 +158,7 @@ impl LinearizationBuffers {
                         .map(|&v| DMatrix::zeros(rows, values.tangent_dim(v)))
                         .collect(),
                     cost: 0.0,
+                    is_zero: false,
                     row_weights: Vec::with_capacity(rows),
                 });
                 self.by_shape.len() - 1
@@ -191,13 +196,19 @@ fn linearize_into(factor: &dyn Factor, values: &Values, out: &mut WhitenedLinear
             }
         }
     }
-    if out
-        .jacobians
-        .iter()
-        .any(|j| !j.as_slice().iter().all(|v| v.is_finite()))
-    {
+    // One pass over the entries: any non-finite (an error), all zero (nothing to add).
+    let mut all_finite = true;
+    let mut all_zero = out.residual.iter().all(|&r| r == 0.0);
+    for jac in &out.jacobians {
+        for &v in jac.as_slice() {
+            all_finite &= v.is_finite();
+            all_zero &= v == 0.0;
+        }
+    }
+    if !all_finite {
         return Err("non-finite Jacobian");
     }
+    out.is_zero = all_zero;
     out.cost = 0.5 * kernel.rho(s);
     Ok(())
 }

@@ -33,6 +33,18 @@ impl VariableValue {
             VariableValue::Vector(v) => VariableValue::Vector(v + DVector::from_column_slice(delta)),
         }
     }
+
+    /// [`VariableValue::retract`] in place (the same arithmetic, no allocation).
+    pub fn retract_in_place(&mut self, delta: &[f64]) {
+        match self {
+            VariableValue::Pose(pose) => *pose = pose.retract(&Vector6::from_column_slice(delta)),
+            VariableValue::Vector(v) => {
+                for (x, d) in v.iter_mut().zip(delta) {
+                    *x += d;
+                }
+            }
+        }
+    }
 }
 
 /// One variable: a name for reports, its value, and whether the solver may move it.
@@ -91,6 +103,28 @@ impl Values {
     /// Hold `id` constant (or release it).
     pub fn set_fixed(&mut self, id: VariableId, fixed: bool) {
         self.variables[id.0].fixed = fixed;
+    }
+
+    /// Overwrite every variable with `other`'s (names, values, fixed flags),
+    /// reusing this set's allocations where the shapes agree.
+    pub fn copy_from(&mut self, other: &Values) {
+        if self.variables.len() != other.variables.len() {
+            self.variables.clone_from(&other.variables);
+            return;
+        }
+        for (mine, theirs) in self.variables.iter_mut().zip(&other.variables) {
+            mine.name.clone_from(&theirs.name);
+            mine.fixed = theirs.fixed;
+            match (&mut mine.value, &theirs.value) {
+                (VariableValue::Vector(a), VariableValue::Vector(b)) if a.len() == b.len() => a.copy_from(b),
+                (mine, theirs) => mine.clone_from(theirs),
+            }
+        }
+    }
+
+    /// The value of `id`, to change in place.
+    pub fn value_mut(&mut self, id: VariableId) -> &mut VariableValue {
+        &mut self.variables[id.0].value
     }
 
     /// Replace the value of `id`.

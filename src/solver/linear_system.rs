@@ -7,9 +7,11 @@
 //! trial only refactors numerically into buffers allocated once
 //! (`SymbolicCholesky::factorize_numeric_llt`, single-threaded).
 //!
-//! `H` is accumulated block by block (each factor's `J^T J` blocks are
-//! contiguous, see [`LinearSystem::accumulate`]) and scattered into the
-//! compressed-column values of the pattern before each factorisation.
+//! `H` is accumulated block by block ([`LinearSystem::accumulate`]) straight
+//! into the storage its factorisation reads: the dense blocks of the block
+//! elimination (`schur`), copied whole before each factorisation, or one
+//! dense column-major block per pair of variables, scattered into faer's
+//! compressed columns.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -33,15 +35,31 @@ pub struct LinearSystem {
     pub offsets: Vec<Option<usize>>,
     /// Total tangent dimension of the free variables.
     pub dim: usize,
-    /// Per factor, per pair `(a, b)` of its free variable slots with `offset(a) >= offset(b)`: start of that block in `values`.
-    factor_blocks: Vec<Vec<(usize, usize, usize)>>,
-    /// Diagonal entry positions in `values`, per tangent index.
+    /// Per factor, per pair `(a, b)` of its free variable slots with
+    /// `offset(a) >= offset(b)`: where that block sits in the storage of `H`.
+    factor_blocks: Vec<Vec<FactorBlock>>,
+    /// Per tangent index, the storage position of its diagonal entry.
     diagonal_slots: Vec<usize>,
-    /// Number of stored entries (lower triangle, block-wise).
-    entry_count: usize,
-    /// `(row, col)` tangent indices of every stored entry (block-wise order).
+    /// Per tangent index, the index in `indices` of its diagonal entry.
+    diagonal_entries: Vec<usize>,
+    /// Length of the storage of `H`.
+    storage_len: usize,
+    /// `(row, col)` tangent indices (`row >= col`) of every entry of the lower triangle.
     indices: Vec<(usize, usize)>,
+    /// Storage position of every entry of `indices`.
+    positions: Vec<usize>,
     factorization: Factorization,
+}
+
+/// One `J^T J` block of a factor: `J_a^T J_b` for its variable slots `a`, `b`
+/// goes to the storage of `H` at `start + i + j * stride` (`i` a column of
+/// `J_a`, `j` of `J_b`; for `a` = `b` the lower triangle `i >= j` only).
+#[derive(Clone, Copy)]
+struct FactorBlock {
+    slot_a: usize,
+    slot_b: usize,
+    start: usize,
+    stride: usize,
 }
 
 /// Largest tangent dimension of the global variables for block elimination
@@ -61,7 +79,7 @@ enum Factorization {
 struct SparseCholesky {
     /// The lower triangle of `H`, compressed columns.
     pattern: SymbolicSparseColMat<usize>,
-    /// Per stored entry (block-wise order), its index in the compressed-column values.
+    /// Per entry of the lower triangle (`LinearSystem::indices`), its index in the compressed-column values.
     csc_position: Vec<usize>,
     symbolic: SymbolicCholesky<usize>,
     /// `H + damping` in compressed-column order.
@@ -203,8 +221,8 @@ struct BlockPattern {
     block_order: Vec<(VariableId, VariableId)>,
     /// Number of stored scalars.
     entry_count: usize,
-    /// Per factor: `(slot a, slot b, block start)` of each block it touches.
-    factor_blocks: Vec<Vec<(usize, usize, usize)>>,
+    /// Per factor: the blocks it touches (start in the block-wise storage, stride: rows of the block).
+    factor_blocks: Vec<Vec<FactorBlock>>,
 }
 
 impl BlockPattern {
@@ -233,7 +251,12 @@ impl BlockPattern {
                     if oa < ob || (a == b && slot_a != slot_b) {
                         continue;
                     }
-                    list.push((slot_a, slot_b, pattern.block_for(values, a, b)));
+                    list.push(FactorBlock {
+                        slot_a,
+                        slot_b,
+                        start: pattern.block_for(values, a, b),
+                        stride: values.tangent_dim(a),
+                    });
                 }
             }
             pattern.factor_blocks.push(list);
@@ -241,18 +264,14 @@ impl BlockPattern {
         pattern
     }
 
-    /// The start of block `(a, b)`, stored after the others if new (a
-    /// diagonal block keeps its lower triangle only).
+    /// The start of block `(a, b)` (dense, column-major; a diagonal block's
+    /// upper triangle is never written), stored after the others if new.
     fn block_for(&mut self, values: &Values, a: VariableId, b: VariableId) -> usize {
         let tangent = |id: VariableId| values.tangent_dim(id);
         let entry_count = &mut self.entry_count;
         let block_order = &mut self.block_order;
         let layout = self.blocks.entry((a.0, b.0)).or_insert_with(|| {
-            let size = if a == b {
-                tangent(a) * (tangent(a) + 1) / 2
-            } else {
-                tangent(a) * tangent(b)
-            };
+            let size = tangent(a) * tangent(b);
             let start = *entry_count;
             *entry_count += size;
             block_order.push((a, b));
@@ -261,36 +280,31 @@ impl BlockPattern {
         layout.start
     }
 
-    /// Scalar `(row, col)` of every stored entry, in storage order, and the
-    /// storage slot of each diagonal entry.
+    /// Scalar `(row, col)` of every entry of the lower triangle, block by
+    /// block, with its position in a storage where the block at tangent
+    /// offsets `(row, col)`, stored block-wise from `start` with `rows` rows,
+    /// starts at `place(start, rows, row, col).0` with column stride `.1`.
     fn entry_indices(
         &self,
         values: &Values,
         offsets: &[Option<usize>],
-        dim: usize,
+        place: impl Fn(usize, usize, usize, usize) -> (usize, usize),
     ) -> (Vec<(usize, usize)>, Vec<usize>) {
         let tangent = |id: VariableId| values.tangent_dim(id);
-        let mut indices = vec![(0usize, 0usize); self.entry_count];
-        let mut diagonal_slots = vec![0; dim];
+        let mut indices = Vec::with_capacity(self.entry_count);
+        let mut positions = Vec::with_capacity(self.entry_count);
         for &(a, b) in &self.block_order {
-            let start = self.blocks[&(a.0, b.0)].start;
             let (oa, ob) = (offsets[a.0].unwrap_or(0), offsets[b.0].unwrap_or(0));
             let (da, db) = (tangent(a), tangent(b));
-            let mut k = start;
+            let (start, stride) = place(self.blocks[&(a.0, b.0)].start, da, oa, ob);
             for j in 0..db {
-                for i in 0..da {
-                    if a == b && i < j {
-                        continue;
-                    }
-                    indices[k] = (oa + i, ob + j);
-                    if a == b && i == j {
-                        diagonal_slots[oa + i] = k;
-                    }
-                    k += 1;
+                for i in (if a == b { j } else { 0 })..da {
+                    indices.push((oa + i, ob + j));
+                    positions.push(start + i + j * stride);
                 }
             }
         }
-        (indices, diagonal_slots)
+        (indices, positions)
     }
 }
 
@@ -311,30 +325,58 @@ impl LinearSystem {
         if layout.dim == 0 {
             return Err("every variable is fixed: nothing to solve".into());
         }
-        let pattern = BlockPattern::new(values, factors, &layout.offsets);
-        let (indices, diagonal_slots) = pattern.entry_indices(values, &layout.offsets, layout.dim);
+        let mut pattern = BlockPattern::new(values, factors, &layout.offsets);
+        let block_wise = |start, rows, _, _| (start, rows);
+        let (indices, mut positions) = pattern.entry_indices(values, &layout.offsets, block_wise);
         // The reduced system of the elimination is dense: worth it while it is small.
         let schur = (!layout.group_ranges.is_empty() && layout.globals <= MAX_SCHUR_GLOBALS)
             .then(|| SchurLayout::new(&indices, layout.globals, layout.group_ranges))
             .flatten();
+        let mut storage_len = pattern.entry_count;
         let factorization = match schur {
-            Some(schur) => Factorization::Schur(schur),
+            Some(schur) => {
+                // Accumulate straight into the elimination's dense blocks.
+                positions = pattern
+                    .entry_indices(values, &layout.offsets, |_, _, row, col| schur.place(row, col))
+                    .1;
+                for (factor, blocks) in factors.iter().zip(&mut pattern.factor_blocks) {
+                    let offset = |slot: usize| layout.offsets[factor.variables()[slot].0].unwrap_or(0);
+                    for block in blocks {
+                        (block.start, block.stride) = schur.place(offset(block.slot_a), offset(block.slot_b));
+                    }
+                }
+                storage_len = schur.storage_len();
+                Factorization::Schur(schur)
+            }
             None => Factorization::Sparse(Box::new(SparseCholesky::new(&indices, layout.dim)?)),
         };
+        let mut diagonal_entries = vec![0; layout.dim];
+        for (k, &(row, col)) in indices.iter().enumerate() {
+            if row == col {
+                diagonal_entries[row] = k;
+            }
+        }
         Ok(Self {
             offsets: layout.offsets,
             dim: layout.dim,
             factor_blocks: pattern.factor_blocks,
-            diagonal_slots,
-            entry_count: pattern.entry_count,
+            diagonal_slots: diagonal_entries.iter().map(|&k| positions[k]).collect(),
+            diagonal_entries,
+            storage_len,
             indices,
+            positions,
             factorization,
         })
     }
 
     /// A zeroed value array for `H`.
     pub fn zero_hessian(&self) -> Vec<f64> {
-        vec![0.0; self.entry_count]
+        vec![0.0; self.storage_len]
+    }
+
+    /// Length of [`LinearSystem::zero_hessian`]'s array.
+    pub fn zero_hessian_len(&self) -> usize {
+        self.storage_len
     }
 
     /// Add factor `index`'s weighted `J^T J` blocks (whitened, robust-weighted
@@ -377,24 +419,10 @@ impl LinearSystem {
                 }
             }
         }
-        for &(slot_a, slot_b, start) in &self.factor_blocks[index] {
-            let (ja, jb) = (jacobians[slot_a].as_slice(), jacobians[slot_b].as_slice());
-            let same = variables[slot_a] == variables[slot_b];
-            let (columns_a, columns_b) = (ja.len() / rows, jb.len() / rows);
-            // The block's entries, column-major (the lower triangle of a diagonal block).
-            let size = if same {
-                columns_a * (columns_a + 1) / 2
-            } else {
-                columns_a * columns_b
-            };
-            let mut block = hessian[start..start + size].iter_mut();
-            for (j, column_b) in jb.chunks_exact(rows).enumerate() {
-                for column_a in ja.chunks_exact(rows).skip(if same { j } else { 0 }) {
-                    if let Some(entry) = block.next() {
-                        *entry += dot::<R>(column_a, column_b);
-                    }
-                }
-            }
+        for block in &self.factor_blocks[index] {
+            let (ja, jb) = (jacobians[block.slot_a].as_slice(), jacobians[block.slot_b].as_slice());
+            let same = variables[block.slot_a] == variables[block.slot_b];
+            add_block_product::<R>(ja, jb, same, rows, block.stride, &mut hessian[block.start..]);
         }
     }
 
@@ -411,10 +439,10 @@ impl LinearSystem {
             Factorization::Sparse(sparse) => sparse,
         };
         sparse.factored = false;
-        for (k, &position) in sparse.csc_position.iter().enumerate() {
-            sparse.matrix_values[position] = hessian[k];
+        for (&csc, &position) in sparse.csc_position.iter().zip(&self.positions) {
+            sparse.matrix_values[csc] = hessian[position];
         }
-        for (i, &k) in self.diagonal_slots.iter().enumerate() {
+        for (i, &k) in self.diagonal_entries.iter().enumerate() {
             sparse.matrix_values[sparse.csc_position[k]] += damping[i];
         }
         if sparse.matrix_values.iter().any(|v| !v.is_finite()) {
@@ -471,11 +499,79 @@ impl LinearSystem {
     /// `H` as a dense symmetric matrix (for the rank analysis of small problems).
     pub fn dense(&self, hessian: &[f64]) -> DMatrix<f64> {
         let mut dense = DMatrix::zeros(self.dim, self.dim);
-        for (&(row, col), &value) in self.indices.iter().zip(hessian) {
-            dense[(row, col)] = value;
-            dense[(col, row)] = value;
+        for (&(row, col), &position) in self.indices.iter().zip(&self.positions) {
+            dense[(row, col)] = hessian[position];
+            dense[(col, row)] = hessian[position];
         }
         dense
+    }
+}
+
+/// Add `A^T B` (or, when `same`, the lower triangle of `A^T A`) for two
+/// column-major Jacobian blocks of `rows` rows to the block at the start of
+/// `block`, entry `(i, j)` at `i + j * stride`.
+///
+/// The shapes a calibration graph has (`R` rows; 1, 2, 3 or 6 columns: an
+/// offset, a reference tension, an anchor, a pose) go to kernels whose sizes
+/// are known at compile time (unrolled, no bounds checks); the rest to the
+/// general loop. Both add the same products in the same order.
+#[inline(always)]
+fn add_block_product<const R: usize>(a: &[f64], b: &[f64], same: bool, rows: usize, stride: usize, block: &mut [f64]) {
+    if R != 0 {
+        macro_rules! kernels {
+            ($(($ca:literal, $cb:literal)),*) => {
+                match (a.len() / R, b.len() / R, same) {
+                    $(($ca, $cb, false) => return block_product::<R, $ca, $cb, false>(a, b, stride, block),)*
+                    (1, 1, true) => return block_product::<R, 1, 1, true>(a, a, stride, block),
+                    (2, 2, true) => return block_product::<R, 2, 2, true>(a, a, stride, block),
+                    (3, 3, true) => return block_product::<R, 3, 3, true>(a, a, stride, block),
+                    (6, 6, true) => return block_product::<R, 6, 6, true>(a, a, stride, block),
+                    _ => {}
+                }
+            };
+        }
+        kernels!(
+            (1, 1),
+            (1, 3),
+            (3, 1),
+            (3, 3),
+            (2, 1),
+            (2, 3),
+            (6, 1),
+            (6, 3),
+            (2, 6),
+            (6, 2),
+            (1, 2),
+            (3, 2),
+            (1, 6),
+            (3, 6)
+        );
+    }
+    for (j, column_b) in b.chunks_exact(rows).enumerate() {
+        let first = if same { j } else { 0 };
+        for (i, column_a) in a.chunks_exact(rows).enumerate().skip(first) {
+            block[i + j * stride] += dot::<0>(column_a, column_b);
+        }
+    }
+}
+
+/// [`add_block_product`] for `R`-row blocks of `CA` and `CB` columns
+/// (`SAME`: the lower triangle of `A^T A`, `CA = CB`).
+#[inline(always)]
+fn block_product<const R: usize, const CA: usize, const CB: usize, const SAME: bool>(
+    a: &[f64],
+    b: &[f64],
+    stride: usize,
+    block: &mut [f64],
+) {
+    let a: &[f64] = &a[..R * CA];
+    let b: &[f64] = &b[..R * CB];
+    for j in 0..CB {
+        let column_b = &b[j * R..(j + 1) * R];
+        let column = &mut block[j * stride..j * stride + CA];
+        for i in (if SAME { j } else { 0 })..CA {
+            column[i] += dot::<R>(&a[i * R..(i + 1) * R], column_b);
+        }
     }
 }
 

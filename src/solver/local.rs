@@ -142,6 +142,9 @@ fn linearize_group(graph: &FactorGraph, group: &Group, values: &Values, work: &m
             return None;
         };
         cost += linearized.cost;
+        if linearized.is_zero {
+            continue;
+        }
         let rows = linearized.residual.len();
         for &(slot_a, offset_a) in slots {
             let ja = linearized.jacobians[slot_a].as_slice();

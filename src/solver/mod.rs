@@ -176,10 +176,35 @@ pub(crate) struct Linearization {
 
 /// Linearise every factor at `values`.
 pub(crate) fn linearize(graph: &FactorGraph, values: &Values, system: &LinearSystem) -> Result<Linearization, String> {
-    let mut hessian = system.zero_hessian();
-    let mut gradient = vec![0.0; system.dim];
+    linearize_with(graph, values, system, &mut Workspace::default())
+}
+
+/// What the iterations reuse instead of allocating: the factors' Jacobian
+/// buffers, the trial point's values and a spent linearisation's arrays.
+#[derive(Default)]
+struct Workspace {
+    buffers: LinearizationBuffers,
+    candidate: Values,
+    spare: Option<Linearization>,
+}
+
+/// [`linearize`] into the arrays of `work.spare` (if any) with `work`'s buffers.
+fn linearize_with(
+    graph: &FactorGraph,
+    values: &Values,
+    system: &LinearSystem,
+    work: &mut Workspace,
+) -> Result<Linearization, String> {
+    let (mut hessian, mut gradient) = match work.spare.take() {
+        Some(spare) => (spare.hessian, spare.gradient),
+        None => (system.zero_hessian(), vec![0.0; system.dim]),
+    };
+    hessian.clear();
+    hessian.resize(system.zero_hessian_len(), 0.0);
+    gradient.clear();
+    gradient.resize(system.dim, 0.0);
     let mut cost = 0.0;
-    let mut buffers = LinearizationBuffers::default();
+    let buffers = &mut work.buffers;
     for (index, factor) in graph.factors.iter().enumerate() {
         let variables = factor.variables();
         let linearized = buffers.linearize(factor.as_ref(), values).map_err(|what| {
@@ -187,6 +212,10 @@ pub(crate) fn linearize(graph: &FactorGraph, values: &Values, system: &LinearSys
             format!("{} factor on [{}]: {what}", factor.kind(), names.join(", "))
         })?;
         cost += linearized.cost;
+        if linearized.is_zero {
+            // Adding exact zeros would change nothing (an inactive tension guard).
+            continue;
+        }
         system.accumulate(
             index,
             variables,
@@ -203,16 +232,15 @@ pub(crate) fn linearize(graph: &FactorGraph, values: &Values, system: &LinearSys
     })
 }
 
-/// Apply a tangent step to every free variable.
-pub(crate) fn retract_all(values: &Values, system: &LinearSystem, step: &[f64]) -> Values {
-    let mut next = values.clone();
+/// `next` = `values` with a tangent step applied to every free variable.
+fn retract_all(values: &Values, system: &LinearSystem, step: &[f64], next: &mut Values) {
+    next.copy_from(values);
     for (id, variable) in values.iter() {
         if let Some(offset) = system.offsets[id.0] {
             let dim = variable.value.tangent_dim();
-            next.set(id, variable.value.retract(&step[offset..offset + dim]));
+            next.value_mut(id).retract_in_place(&step[offset..offset + dim]);
         }
     }
-    next
 }
 
 /// Minimise the graph's cost from its current values; the values are updated in place.
@@ -227,7 +255,8 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
     if !groups.is_empty() {
         groups.refine(graph, &mut values);
     }
-    let Ok(mut linearization) = linearize(graph, &values, &system) else {
+    let mut work = Workspace::default();
+    let Ok(mut linearization) = linearize_with(graph, &values, &system, &mut work) else {
         return Ok(SolveSummary {
             initial_cost: f64::NAN,
             final_cost: f64::NAN,
@@ -240,6 +269,7 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
     let mut damping = Damping {
         value: params.initial_damping,
         nu: 2.0,
+        max: params.max_damping,
     };
     let mut history = Vec::new();
     let mut termination = Termination::MaxIterations;
@@ -257,11 +287,10 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
             &values,
             &linearization,
             &mut damping,
-            params,
+            &mut work,
         );
         let Some(Accepted {
             step,
-            candidate,
             linearization: next,
             gain_ratio,
         }) = accepted
@@ -289,8 +318,9 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
             step_norm,
             trials,
         });
-        values = candidate;
-        linearization = next;
+        // The trial point (in `work.candidate`) becomes the current one.
+        std::mem::swap(&mut values, &mut work.candidate);
+        work.spare = Some(std::mem::replace(&mut linearization, next));
         if relative_decrease < params.relative_cost_tolerance {
             termination = Termination::CostConverged;
             break;
@@ -317,6 +347,8 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
 struct Damping {
     value: f64,
     nu: f64,
+    /// The damping past which no further trial is made ([`LmParams::max_damping`]).
+    max: f64,
 }
 
 impl Damping {
@@ -335,10 +367,9 @@ impl Damping {
 }
 
 /// A step that lowered the cost, with the linearisation at its end point
-/// (the next iteration's).
+/// (the next iteration's; the end point itself is left in `Workspace::candidate`).
 struct Accepted {
     step: Vec<f64>,
-    candidate: Values,
     linearization: Linearization,
     gain_ratio: f64,
 }
@@ -353,7 +384,7 @@ fn damped_step(
     values: &Values,
     linearization: &Linearization,
     damping: &mut Damping,
-    params: &LmParams,
+    work: &mut Workspace,
 ) -> (Option<Accepted>, usize) {
     let cost = linearization.cost;
     let gradient = &linearization.gradient;
@@ -364,7 +395,7 @@ fn damped_step(
         .collect();
     let rhs: Vec<f64> = gradient.iter().map(|g| -g).collect();
     let mut trials = 0;
-    while damping.value <= params.max_damping {
+    while damping.value <= damping.max {
         trials += 1;
         let damp: Vec<f64> = diagonal.iter().map(|d| damping.value * d).collect();
         let Some(step) = system.solve(&linearization.hessian, &damp, &rhs) else {
@@ -379,7 +410,8 @@ fn damped_step(
                 .zip(gradient)
                 .map(|((dx, d), g)| dx * (d * dx - g))
                 .sum::<f64>();
-        let mut candidate = retract_all(values, system, &step);
+        let mut candidate = std::mem::take(&mut work.candidate);
+        retract_all(values, system, &step, &mut candidate);
         if !groups.is_empty() {
             groups.refine(graph, &mut candidate);
         }
@@ -387,19 +419,24 @@ fn damped_step(
         // the same sum, and an accepted step (nearly every trial) then needs no
         // second pass over the factors. A point where the model is undefined
         // or a Jacobian is not finite is rejected.
-        match linearize(graph, &candidate, system) {
+        let trial = linearize_with(graph, &candidate, system, work);
+        work.candidate = candidate;
+        match trial {
             Ok(next) if next.cost < cost && predicted > 0.0 => {
                 let gain_ratio = (cost - next.cost) / predicted;
                 damping.accept(gain_ratio);
                 let accepted = Accepted {
                     step,
-                    candidate,
                     linearization: next,
                     gain_ratio,
                 };
                 return (Some(accepted), trials);
             }
-            _ => damping.reject(),
+            Ok(rejected) => {
+                work.spare = Some(rejected);
+                damping.reject();
+            }
+            Err(_) => damping.reject(),
         }
     }
     (None, trials)

@@ -27,8 +27,6 @@ pub(super) struct SchurLayout {
     groups: Vec<(usize, usize)>,
     /// Per group: offset of its `D_k` (then `B_k`) in the block buffer.
     group_base: Vec<usize>,
-    /// Per stored entry of `H`: its position in the block buffer.
-    position: Vec<usize>,
     /// Block buffer: `A` (globals x globals, column-major), then per group
     /// `D_k` (m x m) and `B_k` (m x globals), column-major; after
     /// factorisation `A` holds the Cholesky factor of the reduced system,
@@ -38,56 +36,59 @@ pub(super) struct SchurLayout {
 }
 
 impl SchurLayout {
-    /// A layout for `H` whose stored entries sit at `indices` (`(row, col)`,
-    /// `row >= col`, tangent indices with the globals first), with `groups`
-    /// `(first index, dimension)`. `None` if an entry couples two groups.
+    /// A layout for `H` whose lower triangle has entries at `indices`
+    /// (`(row, col)`, `row >= col`, tangent indices with the globals first),
+    /// with `groups` `(first index, dimension)`. `None` if an entry couples
+    /// two groups.
     pub(super) fn new(indices: &[(usize, usize)], globals: usize, groups: Vec<(usize, usize)>) -> Option<Self> {
-        let dim = groups.last().map_or(globals, |&(start, m)| start + m);
-        let mut group_of = vec![usize::MAX; dim];
         let mut group_base = Vec::with_capacity(groups.len());
         let mut size = globals * globals;
-        for (k, &(start, m)) in groups.iter().enumerate() {
-            group_of[start..start + m].fill(k);
+        for &(_, m) in &groups {
             group_base.push(size);
             size += m * m + m * globals;
         }
-        let mut position = Vec::with_capacity(indices.len());
-        for &(row, col) in indices {
-            let (row, col) = if row >= col { (row, col) } else { (col, row) };
-            let slot = if row < globals {
-                row + col * globals
-            } else {
-                let k = group_of[row];
-                let (start, m) = groups[k];
-                if col < globals {
-                    group_base[k] + m * m + (row - start) + col * m
-                } else if group_of[col] == k {
-                    group_base[k] + (row - start) + (col - start) * m
-                } else {
-                    return None;
-                }
-            };
-            position.push(slot);
-        }
-        Some(Self {
+        let layout = Self {
             globals,
             groups,
             group_base,
-            position,
             values: vec![0.0; size],
             factored: false,
-        })
+        };
+        let group_of = |index: usize| layout.groups.partition_point(|&(start, _)| start <= index) - 1;
+        let coupled = indices
+            .iter()
+            .any(|&(row, col)| row >= globals && col >= globals && group_of(row) != group_of(col));
+        (!coupled).then_some(layout)
     }
 
-    /// Factor `H + diag(damping)` (`hessian` in the stored-entry order);
+    /// Where the entry `(row, col)` of `H` (`row >= col`, not coupling two
+    /// groups) sits in the block buffer, and the stride between its columns.
+    pub(super) fn place(&self, row: usize, col: usize) -> (usize, usize) {
+        let g = self.globals;
+        if row < g {
+            return (row + col * g, g);
+        }
+        let k = self.groups.partition_point(|&(start, _)| start <= row) - 1;
+        let (start, m) = self.groups[k];
+        if col < g {
+            (self.group_base[k] + m * m + (row - start) + col * m, m)
+        } else {
+            (self.group_base[k] + (row - start) + (col - start) * m, m)
+        }
+    }
+
+    /// Length of the block buffer (the storage of `H` it is factored from).
+    pub(super) fn storage_len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// Factor `H + diag(damping)`, `hessian` in the layout of the block
+    /// buffer ([`SchurLayout::place`]; only lower triangles are read);
     /// `false` if a block or the reduced system is not positive definite.
     pub(super) fn factorize(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
         self.factored = false;
         let g = self.globals;
-        self.values.fill(0.0);
-        for (&slot, &h) in self.position.iter().zip(hessian) {
-            self.values[slot] += h;
-        }
+        self.values.copy_from_slice(hessian);
         for (i, d) in damping[..g].iter().enumerate() {
             self.values[i + i * g] += d;
         }
@@ -264,18 +265,20 @@ mod tests {
             }
         }
         let mut indices = Vec::new();
-        let mut entries = Vec::new();
         for c in 0..dim {
             for r in c..dim {
                 let same_group = r < g || c < g || (r - g) / m == (c - g) / m;
                 if same_group {
                     indices.push((r, c));
-                    entries.push(h[(r, c)]);
                 }
             }
         }
         let groups = (0..n).map(|k| (g + k * m, m)).collect();
         let mut layout = SchurLayout::new(&indices, g, groups).expect("arrowhead");
+        let mut entries = vec![0.0; layout.storage_len()];
+        for &(r, c) in &indices {
+            entries[layout.place(r, c).0] = h[(r, c)];
+        }
         let damping: Vec<f64> = (0..dim).map(|i| 0.1 + 0.01 * i as f64).collect();
         assert!(layout.factorize(&entries, &damping));
         let rhs: Vec<f64> = (0..dim).map(|i| (i as f64).sin()).collect();
@@ -294,7 +297,9 @@ mod tests {
     fn coupled_groups_are_rejected_and_indefinite_blocks_fail() {
         assert!(SchurLayout::new(&[(3, 2)], 1, vec![(1, 2), (3, 2)]).is_none());
         let mut layout = SchurLayout::new(&[(0, 0), (1, 1)], 1, vec![(1, 1)]).expect("layout");
-        assert!(!layout.factorize(&[1.0, -1.0], &[0.0, 0.0]));
+        assert_eq!(layout.storage_len(), 3);
+        assert_eq!(layout.place(1, 1).0, 1);
+        assert!(!layout.factorize(&[1.0, -1.0, 0.0], &[0.0, 0.0]));
         assert!(layout.solve(&[1.0, 1.0]).is_none());
     }
 }
