@@ -1,6 +1,31 @@
 //! A factor with some of its rows left out: the readings a gross-error test
 //! removed (`crate::calib::gross_errors`). The rows are dropped, not
 //! down-weighted, so the per-type statistics count only the readings used.
+//!
+//! ```
+//! use nalgebra::{DMatrix, DVector};
+//! use sagcal::graph::{Factor, FactorGraph, MaskedFactor, Values, VariableId, VariableValue};
+//! /// Two readings of a 2-vector, `z`, with sigma 1 each.
+//! struct Readings { variable: [VariableId; 1], z: [f64; 2], sigma: DVector<f64> }
+//! impl Factor for Readings {
+//!     fn variables(&self) -> &[VariableId] { &self.variable }
+//!     fn residual_dim(&self) -> usize { 2 }
+//!     fn evaluate(&self, values: &Values, _: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+//!         let x = values.vector(self.variable[0]);
+//!         Some(DVector::from_vec(vec![x[0] - self.z[0], x[1] - self.z[1]]))
+//!     }
+//!     fn sigmas(&self) -> &DVector<f64> { &self.sigma }
+//!     fn kind(&self) -> &'static str { "readings" }
+//! }
+//! let mut values = Values::new();
+//! let x = values.insert("x", VariableValue::Vector(DVector::zeros(2)));
+//! let readings = || Box::new(Readings { variable: [x], z: [1.0, 40.0], sigma: DVector::from_element(2, 1.0) });
+//! // The second reading is a gross error: drop its row, keep the first.
+//! let masked = MaskedFactor::new(readings(), &[1]).unwrap();
+//! assert_eq!(masked.residual_dim(), 1);
+//! assert_eq!(FactorGraph::factor_cost(&masked, &values), Some(0.5)); // only (0 - 1)^2 / 2 is left
+//! assert!(MaskedFactor::new(readings(), &[0, 1]).is_none()); // nothing left to say
+//! ```
 
 use nalgebra::{DMatrix, DVector};
 

@@ -9,6 +9,24 @@
 //! (Triggs et al., *Bundle Adjustment: A Modern Synthesis*, 2000, Sec. 3;
 //! Ceres `loss_function.h`.) The solver uses iteratively reweighted least
 //! squares: the whitened residual and Jacobian are scaled by `sqrt(rho'(s))`.
+//!
+//! ```
+//! use sagcal::graph::RobustKernel;
+//! let huber = RobustKernel::parse("huber").map_err(sagcal::Error::InvalidInput)?;
+//! assert_eq!(huber, RobustKernel::Huber(1.345)); // the 95 %-efficiency default
+//! // Least squares inside k sigmas, linear tails outside, continuous at s = k^2.
+//! assert_eq!(huber.rho(1.0), 1.0);
+//! let k2 = 1.345f64 * 1.345;
+//! assert!((huber.rho(k2 * (1.0 + 1e-12)) - k2).abs() < 1e-9);
+//! // The IRLS weight is rho'(s): check it by central differences for both kernels at 3 sigmas.
+//! for kernel in [huber, RobustKernel::Cauchy(2.3849)] {
+//!     let (s, h) = (9.0, 1e-5);
+//!     let slope = (kernel.rho(s + h) - kernel.rho(s - h)) / (2.0 * h);
+//!     assert!((slope - kernel.weight(s)).abs() < 1e-8);
+//! }
+//! assert!(RobustKernel::parse("cauchy:-1").is_err());
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use serde::{Deserialize, Serialize};
 

@@ -8,6 +8,25 @@
 //! per-type statistics); the first one evaluated at a point makes the call,
 //! the others find its result here. Solvers evaluate a pose's factors one
 //! after the other, so one remembered result per graph is enough.
+//!
+//! ```
+//! use std::cell::Cell;
+//! use sagcal::graph::SharedEvaluation;
+//! // Two factors read one expensive call (here: both roots of x^2 - s); the call runs once per input.
+//! let calls = Cell::new(0);
+//! let roots = SharedEvaluation::<1, [f64; 2]>::default();
+//! let evaluate = |out: &mut [f64; 2], _jacobians: bool| {
+//!     calls.set(calls.get() + 1);
+//!     *out = [2f64.sqrt(), -2f64.sqrt()];
+//! };
+//! let plus = roots.read(&[2.0], false, evaluate, |r| r[0]);
+//! let minus = roots.read(&[2.0], false, evaluate, |r| r[1]);
+//! assert!((plus * plus - 2.0).abs() < 1e-15 && minus == -plus);
+//! assert_eq!(calls.get(), 1);
+//! // Asking for Jacobians the memo does not hold, or new inputs, calls again.
+//! roots.read(&[2.0], true, evaluate, |_| ());
+//! assert_eq!(calls.get(), 2);
+//! ```
 
 use std::sync::{Mutex, PoisonError};
 

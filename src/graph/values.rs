@@ -1,4 +1,23 @@
 //! Variables and their values.
+//!
+//! ```
+//! use nalgebra::{DVector, Vector3, Vector6};
+//! use sagcal::graph::{Values, VariableValue};
+//! use sagcal::model::PlatformPose;
+//! let mut values = Values::new();
+//! let pose = values.insert("pose 1", VariableValue::Pose(PlatformPose::from_position(Vector3::new(0.0, 0.0, 10.0))));
+//! let anchor = values.insert("anchor 1", VariableValue::Vector(DVector::from_vec(vec![-125.0, -110.0, 48.0])));
+//! assert_eq!((values.tangent_dim(pose), values.tangent_dim(anchor)), (6, 3));
+//! // A vector retracts additively, a pose along its tangent [dtheta, dp].
+//! let moved = values.variable(anchor).value.retract(&[1.0, 0.0, -0.5]);
+//! values.set(anchor, moved);
+//! assert_eq!(values.vector(anchor).as_slice(), &[-124.0, -110.0, 47.5]);
+//! let lifted = values.variable(pose).value.retract(Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, 2.0).as_slice());
+//! values.set(pose, lifted);
+//! assert_eq!(values.pose(pose).position_m.z, 12.0);
+//! values.set_fixed(anchor, true); // the solver holds it
+//! assert!(values.variable(anchor).fixed && !values.variable(pose).fixed);
+//! ```
 
 use nalgebra::{DVector, Vector6};
 

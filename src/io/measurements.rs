@@ -59,6 +59,27 @@
 //! folder of the paper's published program (`pos_i_cpp_test.csv`,
 //! `R_i_cpp_test.csv`, `lc_meas_cpp_test.csv`, `forces_cpp_test.csv`; see
 //! [`crate::io::authors`] for the columns and the mapping).
+//!
+//! ```
+//! use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
+//! let dir = std::env::temp_dir().join(format!("sagcal-measurements-doc-{}", std::process::id()));
+//! std::fs::create_dir_all(&dir).unwrap();
+//! let good = dir.join("good.csv");
+//! std::fs::write(&good, "# simulated by sagcal, seed 7\n\
+//!     x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,l1_m,l2_m,l3_m,l4_m,f_ref_n\n\
+//!     9.94,9.93,15.9,-1.06,-0.19,0.97,183.32,169.16,155.64,170.93,698.72\n").unwrap();
+//! let set = read_measurements(&good, &ReadOptions::default())?;
+//! assert_eq!(set.format, MeasurementFormat::Sagcal);
+//! assert_eq!((set.poses[0].line, set.poses[0].encoder_lengths_m[3]), (3, 170.93));
+//! // A load cell that pulls the wrong way is an error naming the file, the row and the column.
+//! let bad = dir.join("bad.csv");
+//! std::fs::write(&bad, "x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,l1_m,l2_m,l3_m,l4_m,f_ref_n\n\
+//!     9.94,9.93,15.9,-1.06,-0.19,0.97,183.32,169.16,155.64,170.93,-698.72\n").unwrap();
+//! let message = read_measurements(&bad, &ReadOptions::default()).unwrap_err().to_string();
+//! assert!(message.contains("bad.csv: row 2, field `f_ref_n`"), "{message}");
+//! # std::fs::remove_dir_all(&dir).unwrap();
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use std::path::{Path, PathBuf};
 

@@ -21,6 +21,24 @@
 //! Measurement files and RecurDyn logs are read by
 //! [`read_measurements`]: their localiser pose is kept (for comparison, or a
 //! prior) and their load cell is the reference cable's tension.
+//!
+//! ```
+//! use sagcal::io::readings::{read_readings, ReadingsFormat};
+//! let path = std::env::temp_dir().join(format!("sagcal-readings-doc-{}.csv", std::process::id()));
+//! // The second row has no load-cell reading (an empty field).
+//! std::fs::write(&path, "# encoder readings of the calibrated robot\n\
+//!     l1_m,l2_m,l3_m,l4_m,f_ref_n\n\
+//!     183.32,169.16,155.64,170.93,698.72\n\
+//!     183.40,169.10,155.70,170.90,\n").unwrap();
+//! let file = read_readings(&path, 0)?;
+//! assert_eq!(file.format, ReadingsFormat::ReadingsOnly);
+//! assert_eq!(file.rows.len(), 2);
+//! assert_eq!((file.rows[0].load_cell_n, file.rows[1].load_cell_n), (Some(698.72), None));
+//! assert_eq!((file.rows[1].line, file.rows[1].encoder_lengths_m[0]), (4, 183.40));
+//! assert!(file.rows[0].localiser_pose.is_none()); // readings alone carry no pose
+//! # std::fs::remove_file(&path).unwrap();
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use std::path::{Path, PathBuf};
 

@@ -36,6 +36,25 @@
 //! about 6e-7 N, the two hand-written rows (3 or 4 decimals) 2e-7 N and 1.6e-5 N
 //! against about 1e-3 N, while the one inconsistent row is off by 106 N.
 //! The same tolerance is used for `|fz| <= fc` when `fh` is missing.
+//!
+//! ```
+//! use sagcal::io::recurdyn::{looks_like_recurdyn, read_recurdyn, LoadOptions};
+//! let header = "x,y,z,pitch,roll,yaw,L1,L2,L3,L4,fc1,fz1,fh1,fc2,fz2,fh2,fc3,fz3,fh3,fc4,fz4,fh4,";
+//! assert!(looks_like_recurdyn(&header.split(',').collect::<Vec<_>>()));
+//! // Row 3's cable 1 tensions disagree: fc1 = 500 N but sqrt(300^2 + 400^2) = 500 N is not 510 N.
+//! let text = format!("{header}\n\
+//!     1.234567,2.345678,15.456789,0.1,0.2,0.3,183.3,169.2,155.6,170.9,500,300,400,,,,,,,,,,\n\
+//!     3.234567,2.345678,15.456789,0.1,0.2,0.3,183.1,169.4,155.8,170.7,510,300,400,,,,,,,,,,\n");
+//! let path = std::env::temp_dir().join(format!("sagcal-recurdyn-doc-{}.csv", std::process::id()));
+//! std::fs::write(&path, text).unwrap();
+//! let log = read_recurdyn(&path, &LoadOptions::default())?;
+//! assert_eq!((log.rows.len(), log.rows[0].line), (1, 2));
+//! let total = log.rows[0].tensions[0].unwrap().total_n;
+//! assert_eq!(total, 500.0);
+//! assert_eq!(log.rejected[0].line, 3);
+//! # std::fs::remove_file(&path).unwrap();
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};

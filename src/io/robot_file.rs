@@ -28,6 +28,24 @@
 //! without it gets no paper column. Files written from a robot (`calibrate
 //! --out`, `diagnose --out`, `simulate --truth`) keep it: they describe the
 //! same robot.
+//!
+//! ```
+//! use sagcal::model::Robot;
+//! let small = Robot::builtin("small")?;
+//! let dir = std::env::temp_dir().join(format!("sagcal-robot-file-doc-{}", std::process::id()));
+//! std::fs::create_dir_all(&dir).unwrap();
+//! // Written and read back, the robot is the same, to the last bit.
+//! let path = dir.join("small.toml");
+//! std::fs::write(&path, small.to_file_contents().to_toml()?).unwrap();
+//! assert_eq!(Robot::from_file(&path)?, small);
+//! // A reference cable that does not exist is an error naming the file.
+//! let text = std::fs::read_to_string(&path).unwrap().replace("reference_cable = 1", "reference_cable = 7");
+//! std::fs::write(&path, text).unwrap();
+//! let message = Robot::from_file(&path).unwrap_err().to_string();
+//! assert!(message.contains("small.toml") && message.contains("reference_cable"), "{message}");
+//! # std::fs::remove_dir_all(&dir).unwrap();
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use std::path::{Path, PathBuf};
 

@@ -11,6 +11,29 @@
 //! Hessian of the potential energy at fixed cable lengths; `K` itself is
 //! symmetric at an equilibrium up to the finite differences taken of `J^T`
 //! and `w` at fixed tensions).
+//!
+//! ```
+//! use nalgebra::{Matrix6, Vector2, Vector3};
+//! use sagcal::localize::stiffness::{smallest_stiffness, stiffness};
+//! use sagcal::localize::{model_at_pose, SlotRobot};
+//! use sagcal::model::statics::{solve_level, StaticsOptions};
+//! use sagcal::model::Robot;
+//! let robot = Robot::builtin("large")?;
+//! let eq = solve_level(&robot, Vector3::new(3.0, 2.0, 12.0), &StaticsOptions::default())?;
+//! let slots = SlotRobot::new(&robot);
+//! let reference = eq.tensions[robot.reference_cable];
+//! let model = model_at_pose(&slots, &eq.pose, &Vector2::new(reference.horizontal_n, reference.vertical_n)).unwrap();
+//! let k = stiffness(&robot, &slots, &eq.pose, &model);
+//! // A Hessian of the potential energy: symmetric at an equilibrium (up to the finite differences),
+//! // and positive definite where the platform hangs stably.
+//! assert!((k - k.transpose()).norm() < 1e-4 * k.norm());
+//! assert!(smallest_stiffness(&k) > 0.0);
+//! // The smallest eigenvalue of the symmetric part, closed form: [[2, 1], [1, 2]] has 1.
+//! let mut two = Matrix6::identity() * 5.0;
+//! two.fixed_view_mut::<2, 2>(0, 0).copy_from(&nalgebra::Matrix2::new(2.0, 0.0, 2.0, 2.0));
+//! assert!((smallest_stiffness(&two) - 1.0).abs() < 1e-12);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::{Matrix6, SMatrix, Vector3, Vector6};
 

@@ -25,6 +25,27 @@
 //! with `sinhc(y) = sinh(y)/y` evaluated by its Taylor series near 0. No
 //! difference of nearly equal numbers remains, and as `g_c -> 0` they tend to
 //! the straight cable: `length = span * sqrt(1 + u^2)`, drop `= span * u`.
+//!
+//! ```
+//! use sagcal::model::Catenary;
+//! // A massless cable is the straight line: length = span sqrt(1 + u^2), drop = span u (u = f_v / f_h).
+//! let straight = Catenary {
+//!     span_m: 30.0,
+//!     horizontal_tension_n: 400.0,
+//!     vertical_tension_n: 300.0,
+//!     cable_weight_n_per_m: 0.0,
+//! };
+//! assert!((straight.length_m() - 37.5).abs() < 1e-12 && (straight.drop_m() - 22.5).abs() < 1e-12);
+//! // A heavy cable agrees with the paper's own form, eq. (1)-(4) with the constants of eq. (2)-(3).
+//! let heavy = Catenary { cable_weight_n_per_m: 0.71, ..straight };
+//! let (anchor_z, k) = (48.0, 0.71 / 400.0);
+//! let (c1, c2) = heavy.constants(anchor_z);
+//! let z_attachment = (((30.0 + c1) * k).cosh() - c2) / k;
+//! let arc = (((30.0 + c1) * k).sinh() - (c1 * k).sinh()) / k;
+//! assert!((anchor_z - z_attachment - heavy.drop_m()).abs() < 1e-9);
+//! assert!((arc.abs() - heavy.length_m()).abs() < 1e-9);
+//! assert!(heavy.length_m() > straight.length_m());
+//! ```
 
 /// `sinh(y) / y`, accurate to a few ulp for every finite `y` (1 at `y = 0`).
 pub fn sinhc(y: f64) -> f64 {

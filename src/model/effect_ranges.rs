@@ -2,6 +2,20 @@
 //! its own data (rope cross-section from the cable weight, platform size):
 //! the ranges the hidden-effect experiment draws from and the magnitudes at
 //! which `diagnose` states the power of its tests.
+//!
+//! ```
+//! use sagcal::model::effect_ranges::{axial_stiffness_range_n, effect_ranges};
+//! use sagcal::model::Robot;
+//! let robot = Robot::builtin("large")?;
+//! // The rope's cross-section from its weight per metre is that of a 4 mm radius rope,
+//! // and EA = A E with E = 30 .. 160 GPa for aramid.
+//! let area_m2 = std::f64::consts::PI * 0.004f64.powi(2);
+//! let (low, high) = axial_stiffness_range_n(&robot);
+//! assert!((low / (area_m2 * 30e9) - 1.0).abs() < 1e-9 && (high / (area_m2 * 160e9) - 1.0).abs() < 1e-9);
+//! let ranges = effect_ranges(&robot);
+//! assert!(ranges.iter().any(|r| r.effect == "elastic" && r.justification.contains("50.27 mm^2")));
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use serde::Serialize;
 

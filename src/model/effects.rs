@@ -20,6 +20,25 @@
 //! | `com` | `dx_m`, `dy_m`, `dz_m` (platform frame, m) |
 //! | `segments` | `n` (number of straight elements of a finite-element cable, >= 1) |
 //! | `localiser-mount` | `rx_deg`, `ry_deg`, `rz_deg` (the localiser's mounting rotation, a rotation vector in the platform frame, degrees) |
+//!
+//! ```
+//! use sagcal::model::effects::{EffectKind, Effects};
+//! let mut effects = Effects::default();
+//! effects.apply_spec("elastic:ea_n=2e6").map_err(sagcal::Error::InvalidInput)?;
+//! effects.apply_spec("encoder-scale:gain1=1.002,gain3=0.999").map_err(sagcal::Error::InvalidInput)?;
+//! // EA = 2 MN is a compliance 1e6 / EA of 0.5 per MN, the parameter diagnose fits.
+//! assert_eq!(effects.axial_compliance_per_mn(), 0.5);
+//! assert!(EffectKind::Elastic.present_in(&effects) && EffectKind::EncoderScale.present_in(&effects));
+//! assert!(!EffectKind::Pulley.present_in(&effects));
+//! // `specs` writes what `apply_spec` reads.
+//! let mut again = Effects::default();
+//! for spec in effects.specs() {
+//!     again.apply_spec(&spec).map_err(sagcal::Error::InvalidInput)?;
+//! }
+//! assert_eq!(again, effects);
+//! assert!(Effects::default().apply_spec("elastic:ea_n=-1").is_err());
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use serde::{Deserialize, Serialize};
 

@@ -1,4 +1,15 @@
 //! One static pose's measurements: what the robot's own sensors read there.
+//!
+//! ```
+//! use sagcal::model::measurement::{ReadingSet, Sensor};
+//! // Data snooping left out cable 2's encoder and the load cell of one pose.
+//! let excluded = ReadingSet::NONE.with(Sensor::Encoder(1)).with(Sensor::LoadCell);
+//! assert!(excluded.contains(Sensor::LoadCell) && !excluded.contains(Sensor::Encoder(0)));
+//! let words: Vec<String> = excluded.iter().map(Sensor::describe).collect();
+//! assert_eq!(words, ["encoder of cable 2", "load cell"]);
+//! assert!(excluded.without(Sensor::Encoder(1)).without(Sensor::LoadCell).is_empty());
+//! assert_eq!(Sensor::ALL.len(), 4 + 1 + 3 + 3); // encoders, load cell, localiser position and orientation
+//! ```
 
 use serde::{Deserialize, Serialize};
 

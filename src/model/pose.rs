@@ -15,6 +15,21 @@
 //! convention (product manifold SO(3) x R^3, rotation block first), so the
 //! generated Jacobians (`residual.jacobian(rot)`, `residual.jacobian(pos)`)
 //! are exactly the derivatives along this retraction.
+//!
+//! ```
+//! use nalgebra::{Vector3, Vector6};
+//! use sagcal::model::PlatformPose;
+//! let pose = PlatformPose::from_roll_pitch_yaw_deg(Vector3::new(1.0, 2.0, 3.0), 10.0, -5.0, 30.0);
+//! let (roll, pitch, yaw) = pose.roll_pitch_yaw_deg();
+//! assert!((roll - 10.0).abs() < 1e-12 && (pitch + 5.0).abs() < 1e-12 && (yaw - 30.0).abs() < 1e-12);
+//! // The position moves additively in the world frame, the rotation by |dtheta| about its axis,
+//! // and `local_coordinates` undoes `retract`.
+//! let xi = Vector6::new(0.01, -0.02, 0.03, 0.5, -0.25, 1.0);
+//! let moved = pose.retract(&xi);
+//! assert!((moved.position_m - pose.position_m - Vector3::new(0.5, -0.25, 1.0)).norm() < 1e-12);
+//! assert!((pose.angle_to_deg(&moved) - 0.0014f64.sqrt().to_degrees()).abs() < 1e-9);
+//! assert!((pose.local_coordinates(&moved) - xi).norm() < 1e-12);
+//! ```
 
 use nalgebra::{Rotation3, UnitQuaternion, Vector3, Vector4, Vector6};
 

@@ -1,5 +1,19 @@
 //! The robot's geometry and masses. Files are read and validated into a
 //! [`Robot`] by `io::robot_file`; the physics never sees a file.
+//!
+//! ```
+//! use sagcal::model::robot::{Robot, CALIBRATED_PARAMETERS};
+//! let robot = Robot::builtin("large")?;
+//! // Its cable is an aramid rope of 4 mm radius at 1440 kg/m^3: g_c = pi r^2 rho g.
+//! let g_c = std::f64::consts::PI * 0.004f64.powi(2) * 1440.0 * 9.81;
+//! assert!((robot.cable_weight_n_per_m - g_c).abs() < 1e-12);
+//! assert!((robot.platform_weight_n - 34.0 * 9.81).abs() < 1e-9); // a 34 kg platform
+//! // Robot files count cables from 1, the robot from 0: the load cell is on cable 1.
+//! assert_eq!(robot.reference_cable, 0);
+//! // Calibrated: 4 anchors of 3 coordinates and 4 encoder offsets.
+//! assert_eq!(CALIBRATED_PARAMETERS, 4 * 3 + 4);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::{SMatrix, Vector3};
 use serde::{Deserialize, Serialize};

@@ -23,6 +23,24 @@
 //!
 //! This module holds the equations; `solve` the solvers. Both are
 //! hand-written and share no code with `generated/`: the tests compare the two.
+//!
+//! ```
+//! use nalgebra::Vector3;
+//! use sagcal::model::statics::{solve_forward, solve_level, StaticsOptions};
+//! use sagcal::model::Robot;
+//! let robot = Robot::builtin("large")?;
+//! let options = StaticsOptions::default();
+//! // Problem (a): the most level equilibrium at a position, and its tensions.
+//! let eq = solve_level(&robot, Vector3::new(10.0, 5.0, 20.0), &options)?;
+//! // The cables' vertical pulls carry the platform's weight (force balance along z).
+//! let lift: f64 = eq.tensions.iter().map(|t| t.vertical_n).sum();
+//! assert!((lift - robot.platform_weight_n).abs() < 1e-6);
+//! assert!(eq.max_height_residual_m() < 1e-9);
+//! // Problem (c): the four cable lengths give the pose back.
+//! let back = solve_forward(&robot, &eq.cable_lengths_m, None, &options)?;
+//! assert!((back.pose.position_m - eq.pose.position_m).norm() < 1e-6);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::{Matrix6, SMatrix, Vector3, Vector6};
 

@@ -1,6 +1,23 @@
 //! The Cramer-Rao bound of a set of poses from their per-pose information
 //! (see `information`): `Sigma = (sum_k I_k)^-1`, summarised as the
 //! root-mean-square errors it allows.
+//!
+//! ```
+//! use nalgebra::DMatrix;
+//! use sagcal::plan::information::PoseInformation;
+//! use sagcal::plan::plan_bound;
+//! // Sixteen poses, each measuring one global parameter with sigma 2 cm: Sigma = (0.02 m)^2 1,
+//! // so the RMS anchor error is sqrt(3) x 2 cm and the RMS offset error 2 cm.
+//! let poses: Vec<PoseInformation> = (0..16)
+//!     .map(|k| PoseInformation { factor: DMatrix::from_fn(16, 1, |r, _| if r == k { 1.0 / 0.02 } else { 0.0 }) })
+//!     .collect();
+//! let all: Vec<usize> = (0..16).collect();
+//! let bound = plan_bound(&poses, &all).unwrap();
+//! assert!((bound.anchor_rms_m - 3f64.sqrt() * 0.02).abs() < 1e-12);
+//! assert!((bound.offset_rms_m - 0.02).abs() < 1e-12);
+//! // Fifteen of them leave a parameter undetermined: no bound.
+//! assert!(plan_bound(&poses, &all[..15]).is_none());
+//! ```
 
 use nalgebra::DMatrix;
 use serde::Serialize;

@@ -2,6 +2,23 @@
 //! and every cable inside the frame. (Stability at fixed cable lengths is the
 //! third condition; it needs the localiser's stiffness and is checked where
 //! candidates are drawn, `experiments::plan_candidates`.)
+//!
+//! ```
+//! use nalgebra::Vector3;
+//! use sagcal::model::statics::{solve_level, StaticsOptions};
+//! use sagcal::model::Robot;
+//! use sagcal::plan::Margins;
+//! let robot = Robot::builtin("large")?;
+//! let margins = Margins::for_robot(&robot);
+//! // 10 % of each cable's share of the 333.54 N platform.
+//! assert!((margins.min_horizontal_tension_n - 0.1 * 333.54 / 4.0).abs() < 1e-12);
+//! let eq = solve_level(&robot, Vector3::new(0.0, 0.0, 15.0), &StaticsOptions::default())?;
+//! assert_eq!(margins.violation(&robot, &eq), None);
+//! // Anchors 48 m up: every cable sags below them, so a 48 m clearance fails.
+//! let high = Margins { min_cable_height_m: 48.0, ..margins };
+//! assert!(high.violation(&robot, &eq).unwrap().contains("sags to"));
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use serde::Serialize;
 

@@ -29,6 +29,24 @@
 //! After every greedy step and every exchange, `C` is recomputed from `M` by
 //! Cholesky (`O(n^3)`, negligible next to a sweep), so the updates never
 //! accumulate rounding.
+//!
+//! ```
+//! use nalgebra::DMatrix;
+//! use sagcal::plan::information::PoseInformation;
+//! use sagcal::plan::{choose_poses, DesignOptions};
+//! // 32 candidates: each global parameter measured once with sigma 1 (candidates 0..16)
+//! // and once with sigma 1/2 (16..32). The A-criterion weighs the 12 anchor coordinates:
+//! // the A-optimal 12 poses are their precise measurements, and the trace of the anchor
+//! // covariance is then 12 x (1/2)^2 = 3.
+//! let unit = |k: usize, w: f64| PoseInformation { factor: DMatrix::from_fn(16, 1, |r, _| if r == k { w } else { 0.0 }) };
+//! let candidates: Vec<PoseInformation> = (0..16).map(|k| unit(k, 1.0)).chain((0..16).map(|k| unit(k, 2.0))).collect();
+//! let design = choose_poses(&candidates, &DesignOptions::new(12))?;
+//! let mut chosen = design.chosen.clone();
+//! chosen.sort();
+//! assert_eq!(chosen, (16..28).collect::<Vec<_>>());
+//! assert!((design.value - 3.0).abs() < 1e-6);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::DMatrix;
 use serde::Serialize;

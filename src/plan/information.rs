@@ -24,6 +24,34 @@
 //! eigenvalues above `1e-13` of the largest): a pose adds at most
 //! `rows - 8` independent equations (4 with position priors only, 7 with the
 //! orientation prior), which is what makes the design's rank-k updates cheap.
+//!
+//! ```
+//! use nalgebra::Vector3;
+//! use sagcal::calib::{CalibrationOptions, OrientationPrior};
+//! use sagcal::model::sensors::NoisePreset;
+//! use sagcal::model::statics::{solve_level, StaticsOptions};
+//! use sagcal::model::Robot;
+//! use sagcal::plan::pose_information;
+//! let robot = Robot::builtin("large")?;
+//! let eq = solve_level(&robot, Vector3::new(5.0, -4.0, 14.0), &StaticsOptions::default())?;
+//! let paper = CalibrationOptions::new(NoisePreset::Paper.sigmas(robot.platform_weight_n));
+//! // 16 globals. With the orientation prior: 11 readings and 4 height constraints
+//! // less 8 local unknowns, 7 equations; with position priors only, 4.
+//! let on = CalibrationOptions { orientation_prior: OrientationPrior::On, ..paper };
+//! let off = CalibrationOptions { orientation_prior: OrientationPrior::Off, ..paper };
+//! let info = pose_information(&robot, &eq, &on)?;
+//! assert_eq!((info.dim(), info.rank(), pose_information(&robot, &eq, &off)?.rank()), (16, 7, 4));
+//! // Fisher information scales as 1 / sigma^2: every sigma doubled, a quarter of it.
+//! let mut noise = on.noise;
+//! noise.encoder_sigma_m *= 2.0;
+//! noise.load_cell_sigma_n *= 2.0;
+//! noise.position_sigma_m *= 2.0;
+//! noise.orientation_sigma_rad *= 2.0;
+//! let doubled = CalibrationOptions { noise, height_sigma_m: 2.0 * on.height_sigma_m, ..on };
+//! let quarter = pose_information(&robot, &eq, &doubled)?;
+//! assert!((quarter.matrix() * 4.0 - info.matrix()).norm() < 1e-9 * info.matrix().norm());
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::{DMatrix, SymmetricEigen};
 

@@ -2,6 +2,18 @@
 //! nearest neighbour from a start, then 2-opt (reverse a segment whenever
 //! that shortens the path; Croes, *A method for solving travelling-salesman
 //! problems*, Operations Research 6, 1958) until no reversal helps.
+//!
+//! ```
+//! use nalgebra::Vector3;
+//! use sagcal::plan::{path_length_m, visiting_order};
+//! // Five points on a line, shuffled: the shortest open path walks the line from the end nearest the start.
+//! let xs = [3.0, 0.0, 4.0, 1.0, 2.0];
+//! let points: Vec<Vector3<f64>> = xs.iter().map(|&x| Vector3::new(x, 0.0, 10.0)).collect();
+//! let order = visiting_order(&points, &Vector3::new(-1.0, 0.0, 10.0));
+//! assert_eq!(order, [1, 3, 4, 0, 2]);
+//! let visited: Vec<Vector3<f64>> = order.iter().map(|&k| points[k]).collect();
+//! assert_eq!(path_length_m(&visited), 4.0);
+//! ```
 
 use nalgebra::Vector3;
 

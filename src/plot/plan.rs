@@ -4,6 +4,23 @@
 //! Cramer-Rao bound allows for the plan and for random pose sets of the same
 //! size (the mean covariance of the random sets), top and side views at true
 //! scale around the anchor.
+//!
+//! ```
+//! use sagcal::plot::plan::{plan_plot_svg, PlanPlot};
+//! let plot = PlanPlot {
+//!     title: "plan: 3 poses".into(),
+//!     caption: "sagcal plan --robot large --poses 3".into(),
+//!     anchors_m: vec![[-125.0, -110.0, 48.0], [125.0, -110.0, 48.0], [125.0, 110.0, 48.0], [-125.0, 110.0, 48.0]],
+//!     workspace_m: Some(([-30.0, -30.0, 1.0], [30.0, 30.0, 28.0])),
+//!     candidates_m: vec![[0.0, 0.0, 10.0], [10.0, 5.0, 12.0], [-8.0, 4.0, 20.0], [5.0, -5.0, 5.0]],
+//!     path_m: vec![[0.0, 0.0, 10.0], [10.0, 5.0, 12.0], [-8.0, 4.0, 20.0]],
+//!     plan_covariance_m2: vec![[[1e-4, 0.0, 0.0], [0.0, 1e-4, 0.0], [0.0, 0.0, 4e-4]]; 4],
+//!     random_covariance_m2: vec![[[4e-4, 0.0, 0.0], [0.0, 4e-4, 0.0], [0.0, 0.0, 1.6e-3]]; 4],
+//! };
+//! let svg = plan_plot_svg(&plot);
+//! assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+//! assert!(svg.contains("plan: 3 poses"));
+//! ```
 
 use std::fmt::Write as _;
 

@@ -8,6 +8,26 @@
 //! level and the tensions as even as in the RecurDyn log. Positions without a
 //! positive-tension equilibrium are redrawn. [`sample_equilibria_with`] can
 //! close the family by a random yaw instead ([`Closure`]), for some or all poses.
+//!
+//! ```
+//! use rand::SeedableRng;
+//! use sagcal::model::Robot;
+//! use sagcal::sim::closed_form::{sample_equilibria_with, Closure, Workspace};
+//! let robot = Robot::builtin("large")?;
+//! // The default box around anchors at x = +-125 m, z = 48 m: x within 24 % of 125 m, z up to 58 % of 48 m.
+//! let workspace = Workspace::around_anchors(&robot);
+//! assert!((workspace.max_m[0] - 30.0).abs() < 1e-12 && (workspace.max_m[2] - 27.84).abs() < 1e-12);
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+//! let closure = Closure::parse("yaw").map_err(sagcal::Error::InvalidInput)?;
+//! let poses = sample_equilibria_with(&robot, &workspace, 4, closure, &mut rng)?;
+//! for eq in &poses {
+//!     let p = eq.pose.position_m;
+//!     assert!((0..3).all(|i| workspace.min_m[i] <= p[i] && p[i] <= workspace.max_m[i]));
+//!     assert!(eq.pose.yaw_rad().to_degrees().abs() <= 1.0 + 1e-6); // the closure's +-1 degree
+//!     assert!(eq.tensions.iter().all(|t| t.is_taut()) && eq.max_height_residual_m() < 1e-9);
+//! }
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::{Vector3, Vector6};
 use rand::Rng;

@@ -97,6 +97,24 @@
 //! tangency) without the shooting recursion. Recomputing a tension from a
 //! stretch limits it to about `EA eps |x| / l0` newtons (`|x|` the size of the
 //! node coordinates), its round-off floor.
+//!
+//! ```
+//! use nalgebra::Vector3;
+//! use sagcal::model::Catenary;
+//! use sagcal::sim::discretised::{pulley_exit, solve_cable};
+//! // One heavy cable between its attachment (origin) and an anchor 60 m away, 20 m up:
+//! // the 200-element chain's pull on the attachment matches the catenary's (f_h, f_v)
+//! // to O(1/n^2).
+//! let cable = Catenary { span_m: 60.0, horizontal_tension_n: 300.0, vertical_tension_n: 150.0, cable_weight_n_per_m: 0.71 };
+//! let anchor = Vector3::new(cable.span_m, 0.0, cable.drop_m());
+//! let chain = solve_cable(&Vector3::zeros(), &anchor, cable.length_m(), 0.71, 200, f64::INFINITY)?;
+//! assert!((chain.platform_force_n - Vector3::new(300.0, 0.0, 150.0)).norm() < 1e-3 * 300.0);
+//! // A horizontal cable leaves its pulley at the top, a quarter turn of the groove past the entry.
+//! let exit = pulley_exit(&Vector3::zeros(), 0.2, &Vector3::new(-500.0, 0.0, 0.0)).unwrap();
+//! assert!((exit.exit_point_m - Vector3::new(0.2, 0.0, 0.2)).norm() < 1e-12);
+//! assert!((exit.wrap_angle_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use std::f64::consts::PI;
 
