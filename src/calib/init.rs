@@ -150,6 +150,7 @@ pub(super) fn relaxed_statics(options: &CalibrationOptions) -> CalibrationOption
 }
 
 /// A warmed-up start of the catenary stages.
+#[derive(Debug, Clone)]
 pub(super) struct CatenaryStart {
     /// Anchors of the candidate, offsets in closed form.
     pub robot: Robot,
@@ -176,19 +177,30 @@ impl CatenaryStart {
 }
 
 /// The warmed-up `candidates` (the initial guess, a rigid-cable calibration
-/// from it, or anchors mixed from both: [`mixed_anchors`]), best first. Each is warmed up (per-pose statics,
-/// closed-form offsets) and scored by its relaxed catenary cost per feasible
-/// pose (a start with fewer feasible poses is penalised); candidates with
-/// fewer than [`MIN_POSES`] feasible poses are dropped. The score only orders
-/// them: a start's cost says little about the basin it lies in (see
-/// [`super::calibrate_once`]), so every start is solved and the lowest final
-/// cost wins.
+/// from it, or anchors mixed from both: [`mixed_anchors`]), best first: the
+/// two halves [`warm_candidates`] and [`rank_starts`].
 pub(super) fn catenary_starts(
     candidates: impl IntoIterator<Item = Robot>,
     measurements: &[PoseMeasurement],
     relaxed_options: &CalibrationOptions,
 ) -> Vec<CatenaryStart> {
-    let mut scored: Vec<(f64, CatenaryStart)> = Vec::new();
+    let warmed = warm_candidates(candidates, measurements);
+    rank_starts(&warmed, measurements, relaxed_options)
+        .into_iter()
+        .cloned()
+        .collect()
+}
+
+/// Every candidate warmed up (per-pose statics, closed-form offsets), in the
+/// order given; candidates with fewer than [`MIN_POSES`] feasible poses are
+/// dropped. Independent of the calibration options (the statics and the
+/// offsets see only the robot and the readings), so one warm-up serves the
+/// calibrations with and without the orientation prior.
+pub(super) fn warm_candidates(
+    candidates: impl IntoIterator<Item = Robot>,
+    measurements: &[PoseMeasurement],
+) -> Vec<CatenaryStart> {
+    let mut warmed = Vec::new();
     for candidate in candidates {
         let warm = warm_up(&candidate, measurements);
         let mut start = candidate;
@@ -199,11 +211,33 @@ pub(super) fn catenary_starts(
         if feasible.len() < MIN_POSES {
             continue;
         }
-        let chosen: Vec<PoseMeasurement> = feasible.iter().map(|&k| measurements[k]).collect();
-        let poses: Vec<PlatformPose> = feasible.iter().map(|&k| warm.poses[k]).collect();
-        let tensions: Vec<CableTension> = feasible.iter().map(|&k| warm.tensions[k]).collect();
+        warmed.push(CatenaryStart {
+            robot: start,
+            poses: warm.poses,
+            tensions: warm.tensions,
+            feasible,
+        });
+    }
+    warmed
+}
+
+/// The warmed-up starts ([`warm_candidates`]) best first, each scored by its
+/// relaxed catenary cost per feasible pose under `relaxed_options` (a start
+/// with fewer feasible poses is penalised); a start whose cost cannot be
+/// evaluated, or whose anchors repeat a better-placed one, is dropped. The
+/// score only orders them: a start's cost says little about the basin it lies
+/// in (see [`super::calibrate_once`]), so every start is solved and the
+/// lowest final cost wins.
+pub(super) fn rank_starts<'a>(
+    warmed: &'a [CatenaryStart],
+    measurements: &[PoseMeasurement],
+    relaxed_options: &CalibrationOptions,
+) -> Vec<&'a CatenaryStart> {
+    let mut scored: Vec<(f64, &CatenaryStart)> = Vec::new();
+    for start in warmed {
+        let (chosen, poses, tensions) = start.feasible_subset(measurements);
         let graph = build_graph(
-            &start,
+            &start.robot,
             &chosen,
             &poses,
             &tensions,
@@ -214,23 +248,16 @@ pub(super) fn catenary_starts(
         let Some(cost) = graph.graph.cost(&graph.graph.values) else {
             continue;
         };
-        let score = cost / feasible.len() as f64 * (1.0 + (measurements.len() - feasible.len()) as f64);
+        let feasible = start.feasible.len();
+        let score = cost / feasible as f64 * (1.0 + (measurements.len() - feasible) as f64);
         // The same anchors twice (a rigid stage that did not move) would only be solved twice.
-        let duplicate = scored
-            .iter()
-            .any(|(_, other)| (0..CABLE_COUNT).all(|i| (other.robot.anchors_m[i] - start.anchors_m[i]).norm() < 1e-6));
+        let duplicate = scored.iter().any(|(_, other)| {
+            (0..CABLE_COUNT).all(|i| (other.robot.anchors_m[i] - start.robot.anchors_m[i]).norm() < 1e-6)
+        });
         if duplicate {
             continue;
         }
-        scored.push((
-            score,
-            CatenaryStart {
-                robot: start,
-                poses: warm.poses,
-                tensions: warm.tensions,
-                feasible,
-            },
-        ));
+        scored.push((score, start));
     }
     scored.sort_by(|a, b| a.0.total_cmp(&b.0));
     scored.into_iter().map(|(_, start)| start).collect()
@@ -280,12 +307,13 @@ pub(super) fn final_start(
     measurements: &[PoseMeasurement],
     feasible: &[usize],
 ) -> Result<FinalStart> {
-    let WarmUp {
-        poses: rewarmed_poses,
-        tensions: rewarmed_tensions,
-        failures: still_failing,
-        ..
-    } = warm_up(relaxed_robot, measurements);
+    // Only the poses that sat out are warmed up again (each pose's statics
+    // is its own problem): `sat_out[j]` is the measurement of `rewarmed[j]`.
+    let sat_out: Vec<usize> = (0..measurements.len()).filter(|k| !feasible.contains(k)).collect();
+    let rewarmed = warm_up(
+        relaxed_robot,
+        &sat_out.iter().map(|&k| measurements[k]).collect::<Vec<_>>(),
+    );
     let mut start = FinalStart {
         measurements: Vec::new(),
         poses: Vec::new(),
@@ -301,12 +329,14 @@ pub(super) fn final_start(
                 horizontal_n: t[0],
                 vertical_n: t[1],
             });
-        } else if still_failing.contains(&k) {
-            start.excluded.push(k);
-            continue;
         } else {
-            start.poses.push(rewarmed_poses[k]);
-            start.tensions.push(rewarmed_tensions[k]);
+            let j = sat_out.partition_point(|&s| s < k);
+            if rewarmed.failures.contains(&j) {
+                start.excluded.push(k);
+                continue;
+            }
+            start.poses.push(rewarmed.poses[j]);
+            start.tensions.push(rewarmed.tensions[j]);
         }
         start.measurements.push(measurements[k]);
     }

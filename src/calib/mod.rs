@@ -154,24 +154,63 @@ fn calibrate_once(
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
 ) -> Result<CalibrationResult> {
-    // (1) Rigid, massless cables from the initial guess: the whole job for the
-    // rigid model, a second candidate start for the catenary.
-    let (rigid_stage, rigid) = rigid_calibration(initial, measurements, options)?;
     if options.model == CableModel::Rigid {
+        let (rigid_stage, rigid) = rigid_calibration(initial, measurements, options)?;
         return finish(initial, rigid, vec![rigid_stage], Vec::new());
     }
+    let prepared = CatenaryPreparation::new(initial, measurements, options)?;
+    calibrate_prepared(initial, measurements, options, &prepared)
+}
+
+/// Stages (1) and (2) of the catenary pipeline, which the orientation prior
+/// does not enter: the rigid calibration (its pose priors always hold the
+/// localiser's orientation, whatever [`CalibrationOptions::orientation_prior`]
+/// says) and the per-pose warm-ups of the two starts (the statics at the
+/// measured positions and load-cell tensions). [`OrientationPrior::Auto`]
+/// makes them once for its calibrations with and without the prior.
+struct CatenaryPreparation {
+    rigid_stage: StageSummary,
+    rigid_robot: Robot,
+    /// The initial guess and the rigid calibration, warmed up ([`init::warm_candidates`]).
+    warmed: Vec<init::CatenaryStart>,
+}
+
+impl CatenaryPreparation {
+    fn new(initial: &Robot, measurements: &[PoseMeasurement], options: &CalibrationOptions) -> Result<Self> {
+        // (1) Rigid, massless cables from the initial guess: a second
+        // candidate start for the catenary.
+        let (rigid_stage, rigid) = rigid_calibration(initial, measurements, options)?;
+        let rigid_robot = robot_from_graph(initial, &rigid);
+        let warmed = init::warm_candidates([initial.clone(), rigid_robot.clone()], measurements);
+        Ok(CatenaryPreparation {
+            rigid_stage,
+            rigid_robot,
+            warmed,
+        })
+    }
+}
+
+/// The catenary stages (2)-(4) of [`calibrate_once`] under `options` from a
+/// [`CatenaryPreparation`] made for the same initial guess and measurements.
+fn calibrate_prepared(
+    initial: &Robot,
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+    prepared: &CatenaryPreparation,
+) -> Result<CalibrationResult> {
+    let rigid_stage = prepared.rigid_stage.clone();
     // (2) Two warmed-up starts: the initial guess and the rigid calibration,
     // each with per-pose statics and closed-form offsets. Both are solved and
     // the lower final cost wins (see the module docs, "Basins").
     let relaxed_options = init::relaxed_statics(options);
-    let rigid_robot = robot_from_graph(initial, &rigid);
-    let starts = init::catenary_starts([initial.clone(), rigid_robot.clone()], measurements, &relaxed_options);
+    let starts = init::rank_starts(&prepared.warmed, measurements, &relaxed_options);
     // The start with the lower warm-up cost first: a minimum that fits the
     // data as well as the noise allows needs no other start (the common case,
-    // at the cost of one solve).
+    // at the cost of one solve). Otherwise it joins the other starts' solves.
+    let mut solves = Vec::with_capacity(starts.len());
     if let Some(first) = starts.first() {
-        if let Ok(solved) = solve_catenary(initial, first, measurements, options, &relaxed_options) {
-            if solved.final_stage.summary.termination.converged() && solved.consistent_with_noise() {
+        match solve_catenary(initial, first, measurements, options, &relaxed_options) {
+            Ok(solved) if solved.final_stage.summary.termination.converged() && solved.consistent_with_noise() => {
                 return finish(
                     initial,
                     solved.full,
@@ -179,21 +218,28 @@ fn calibrate_once(
                     solved.excluded,
                 );
             }
+            other => solves.push(other),
         }
     }
-    let solves = solve_starts(initial, &starts, measurements, options, &relaxed_options);
+    solves.extend(solve_starts(
+        initial,
+        starts.iter().skip(1).copied(),
+        measurements,
+        options,
+        &relaxed_options,
+    ));
     let agree = solves.len() == 2 && CatenarySolve::same_minimum(&solves[0], &solves[1]);
     let mut best = best_of(solves, measurements);
     // (2') If the starts did not lead to one minimum and the best fits the data
     // worse than the noise allows, the anchors mixed cable by cable from both.
     if !agree && !best.as_ref().is_ok_and(|b| b.consistent_with_noise()) {
         let mixed = init::catenary_starts(
-            init::mixed_anchors(initial, &rigid_robot),
+            init::mixed_anchors(initial, &prepared.rigid_robot),
             measurements,
             &relaxed_options,
         );
         let more = best_of(
-            solve_starts(initial, &mixed, measurements, options, &relaxed_options),
+            solve_starts(initial, mixed.iter(), measurements, options, &relaxed_options),
             measurements,
         );
         best = match (best, more) {
@@ -213,15 +259,15 @@ fn calibrate_once(
 }
 
 /// The catenary stages solved from every start that can be solved.
-fn solve_starts(
+fn solve_starts<'a>(
     initial: &Robot,
-    starts: &[init::CatenaryStart],
+    starts: impl IntoIterator<Item = &'a init::CatenaryStart>,
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
     relaxed_options: &CalibrationOptions,
 ) -> Vec<Result<CatenarySolve>> {
     starts
-        .iter()
+        .into_iter()
         .map(|start| solve_catenary(initial, start, measurements, options, relaxed_options))
         .collect()
 }
@@ -501,5 +547,44 @@ pub fn set_effect_estimates(built: &mut CalibrationGraph, estimates: &[EffectEst
             vars.of(estimate.effect),
             crate::graph::VariableValue::Vector(nalgebra::DVector::from_vec(estimate.variable_values())),
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::sensors::NoisePreset;
+    use crate::sim::closed_form::{measure, sample_equilibria, Workspace};
+    use rand::SeedableRng;
+
+    /// [`OrientationPrior::Auto`] makes one [`CatenaryPreparation`] for its
+    /// calibrations with and without the prior: that is only right while the
+    /// rigid stage and the warm-ups come out the same, bit for bit, under both.
+    #[test]
+    fn preparation_does_not_depend_on_the_orientation_prior() {
+        let truth = Robot::builtin("large").unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), 12, &mut rng).unwrap();
+        let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
+        let data = measure(&truth, &equilibria, &noise, &mut rng);
+        let mut guess = truth.clone();
+        guess.anchors_m[2].y -= 4.0;
+        guess.length_offsets_m = [3.0, -2.0, 1.0, 0.5];
+        let prepared = |orientation_prior| {
+            let options = CalibrationOptions {
+                orientation_prior,
+                ..CalibrationOptions::new(noise)
+            };
+            CatenaryPreparation::new(&guess, &data, &options).unwrap()
+        };
+        let (on, off) = (prepared(OrientationPrior::On), prepared(OrientationPrior::Off));
+        // Debug strings: the stage history holds NaN gain ratios, which `==` would reject.
+        assert_eq!(format!("{:?}", on.rigid_stage), format!("{:?}", off.rigid_stage));
+        assert_eq!(on.rigid_robot.anchors_m, off.rigid_robot.anchors_m);
+        assert_eq!(on.rigid_robot.length_offsets_m, off.rigid_robot.length_offsets_m);
+        assert_eq!(format!("{:?}", on.warmed), format!("{:?}", off.warmed));
+        // The rigid stage moved the anchors: the two warmed starts differ.
+        assert_eq!(on.warmed.len(), 2);
+        assert!((on.rigid_robot.anchors_m[2] - guess.anchors_m[2]).norm() > 1.0);
     }
 }

@@ -7,7 +7,7 @@ use serde::Serialize;
 use super::graph::{build_graph, measured_pose};
 use super::options::{CableModel, CalibrationOptions, OrientationPrior};
 use super::result::CalibrationResult;
-use super::{calibrate_once, finish, solve_stage};
+use super::{calibrate_prepared, finish, solve_stage, CatenaryPreparation};
 use crate::error::Result;
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::Robot;
@@ -119,15 +119,18 @@ pub(super) fn calibrate_testing_orientation(
         orientation_prior: OrientationPrior::Off,
         ..*options
     };
-    let Ok(mut result) = calibrate_once(initial, measurements, &with_prior) else {
-        return calibrate_once(initial, measurements, &without_prior);
+    // The rigid stage and the warm-ups do not depend on the prior: made once
+    // for both calibrations (an error there is the same for both).
+    let prepared = CatenaryPreparation::new(initial, measurements, &with_prior)?;
+    let Ok(mut result) = calibrate_prepared(initial, measurements, &with_prior, &prepared) else {
+        return calibrate_prepared(initial, measurements, &without_prior, &prepared);
     };
     let mut check = orientation_check(&result, measurements, options.noise.orientation_sigma_rad);
     if check.chi_square <= check.limit {
         result.orientation_check = Some(check);
         return Ok(result);
     }
-    let mut result = calibrate_once(initial, measurements, &without_prior)?;
+    let mut result = calibrate_prepared(initial, measurements, &without_prior, &prepared)?;
     // A failed test says the localiser disagrees with the statics *at the
     // anchors found*: if the fit with the prior ended in a wrong basin (its
     // statics orientations then disagree with every localiser reading), the
