@@ -124,6 +124,19 @@ fn automatic_orientation_prior_keeps_consistent_and_drops_biased_orientations() 
     let check = consistent.orientation_check.unwrap();
     eprintln!("consistent: {check:?}");
     assert!(check.prior_used && check.chi_square < check.limit, "{check:?}");
+    // Auto shares its rigid stage and warm-ups between the calibrations with
+    // and without the prior: kept, it is the calibration with the prior, bit for bit.
+    let on = calibrate(
+        &initial,
+        &data,
+        &CalibrationOptions {
+            orientation_prior: OrientationPrior::On,
+            ..options
+        },
+    )
+    .unwrap();
+    assert_eq!(on.robot.anchors_m, consistent.robot.anchors_m);
+    assert_eq!(on.robot.length_offsets_m, consistent.robot.length_offsets_m);
     // The localiser's roll reads 2 degrees off at every pose (the RecurDyn log is ~1.9 degrees
     // off the equilibria): 3.5 sigma per pose, the test must reject the prior.
     let mut biased = data.clone();
@@ -134,7 +147,7 @@ fn automatic_orientation_prior_keeps_consistent_and_drops_biased_orientations() 
     let check = dropped.orientation_check.unwrap();
     eprintln!("biased: {check:?}");
     assert!(!check.prior_used && check.chi_square > check.limit, "{check:?}");
-    // Dropping it is the same as calibrating without it.
+    // Dropping it is the same as calibrating without it, bit for bit.
     let off = calibrate(
         &initial,
         &biased,
@@ -144,9 +157,8 @@ fn automatic_orientation_prior_keeps_consistent_and_drops_biased_orientations() 
         },
     )
     .unwrap();
-    for i in 0..4 {
-        assert!((off.robot.anchors_m[i] - dropped.robot.anchors_m[i]).norm() < 1e-9);
-    }
+    assert_eq!(off.robot.anchors_m, dropped.robot.anchors_m);
+    assert_eq!(off.robot.length_offsets_m, dropped.robot.length_offsets_m);
     // ...and much better than keeping the biased prior.
     let forced = calibrate(
         &initial,

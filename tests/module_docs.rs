@@ -118,8 +118,8 @@ fn every_public_module_opens_with_a_runnable_example() {
         let text = std::fs::read_to_string(&module.file)
             .unwrap_or_else(|e| panic!("module {}: {}: {e}", module.name, module.file.display()));
         let generated = module.file.components().any(|c| c.as_os_str() == "generated");
-        let example = has_runnable_example(&leading_inner_doc(&text))
-            || (generated && has_runnable_example(&module.outer_doc));
+        let example =
+            has_runnable_example(&leading_inner_doc(&text)) || (generated && has_runnable_example(&module.outer_doc));
         if !example {
             missing.push(format!("{} ({})", module.name, module.file.display()));
         }
@@ -137,8 +137,12 @@ fn the_checker_tells_runnable_fences_from_text() {
     assert!(!has_runnable_example(&lines(" ```text\n a = b\n ```")));
     assert!(!has_runnable_example(&lines(" ```ignore\n f();\n ```")));
     // The closing fence of a text block does not open an example.
-    assert!(!has_runnable_example(&lines(" ```text\n a\n ```\n prose\n ```toml\n x = 1\n ```")));
-    assert!(has_runnable_example(&lines(" ```text\n a\n ```\n ```\n assert!(true);\n ```")));
+    assert!(!has_runnable_example(&lines(
+        " ```text\n a\n ```\n prose\n ```toml\n x = 1\n ```"
+    )));
+    assert!(has_runnable_example(&lines(
+        " ```text\n a\n ```\n ```\n assert!(true);\n ```"
+    )));
     assert!(has_runnable_example(&lines(" ```no_run\n f();\n ```")));
     let header = "// banner\n//! Docs.\n//! ```\n//! x();\n//! ```\nuse a;\n//! not leading\n";
     assert_eq!(leading_inner_doc(header).len(), 4);
@@ -147,7 +151,16 @@ fn the_checker_tells_runnable_fences_from_text() {
 #[test]
 fn the_walk_finds_nested_and_path_modules() {
     let names: Vec<String> = public_modules().into_iter().map(|m| m.name).collect();
-    for expected in ["model::catenary", "graph::values", "generated", "calib::report", "sim::closed_form"] {
-        assert!(names.iter().any(|n| n == expected), "{expected} not found among {names:?}");
+    for expected in [
+        "model::catenary",
+        "graph::values",
+        "generated",
+        "calib::report",
+        "sim::closed_form",
+    ] {
+        assert!(
+            names.iter().any(|n| n == expected),
+            "{expected} not found among {names:?}"
+        );
     }
 }
