@@ -27,6 +27,8 @@ pub(super) struct SchurLayout {
     groups: Vec<(usize, usize)>,
     /// Per group: offset of its `D_k` (then `B_k`) in the block buffer.
     group_base: Vec<usize>,
+    /// Per tangent index past the globals, its group.
+    group_of: Vec<usize>,
     /// Block buffer: `A` (globals x globals, column-major), then per group
     /// `D_k` (m x m) and `B_k` (m x globals), column-major; after
     /// factorisation `A` holds the Cholesky factor of the reduced system,
@@ -47,17 +49,22 @@ impl SchurLayout {
             group_base.push(size);
             size += m * m + m * globals;
         }
+        let dim = groups.last().map_or(globals, |&(start, m)| start + m);
+        let mut group_of = vec![usize::MAX; dim.saturating_sub(globals)];
+        for (k, &(start, m)) in groups.iter().enumerate() {
+            group_of[start - globals..start - globals + m].fill(k);
+        }
         let layout = Self {
             globals,
             groups,
             group_base,
+            group_of,
             values: vec![0.0; size],
             factored: false,
         };
-        let group_of = |index: usize| layout.groups.partition_point(|&(start, _)| start <= index) - 1;
-        let coupled = indices
-            .iter()
-            .any(|&(row, col)| row >= globals && col >= globals && group_of(row) != group_of(col));
+        let coupled = indices.iter().any(|&(row, col)| {
+            row >= globals && col >= globals && layout.group_of[row - globals] != layout.group_of[col - globals]
+        });
         (!coupled).then_some(layout)
     }
 
@@ -68,7 +75,7 @@ impl SchurLayout {
         if row < g {
             return (row + col * g, g);
         }
-        let k = self.groups.partition_point(|&(start, _)| start <= row) - 1;
+        let k = self.group_of[row - g];
         let (start, m) = self.groups[k];
         if col < g {
             (self.group_base[k] + m * m + (row - start) + col * m, m)
@@ -88,14 +95,17 @@ impl SchurLayout {
     pub(super) fn factorize(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
         self.factored = false;
         let g = self.globals;
-        self.values.copy_from_slice(hessian);
-        for (i, d) in damping[..g].iter().enumerate() {
-            self.values[i + i * g] += d;
-        }
+        // Each block is copied from `hessian` just before it is factored
+        // (while it is in cache), not the whole buffer up front.
         let (reduced, blocks) = self.values.split_at_mut(g * g);
+        reduced.copy_from_slice(&hessian[..g * g]);
+        for (i, d) in damping[..g].iter().enumerate() {
+            reduced[i + i * g] += d;
+        }
         for (k, &(start, m)) in self.groups.iter().enumerate() {
             let base = self.group_base[k] - g * g;
             let block = &mut blocks[base..base + m * m + m * g];
+            block.copy_from_slice(&hessian[g * g + base..g * g + base + m * m + m * g]);
             let eliminated = match m {
                 8 => eliminate_group::<8>(block, &damping[start..start + m], reduced, g),
                 6 => eliminate_group::<6>(block, &damping[start..start + m], reduced, g),
