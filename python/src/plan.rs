@@ -253,13 +253,16 @@ fn candidate_source(
         None => Some(sagcal::experiments::pose_plan::DEFAULT_CANDIDATES),
         Some(v) if as_path(v).is_some() => None,
         Some(v) if v.is_instance_of::<pyo3::types::PyBool>() => {
-            return Err(invalid("candidates: a count of poses to draw, a path or an (N, 11) array, not a bool"));
+            return Err(invalid(
+                "candidates: a count of poses to draw, a path or an (N, 11) array, not a bool",
+            ));
         }
         Some(v) => match v.extract::<i64>() {
-            Ok(n) => Some(
-                usize::try_from(n)
-                    .map_err(|_| invalid(format!("candidates: a count of poses to draw cannot be negative, got {n}")))?,
-            ),
+            Ok(n) => Some(usize::try_from(n).map_err(|_| {
+                invalid(format!(
+                    "candidates: a count of poses to draw cannot be negative, got {n}"
+                ))
+            })?),
             Err(_) => None,
         },
     };
