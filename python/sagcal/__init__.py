@@ -12,6 +12,8 @@ in and out, the same jobs with the same options, results and error messages.
   (``sagcal calibrate``), with their covariance and the gross-error tests.
 - :func:`diagnose`: what the calibration model gets wrong (``sagcal diagnose``).
 - :func:`localize`: pose and tensions from the cable readings (``sagcal localize``).
+- :func:`plan`: the calibration poses that best determine the anchors, in a
+  short visiting order (``sagcal plan``).
 - :func:`read_measurements`, :func:`write_measurements`: sagcal's CSV (and
   RecurDyn logs) as (N, 11) arrays in the columns of :data:`MEASUREMENT_COLUMNS`.
 
@@ -34,6 +36,7 @@ from ._sagcal import (
     Calibration,
     Diagnosis,
     Localization,
+    PosePlan,
     Robot,
     SagcalError,
     Simulation,
@@ -41,23 +44,18 @@ from ._sagcal import (
     calibrate,
     diagnose,
     localize,
+    plan,
     read_measurements,
     simulate,
     write_measurements,
 )
-
-# --- sagcal.plan (issue 19) --------------------------------------------------
-# The pose planner (src/plan/) is being built on another branch. After the
-# merge, register `plan` in python/src/lib.rs (the marked place there) and add
-# `plan` (and its result class) to the import above, to __all__ below and to
-# __init__.pyi (the marked place there), with a test in python/tests/.
-# ------------------------------------------------------------------------------
 
 __all__ = [
     "MEASUREMENT_COLUMNS",
     "Calibration",
     "Diagnosis",
     "Localization",
+    "PosePlan",
     "Robot",
     "SagcalError",
     "Simulation",
@@ -65,6 +63,7 @@ __all__ = [
     "calibrate",
     "diagnose",
     "localize",
+    "plan",
     "read_measurements",
     "simulate",
     "write_measurements",

@@ -220,6 +220,58 @@ class Localization:
     def position_error_m(self) -> Optional[FloatArray]:
         """Distance from the input's localiser positions, metres: (N,), or ``None``."""
 
+class PosePlan:
+    """The result of :func:`plan` (one row per chosen pose, in visiting order)."""
+
+    @property
+    def positions_m(self) -> FloatArray:
+        """Commanded platform positions, metres: (N, 3)."""
+    @property
+    def roll_pitch_yaw_deg(self) -> FloatArray:
+        """The nominal model's orientations, degrees: (N, 3)."""
+    @property
+    def cable_lengths_m(self) -> FloatArray:
+        """The nominal model's cable lengths, metres: (N, 4)."""
+    @property
+    def min_horizontal_tension_n(self) -> FloatArray:
+        """The smallest horizontal cable tension at each pose, newtons: (N,)."""
+    @property
+    def measurements(self) -> FloatArray:
+        """The plan as noise-free measurements (what ``--out`` writes): (N, 11)."""
+    @property
+    def candidates_m(self) -> FloatArray:
+        """The kept candidates' positions, metres: (M, 3)."""
+    @property
+    def order(self) -> list[int]:
+        """The chosen candidates in visiting order (0-based rows of ``candidates_m``)."""
+    @property
+    def anchor_covariance_m2(self) -> FloatArray:
+        """The plan's bound on each anchor's covariance, m^2: (4, 3, 3)."""
+    @property
+    def anchor_bound_m(self) -> float:
+        """The plan's bound, RMS per anchor, metres."""
+    @property
+    def offset_bound_m(self) -> float:
+        """The plan's bound, RMS per encoder offset, metres."""
+    @property
+    def random_anchor_bound_m(self) -> float:
+        """Mean bound of random sets of as many candidates, RMS per anchor, metres."""
+    @property
+    def random_offset_bound_m(self) -> float:
+        """Mean bound of random sets of as many candidates, RMS per offset, metres."""
+    @property
+    def random35_anchor_bound_m(self) -> Optional[float]:
+        """Mean bound of random sets of 35 candidates, RMS per anchor, metres, or ``None``."""
+    @property
+    def path_length_m(self) -> float:
+        """Length of the visiting path, metres."""
+    @property
+    def seed(self) -> int:
+        """The random seed."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The plan as ``sagcal plan --json`` prints it."""
+
 class Simulation:
     """The result of :func:`simulate`."""
 
@@ -285,6 +337,19 @@ def localize(
 ) -> Localization:
     """Pose and tensions from the cable readings, as ``sagcal localize`` does."""
 
+def plan(
+    robot: Robot,
+    poses: int,
+    *,
+    candidates: Union[int, ArrayLike, PathLike, None] = 1000,
+    workspace: Union[Sequence[float], str, None] = None,
+    noise: str = "paper",
+    criterion: str = "a",
+    seed: int = 1,
+    orientation_prior: str = "off",
+) -> PosePlan:
+    """The calibration poses that best determine the anchors, as ``sagcal plan`` chooses them."""
+
 def simulate(
     robot: Robot,
     poses: int,
@@ -302,5 +367,3 @@ def read_measurements(path: PathLike, reference_cable: int = 1) -> FloatArray:
 
 def write_measurements(path: PathLike, measurements: ArrayLike, comments: Optional[Sequence[str]] = None) -> None:
     """Write an (N, 11) array as a sagcal measurement file (atomically)."""
-
-# --- sagcal.plan (issue 19): the stub of `plan` goes here after src/plan/ is merged. ---

@@ -13,6 +13,7 @@ mod diagnose;
 mod json;
 mod localize;
 mod options;
+mod plan;
 mod robot;
 mod simulate;
 
@@ -50,6 +51,7 @@ fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<calibrate::Calibration>()?;
     m.add_class::<diagnose::Diagnosis>()?;
     m.add_class::<localize::Localization>()?;
+    m.add_class::<plan::PosePlan>()?;
     m.add_class::<simulate::Simulation>()?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose::diagnose, m)?)?;
@@ -57,8 +59,6 @@ fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(data::read_measurements, m)?)?;
     m.add_function(wrap_pyfunction!(data::write_measurements, m)?)?;
-    // --- sagcal.plan (issue 19): the pose planner of src/plan/ is registered here
-    // (`m.add_function(wrap_pyfunction!(plan::plan, m)?)?;`, a `mod plan;` beside
-    // the others) once src/plan/ is merged; see python/sagcal/__init__.py. ---
+    m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     Ok(())
 }

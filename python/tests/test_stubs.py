@@ -67,5 +67,5 @@ def test_functions_have_docstrings_naming_the_command():
     for name in stub_functions():
         doc = getattr(sagcal, name).__doc__
         assert doc and len(doc) > 80, name
-    for name in ["calibrate", "diagnose", "localize", "simulate"]:
+    for name in ["calibrate", "diagnose", "localize", "plan", "simulate"]:
         assert f"sagcal {name}" in " ".join(getattr(sagcal, name).__doc__.split()), name

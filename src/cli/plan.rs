@@ -3,216 +3,86 @@
 
 use std::path::Path;
 
-use nalgebra::Vector3;
-use serde::Serialize;
-
-use sagcal::calib::{CalibrationOptions, OrientationPrior};
-use sagcal::experiments::plan_candidates::{draw_candidates, filter_candidates, frame_workspace, CandidateSet};
-use sagcal::experiments::table2::{pose_pool, Source};
+use sagcal::experiments::pose_plan::{plan_calibration, CandidateSource, PlanProgress, PlanReport, PlanSettings};
 use sagcal::io::measurements::{read_measurements, write_measurements, ReadOptions};
 use sagcal::model::robot::Workspace;
 use sagcal::model::statics::Equilibrium;
 use sagcal::model::Robot;
 use sagcal::plan::information::noise_free_reading;
-use sagcal::plan::{candidate_information, plan_poses, DesignOptions, Margins, Plan};
+use sagcal::plan::Plan;
 use sagcal::plot::plan::{plan_plot_svg, PlanPlot};
 use sagcal::plot::write_figure;
 
 use super::output::{print_json, progress_bar, Table};
 use super::PlanArgs;
 
-/// One pose of the plan, in visiting order.
-#[derive(Debug, Clone, Serialize)]
-struct PlannedPose {
-    /// 1-based position in the visiting order.
-    visit: usize,
-    /// Commanded platform position, metres.
-    position_m: [f64; 3],
-    /// The nominal model's orientation at that position, degrees.
-    roll_pitch_yaw_deg: [f64; 3],
-    /// The nominal model's cable lengths, metres.
-    cable_lengths_m: [f64; 4],
-    /// The smallest horizontal cable tension, newtons.
-    min_horizontal_tension_n: f64,
-}
-
-#[derive(Debug, Clone, Serialize)]
-struct Report {
-    robot: String,
-    seed: u64,
-    noise: sagcal::model::sensors::NoisePreset,
-    criterion: sagcal::plan::Criterion,
-    orientation_prior: OrientationPrior,
-    workspace: Option<Workspace>,
-    candidates_from: String,
-    candidates: CandidateSet,
-    margins: Margins,
-    poses: usize,
-    anchor_bound_m: f64,
-    offset_bound_m: f64,
-    random_anchor_bound_m: f64,
-    random_offset_bound_m: f64,
-    random35_anchor_bound_m: Option<f64>,
-    path_length_m: f64,
-    ridge: f64,
-    exchanges: usize,
-    plan: Vec<PlannedPose>,
-}
-
-/// `x0,x1,y0,y1,z0,z1` in metres.
+/// `x0,x1,y0,y1,z0,z1` in metres (see `sagcal::experiments::pose_plan::parse_workspace`).
 pub fn parse_workspace(text: &str) -> Result<Workspace, String> {
-    let v: Vec<f64> = text
-        .split(',')
-        .map(|p| p.trim().parse::<f64>().map_err(|_| format!("`{p}` is not a number")))
-        .collect::<Result<_, _>>()?;
-    if v.len() != 6 || v.iter().any(|x| !x.is_finite()) || v[0] >= v[1] || v[2] >= v[3] || v[4] >= v[5] {
-        return Err(format!(
-            "`{text}`: a workspace is six finite numbers x0,x1,y0,y1,z0,z1 (metres) with x0 < x1, y0 < y1, z0 < z1"
-        ));
-    }
-    Ok(Workspace {
-        min_m: [v[0], v[2], v[4]],
-        max_m: [v[1], v[3], v[5]],
-    })
+    sagcal::experiments::pose_plan::parse_workspace(text)
 }
 
-/// The candidates: from `--from`, or drawn in `--workspace`, the robot
-/// file's `[workspace]`, or the frame below the anchors.
-fn candidates(
-    args: &PlanArgs,
-    robot: &Robot,
-    margins: &Margins,
-) -> sagcal::Result<(CandidateSet, Option<Workspace>, String)> {
-    if let Some(path) = &args.from {
-        let data = read_measurements(
-            path,
-            &ReadOptions {
-                reference_cable: robot.reference_cable,
-                keep_rounded: false,
-            },
-        )?;
-        let pool = pose_pool(robot, &data.poses, Source::Model)?;
-        let set = filter_candidates(robot, pool.into_iter().map(|p| p.equilibrium).collect(), margins);
-        return Ok((set, None, path.display().to_string()));
-    }
-    let (workspace, from) = match (args.workspace, robot.workspace) {
-        (Some(w), _) => (w, "--workspace"),
-        (None, Some(w)) => (w, "the robot file's [workspace]"),
-        (None, None) => (
-            frame_workspace(robot),
-            "the frame below the anchors (10 % margin, z 5-75 % of the anchors' height)",
-        ),
+/// The settings of `args`; the candidates from `--from`, or drawn in
+/// `--workspace`, the robot file's `[workspace]`, or the frame below the anchors.
+fn settings(args: &PlanArgs, robot: &Robot) -> sagcal::Result<PlanSettings> {
+    let candidates = match &args.from {
+        Some(path) => CandidateSource::Logged {
+            poses: read_measurements(
+                path,
+                &ReadOptions {
+                    reference_cable: robot.reference_cable,
+                    keep_rounded: false,
+                },
+            )?
+            .poses,
+            label: path.display().to_string(),
+        },
+        None => CandidateSource::Drawn {
+            workspace: args.workspace,
+            count: args.candidates,
+        },
     };
-    let bar = progress_bar(1, "{msg} {spinner} {elapsed}");
-    bar.set_message(format!(
-        "drawing {} candidate poses in {from}, seed {}",
-        args.candidates, args.seed
-    ));
-    bar.enable_steady_tick(std::time::Duration::from_millis(200));
-    let set = draw_candidates(robot, &workspace, args.candidates, margins, args.seed)?;
-    bar.finish_and_clear();
-    Ok((set, Some(workspace), format!("{} drawn in {from}", args.candidates)))
+    Ok(PlanSettings {
+        poses: args.poses,
+        noise: args.noise,
+        candidates,
+        seed: args.seed,
+        criterion: args.criterion,
+        orientation_prior: args.orientation_prior,
+    })
 }
 
 /// Plan, print the table (or JSON), write the CSV and the figure.
 pub fn run(args: &PlanArgs) -> sagcal::Result<()> {
     let robot = Robot::from_file(&args.robot)?;
-    let margins = Margins::for_robot(&robot);
     eprintln!(
         "sagcal plan: seed {}, {} poses, {:?}-optimal",
         args.seed, args.poses, args.criterion
     );
-    let (set, workspace, from) = candidates(args, &robot, &margins)?;
-    if set.equilibria.len() < args.poses {
-        return Err(sagcal::Error::InvalidInput(format!(
-            "{} poses requested but only {} candidates keep the margins and are stable ({} outside the margins, {} unstable)",
-            args.poses,
-            set.equilibria.len(),
-            set.outside_margins,
-            set.unstable
-        )));
-    }
-    let mut options = CalibrationOptions::new(args.noise.sigmas(robot.platform_weight_n));
-    options.orientation_prior = args.orientation_prior;
-    let information = candidate_information(&robot, &set.equilibria, &options)?;
-    let design = DesignOptions {
-        criterion: args.criterion,
-        ..DesignOptions::new(args.poses)
+    let settings = settings(args, &robot)?;
+    let mut bar = None;
+    let mut progress = |step: PlanProgress<'_>| match step {
+        PlanProgress::Drawing(message) => {
+            let spinner = progress_bar(1, "{msg} {spinner} {elapsed}");
+            spinner.set_message(message.to_string());
+            spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+            bar = Some(spinner);
+        }
+        PlanProgress::Drawn => bar.take().into_iter().for_each(|b| b.finish_and_clear()),
     };
-    let start = start_point(&set.equilibria);
-    let plan = plan_poses(&set.equilibria, &information, &design, &start, args.seed)?;
-    let report = report(args, &robot, &set, workspace, from, margins, &plan);
+    let planned = plan_calibration(&robot, &settings, &mut progress)?;
+    let (report, plan) = (&planned.report, &planned.plan);
+    let candidates = &report.candidates.equilibria;
     if let Some(path) = &args.out {
-        write_plan_csv(path, &robot, &set.equilibria, &plan, args)?;
+        write_plan_csv(path, &robot, candidates, plan, args)?;
     }
     if let Some(path) = &args.plot {
-        write_plot(path, &robot, &set.equilibria, &plan, workspace, args)?;
+        write_plot(path, &robot, candidates, plan, report.workspace, args)?;
     }
     if args.json {
-        return print_json(&report);
+        return print_json(report);
     }
-    print_report(&report, &plan);
+    print_report(report, plan);
     Ok(())
-}
-
-/// Where the path starts: the candidate nearest the middle of the floor of
-/// the candidates' region (an operator's usual home position).
-fn start_point(candidates: &[Equilibrium]) -> Vector3<f64> {
-    let n = candidates.len().max(1) as f64;
-    let mut centre = candidates.iter().map(|e| e.pose.position_m).sum::<Vector3<f64>>() / n;
-    centre.z = candidates
-        .iter()
-        .map(|e| e.pose.position_m.z)
-        .fold(f64::INFINITY, f64::min);
-    centre
-}
-
-fn report(
-    args: &PlanArgs,
-    robot: &Robot,
-    set: &CandidateSet,
-    workspace: Option<Workspace>,
-    from: String,
-    margins: Margins,
-    plan: &Plan,
-) -> Report {
-    let poses = plan
-        .order
-        .iter()
-        .enumerate()
-        .map(|(visit, &k)| {
-            let eq = &set.equilibria[k];
-            let (r, p, y) = eq.pose.roll_pitch_yaw_deg();
-            PlannedPose {
-                visit: visit + 1,
-                position_m: eq.pose.position_m.into(),
-                roll_pitch_yaw_deg: [r, p, y],
-                cable_lengths_m: eq.cable_lengths_m,
-                min_horizontal_tension_n: eq.tensions.iter().map(|t| t.horizontal_n).fold(f64::INFINITY, f64::min),
-            }
-        })
-        .collect();
-    Report {
-        robot: robot.name.clone(),
-        seed: args.seed,
-        noise: args.noise,
-        criterion: args.criterion,
-        orientation_prior: args.orientation_prior,
-        workspace,
-        candidates_from: from,
-        candidates: set.clone(),
-        margins,
-        poses: plan.order.len(),
-        anchor_bound_m: plan.bound.anchor_rms_m,
-        offset_bound_m: plan.bound.offset_rms_m,
-        random_anchor_bound_m: plan.random.anchor_rms_m,
-        random_offset_bound_m: plan.random.offset_rms_m,
-        random35_anchor_bound_m: plan.random35.as_ref().map(|r| r.anchor_rms_m),
-        path_length_m: plan.path_length_m,
-        ridge: plan.design.ridge,
-        exchanges: plan.design.exchanges,
-        plan: poses,
-    }
 }
 
 /// The plan as a sagcal measurement CSV in visiting order: commanded
@@ -247,7 +117,7 @@ fn write_plan_csv(
     write_measurements(path, &comments, &rows)
 }
 
-fn print_report(report: &Report, plan: &Plan) {
+fn print_report(report: &PlanReport, plan: &Plan) {
     println!(
         "{} candidates ({}; {} outside the margins, {} unstable left out), {} chosen, {:?}-optimal, seed {}",
         report.candidates.equilibria.len(),

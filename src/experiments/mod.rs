@@ -25,5 +25,6 @@ pub mod benchmark;
 pub mod hidden_effects;
 pub mod localize_after_calibration;
 pub mod plan_candidates;
+pub mod pose_plan;
 pub mod selection;
 pub mod table2;
