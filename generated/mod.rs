@@ -3,6 +3,39 @@
 //!
 //! Derived in `codegen/factors.py` (conventions in `codegen/README.md`). Every function
 //! returns its value and fills the Jacobians that are requested (`Some`).
+//!
+//! ```
+//! use nalgebra::{Matrix3x4, SMatrix, Vector3, Vector4};
+//! use sagcal::generated::rigid_length_residual;
+//! // A level platform at the origin with its attachments at its centre, anchors 5 m away
+//! // (a 3-4-5 triangle): a straight cable is 5 m long, so readings of 5 m with offsets
+//! // l0 = [0, 0, 0, 0.1] m leave the residual |a - p| + l0 - z = l0.
+//! let anchors = Matrix3x4::from_columns(&[
+//!     Vector3::new(3.0, 4.0, 0.0),
+//!     Vector3::new(-3.0, 4.0, 0.0),
+//!     Vector3::new(0.0, 3.0, 4.0),
+//!     Vector3::new(0.0, 0.0, 5.0),
+//! ]);
+//! let offsets = Vector4::new(0.0, 0.0, 0.0, 0.1);
+//! let (mut d_pose, mut d_offsets) = (SMatrix::<f64, 4, 6>::zeros(), SMatrix::<f64, 4, 4>::zeros());
+//! let r = rigid_length_residual(
+//!     &Vector3::zeros(),
+//!     &Vector4::new(0.0, 0.0, 0.0, 1.0), // identity, [x, y, z, w]
+//!     &anchors,
+//!     &Matrix3x4::zeros(),
+//!     &offsets,
+//!     &Vector4::repeat(5.0),
+//!     1e-15,
+//!     Some(&mut d_pose),
+//!     None,
+//!     Some(&mut d_offsets),
+//! );
+//! assert!((r - offsets).norm() < 1e-12);
+//! assert_eq!(d_offsets, SMatrix::<f64, 4, 4>::identity());
+//! // Moving the platform by dp shortens cable 1 by the unit vector towards its anchor: -(0.6, 0.8, 0).
+//! let d_position = d_pose.fixed_view::<1, 3>(0, 3);
+//! assert!((d_position - Vector3::new(-0.6, -0.8, 0.0).transpose()).norm() < 1e-12);
+//! ```
 
 mod attachment_height_residual;
 mod cable_geometry;

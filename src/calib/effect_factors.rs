@@ -9,6 +9,27 @@
 //!
 //! With every effect parameter at its neutral value (0) they equal the
 //! baseline factors of [`super::factors`] (tested in `tests/extended_model.rs`).
+//!
+//! ```
+//! use nalgebra::{DMatrix, DVector};
+//! use sagcal::calib::effect_factors::LoadCellFactor;
+//! use sagcal::graph::{Factor, RobustKernel, Values, VariableValue};
+//! let vector = |v: &[f64]| VariableValue::Vector(DVector::from_column_slice(v));
+//! let mut values = Values::new();
+//! let tension = values.insert("reference tension", vector(&[300.0, 400.0])); // (f_h, f_v): |T| = 500 N
+//! let cell = values.insert("load cell", vector(&[0.0, 0.0])); // [bias_n, gain_error], neutral
+//! let factor = LoadCellFactor::new(tension, cell, 510.0, 5.0, RobustKernel::None);
+//! // Neutral: the baseline force factor |T| - f_m = 500 - 510.
+//! assert!((factor.evaluate(&values, None).unwrap()[0] + 10.0).abs() < 1e-12);
+//! // A 2 N bias and a 1 % gain error: 2 + 1.01 * 500 - 510 = -3 N.
+//! values.set(cell, vector(&[2.0, 0.01]));
+//! let mut blocks = vec![DMatrix::zeros(1, 2), DMatrix::zeros(1, 2)];
+//! let r = factor.evaluate(&values, Some(&mut blocks)).unwrap();
+//! assert!((r[0] + 3.0).abs() < 1e-9);
+//! // d r / d(f_h, f_v) = 1.01 (0.6, 0.8); d r / d(bias, gain_error) = (1, |T|).
+//! assert!((blocks[0][(0, 0)] - 0.606).abs() < 1e-12 && (blocks[0][(0, 1)] - 0.808).abs() < 1e-12);
+//! assert!((blocks[1][(0, 0)] - 1.0).abs() < 1e-12 && (blocks[1][(0, 1)] - 500.0).abs() < 1e-9);
+//! ```
 
 use std::sync::Arc;
 

@@ -5,6 +5,50 @@
 //! The generated functions take the cables in *slot order* (slot 0 = the
 //! reference cable); [`SlotOrder`] maps the robot's cable numbering to slots
 //! once, so the variables (anchors, offsets) keep the robot's numbering.
+//!
+//! ```
+//! use std::sync::Arc;
+//! use nalgebra::{DMatrix, DVector, Vector3};
+//! use sagcal::calib::factors::{CalibrationVariables, PoseVariables, RigidLengthFactor, SlotOrder};
+//! use sagcal::graph::{Factor, RobustKernel, Values, VariableValue};
+//! use sagcal::model::{PlatformPose, Robot};
+//! let mut robot = Robot::builtin("large")?;
+//! robot.reference_cable = 2; // the load cell on cable 3: it takes slot 0
+//! let slots = SlotOrder::new(&robot);
+//! assert_eq!(slots.cables, [2, 0, 1, 3]);
+//! let vector = |v: &[f64]| VariableValue::Vector(DVector::from_column_slice(v));
+//! let mut values = Values::new();
+//! let position = Vector3::new(10.0, -5.0, 20.0);
+//! let pose = values.insert("pose", VariableValue::Pose(PlatformPose::from_position(position)));
+//! let reference_tension = values.insert("tension", vector(&[100.0, 100.0]));
+//! let anchors = std::array::from_fn(|i| values.insert(format!("anchor {i}"), vector(robot.anchors_m[i].as_slice())));
+//! let length_offsets = std::array::from_fn(|i| values.insert(format!("offset {i}"), vector(&[0.5])));
+//! // Straight cables of a level platform: reading = |anchor - (p + b)| + offset; cable 3 reads 1 cm long.
+//! let mut readings: [f64; 4] =
+//!     std::array::from_fn(|i| (robot.anchors_m[i] - (position + robot.attachments_m[i])).norm() + 0.5);
+//! readings[2] += 0.01;
+//! let factor = RigidLengthFactor::new(
+//!     Arc::new(slots),
+//!     CalibrationVariables { anchors, length_offsets },
+//!     PoseVariables { pose, reference_tension },
+//!     &readings,
+//!     0.01,
+//!     RobustKernel::None,
+//! );
+//! // Residuals and Jacobian blocks come back in the robot's cable order:
+//! // one block per variable, [pose (6 columns), anchors 1-4 (3), offsets 1-4 (1)].
+//! let dims = [6, 3, 3, 3, 3, 1, 1, 1, 1];
+//! let mut blocks: Vec<DMatrix<f64>> = dims.iter().map(|&d| DMatrix::zeros(4, d)).collect();
+//! let r = factor.evaluate(&values, Some(&mut blocks)).unwrap();
+//! assert!((r - DVector::from_column_slice(&[0.0, 0.0, -0.01, 0.0])).norm() < 1e-9);
+//! for i in 0..4 {
+//!     assert_eq!(blocks[5 + i], DMatrix::from_fn(4, 1, |row, _| if row == i { 1.0 } else { 0.0 }));
+//! }
+//! // Moving anchor 3 along its cable lengthens only cable 3, by the unit vector's share.
+//! let along = (robot.anchors_m[2] - (position + robot.attachments_m[2])).normalize();
+//! assert!((blocks[3].row(2).transpose() - along).norm() < 1e-9 && blocks[3].row(0).norm() == 0.0);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use std::sync::Arc;
 

@@ -27,6 +27,31 @@
 //! Before calibrating, [`super::mistakes`] looks for the common mistakes that
 //! are not single blunders (a sensor logged in the wrong unit, a pose outside
 //! the frame).
+//!
+//! ```
+//! use rand::SeedableRng;
+//! use sagcal::calib::gross_errors::{calibrate_checked, GrossErrorOptions, Verdict};
+//! use sagcal::calib::CalibrationOptions;
+//! use sagcal::model::measurement::Sensor;
+//! use sagcal::model::sensors::NoisePreset;
+//! use sagcal::model::Robot;
+//! use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
+//! let truth = Robot::builtin("large")?;
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(63);
+//! let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), 15, &mut rng)?;
+//! let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
+//! let mut data = measure(&truth, &equilibria, &noise, &mut rng);
+//! data[4].encoder_lengths_m[2] += 2.0; // the drum of cable 3 slipped 2 m before row 5 was read
+//! let options = CalibrationOptions::new(noise);
+//! let checked = calibrate_checked(&truth, &data, &options, &GrossErrorOptions::default())?;
+//! assert_eq!(checked.verdict, Verdict::Consistent);
+//! assert_eq!(checked.excluded.len(), 1, "{:#?}", checked.excluded);
+//! let blunder = &checked.excluded[0].test;
+//! assert_eq!((blunder.pose, blunder.sensor), (4, Sensor::Encoder(2)));
+//! // Its estimated error is the slip, to within a few of the encoders' 10 mm sigma.
+//! assert!((blunder.estimated_error - 2.0).abs() < 0.05, "{}", blunder.describe());
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use serde::Serialize;
 

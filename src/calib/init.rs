@@ -320,7 +320,7 @@ pub(super) fn final_start(
         tensions: Vec::new(),
         excluded: Vec::new(),
     };
-    for k in 0..measurements.len() {
+    for (k, measurement) in measurements.iter().enumerate() {
         if let Some(slot) = feasible.iter().position(|&f| f == k) {
             let vars = relaxed.poses[slot];
             let t = relaxed.graph.values.vector(vars.reference_tension);
@@ -338,7 +338,7 @@ pub(super) fn final_start(
             start.poses.push(rewarmed.poses[j]);
             start.tensions.push(rewarmed.tensions[j]);
         }
-        start.measurements.push(measurements[k]);
+        start.measurements.push(*measurement);
     }
     if start.measurements.len() < MIN_POSES {
         return Err(Error::NoEquilibrium(format!(

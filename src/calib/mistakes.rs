@@ -20,6 +20,34 @@
 //!   estimated error (within 5 sigma of each other, over 10 sigma from 0);
 //! - **a pose whose readings fail together**: three or more readings of one
 //!   row left out that nothing above explains.
+//!
+//! ```
+//! use rand::SeedableRng;
+//! use sagcal::calib::mistakes::{before_calibration, without_rows_outside, MistakeKind};
+//! use sagcal::model::sensors::NoisePreset;
+//! use sagcal::model::Robot;
+//! use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
+//! let robot = Robot::builtin("large")?;
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+//! let equilibria = sample_equilibria(&robot, &Workspace::default_for(&robot), 8, &mut rng)?;
+//! let noise = NoisePreset::Paper.sigmas(robot.platform_weight_n);
+//! let mut data = measure(&robot, &equilibria, &noise, &mut rng);
+//! assert!(before_calibration(&robot, &data).is_empty());
+//! // The load cell logged in kN, and row 3's position 200 m east (the anchors are at x = +-125 m).
+//! for m in &mut data {
+//!     m.reference_tension_n /= 1000.0;
+//! }
+//! data[2].position_m[0] = 200.0;
+//! let found = before_calibration(&robot, &data);
+//! assert_eq!(found.len(), 2, "{found:#?}");
+//! assert_eq!(found[0].kind, MistakeKind::WrongUnit);
+//! assert!(found[0].message.contains("they look like kN, not N"), "{}", found[0].message);
+//! assert_eq!((found[1].kind, found[1].rows.clone()), (MistakeKind::OutsideFrame, vec![2]));
+//! assert!(found[1].message.starts_with("row 3"), "{}", found[1].message);
+//! let (kept, rows) = without_rows_outside(&data, &found);
+//! assert_eq!((kept.len(), rows), (7, vec![0, 1, 3, 4, 5, 6, 7]));
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::Vector3;
 use serde::Serialize;

@@ -1,4 +1,31 @@
 //! A calibration's result as a serialisable report (what `sagcal calibrate --json` prints).
+//!
+//! ```
+//! use rand::SeedableRng;
+//! use sagcal::calib::report::CalibrationReport;
+//! use sagcal::calib::{calibrate, CableModel, CalibrationOptions};
+//! use sagcal::model::sensors::NoisePreset;
+//! use sagcal::model::Robot;
+//! use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
+//! let truth = Robot::builtin("large")?;
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2);
+//! let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), 10, &mut rng)?;
+//! // Noise-free readings (weighted by the paper's sigmas): the fit lands on the truth.
+//! let data = measure(&truth, &equilibria, &NoisePreset::None.sigmas(truth.platform_weight_n), &mut rng);
+//! let mut nominal = truth.clone();
+//! nominal.anchors_m[0].x += 0.2; // the drawing puts anchor 1 0.2 m off
+//! let options = CalibrationOptions::new(NoisePreset::Paper.sigmas(truth.platform_weight_n));
+//! let result = calibrate(&nominal, &data, &options)?;
+//! let report = CalibrationReport::new(&result, &nominal, CableModel::Catenary, &[], Some(&truth));
+//! assert_eq!((report.poses_used, report.converged), (10, true));
+//! // Calibrated minus nominal: the 0.2 m the drawing was off, back.
+//! assert!((report.anchor_change_m[0][0] + 0.2).abs() < 1e-4, "{:?}", report.anchor_change_m);
+//! assert!(report.error_against_truth.unwrap().anchor_mean_euclidean_m < 1e-4);
+//! let json = serde_json::to_value(&report).unwrap();
+//! assert_eq!(json["anchors_m"][0][0], report.anchors_m[0][0]);
+//! assert_eq!(json["robot"], "large");
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use serde::Serialize;
 

@@ -18,6 +18,47 @@
 //! was never fitted on. Data: a RecurDyn log (every cable's tension) or a
 //! sagcal measurement file (the encoder readings as lengths, the load cell
 //! as the reference cable's tension).
+//!
+//! ```
+//! use rand::SeedableRng;
+//! use sagcal::diagnose::verify::{paper_table1, verify, Closure, MeasuredData, MeasuredRow};
+//! use sagcal::model::robot::PaperRobot;
+//! use sagcal::model::statics::StaticsOptions;
+//! use sagcal::model::Robot;
+//! use sagcal::sim::closed_form::{sample_equilibria, Workspace};
+//! let robot = Robot::builtin("large")?;
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+//! let equilibria = sample_equilibria(&robot, &Workspace::default_for(&robot), 3, &mut rng)?;
+//! // Rows measured by the model itself (every cable's length and tension) ...
+//! let mut rows: Vec<MeasuredRow> = equilibria
+//!     .iter()
+//!     .enumerate()
+//!     .map(|(k, eq)| {
+//!         let (roll, pitch, yaw) = eq.pose.roll_pitch_yaw_deg();
+//!         MeasuredRow {
+//!             line: k + 2,
+//!             position_m: eq.pose.position_m.into(),
+//!             roll_pitch_yaw_deg: [roll, pitch, yaw],
+//!             cable_lengths_m: eq.cable_lengths_m,
+//!             tensions_n: eq.tensions.map(|t| Some(t.magnitude_n())),
+//!         }
+//!     })
+//!     .collect();
+//! // ... but the first row logs cable 2 1 % long.
+//! rows[0].cable_lengths_m[1] *= 1.01;
+//! let data = MeasuredData { path: "model".into(), rows, rejected: Vec::new() };
+//! let report = verify(&robot, &data, Closure::ReferenceTension, &StaticsOptions::default());
+//! assert_eq!(report.rows.len(), 3);
+//! // |L - 1.01 L| / (1.01 L) on that reading, 0 on the other 11.
+//! let error_pct = report.rows[0].length_error_pct[1];
+//! assert!((error_pct - 100.0 * 0.01 / 1.01).abs() < 1e-6, "{error_pct}");
+//! assert!((report.mpe_length_pct.unwrap() - error_pct / 12.0).abs() < 1e-6);
+//! assert!(report.mpe_force_pct.unwrap() < 1e-6 && report.orientation_error_deg.unwrap() < 1e-6);
+//! // The paper's Table I, printed beside it for its robots.
+//! assert_eq!(report.paper_table1, Some(paper_table1(PaperRobot::Large)));
+//! assert_eq!(paper_table1(PaperRobot::Large).mpe_force_pct, 0.9154);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Serialize;

@@ -12,6 +12,32 @@
 //! [`crate::calib::calibrate`] (catenary length, attachment height at 0.1 mm,
 //! reference tension, pose prior with orientation), see
 //! [`BenchmarkProblem::graph`].
+//!
+//! ```
+//! use sagcal::experiments::benchmark::{BenchmarkProblem, OFFSET_PERTURBATION_M};
+//! use sagcal::graph::FactorGraph;
+//! let problem = BenchmarkProblem::new(5, 7)?;
+//! for i in 0..4 {
+//!     let moved = problem.initial.length_offsets_m[i] - problem.truth.length_offsets_m[i];
+//!     assert!((moved.abs() - OFFSET_PERTURBATION_M).abs() < 1e-12);
+//! }
+//! let built = problem.graph();
+//! // Per pose: catenary length (eq. 14, 4 rows), attachment height (eq. 15, 4),
+//! // reference tension (eq. 16, 1) and pose prior (6); no tension guard.
+//! for kind in ["catenary_length", "attachment_height", "reference_tension", "pose_prior"] {
+//!     assert_eq!(built.graph.factors.iter().filter(|f| f.kind() == kind).count(), 5, "{kind}");
+//! }
+//! let rows: usize = built.graph.factors.iter().map(|f| f.residual_dim()).sum();
+//! assert_eq!((built.graph.factors.len(), rows), (20, 5 * 15));
+//! // The poses start on their statics at the initial anchors: the 0.1 mm height
+//! // constraints hold there (cost far below one per row).
+//! let values = &built.graph.values;
+//! let heights = built.graph.factors.iter().filter(|f| f.kind() == "attachment_height");
+//! let height_cost: f64 = heights.map(|f| FactorGraph::factor_cost(f.as_ref(), values).unwrap()).sum();
+//! assert!(height_cost < 1e-6, "{height_cost}");
+//! assert_eq!(BenchmarkProblem::stopping().max_iterations, 100);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};

@@ -47,6 +47,36 @@
 //! so it is supported as a known geometry input instead (the robot file's
 //! `[effects] pulley_radius_m`), and each pulley case also reports the anchor
 //! error of a calibration that is given the radius.
+//!
+//! ```
+//! use rand::SeedableRng;
+//! use sagcal::experiments::hidden_effects::{
+//!     case_seed, draw_effects, simulate_case, HiddenEffectOptions, TRUTH_ANCHOR_SPREAD_M, TRUTH_OFFSET_SPREAD_M,
+//! };
+//! use sagcal::model::effects::EffectKind;
+//! use sagcal::model::Robot;
+//! let nominal = Robot::builtin("large")?;
+//! let hidden = [EffectKind::EncoderScale, EffectKind::LoadCell];
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+//! let e = draw_effects(&nominal, &hidden, 150.0, &mut rng);
+//! // Drum gains 1 +- 0.1..0.3 %; load cell bias 5-12 % of the 150 N mean tension, gain 1 +- 2..5 %.
+//! assert!(e.encoder_gain.iter().all(|g| (0.001..0.003).contains(&(g - 1.0).abs())));
+//! assert!((0.05..0.12).contains(&(e.load_cell_bias_n.abs() / 150.0)));
+//! assert!((0.02..0.05).contains(&(e.load_cell_gain - 1.0).abs()));
+//! assert!(e.axial_stiffness_n.is_none() && e.pulley_radius_m == 0.0); // nothing else hidden
+//! // A case: a truth drawn off the nominal robot, its effects set, the data of its simulator.
+//! let options = HiddenEffectOptions { poses: 4, segments: 10, ..HiddenEffectOptions::default() };
+//! let seed = case_seed(7, 0, &hidden, 0);
+//! assert_ne!(seed, case_seed(7, 0, &hidden, 1));
+//! let (data, truth, guess) = simulate_case(&nominal, &hidden, seed, &options)?;
+//! assert_eq!((data.len(), guess.anchors_m), (4, nominal.anchors_m));
+//! for i in 0..4 {
+//!     let moved = truth.anchors_m[i] - nominal.anchors_m[i];
+//!     assert!(moved.amax() <= TRUTH_ANCHOR_SPREAD_M && truth.length_offsets_m[i].abs() <= TRUTH_OFFSET_SPREAD_M);
+//!     assert!((0.001..0.003).contains(&(truth.effects.encoder_gain[i] - 1.0).abs()));
+//! }
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::{DMatrix, DVector, Vector3};
 use rand::{Rng, SeedableRng};

@@ -18,6 +18,56 @@
 //! position, or the model's equilibrium). A row no stable equilibrium
 //! explains, or that fails its consistency test, is counted as flagged and
 //! left out of the error statistics.
+//!
+//! ```
+//! use rand::SeedableRng;
+//! use sagcal::calib::{CableModel, OrientationPrior};
+//! use sagcal::experiments::localize_after_calibration::{run_trial, summarise, LocalizeTrial};
+//! use sagcal::experiments::table2::{pose_pool, Protocol, Source};
+//! use sagcal::model::effects::EffectSet;
+//! use sagcal::model::sensors::NoisePreset;
+//! use sagcal::model::Robot;
+//! use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
+//! use sagcal::stats::chi_square_critical;
+//! let truth = Robot::builtin("large")?;
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(8);
+//! let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), 12, &mut rng)?;
+//! let log = measure(&truth, &equilibria, &NoisePreset::None.sigmas(truth.platform_weight_n), &mut rng);
+//! let pool = pose_pool(&truth, &log, Source::Model)?;
+//! let protocol = Protocol {
+//!     noise: NoisePreset::Paper,
+//!     model: CableModel::Catenary,
+//!     anchor_perturbation_m: 1.0,
+//!     offset_perturbation_m: 10.0,
+//!     basin_radius_m: 3.0,
+//!     orientation_prior: OrientationPrior::Auto,
+//!     estimate: EffectSet::NONE,
+//!     apply_gross_errors: false,
+//! };
+//! // Calibrate on 8 poses of the 12, localise the other 4 from their encoders and load cell.
+//! let trial = run_trial(&truth, &pool, 8, 0, 5, &protocol);
+//! assert!(trial.calibrated && trial.held_out == 4);
+//! assert_eq!((trial.errors_m.len(), trial.flagged), (4, 0));
+//! for (e, s) in trial.errors_m.iter().zip(&trial.predicted_sigma_m) {
+//!     assert!(*e < 3.0 * s, "{e} m off, predicted sigma {s} m");
+//! }
+//! // The summary's 95 % radius: chi-square with 3 dof, sqrt(7.815 / 3) = 1.61 x the sigmas' norm.
+//! let hand = LocalizeTrial {
+//!     trial: 0,
+//!     calibrated: true,
+//!     anchor_error_m: Some(0.1),
+//!     held_out: 2,
+//!     errors_m: vec![0.03, 0.04],
+//!     predicted_sigma_m: vec![0.02, 0.02],
+//!     flagged: 0,
+//!     truth_errors_m: vec![0.0, 0.0],
+//! };
+//! assert!((chi_square_critical(3, 0.05) - 7.8147).abs() < 1e-4);
+//! let summary = summarise(&[hand])?;
+//! assert!((summary.position_rms_error_m - (0.5f64 * (0.03f64.powi(2) + 0.04f64.powi(2))).sqrt()).abs() < 1e-12);
+//! assert_eq!(summary.within_95_percent, 0.5); // 0.03 < 1.61 x 0.02 = 0.032 < 0.04
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

@@ -3,6 +3,31 @@
 //! every cable clear of the floor ([`Margins`]) and hang in a stable
 //! equilibrium (the stiffness at fixed cable lengths is positive definite,
 //! [`crate::localize::stiffness`]).
+//!
+//! ```
+//! use sagcal::experiments::plan_candidates::{draw_candidates, filter_candidates, frame_workspace};
+//! use sagcal::model::Robot;
+//! use sagcal::plan::Margins;
+//! let robot = Robot::builtin("large")?;
+//! // Anchors at x = +-125 m, y = +-110 m, z = 48 m: 10 % in from each side, z from 5 % to 75 % of 48 m.
+//! let frame = frame_workspace(&robot);
+//! let expected = [[-100.0, -88.0, 2.4], [100.0, 88.0, 36.0]];
+//! for (got, want) in [frame.min_m, frame.max_m].iter().zip(&expected) {
+//!     assert!((0..3).all(|i| (got[i] - want[i]).abs() < 1e-12), "{got:?}");
+//! }
+//! let margins = Margins::for_robot(&robot);
+//! let set = draw_candidates(&robot, &frame, 4, &margins, 11)?;
+//! assert_eq!(set.equilibria.len(), 4);
+//! assert_eq!(set.examined, 4 + set.outside_margins + set.unstable);
+//! assert!(set.equilibria.iter().all(|eq| margins.violation(&robot, eq).is_none()));
+//! // Judged again, every kept pose stays. Candidate k comes from its own stream (seed, k):
+//! // drawing one with the same seed gives the first again, whatever the thread count.
+//! let again = filter_candidates(&robot, set.equilibria.clone(), &margins);
+//! assert_eq!((again.equilibria.len(), again.outside_margins, again.unstable), (4, 0, 0));
+//! let first = draw_candidates(&robot, &frame, 1, &margins, 11)?;
+//! assert_eq!(first.equilibria[0].pose.position_m, set.equilibria[0].pose.position_m);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::Vector2;
 use rand::SeedableRng;

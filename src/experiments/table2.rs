@@ -15,6 +15,47 @@
 //!
 //! Every trial has its own random stream, seeded from `(seed, pose count,
 //! trial)`, so results do not depend on the number of threads.
+//!
+//! ```
+//! use rand::SeedableRng;
+//! use sagcal::calib::{CableModel, OrientationPrior};
+//! use sagcal::experiments::table2::{pose_pool, run_trial, trial_inputs, Protocol, Source};
+//! use sagcal::model::effects::EffectSet;
+//! use sagcal::model::sensors::NoisePreset;
+//! use sagcal::model::Robot;
+//! use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
+//! let truth = Robot::builtin("large")?;
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(8);
+//! let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), 12, &mut rng)?;
+//! // A noise-free log of the truth: the model source re-solves each row's equilibrium.
+//! let log = measure(&truth, &equilibria, &NoisePreset::None.sigmas(truth.platform_weight_n), &mut rng);
+//! let pool = pose_pool(&truth, &log, Source::Model)?;
+//! for (p, eq) in pool.iter().zip(&equilibria) {
+//!     assert!((0..4).all(|i| (p.cable_lengths_m[i] - eq.cable_lengths_m[i]).abs() < 1e-6));
+//! }
+//! let protocol = Protocol {
+//!     noise: NoisePreset::Paper,
+//!     model: CableModel::Catenary,
+//!     anchor_perturbation_m: 1.0,
+//!     offset_perturbation_m: 10.0,
+//!     basin_radius_m: 3.0,
+//!     orientation_prior: OrientationPrior::Auto,
+//!     estimate: EffectSet::NONE,
+//!     apply_gross_errors: false,
+//! };
+//! // Trial 0 with 8 poses: its subset, noise and guess follow from (seed, poses, trial) alone.
+//! let (chosen, data, guess, _) = trial_inputs(&truth, &pool, 8, 0, 5, &protocol);
+//! assert_eq!((chosen.len(), data.len()), (8, 8));
+//! assert!((0..4).all(|i| ((guess.anchors_m[i] - truth.anchors_m[i]).norm() - 1.0).abs() < 1e-12));
+//! assert!(guess.length_offsets_m.iter().all(|o| o.abs() == 10.0)); // the truth's are 0
+//! let trial = run_trial(&truth, &pool, 8, 0, 5, &protocol);
+//! assert!(trial.converged, "{:?}", trial.failure);
+//! assert_eq!(trial.lines, chosen.iter().map(|&k| pool[k].line).collect::<Vec<_>>());
+//! // The error is of the size the Cramer-Rao bound expects.
+//! let (error_m, bound_m) = (trial.error.unwrap().anchor_mean_euclidean_m, trial.anchor_crlb_m.unwrap());
+//! assert!(error_m < 3.0 * bound_m, "{error_m} m against a bound of {bound_m} m");
+//! # Ok::<(), sagcal::Error>(())
+//! ```
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 use rand::{Rng, SeedableRng};

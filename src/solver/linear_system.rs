@@ -26,6 +26,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use nalgebra::DMatrix;
 
+use super::accumulate::{FactorRuns, SlotBlock};
 use super::schur::SchurLayout;
 use crate::graph::{Factor, Values, VariableId};
 
@@ -35,9 +36,8 @@ pub struct LinearSystem {
     pub offsets: Vec<Option<usize>>,
     /// Total tangent dimension of the free variables.
     pub dim: usize,
-    /// Per factor, per pair `(a, b)` of its free variable slots with
-    /// `offset(a) >= offset(b)`: where that block sits in the storage of `H`.
-    factor_blocks: Vec<Vec<FactorBlock>>,
+    /// Per factor, how its `J^T J` blocks add into the storage of `H`.
+    factor_runs: Vec<FactorRuns>,
     /// Per tangent index, the storage position of its diagonal entry.
     diagonal_slots: Vec<usize>,
     /// Per tangent index, the index in `indices` of its diagonal entry.
@@ -49,17 +49,6 @@ pub struct LinearSystem {
     /// Storage position of every entry of `indices`.
     positions: Vec<usize>,
     factorization: Factorization,
-}
-
-/// One `J^T J` block of a factor: `J_a^T J_b` for its variable slots `a`, `b`
-/// goes to the storage of `H` at `start + i + j * stride` (`i` a column of
-/// `J_a`, `j` of `J_b`; for `a` = `b` the lower triangle `i >= j` only).
-#[derive(Clone, Copy)]
-struct FactorBlock {
-    slot_a: usize,
-    slot_b: usize,
-    start: usize,
-    stride: usize,
 }
 
 /// Largest tangent dimension of the global variables for block elimination
@@ -222,7 +211,7 @@ struct BlockPattern {
     /// Number of stored scalars.
     entry_count: usize,
     /// Per factor: the blocks it touches (start in the block-wise storage, stride: rows of the block).
-    factor_blocks: Vec<Vec<FactorBlock>>,
+    factor_blocks: Vec<Vec<SlotBlock>>,
 }
 
 impl BlockPattern {
@@ -251,7 +240,7 @@ impl BlockPattern {
                     if oa < ob || (a == b && slot_a != slot_b) {
                         continue;
                     }
-                    list.push(FactorBlock {
+                    list.push(SlotBlock {
                         slot_a,
                         slot_b,
                         start: pattern.block_for(values, a, b),
@@ -356,10 +345,19 @@ impl LinearSystem {
                 diagonal_entries[row] = k;
             }
         }
+        let factor_runs = factors
+            .iter()
+            .zip(&pattern.factor_blocks)
+            .map(|(factor, blocks)| {
+                let variables = factor.variables();
+                let dims: Vec<usize> = variables.iter().map(|&v| values.tangent_dim(v)).collect();
+                FactorRuns::new(variables, &layout.offsets, &dims, blocks)
+            })
+            .collect();
         Ok(Self {
             offsets: layout.offsets,
             dim: layout.dim,
-            factor_blocks: pattern.factor_blocks,
+            factor_runs,
             diagonal_slots: diagonal_entries.iter().map(|&k| positions[k]).collect(),
             diagonal_entries,
             storage_len,
@@ -380,50 +378,18 @@ impl LinearSystem {
     }
 
     /// Add factor `index`'s weighted `J^T J` blocks (whitened, robust-weighted
-    /// Jacobian blocks `jacobians`) into `hessian`, and `J^T r` into `gradient`.
+    /// Jacobian blocks `jacobians`, one per variable slot) into `hessian`, and
+    /// `J^T r` into `gradient`; `rows_buffer` is scratch the caller reuses.
     pub fn accumulate(
         &self,
         index: usize,
-        variables: &[VariableId],
         jacobians: &[DMatrix<f64>],
         residual: &[f64],
         hessian: &mut [f64],
         gradient: &mut [f64],
+        rows_buffer: &mut Vec<f64>,
     ) {
-        match residual.len() {
-            1 => self.accumulate_rows::<1>(index, variables, jacobians, residual, hessian, gradient),
-            4 => self.accumulate_rows::<4>(index, variables, jacobians, residual, hessian, gradient),
-            6 => self.accumulate_rows::<6>(index, variables, jacobians, residual, hessian, gradient),
-            _ => self.accumulate_rows::<0>(index, variables, jacobians, residual, hessian, gradient),
-        }
-    }
-
-    /// [`LinearSystem::accumulate`] for `R`-row factors (`R = 0`: any row count).
-    #[inline(always)]
-    fn accumulate_rows<const R: usize>(
-        &self,
-        index: usize,
-        variables: &[VariableId],
-        jacobians: &[DMatrix<f64>],
-        residual: &[f64],
-        hessian: &mut [f64],
-        gradient: &mut [f64],
-    ) {
-        let rows = if R == 0 { residual.len() } else { R };
-        for (slot, &var) in variables.iter().enumerate() {
-            if let Some(offset) = self.offsets[var.0] {
-                // Column-major: column c of the block is data[c * rows..(c + 1) * rows].
-                let data = jacobians[slot].as_slice();
-                for c in 0..data.len() / rows {
-                    gradient[offset + c] += dot::<R>(&data[c * rows..(c + 1) * rows], residual);
-                }
-            }
-        }
-        for block in &self.factor_blocks[index] {
-            let (ja, jb) = (jacobians[block.slot_a].as_slice(), jacobians[block.slot_b].as_slice());
-            let same = variables[block.slot_a] == variables[block.slot_b];
-            add_block_product::<R>(ja, jb, same, rows, block.stride, &mut hessian[block.start..]);
-        }
+        self.factor_runs[index].accumulate(jacobians, residual, hessian, gradient, rows_buffer);
     }
 
     /// The diagonal of `H` from its value array.
@@ -504,74 +470,6 @@ impl LinearSystem {
             dense[(col, row)] = hessian[position];
         }
         dense
-    }
-}
-
-/// Add `A^T B` (or, when `same`, the lower triangle of `A^T A`) for two
-/// column-major Jacobian blocks of `rows` rows to the block at the start of
-/// `block`, entry `(i, j)` at `i + j * stride`.
-///
-/// The shapes a calibration graph has (`R` rows; 1, 2, 3 or 6 columns: an
-/// offset, a reference tension, an anchor, a pose) go to kernels whose sizes
-/// are known at compile time (unrolled, no bounds checks); the rest to the
-/// general loop. Both add the same products in the same order.
-#[inline(always)]
-fn add_block_product<const R: usize>(a: &[f64], b: &[f64], same: bool, rows: usize, stride: usize, block: &mut [f64]) {
-    if R != 0 {
-        macro_rules! kernels {
-            ($(($ca:literal, $cb:literal)),*) => {
-                match (a.len() / R, b.len() / R, same) {
-                    $(($ca, $cb, false) => return block_product::<R, $ca, $cb, false>(a, b, stride, block),)*
-                    (1, 1, true) => return block_product::<R, 1, 1, true>(a, a, stride, block),
-                    (2, 2, true) => return block_product::<R, 2, 2, true>(a, a, stride, block),
-                    (3, 3, true) => return block_product::<R, 3, 3, true>(a, a, stride, block),
-                    (6, 6, true) => return block_product::<R, 6, 6, true>(a, a, stride, block),
-                    _ => {}
-                }
-            };
-        }
-        kernels!(
-            (1, 1),
-            (1, 3),
-            (3, 1),
-            (3, 3),
-            (2, 1),
-            (2, 3),
-            (6, 1),
-            (6, 3),
-            (2, 6),
-            (6, 2),
-            (1, 2),
-            (3, 2),
-            (1, 6),
-            (3, 6)
-        );
-    }
-    for (j, column_b) in b.chunks_exact(rows).enumerate() {
-        let first = if same { j } else { 0 };
-        for (i, column_a) in a.chunks_exact(rows).enumerate().skip(first) {
-            block[i + j * stride] += dot::<0>(column_a, column_b);
-        }
-    }
-}
-
-/// [`add_block_product`] for `R`-row blocks of `CA` and `CB` columns
-/// (`SAME`: the lower triangle of `A^T A`, `CA = CB`).
-#[inline(always)]
-fn block_product<const R: usize, const CA: usize, const CB: usize, const SAME: bool>(
-    a: &[f64],
-    b: &[f64],
-    stride: usize,
-    block: &mut [f64],
-) {
-    let a: &[f64] = &a[..R * CA];
-    let b: &[f64] = &b[..R * CB];
-    for j in 0..CB {
-        let column_b = &b[j * R..(j + 1) * R];
-        let column = &mut block[j * stride..j * stride + CA];
-        for i in (if SAME { j } else { 0 })..CA {
-            column[i] += dot::<R>(&a[i * R..(i + 1) * R], column_b);
-        }
     }
 }
 

@@ -34,6 +34,7 @@
 //! # Ok::<(), sagcal::Error>(())
 //! ```
 
+mod accumulate;
 mod covariance;
 mod linear_system;
 mod local;
@@ -184,6 +185,8 @@ pub(crate) fn linearize(graph: &FactorGraph, values: &Values, system: &LinearSys
 #[derive(Default)]
 struct Workspace {
     buffers: LinearizationBuffers,
+    /// Scratch of [`LinearSystem::accumulate`].
+    rows_buffer: Vec<f64>,
     candidate: Values,
     spare: Option<Linearization>,
 }
@@ -204,7 +207,9 @@ fn linearize_with(
     gradient.clear();
     gradient.resize(system.dim, 0.0);
     let mut cost = 0.0;
-    let buffers = &mut work.buffers;
+    let Workspace {
+        buffers, rows_buffer, ..
+    } = work;
     for (index, factor) in graph.factors.iter().enumerate() {
         let variables = factor.variables();
         let linearized = buffers.linearize(factor.as_ref(), values).map_err(|what| {
@@ -218,11 +223,11 @@ fn linearize_with(
         }
         system.accumulate(
             index,
-            variables,
             &linearized.jacobians,
             &linearized.residual,
             &mut hessian,
             &mut gradient,
+            rows_buffer,
         );
     }
     Ok(Linearization {

@@ -173,18 +173,50 @@ fn eliminate_group<const M: usize>(block: &mut [f64], damping: &[f64], reduced: 
     for column in w.chunks_exact_mut(m) {
         forward_substitute(d, m, column);
     }
-    for j in 0..g {
-        let wj = &w[j * m..(j + 1) * m];
-        for i in j..g {
-            let wi = &w[i * m..(i + 1) * m];
-            let mut sum = 0.0;
-            for r in 0..m {
-                sum += wi[r] * wj[r];
+    match (M, g) {
+        (8, 16) => subtract_gram::<8, 16>(w, reduced),
+        (6, 16) => subtract_gram::<6, 16>(w, reduced),
+        _ => {
+            for j in 0..g {
+                let wj = &w[j * m..(j + 1) * m];
+                for i in j..g {
+                    let wi = &w[i * m..(i + 1) * m];
+                    let mut sum = wi[0] * wj[0];
+                    for r in 1..m {
+                        sum += wi[r] * wj[r];
+                    }
+                    reduced[i + j * g] -= sum;
+                }
             }
-            reduced[i + j * g] -= sum;
         }
     }
     true
+}
+
+/// `reduced -= W^T W` (lower triangle) for `W` (`M x G`, column-major) known
+/// in size: `W` is copied row by row so that neighbouring entries of a
+/// column of `reduced` are neighbouring SIMD lanes; each entry sums its `M`
+/// products in order, as the general loop does.
+#[inline(always)]
+fn subtract_gram<const M: usize, const G: usize>(w: &[f64], reduced: &mut [f64]) {
+    let w = &w[..M * G];
+    let mut rows = [[0.0f64; G]; M];
+    for (i, column) in w.chunks_exact(M).enumerate() {
+        for r in 0..M {
+            rows[r][i] = column[r];
+        }
+    }
+    let reduced = &mut reduced[..G * G];
+    for j in 0..G {
+        let column = &mut reduced[j * G..(j + 1) * G];
+        for i in j..G {
+            let mut sum = rows[0][i] * rows[0][j];
+            for row in &rows[1..] {
+                sum += row[i] * row[j];
+            }
+            column[i] -= sum;
+        }
+    }
 }
 
 /// In-place Cholesky `A = L L^T` of the lower triangle of a column-major
