@@ -103,6 +103,7 @@ pub mod mistakes;
 mod options;
 mod orientation;
 mod predict;
+mod prepared;
 pub mod report;
 mod result;
 mod snooping;
@@ -122,6 +123,7 @@ pub use init::warm_start;
 pub use options::{CableModel, CalibrationOptions, OrientationPrior, RobustKernels};
 pub use orientation::OrientationCheck;
 pub use predict::predict_with_effects;
+pub use prepared::PreparedCalibration;
 pub use result::{
     factor_statistics, CalibrationResult, EffectEstimate, FactorStatistics, ParameterUncertainty, StageSummary,
 };

@@ -115,22 +115,37 @@ pub(super) fn calibrate_testing_orientation(
         orientation_prior: OrientationPrior::On,
         ..*options
     };
+    // The rigid stage and the warm-ups do not depend on the prior: made once
+    // for both calibrations (an error there is the same for both).
+    let prepared = CatenaryPreparation::new(initial, measurements, &with_prior)?;
+    testing_orientation_prepared(initial, measurements, options, &prepared)
+}
+
+/// [`calibrate_testing_orientation`] from the rigid stage and warm-ups of a
+/// [`CatenaryPreparation`] made for the same initial guess and measurements.
+pub(super) fn testing_orientation_prepared(
+    initial: &Robot,
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+    prepared: &CatenaryPreparation,
+) -> Result<CalibrationResult> {
+    let with_prior = CalibrationOptions {
+        orientation_prior: OrientationPrior::On,
+        ..*options
+    };
     let without_prior = CalibrationOptions {
         orientation_prior: OrientationPrior::Off,
         ..*options
     };
-    // The rigid stage and the warm-ups do not depend on the prior: made once
-    // for both calibrations (an error there is the same for both).
-    let prepared = CatenaryPreparation::new(initial, measurements, &with_prior)?;
-    let Ok(mut result) = calibrate_prepared(initial, measurements, &with_prior, &prepared) else {
-        return calibrate_prepared(initial, measurements, &without_prior, &prepared);
+    let Ok(mut result) = calibrate_prepared(initial, measurements, &with_prior, prepared) else {
+        return calibrate_prepared(initial, measurements, &without_prior, prepared);
     };
     let mut check = orientation_check(&result, measurements, options.noise.orientation_sigma_rad);
     if check.chi_square <= check.limit {
         result.orientation_check = Some(check);
         return Ok(result);
     }
-    let mut result = calibrate_prepared(initial, measurements, &without_prior, &prepared)?;
+    let mut result = calibrate_prepared(initial, measurements, &without_prior, prepared)?;
     // A failed test says the localiser disagrees with the statics *at the
     // anchors found*: if the fit with the prior ended in a wrong basin (its
     // statics orientations then disagree with every localiser reading), the

@@ -3,6 +3,7 @@
 
 use std::collections::BTreeMap;
 
+use rayon::prelude::*;
 use sagcal::experiments::hidden_effects::{
     effect_ranges, identifiability, mean_reference_tension_n, run_sweep, smallest_effects, EffectRange, HiddenCase,
     HiddenEffectOptions, Identifiability, PAIRS,
@@ -97,13 +98,16 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         ..HiddenEffectOptions::default()
     };
     let cases = sweep(args, &robots, &options)?;
-    let mut smallest = Vec::new();
+    // The identifiability of each robot's smallest effects: independent, in parallel.
+    let mut studies = Vec::new();
     for robot in &robots {
         let mean_tension = mean_reference_tension_n(robot, args.poses, args.seed)?;
-        for (kind, effects) in smallest_effects(robot, mean_tension) {
-            smallest.push(identifiability(robot, kind, &effects, args.poses, args.seed, &options)?);
-        }
+        studies.extend(smallest_effects(robot, mean_tension).into_iter().map(|s| (robot, s)));
     }
+    let smallest = studies
+        .par_iter()
+        .map(|(robot, (kind, effects))| identifiability(robot, *kind, effects, args.poses, args.seed, &options))
+        .collect::<sagcal::Result<Vec<_>>>()?;
     let scores = scores(&robots, &args.noise, &cases);
     let report = Report {
         seed: args.seed,

@@ -9,8 +9,8 @@ use super::selection::Search;
 use super::Baseline;
 use crate::calib::gross_errors::graph_at_solution;
 use crate::calib::{
-    calibrate, refine_with_effects, CableModel, CalibrationError, CalibrationGraph, CalibrationOptions,
-    CalibrationResult, EffectEstimate, OrientationPrior,
+    refine_with_effects, CableModel, CalibrationError, CalibrationGraph, CalibrationOptions, CalibrationResult,
+    EffectEstimate, OrientationPrior,
 };
 use crate::error::Result;
 use crate::model::effect_ranges::smallest_plausible;
@@ -171,7 +171,7 @@ impl Model {
         if !hypotheses.is_empty() {
             // The fit's effects go back to the known inputs before the refinement
             // estimates them (the robot's `[effects]` cannot hold every estimate).
-            let fresh = calibrate(&base.guess, measurements, &options).and_then(|mut fresh| {
+            let fresh = base.calibrate(measurements, &options).and_then(|mut fresh| {
                 fresh.robot.effects = base.result.robot.effects;
                 refine_with_effects(&fresh, measurements, &options)
             });

@@ -68,7 +68,9 @@ pub mod verify;
 
 use crate::calib::gross_errors::{calibrate_checked, ExcludedReading, GrossErrorOptions, Verdict};
 use crate::calib::mistakes::{Mistake, MistakeKind};
-use crate::calib::{calibrate, CalibrationGraph, CalibrationOptions, CalibrationResult, OrientationPrior};
+use crate::calib::{
+    calibrate, CalibrationGraph, CalibrationOptions, CalibrationResult, OrientationPrior, PreparedCalibration,
+};
 use crate::error::{Error, Result};
 use crate::model::effects::{EffectKind, EffectSet};
 use crate::model::measurement::{PoseMeasurement, ReadingSet};
@@ -131,6 +133,12 @@ impl Progress<'_> {
         self.done += 1;
     }
 
+    /// Count `steps` steps as done without a report of their own (fits run
+    /// in parallel under one report).
+    fn advance(&mut self, steps: usize) {
+        self.done += steps;
+    }
+
     /// `steps` more steps than planned.
     fn grow(&mut self, steps: usize) {
         self.total += steps;
@@ -167,8 +175,10 @@ struct Baseline {
     bic: f64,
     /// Mean load-cell reading over the poses used, newtons.
     mean_reference_tension_n: f64,
-    /// The initial guess every calibration starts from.
-    guess: Robot,
+    /// The initial guess every calibration starts from, with the cleaned
+    /// measurements and the stages of their calibration that the
+    /// orientation prior and the free effects do not enter.
+    start: PreparedCalibration,
 }
 
 impl Baseline {
@@ -191,7 +201,8 @@ impl Baseline {
             ..options.calibration
         };
         progress.step("baseline calibration");
-        let result = calibrate(robot, measurements, &base_options)?;
+        let start = PreparedCalibration::new(robot, measurements, &base_options);
+        let result = start.calibrate(&base_options)?;
         let resolved = base_options.as_used_by(&result);
         let used: Vec<PoseMeasurement> = (0..measurements.len())
             .filter(|k| !result.excluded_poses.contains(k))
@@ -223,12 +234,23 @@ impl Baseline {
             variance_factor: variance_factor(chi_square, dof),
             bic: f64::NAN,
             mean_reference_tension_n: f64::NAN,
-            guess: robot.clone(),
+            start,
         };
         base.mean_reference_tension_n =
             base.used.iter().map(|m| m.reference_tension_n).sum::<f64>() / base.used.len() as f64;
         base.bic = base.bic_of(chi_square, 0);
         Ok(base)
+    }
+
+    /// [`calibrate`] of `measurements` from the initial guess under
+    /// `options`, from the shared stages where the measurements are the
+    /// baseline's (the same result, [`PreparedCalibration`]).
+    fn calibrate(&self, measurements: &[PoseMeasurement], options: &CalibrationOptions) -> Result<CalibrationResult> {
+        if measurements == self.start.measurements() {
+            self.start.calibrate(options)
+        } else {
+            calibrate(self.start.initial(), measurements, options)
+        }
     }
 
     /// The BIC of a fit with chi-square `chi` and `added` parameters more than the baseline.

@@ -20,6 +20,7 @@
 //! one common gain) is replaced by it where the data do not reject the
 //! simpler one, and the search goes on until nothing is significant.
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use super::candidates::{inadmissible, rebuild, test_hypothesis, CandidateFit, Hypothesis, Model};
@@ -109,10 +110,16 @@ pub(super) fn forward_selection(search: &Search<'_>, progress: &mut Progress<'_>
             break;
         }
         progress.grow(open.len());
+        // The hypotheses' fits are independent: fitted in parallel, compared in order.
+        let names: Vec<&str> = open.iter().map(|h| h.name()).collect();
+        progress.step(&format!("step {step}: fit {}", names.join(", ")));
+        let fits: Vec<(Option<Model>, CandidateFit)> = open
+            .par_iter()
+            .map(|&hypothesis| test_hypothesis(search, &model, hypothesis, open.len(), step))
+            .collect();
+        progress.advance(open.len() - 1);
         let mut best: Option<(f64, Model, usize)> = None;
-        for &hypothesis in &open {
-            progress.step(&format!("step {step}: fit {}", hypothesis.name()));
-            let (fit, row) = test_hypothesis(search, &model, hypothesis, open.len(), step);
+        for (fit, row) in fits {
             if let (Some(fit), true) = (fit, row.significant) {
                 let score = row.delta_bic;
                 if best.as_ref().is_none_or(|(b, _, _)| score < *b) {
@@ -316,43 +323,68 @@ pub(super) fn cross_validate(
     folds: usize,
     progress: &mut dyn FnMut(&str),
 ) -> Result<f64> {
-    let mut sum = 0.0;
-    let mut count = 0usize;
     let full = rebuild(fit, used, options);
+    // The folds are independent: solved in parallel, summed in fold order
+    // (the same sum, term by term, as one fold after the other).
     for fold in 0..folds {
         progress(&format!("cross-validation fold {}/{folds}", fold + 1));
-        let (train, test): (Vec<usize>, Vec<usize>) = (0..used.len()).partition(|k| k % folds != fold);
-        let subset = |indices: &[usize]| -> CalibrationGraph { subgraph(&full, fit, used, indices, options) };
-        let mut trained = subset(&train);
-        optimize(&mut trained.graph, &options.lm)
-            .map_err(|e| Error::InvalidInput(format!("cross-validation fold {}: {e}", fold + 1)))?;
-        let mut held_out = subset(&test);
-        for id in global_ids(&trained) {
-            held_out
-                .graph
-                .values
-                .set(id, trained.graph.values.variable(id).value.clone());
-            held_out.graph.values.set_fixed(id, true);
+    }
+    let terms: Vec<Result<Vec<(f64, usize)>>> = (0..folds)
+        .into_par_iter()
+        .map(|fold| held_out_terms(&full, fit, used, options, folds, fold))
+        .collect();
+    let mut sum = 0.0;
+    let mut count = 0usize;
+    for fold_terms in terms {
+        for (squared, rows) in fold_terms? {
+            sum += squared;
+            count += rows;
         }
-        optimize(&mut held_out.graph, &options.lm)
-            .map_err(|e| Error::InvalidInput(format!("cross-validation fold {} (held-out poses): {e}", fold + 1)))?;
-        for f in held_out
+    }
+    Ok((sum / count.max(1) as f64).sqrt())
+}
+
+/// One fold of [`cross_validate`]: train on the poses not in `fold`, solve
+/// the held-out poses with the trained globals held; per held-out
+/// measurement factor, its whitened squared residual and its rows.
+fn held_out_terms(
+    full: &CalibrationGraph,
+    fit: &CalibrationResult,
+    used: &[PoseMeasurement],
+    options: &CalibrationOptions,
+    folds: usize,
+    fold: usize,
+) -> Result<Vec<(f64, usize)>> {
+    let (train, test): (Vec<usize>, Vec<usize>) = (0..used.len()).partition(|k| k % folds != fold);
+    let subset = |indices: &[usize]| -> CalibrationGraph { subgraph(full, fit, used, indices, options) };
+    let mut trained = subset(&train);
+    optimize(&mut trained.graph, &options.lm)
+        .map_err(|e| Error::InvalidInput(format!("cross-validation fold {}: {e}", fold + 1)))?;
+    let mut held_out = subset(&test);
+    for id in global_ids(&trained) {
+        held_out
             .graph
-            .factors
-            .iter()
-            .filter(|f| MEASUREMENT_KINDS.contains(&f.kind()))
-        {
+            .values
+            .set(id, trained.graph.values.variable(id).value.clone());
+        held_out.graph.values.set_fixed(id, true);
+    }
+    optimize(&mut held_out.graph, &options.lm)
+        .map_err(|e| Error::InvalidInput(format!("cross-validation fold {} (held-out poses): {e}", fold + 1)))?;
+    held_out
+        .graph
+        .factors
+        .iter()
+        .filter(|f| MEASUREMENT_KINDS.contains(&f.kind()))
+        .map(|f| {
             let r = f.evaluate(&held_out.graph.values, None).ok_or_else(|| {
                 Error::NoEquilibrium(format!(
                     "cross-validation fold {}: a held-out pose went slack",
                     fold + 1
                 ))
             })?;
-            sum += whitened_squared_norm(&r, f.sigmas());
-            count += r.len();
-        }
-    }
-    Ok((sum / count.max(1) as f64).sqrt())
+            Ok((whitened_squared_norm(&r, f.sigmas()), r.len()))
+        })
+        .collect()
 }
 
 /// The graph of a subset of the poses, with every value (globals, effects,

@@ -84,7 +84,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::calib::{build_graph, calibrate, CableModel, CalibrationError, CalibrationOptions};
+use crate::calib::{calibrate, CalibrationError, CalibrationOptions};
 use crate::diagnose::{diagnose, power_against, CandidateFit, DiagnoseOptions};
 use crate::error::{Error, Result};
 use crate::model::effect_ranges::{
@@ -92,15 +92,16 @@ use crate::model::effect_ranges::{
     LOCALISER_MOUNT_HIGH_DEG, LOCALISER_MOUNT_LOW_DEG, SEGMENTS_HIGH, SEGMENTS_LOW,
 };
 pub use crate::model::effect_ranges::{effect_ranges, EffectRange, CABLE_DENSITY_KG_M3};
-use crate::model::effects::{EffectKind, EffectSet, Effects};
+use crate::model::effects::{EffectKind, Effects};
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::NoisePreset;
-use crate::model::statics::CableTension;
+use crate::model::statics::Equilibrium;
 use crate::sim::closed_form::{sample_equilibria, sample_equilibria_with, Closure, Workspace, DEFAULT_MAX_YAW_DEG};
-use crate::sim::effects::{measure_with_effects, solve_with_effects};
-use crate::solver::{marginal_covariance, Covariance};
+use crate::sim::effects::measure_with_effects;
 use crate::stats::{chi_square_critical, noncentral_chi_square_survival};
+
+pub use super::identifiability::{identifiability, Identifiability};
 
 /// Settings of the experiment.
 #[derive(Debug, Clone, PartialEq)]
@@ -311,15 +312,27 @@ pub const TRUTH_ANCHOR_SPREAD_M: f64 = 0.5;
 /// The encoders' true length offsets are drawn from `+-` this, metres.
 pub const TRUTH_OFFSET_SPREAD_M: f64 = 3.0;
 
-/// One case's data: the measurements, the true robot (off the nominal one,
-/// its effects set) and the initial guess (the nominal robot). The poses are
-/// closed by `options.closure`.
-pub fn simulate_case(
+/// A case before its sensors are read: the true robot (drawn off the
+/// nominal one, its effects not yet set), the drawn effects, the true
+/// equilibria and the random stream after them. The noise reading enters
+/// only the sensors, so the cases of one seed under several noise readings
+/// share it ([`run_sweep`]).
+pub struct SimulatedTruth {
+    truth: Robot,
+    effects: Effects,
+    equilibria: Vec<Equilibrium>,
+    rng: ChaCha8Rng,
+    nominal: Robot,
+}
+
+/// Draw the truth of the case `seed` hiding `hidden` (the poses closed by
+/// `options.closure`; `options.noise` is not used).
+pub fn simulate_truth(
     nominal: &Robot,
     hidden: &[EffectKind],
     seed: u64,
     options: &HiddenEffectOptions,
-) -> Result<(Vec<PoseMeasurement>, Robot, Robot)> {
+) -> Result<SimulatedTruth> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut truth = nominal.clone();
     for i in 0..CABLE_COUNT {
@@ -335,10 +348,46 @@ pub fn simulate_case(
         .sum::<f64>()
         / equilibria.len() as f64;
     let effects = draw_effects(&truth, hidden, mean_tension, &mut rng);
-    let noise = options.noise.sigmas(truth.platform_weight_n);
-    let measurements = measure_with_effects(&truth, &effects, &equilibria, &noise, options.segments, &mut rng)?;
-    truth.effects = effects;
-    Ok((measurements, truth, nominal.clone()))
+    Ok(SimulatedTruth {
+        truth,
+        effects,
+        equilibria,
+        rng,
+        nominal: nominal.clone(),
+    })
+}
+
+impl SimulatedTruth {
+    /// The case's data under `noise`: the measurements (the discretised
+    /// robot with `segments` per cable), the true robot with its effects set
+    /// and the initial guess (the nominal robot).
+    pub fn measure(&self, noise: NoisePreset, segments: usize) -> Result<(Vec<PoseMeasurement>, Robot, Robot)> {
+        let mut rng = self.rng.clone();
+        let sigmas = noise.sigmas(self.truth.platform_weight_n);
+        let measurements = measure_with_effects(
+            &self.truth,
+            &self.effects,
+            &self.equilibria,
+            &sigmas,
+            segments,
+            &mut rng,
+        )?;
+        let mut truth = self.truth.clone();
+        truth.effects = self.effects;
+        Ok((measurements, truth, self.nominal.clone()))
+    }
+}
+
+/// One case's data: the measurements, the true robot (off the nominal one,
+/// its effects set) and the initial guess (the nominal robot). The poses are
+/// closed by `options.closure`.
+pub fn simulate_case(
+    nominal: &Robot,
+    hidden: &[EffectKind],
+    seed: u64,
+    options: &HiddenEffectOptions,
+) -> Result<(Vec<PoseMeasurement>, Robot, Robot)> {
+    simulate_truth(nominal, hidden, seed, options)?.measure(options.noise, options.segments)
 }
 
 /// The pairs of effects the sweep hides together.
@@ -367,7 +416,23 @@ pub fn run_case(
     seed: u64,
     options: &HiddenEffectOptions,
 ) -> Result<HiddenCase> {
-    let (measurements, truth, guess) = simulate_case(nominal, hidden, seed, options)?;
+    diagnose_case(
+        nominal,
+        hidden,
+        seed,
+        options,
+        simulate_case(nominal, hidden, seed, options)?,
+    )
+}
+
+/// [`run_case`] on the case's simulated data (`measurements, truth, guess`).
+fn diagnose_case(
+    nominal: &Robot,
+    hidden: &[EffectKind],
+    seed: u64,
+    options: &HiddenEffectOptions,
+    (measurements, truth, guess): (Vec<PoseMeasurement>, Robot, Robot),
+) -> Result<HiddenCase> {
     let mut diagnose_options =
         DiagnoseOptions::new(CalibrationOptions::new(options.noise.sigmas(truth.platform_weight_n)));
     diagnose_options.folds = options.folds;
@@ -484,161 +549,60 @@ pub fn run_sweep(
     let mut sets: Vec<Vec<EffectKind>> = vec![Vec::new()];
     sets.extend(EffectKind::ALL.map(|k| vec![k]));
     sets.extend(PAIRS.map(|p| p.to_vec()));
+    // One job per robot, hidden set and seed: its truth is drawn once and
+    // read under every noise reading (the same data as drawing it per case).
     let mut jobs = Vec::new();
-    for (r, _) in robots.iter().enumerate() {
-        for noise in noises {
-            for set in &sets {
-                jobs.extend((0..seeds).map(|i| (r, *noise, set.clone(), i)));
+    for r in 0..robots.len() {
+        for set in &sets {
+            jobs.extend((0..seeds).map(|i| (r, set.clone(), i)));
+        }
+    }
+    let name = |r: usize, set: &[EffectKind], noise: String, seed: u64| {
+        format!(
+            "hidden-effect case robot `{}`, effects {}, {noise} noise, seed {seed}",
+            robots[r].name,
+            set_name(set.iter().map(|k| k.name().to_string()))
+        )
+    };
+    let done: Vec<Vec<Result<HiddenCase>>> = jobs
+        .par_iter()
+        .map(|(r, set, index)| {
+            let seed = case_seed(base_seed, *r, set, *index);
+            let simulated = simulate_truth(&robots[*r], set, seed, options);
+            noises
+                .iter()
+                .map(|noise| {
+                    let case_options = HiddenEffectOptions {
+                        noise: *noise,
+                        ..*options
+                    };
+                    let case = simulated
+                        .as_ref()
+                        .map_err(|e| Error::InvalidInput(e.to_string()))
+                        .and_then(|truth| truth.measure(*noise, options.segments))
+                        .and_then(|data| diagnose_case(&robots[*r], set, seed, &case_options, data))
+                        .map_err(|e| {
+                            Error::InvalidInput(format!("{}: {e}", name(*r, set, format!("{noise:?}"), seed)))
+                        });
+                    progress();
+                    case
+                })
+                .collect()
+        })
+        .collect();
+    // Back in the order robot, noise reading, hidden set, seed.
+    let mut by_job: Vec<std::vec::IntoIter<Result<HiddenCase>>> = done.into_iter().map(Vec::into_iter).collect();
+    let mut cases = Vec::with_capacity(jobs.len() * noises.len());
+    for r in 0..robots.len() {
+        for _ in noises {
+            for (j, job) in jobs.iter().enumerate() {
+                if job.0 == r {
+                    if let Some(case) = by_job[j].next() {
+                        cases.push(case?);
+                    }
+                }
             }
         }
     }
-    jobs.par_iter()
-        .map(|(r, noise, set, index)| {
-            let seed = case_seed(base_seed, *r, set, *index);
-            let case_options = HiddenEffectOptions {
-                noise: *noise,
-                ..*options
-            };
-            let case = run_case(&robots[*r], set, seed, &case_options).map_err(|e| {
-                Error::InvalidInput(format!(
-                    "hidden-effect case robot `{}`, effects {}, {noise:?} noise, seed {seed}: {e}",
-                    robots[*r].name,
-                    set_name(set.iter().map(|k| k.name().to_string()))
-                ))
-            });
-            progress();
-            case
-        })
-        .collect()
-}
-
-/// Evidence that an effect's parameter is (not) identifiable apart from the anchors.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Identifiability {
-    /// Robot name.
-    pub robot: String,
-    /// The effect examined.
-    pub effect: String,
-    /// Its true value.
-    pub value: f64,
-    /// Poses.
-    pub poses: usize,
-    /// 1-sigma of the parameter from the Fisher information with anchors and offsets free.
-    pub sigma: f64,
-    /// 1-sigma with anchors and offsets known (the parameter alone).
-    pub sigma_alone: f64,
-    /// Multiple correlation of the parameter with the anchors and offsets,
-    /// `sqrt(1 - sigma_alone^2 / sigma^2)`: 1 = fully absorbed.
-    pub correlation_with_anchors: f64,
-    /// The anchor shift that mimics the effect, `Sigma_ap / Sigma_pp * value`, per anchor, metres.
-    pub mimicking_anchor_shift_m: Vec<[f64; 3]>,
-    /// Baseline calibration of noise-free data with the effect: chi-square left (stated noise).
-    pub baseline_chi_square: f64,
-    /// Its degrees of freedom.
-    pub baseline_dof: usize,
-    /// The baseline's mean Euclidean anchor error (the bias the effect causes), metres.
-    pub baseline_anchor_bias_m: f64,
-    /// That bias over the anchors' stated 1-sigma ([`crate::diagnose::error_over_sigma`]).
-    pub baseline_bias_over_sigma: f64,
-    /// The mimicking shift's mean Euclidean size, metres.
-    pub mimicking_shift_mean_m: f64,
-}
-
-/// The identifiability of a pulley radius (or any effect) on `truth`: Fisher
-/// information at the true equilibria of the discretised robot, and the bias
-/// of a baseline calibration of noise-free data.
-pub fn identifiability(
-    truth: &Robot,
-    effect: EffectKind,
-    effects: &Effects,
-    poses: usize,
-    seed: u64,
-    options: &HiddenEffectOptions,
-) -> Result<Identifiability> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let equilibria = sample_equilibria_with(truth, &Workspace::default_for(truth), poses, options.closure, &mut rng)?;
-    let solved = solve_with_effects(truth, effects, &equilibria, options.segments)?;
-    let noise = options.noise.sigmas(truth.platform_weight_n);
-    let free = NoisePreset::None.sigmas(truth.platform_weight_n);
-    let measurements = measure_with_effects(truth, effects, &equilibria, &free, options.segments, &mut rng)?;
-    let mut known = truth.clone();
-    known.effects = *effects;
-    let calibration = CalibrationOptions {
-        free_effects: EffectSet::of(effect),
-        ..CalibrationOptions::new(noise)
-    };
-    let true_poses: Vec<_> = solved.iter().map(|s| s.pose).collect();
-    let true_tensions: Vec<CableTension> = solved
-        .iter()
-        .map(|s| {
-            let f = s.cables[truth.reference_cable].platform_force_n;
-            CableTension {
-                horizontal_n: f.x.hypot(f.y),
-                vertical_n: f.z,
-            }
-        })
-        .collect();
-    let built = build_graph(
-        &known,
-        &measurements,
-        &true_poses,
-        &true_tensions,
-        CableModel::Catenary,
-        &calibration,
-    );
-    let vars = built.effects.expect("extended graph");
-    let parameter = vars.of(effect);
-    let mut selected: Vec<_> = built.globals.anchors.to_vec();
-    selected.extend(built.globals.length_offsets);
-    selected.push(parameter);
-    let joint = match marginal_covariance(&built.graph, &selected).map_err(Error::InvalidInput)? {
-        Covariance::Full(c) => c,
-        Covariance::RankDeficient(_) => {
-            return Err(Error::InvalidInput(
-                "identifiability: the information matrix is singular".into(),
-            ))
-        }
-    };
-    // The parameter's first component follows the 12 anchor coordinates and 4 offsets.
-    let p = 3 * CABLE_COUNT + CABLE_COUNT;
-    let sigma = joint[(p, p)].sqrt();
-    let information: DMatrix<f64> = joint
-        .clone()
-        .try_inverse()
-        .ok_or_else(|| Error::InvalidInput("identifiability: singular covariance".into()))?;
-    let sigma_alone = (1.0 / information[(p, p)]).sqrt();
-    let value = EffectKind::parameters(effect, effects)[0];
-    let shifts: Vec<[f64; 3]> = (0..CABLE_COUNT)
-        .map(|i| std::array::from_fn(|c| joint[(3 * i + c, p)] / joint[(p, p)] * value))
-        .collect();
-    let mimicking_shift_mean_m = shifts.iter().map(|s| Vector3::from(*s).norm()).sum::<f64>() / CABLE_COUNT as f64;
-    // The bias: a baseline calibration (effect ignored) of the noise-free data.
-    let baseline = calibrate(truth, &measurements, &CalibrationOptions::new(noise))?;
-    let statistics = &baseline.factor_statistics;
-    let chi: f64 = statistics
-        .iter()
-        .filter(|s| s.kind != "tension_guard")
-        .map(|s| s.chi_square)
-        .sum();
-    let components: usize = statistics
-        .iter()
-        .filter(|s| crate::diagnose::MEASUREMENT_KINDS.contains(&s.kind.as_str()))
-        .map(|s| s.components)
-        .sum();
-    let dof = (components + 4 * poses).saturating_sub(8 * poses + 16);
-    Ok(Identifiability {
-        robot: truth.name.clone(),
-        effect: effect.name().into(),
-        value,
-        poses,
-        sigma,
-        sigma_alone,
-        correlation_with_anchors: (1.0 - (sigma_alone / sigma).powi(2)).max(0.0).sqrt(),
-        mimicking_anchor_shift_m: shifts,
-        baseline_chi_square: chi,
-        baseline_dof: dof,
-        baseline_anchor_bias_m: CalibrationError::between(&baseline.robot, truth).anchor_mean_euclidean_m,
-        baseline_bias_over_sigma: crate::diagnose::error_over_sigma(&baseline.robot, truth, &baseline.uncertainty),
-        mimicking_shift_mean_m,
-    })
+    Ok(cases)
 }

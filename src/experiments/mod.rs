@@ -23,6 +23,7 @@
 
 pub mod benchmark;
 pub mod hidden_effects;
+mod identifiability;
 pub mod localize_after_calibration;
 pub mod plan_candidates;
 pub mod pose_plan;
