@@ -10,8 +10,8 @@
 //! * `elastic`: the cables are synthetic-fibre ropes of density 1.44 g/cm^3
 //!   (the large robot's 72.4 g/m is an 8 mm rope), so the fibre cross section
 //!   is `A = g_c / (rho g)` and `EA = A E`, `E` drawn log-uniformly. The large
-//!   robot's long spans call for an aramid rope, `E` = 30-100 GPa (rope
-//!   construction lowers the fibre's 70-130 GPa). The small robot's 3 mm rope
+//!   robot's long spans call for an aramid rope, `E` = 30-160 GPa (from a
+//!   loosely laid rope to the stiff fibre grades). The small robot's 3 mm rope
 //!   is taken as a nylon braid, `E` = 1-3 GPa: with its 6-22 N
 //!   tensions an aramid rope would stretch less than a millimetre, below the
 //!   encoders' noise, and could not change the anchors by their 1-sigma.
@@ -25,8 +25,9 @@
 //!   tension (full scale 2-3 x the mean) has zero and span errors of a few %
 //!   of full scale.
 //! * `com`: a horizontal shift in a random direction: a payload mounted off
-//!   the centre of the 0.42 m platform, 14-25 cm on the large robot (smaller
-//!   shifts move its anchors by less than their 1-sigma), 8-20 cm on the small one.
+//!   the centre of the 0.42 m platform, 5-25 cm on the large robot, 5-20 cm
+//!   on the small one (the weak end moves the anchors by less than their
+//!   1-sigma: the cases a diagnosis may miss).
 //!
 //! The experiment reports, per effect, the smallest ratio of the baseline's
 //! anchor error to its stated 1-sigma: above 1, every magnitude drawn changes
