@@ -449,6 +449,21 @@ impl LinearSystem {
         solution.iter().all(|v| v.is_finite()).then_some(solution)
     }
 
+    /// `a^T (H + damping)^-1 a` with the last successful
+    /// [`LinearSystem::factorize`] (a row's leverage when `a` is a whitened
+    /// Jacobian row and the damping zero); `None` if there is no
+    /// factorisation or the value is not finite. The block elimination visits
+    /// only the groups where `a` is non-zero, with the same value as
+    /// [`LinearSystem::solve_factored`] and the dot product.
+    pub fn inverse_quadratic_form(&mut self, a: &[f64]) -> Option<f64> {
+        if let Factorization::Schur(layout) = &self.factorization {
+            return layout.inverse_quadratic_form(a);
+        }
+        let x = self.solve_factored(a)?;
+        let form: f64 = a.iter().zip(&x).map(|(a, x)| a * x).sum();
+        form.is_finite().then_some(form)
+    }
+
     /// Whether the local groups are eliminated block by block (else faer's sparse Cholesky).
     pub fn uses_block_elimination(&self) -> bool {
         matches!(self.factorization, Factorization::Schur(_))

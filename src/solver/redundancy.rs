@@ -17,7 +17,8 @@ use crate::graph::FactorGraph;
 
 /// Per factor (graph order) whose kind is in `kinds`, the redundancy number
 /// of each residual row (`None` for the other factors), at the graph's values.
-/// Each row costs one solve with the factored information matrix.
+/// Each row costs one solve with the factored information matrix, over the
+/// blocks the row touches.
 pub fn redundancy_numbers(graph: &FactorGraph, kinds: &[&str]) -> Result<Vec<Option<Vec<f64>>>, String> {
     let mut system = LinearSystem::new(&graph.values, &graph.factors, &graph.local_groups)?;
     let hessian = linearize(graph, &graph.values, &system)
@@ -62,10 +63,9 @@ pub fn redundancy_numbers(graph: &FactorGraph, kinds: &[&str]) -> Result<Vec<Opt
                     }
                 }
             }
-            let x = system
-                .solve_factored(&a)
+            let leverage = system
+                .inverse_quadratic_form(&a)
                 .ok_or("redundancy numbers: the solve with the information matrix failed")?;
-            let leverage: f64 = a.iter().zip(&x).map(|(a, x)| a * x).sum();
             numbers.push((1.0 - leverage).clamp(0.0, 1.0));
         }
         all.push(Some(numbers));

@@ -166,6 +166,68 @@ impl SchurLayout {
     }
 }
 
+impl SchurLayout {
+    /// `a^T (H + damping)^-1 a` with the last successful factorisation, for an
+    /// `a` that is zero outside the globals and a few groups (one factor's
+    /// row): the groups where `a` is zero contribute exact zeros to the
+    /// reduced right-hand side and to the product, so only the others are
+    /// visited. The value is that of [`SchurLayout::solve`] followed by the
+    /// dot product, bit for bit. `None` if there is no factorisation.
+    pub(super) fn inverse_quadratic_form(&self, a: &[f64]) -> Option<f64> {
+        if !self.factored {
+            return None;
+        }
+        let g = self.globals;
+        let (reduced, _) = self.values.split_at(g * g);
+        let touched: Vec<usize> = (0..self.groups.len())
+            .filter(|&k| {
+                let (start, m) = self.groups[k];
+                a[start..start + m].iter().any(|&v| v != 0.0)
+            })
+            .collect();
+        let mut x_global = a[..g].to_vec();
+        let mut y: Vec<Vec<f64>> = Vec::with_capacity(touched.len());
+        // y_k = L_k^-1 b_k; b_g -= W_k^T y_k (as in `solve`, touched groups only).
+        for &k in &touched {
+            let (start, m) = self.groups[k];
+            let base = self.group_base[k];
+            let (d, w) = self.values[base..base + m * m + m * g].split_at(m * m);
+            let mut yk = a[start..start + m].to_vec();
+            forward_substitute(d, m, &mut yk);
+            for (j, bj) in x_global.iter_mut().enumerate() {
+                *bj -= w[j * m..(j + 1) * m]
+                    .iter()
+                    .zip(yk.iter())
+                    .map(|(a, b)| a * b)
+                    .sum::<f64>();
+            }
+            y.push(yk);
+        }
+        if g > 0 {
+            forward_substitute(reduced, g, &mut x_global);
+            backward_substitute(reduced, g, &mut x_global);
+        }
+        let mut form: f64 = a[..g].iter().zip(&x_global).map(|(a, x)| a * x).sum();
+        // x_k = L_k^-T (y_k - W_k x_g), then the product over the group.
+        for (&k, yk) in touched.iter().zip(&mut y) {
+            let (start, m) = self.groups[k];
+            let base = self.group_base[k];
+            let (d, w) = self.values[base..base + m * m + m * g].split_at(m * m);
+            for (j, &xj) in x_global.iter().enumerate() {
+                for (yi, wi) in yk.iter_mut().zip(&w[j * m..(j + 1) * m]) {
+                    *yi -= wi * xj;
+                }
+            }
+            backward_substitute(d, m, yk);
+            // Term by term, continuing the sum in index order as the dot product does.
+            for (a, x) in a[start..start + m].iter().zip(yk.iter()) {
+                form += a * x;
+            }
+        }
+        form.is_finite().then_some(form)
+    }
+}
+
 /// Factor one group's damped `D` in place (`block` = `D`, then `B`, column-major)
 /// into `L`, turn `B` into `W = L^-1 B`, and subtract `W^T W` from the
 /// reduced system's lower triangle. `M` is the group dimension when known at
@@ -333,6 +395,60 @@ mod tests {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
         assert!(worst < 1e-12, "elimination vs dense: {worst:e}");
+    }
+
+    /// The quadratic form over a row touching the globals and one group is
+    /// the full solve's dot product bit for bit, and matches the dense inverse.
+    #[test]
+    fn inverse_quadratic_form_equals_the_full_solve() {
+        let (g, m, n) = (3usize, 2usize, 5usize);
+        let dim = g + m * n;
+        let mut h = nalgebra::DMatrix::<f64>::zeros(dim, dim);
+        let mut indices = Vec::new();
+        for k in 0..n {
+            for r in 0..4 {
+                let mut row = nalgebra::DVector::<f64>::zeros(dim);
+                for i in 0..g {
+                    row[i] = ((k * 7 + r * 3 + i) as f64 * 0.37).sin();
+                }
+                for i in 0..m {
+                    row[g + k * m + i] = ((k * 5 + r + 11 * i) as f64 * 0.53).cos();
+                }
+                h += &row * row.transpose();
+            }
+        }
+        for c in 0..dim {
+            for r in c..dim {
+                if r < g || c < g || (r - g) / m == (c - g) / m {
+                    indices.push((r, c));
+                }
+            }
+        }
+        let groups = (0..n).map(|k| (g + k * m, m)).collect();
+        let mut layout = SchurLayout::new(&indices, g, groups).expect("arrowhead");
+        let mut entries = vec![0.0; layout.storage_len()];
+        for &(r, c) in &indices {
+            entries[layout.place(r, c).0] = h[(r, c)];
+        }
+        let damping: Vec<f64> = (0..dim).map(|i| 0.05 + 0.01 * i as f64).collect();
+        assert!(layout.factorize(&entries, &damping));
+        let damped = &h + nalgebra::DMatrix::from_diagonal(&nalgebra::DVector::from_vec(damping));
+        let inverse = damped.cholesky().expect("SPD").inverse();
+        for group in [0, 2, 4] {
+            let mut a = vec![0.0; dim];
+            for (i, v) in a.iter_mut().enumerate().take(g) {
+                *v = 0.3 + i as f64;
+            }
+            a[g + group * m] = -1.25;
+            a[g + group * m + 1] = 0.5;
+            let x = layout.solve(&a).expect("solution");
+            let full: f64 = a.iter().zip(&x).map(|(a, x)| a * x).sum();
+            let form = layout.inverse_quadratic_form(&a).expect("form");
+            assert_eq!(form.to_bits(), full.to_bits(), "group {group}");
+            let va = nalgebra::DVector::from_vec(a);
+            let dense = (va.transpose() * &inverse * &va)[(0, 0)];
+            assert!((form - dense).abs() < 1e-10 * dense.abs(), "{form} vs {dense}");
+        }
     }
 
     #[test]
