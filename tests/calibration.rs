@@ -120,21 +120,20 @@ fn automatic_orientation_prior_keeps_consistent_and_drops_biased_orientations() 
     let initial = perturbed(&truth, 10.0, 80.0, &mut rng);
     let options = CalibrationOptions::new(noise);
     assert_eq!(options.orientation_prior, OrientationPrior::Auto);
+    let with_prior = |orientation_prior, data: &[_]| {
+        let options = CalibrationOptions {
+            orientation_prior,
+            ..options
+        };
+        calibrate(&initial, data, &options).unwrap()
+    };
     let consistent = calibrate(&initial, &data, &options).unwrap();
     let check = consistent.orientation_check.unwrap();
     eprintln!("consistent: {check:?}");
     assert!(check.prior_used && check.chi_square < check.limit, "{check:?}");
     // Auto shares its rigid stage and warm-ups between the calibrations with
     // and without the prior: kept, it is the calibration with the prior, bit for bit.
-    let on = calibrate(
-        &initial,
-        &data,
-        &CalibrationOptions {
-            orientation_prior: OrientationPrior::On,
-            ..options
-        },
-    )
-    .unwrap();
+    let on = with_prior(OrientationPrior::On, &data);
     assert_eq!(on.robot.anchors_m, consistent.robot.anchors_m);
     assert_eq!(on.robot.length_offsets_m, consistent.robot.length_offsets_m);
     // The localiser's roll reads 2 degrees off at every pose (the RecurDyn log is ~1.9 degrees
@@ -148,27 +147,11 @@ fn automatic_orientation_prior_keeps_consistent_and_drops_biased_orientations() 
     eprintln!("biased: {check:?}");
     assert!(!check.prior_used && check.chi_square > check.limit, "{check:?}");
     // Dropping it is the same as calibrating without it, bit for bit.
-    let off = calibrate(
-        &initial,
-        &biased,
-        &CalibrationOptions {
-            orientation_prior: OrientationPrior::Off,
-            ..options
-        },
-    )
-    .unwrap();
+    let off = with_prior(OrientationPrior::Off, &biased);
     assert_eq!(off.robot.anchors_m, dropped.robot.anchors_m);
     assert_eq!(off.robot.length_offsets_m, dropped.robot.length_offsets_m);
     // ...and much better than keeping the biased prior.
-    let forced = calibrate(
-        &initial,
-        &biased,
-        &CalibrationOptions {
-            orientation_prior: OrientationPrior::On,
-            ..options
-        },
-    )
-    .unwrap();
+    let forced = with_prior(OrientationPrior::On, &biased);
     let error_dropped = CalibrationError::between(&dropped.robot, &truth).anchor_mean_euclidean_m;
     let error_forced = CalibrationError::between(&forced.robot, &truth).anchor_mean_euclidean_m;
     eprintln!("anchor error: prior dropped {error_dropped:.3} m, biased prior kept {error_forced:.3} m");

@@ -344,6 +344,29 @@ pub(super) fn backward_substitute(l: &[f64], n: usize, x: &mut [f64]) {
 mod tests {
     use super::*;
 
+    /// The block elimination of `h + diag(damping)`, an arrowhead matrix of
+    /// `g` globals and `n` groups of `m` (`shape` = `(g, m, n)`), factored.
+    fn factored_arrowhead(h: &nalgebra::DMatrix<f64>, shape: (usize, usize, usize), damping: &[f64]) -> SchurLayout {
+        let (g, m, n) = shape;
+        let dim = g + m * n;
+        let mut indices = Vec::new();
+        for c in 0..dim {
+            for r in c..dim {
+                if r < g || c < g || (r - g) / m == (c - g) / m {
+                    indices.push((r, c));
+                }
+            }
+        }
+        let groups = (0..n).map(|k| (g + k * m, m)).collect();
+        let mut layout = SchurLayout::new(&indices, g, groups).expect("arrowhead");
+        let mut entries = vec![0.0; layout.storage_len()];
+        for &(r, c) in &indices {
+            entries[layout.place(r, c).0] = h[(r, c)];
+        }
+        assert!(layout.factorize(&entries, damping));
+        layout
+    }
+
     /// A random arrowhead SPD system solved by elimination matches a dense solve.
     #[test]
     fn elimination_matches_dense_cholesky() {
@@ -368,23 +391,8 @@ mod tests {
                 h += &row * row.transpose();
             }
         }
-        let mut indices = Vec::new();
-        for c in 0..dim {
-            for r in c..dim {
-                let same_group = r < g || c < g || (r - g) / m == (c - g) / m;
-                if same_group {
-                    indices.push((r, c));
-                }
-            }
-        }
-        let groups = (0..n).map(|k| (g + k * m, m)).collect();
-        let mut layout = SchurLayout::new(&indices, g, groups).expect("arrowhead");
-        let mut entries = vec![0.0; layout.storage_len()];
-        for &(r, c) in &indices {
-            entries[layout.place(r, c).0] = h[(r, c)];
-        }
         let damping: Vec<f64> = (0..dim).map(|i| 0.1 + 0.01 * i as f64).collect();
-        assert!(layout.factorize(&entries, &damping));
+        let layout = factored_arrowhead(&h, (g, m, n), &damping);
         let rhs: Vec<f64> = (0..dim).map(|i| (i as f64).sin()).collect();
         let x = layout.solve(&rhs).expect("solution");
         let damped = &h + nalgebra::DMatrix::from_diagonal(&nalgebra::DVector::from_vec(damping));
@@ -404,7 +412,6 @@ mod tests {
         let (g, m, n) = (3usize, 2usize, 5usize);
         let dim = g + m * n;
         let mut h = nalgebra::DMatrix::<f64>::zeros(dim, dim);
-        let mut indices = Vec::new();
         for k in 0..n {
             for r in 0..4 {
                 let mut row = nalgebra::DVector::<f64>::zeros(dim);
@@ -417,21 +424,8 @@ mod tests {
                 h += &row * row.transpose();
             }
         }
-        for c in 0..dim {
-            for r in c..dim {
-                if r < g || c < g || (r - g) / m == (c - g) / m {
-                    indices.push((r, c));
-                }
-            }
-        }
-        let groups = (0..n).map(|k| (g + k * m, m)).collect();
-        let mut layout = SchurLayout::new(&indices, g, groups).expect("arrowhead");
-        let mut entries = vec![0.0; layout.storage_len()];
-        for &(r, c) in &indices {
-            entries[layout.place(r, c).0] = h[(r, c)];
-        }
         let damping: Vec<f64> = (0..dim).map(|i| 0.05 + 0.01 * i as f64).collect();
-        assert!(layout.factorize(&entries, &damping));
+        let layout = factored_arrowhead(&h, (g, m, n), &damping);
         let damped = &h + nalgebra::DMatrix::from_diagonal(&nalgebra::DVector::from_vec(damping));
         let inverse = damped.cholesky().expect("SPD").inverse();
         for group in [0, 2, 4] {
