@@ -18,14 +18,6 @@ use nalgebra::DMatrix;
 
 use crate::graph::VariableId;
 
-/// Where a factor's products are added: the storage of `H`, the gradient
-/// `J^T r`, and scratch for the gathered rows.
-pub(super) struct Targets<'a> {
-    pub hessian: &'a mut [f64],
-    pub gradient: &'a mut [f64],
-    pub rows_buffer: &'a mut Vec<f64>,
-}
-
 /// Consecutive factor slots `first_slot..end_slot` whose tangent columns are
 /// `offset..offset + width` of the step vector.
 #[derive(Clone, Copy, Debug)]
@@ -189,23 +181,32 @@ impl FactorRuns {
     /// Add `J^T J` (whitened Jacobian blocks per slot, column-major with
     /// `residual.len()` rows) into `hessian` and `J^T r` into `gradient`;
     /// `rows_buffer` is reused scratch.
-    pub(super) fn accumulate(&self, jacobians: &[DMatrix<f64>], residual: &[f64], targets: Targets) {
+    pub(super) fn accumulate(
+        &self,
+        jacobians: &[DMatrix<f64>],
+        residual: &[f64],
+        hessian: &mut [f64],
+        gradient: &mut [f64],
+        rows_buffer: &mut Vec<f64>,
+    ) {
         match residual.len() {
-            1 => self.accumulate_rows::<1>(jacobians, residual, targets),
-            4 => self.accumulate_rows::<4>(jacobians, residual, targets),
-            6 => self.accumulate_rows::<6>(jacobians, residual, targets),
-            _ => self.accumulate_rows::<0>(jacobians, residual, targets),
+            1 => self.accumulate_rows::<1>(jacobians, residual, hessian, gradient, rows_buffer),
+            4 => self.accumulate_rows::<4>(jacobians, residual, hessian, gradient, rows_buffer),
+            6 => self.accumulate_rows::<6>(jacobians, residual, hessian, gradient, rows_buffer),
+            _ => self.accumulate_rows::<0>(jacobians, residual, hessian, gradient, rows_buffer),
         }
     }
 
     /// [`FactorRuns::accumulate`] for `R`-row factors (`R = 0`: any row count).
     #[inline(always)]
-    fn accumulate_rows<const R: usize>(&self, jacobians: &[DMatrix<f64>], residual: &[f64], targets: Targets) {
-        let Targets {
-            hessian,
-            gradient,
-            rows_buffer,
-        } = targets;
+    fn accumulate_rows<const R: usize>(
+        &self,
+        jacobians: &[DMatrix<f64>],
+        residual: &[f64],
+        hessian: &mut [f64],
+        gradient: &mut [f64],
+        rows_buffer: &mut Vec<f64>,
+    ) {
         let rows = if R == 0 { residual.len() } else { R };
         // (1) Each run's columns, row by row: run k at `base[k]`, `rows x width`.
         if rows_buffer.len() < rows * self.columns {
@@ -403,19 +404,9 @@ mod tests {
             let residual: Vec<f64> = (0..rows).map(|r| value(1000 + r)).collect();
             let mut run_buffer = Vec::new();
             let (mut h_merged, mut g_merged) = (vec![0.0; n * n], vec![0.0; n]);
-            let targets = Targets {
-                hessian: &mut h_merged,
-                gradient: &mut g_merged,
-                rows_buffer: &mut run_buffer,
-            };
-            merged.accumulate(&jacobians, &residual, targets);
+            merged.accumulate(&jacobians, &residual, &mut h_merged, &mut g_merged, &mut run_buffer);
             let (mut h_single, mut g_single) = (vec![0.0; n * n], vec![0.0; n]);
-            let targets = Targets {
-                hessian: &mut h_single,
-                gradient: &mut g_single,
-                rows_buffer: &mut run_buffer,
-            };
-            single.accumulate(&jacobians, &residual, targets);
+            single.accumulate(&jacobians, &residual, &mut h_single, &mut g_single, &mut run_buffer);
             assert_eq!(h_merged, h_single, "{rows} rows");
             assert_eq!(g_merged, g_single, "{rows} rows");
             // The independent product: the free columns side by side.

@@ -26,7 +26,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use nalgebra::DMatrix;
 
-use super::accumulate::{FactorRuns, SlotBlock, Targets};
+use super::accumulate::{FactorRuns, SlotBlock};
 use super::schur::SchurLayout;
 use crate::graph::{Factor, Values, VariableId};
 
@@ -389,12 +389,7 @@ impl LinearSystem {
         gradient: &mut [f64],
         rows_buffer: &mut Vec<f64>,
     ) {
-        let targets = Targets {
-            hessian,
-            gradient,
-            rows_buffer,
-        };
-        self.factor_runs[index].accumulate(jacobians, residual, targets);
+        self.factor_runs[index].accumulate(jacobians, residual, hessian, gradient, rows_buffer);
     }
 
     /// The diagonal of `H` from its value array.
