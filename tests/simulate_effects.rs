@@ -263,3 +263,43 @@ fn elastic_cables_lower_the_platform_by_the_stretch() {
         );
     }
 }
+
+/// A load-cell bias larger than the small robot's lightest reference tension
+/// makes a reading negative: `simulate` refuses, names the row and field, and
+/// writes neither the data nor the truth file.
+#[test]
+fn a_refused_data_file_leaves_no_truth_file_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = robot_path("small");
+    let out = sagcal(
+        dir.path(),
+        &[
+            "simulate",
+            "--robot",
+            &robot,
+            "--poses",
+            "30",
+            "--seed",
+            "11",
+            "--noise",
+            "paper",
+            "--effect",
+            "loadcell:bias_n=-20,gain=1.0",
+            "--out",
+            "d.csv",
+            "--truth",
+            "t.toml",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("refusing to write d.csv") && stderr.contains("field `f_ref_n`"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("d.csv").exists());
+    assert!(
+        !dir.path().join("t.toml").exists(),
+        "the truth was written beside a refused data file"
+    );
+}

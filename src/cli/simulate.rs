@@ -22,6 +22,8 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
     let workspace = Workspace::default_for(&truth);
     let equilibria = sample_equilibria_with(&truth, &workspace, args.poses, args.closure, &mut rng)?;
     let data = measure_poses(args, &truth, from_file, &equilibria, &mut rng)?;
+    // Nothing is written unless the measurements can be: no truth file beside a refused data file.
+    sagcal::io::measurements::validate_for_writing(&args.out, &data)?;
     if let Some(path) = &args.truth {
         write_truth(path, args, &truth)?;
     }

@@ -314,8 +314,10 @@ pub fn pose_values(pose: &PoseMeasurement) -> [f64; N_COLUMNS] {
     ]
 }
 
-/// Refuse data that [`read_measurements`] would not read back.
-fn validate_for_writing(path: &Path, poses: &[PoseMeasurement]) -> Result<()> {
+/// Refuse data that [`read_measurements`] would not read back (the check
+/// [`write_measurements`] makes first; callers that write other files with
+/// the measurements make it before writing any of them).
+pub fn validate_for_writing(path: &Path, poses: &[PoseMeasurement]) -> Result<()> {
     if poses.is_empty() {
         return Err(Error::InvalidInput(format!(
             "refusing to write {}: no measurements (a measurement file needs at least one row)",
