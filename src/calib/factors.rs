@@ -188,11 +188,12 @@ fn split_offset_jacobian(jacobian: &SMatrix<f64, 4, 4>, slots: &SlotOrder, block
 
 /// Turn a slot-ordered residual into robot cable order.
 pub(super) fn slots_to_cables(slots: &SlotOrder, residual: &Vector4<f64>) -> DVector<f64> {
-    let mut out = DVector::zeros(CABLE_COUNT);
+    // On the stack, then copied (`DVector::zeros` is a `calloc`).
+    let mut out = [0.0; CABLE_COUNT];
     for (slot, &cable) in slots.cables.iter().enumerate() {
         out[cable] = residual[slot];
     }
-    out
+    DVector::from_column_slice(&out)
 }
 
 /// Reorder the rows of Jacobian blocks from slot order to cable order.

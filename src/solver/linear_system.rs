@@ -125,8 +125,8 @@ impl SparseCholesky {
     }
 }
 
-/// Blocks by `(row variable, column variable)` index.
-type BlockMap = HashMap<(usize, usize), BlockLayout, BuildHasherDefault<IndexHasher>>;
+/// Block starts by `(row variable, column variable)` index.
+type BlockMap = HashMap<(usize, usize), usize, BuildHasherDefault<IndexHasher>>;
 
 /// A multiplicative hasher for small integer keys (variable indices): the
 /// pattern analysis looks up one block per pair of variables of every
@@ -206,8 +206,8 @@ impl TangentLayout {
 /// where each factor's slot pairs accumulate.
 struct BlockPattern {
     blocks: BlockMap,
-    /// `(row variable, column variable)` of each block, in storage order.
-    block_order: Vec<(VariableId, VariableId)>,
+    /// `(row variable, column variable, start)` of each block, in storage order.
+    block_order: Vec<(VariableId, VariableId, usize)>,
     /// Number of stored scalars.
     entry_count: usize,
     /// Per factor: the blocks it touches (start in the block-wise storage, stride: rows of the block).
@@ -231,10 +231,14 @@ impl BlockPattern {
         }
         for factor in factors {
             let vars = factor.variables();
-            let mut list = Vec::new();
+            let mut list = Vec::with_capacity(vars.len() * (vars.len() + 1) / 2);
             for (slot_a, &a) in vars.iter().enumerate() {
+                let Some(oa) = offsets[a.0] else {
+                    continue;
+                };
+                let stride = values.tangent_dim(a);
                 for (slot_b, &b) in vars.iter().enumerate() {
-                    let (Some(oa), Some(ob)) = (offsets[a.0], offsets[b.0]) else {
+                    let Some(ob) = offsets[b.0] else {
                         continue;
                     };
                     if oa < ob || (a == b && slot_a != slot_b) {
@@ -244,7 +248,7 @@ impl BlockPattern {
                         slot_a,
                         slot_b,
                         start: pattern.block_for(values, a, b),
-                        stride: values.tangent_dim(a),
+                        stride,
                     });
                 }
             }
@@ -256,50 +260,33 @@ impl BlockPattern {
     /// The start of block `(a, b)` (dense, column-major; a diagonal block's
     /// upper triangle is never written), stored after the others if new.
     fn block_for(&mut self, values: &Values, a: VariableId, b: VariableId) -> usize {
-        let tangent = |id: VariableId| values.tangent_dim(id);
         let entry_count = &mut self.entry_count;
         let block_order = &mut self.block_order;
-        let layout = self.blocks.entry((a.0, b.0)).or_insert_with(|| {
-            let size = tangent(a) * tangent(b);
+        *self.blocks.entry((a.0, b.0)).or_insert_with(|| {
             let start = *entry_count;
-            *entry_count += size;
-            block_order.push((a, b));
-            BlockLayout { start }
-        });
-        layout.start
+            *entry_count += values.tangent_dim(a) * values.tangent_dim(b);
+            block_order.push((a, b, start));
+            start
+        })
     }
 
     /// Scalar `(row, col)` of every entry of the lower triangle, block by
-    /// block, with its position in a storage where the block at tangent
-    /// offsets `(row, col)`, stored block-wise from `start` with `rows` rows,
-    /// starts at `place(start, rows, row, col).0` with column stride `.1`.
-    fn entry_indices(
-        &self,
-        values: &Values,
-        offsets: &[Option<usize>],
-        place: impl Fn(usize, usize, usize, usize) -> (usize, usize),
-    ) -> (Vec<(usize, usize)>, Vec<usize>) {
-        let tangent = |id: VariableId| values.tangent_dim(id);
+    /// block, with its position in the block-wise storage (each block
+    /// column-major from its start, the rows of the block apart).
+    fn entry_indices(&self, values: &Values, offsets: &[Option<usize>]) -> (Vec<(usize, usize)>, Vec<usize>) {
         let mut indices = Vec::with_capacity(self.entry_count);
         let mut positions = Vec::with_capacity(self.entry_count);
-        for &(a, b) in &self.block_order {
+        for &(a, b, start) in &self.block_order {
             let (oa, ob) = (offsets[a.0].unwrap_or(0), offsets[b.0].unwrap_or(0));
-            let (da, db) = (tangent(a), tangent(b));
-            let (start, stride) = place(self.blocks[&(a.0, b.0)].start, da, oa, ob);
+            let (da, db) = (values.tangent_dim(a), values.tangent_dim(b));
             for j in 0..db {
-                for i in (if a == b { j } else { 0 })..da {
-                    indices.push((oa + i, ob + j));
-                    positions.push(start + i + j * stride);
-                }
+                let first = if a == b { j } else { 0 };
+                indices.extend((first..da).map(|i| (oa + i, ob + j)));
+                positions.extend((first..da).map(|i| start + i + j * da));
             }
         }
         (indices, positions)
     }
-}
-
-/// A block of `H` between variables `row_var` (larger offset) and `col_var`.
-struct BlockLayout {
-    start: usize,
 }
 
 impl LinearSystem {
@@ -315,8 +302,7 @@ impl LinearSystem {
             return Err("every variable is fixed: nothing to solve".into());
         }
         let mut pattern = BlockPattern::new(values, factors, &layout.offsets);
-        let block_wise = |start, rows, _, _| (start, rows);
-        let (indices, mut positions) = pattern.entry_indices(values, &layout.offsets, block_wise);
+        let (indices, mut positions) = pattern.entry_indices(values, &layout.offsets);
         // The reduced system of the elimination is dense: worth it while it is small.
         let schur = (!layout.group_ranges.is_empty() && layout.globals <= MAX_SCHUR_GLOBALS)
             .then(|| SchurLayout::new(&indices, layout.globals, layout.group_ranges))
@@ -325,9 +311,9 @@ impl LinearSystem {
         let factorization = match schur {
             Some(schur) => {
                 // Accumulate straight into the elimination's dense blocks.
-                positions = pattern
-                    .entry_indices(values, &layout.offsets, |_, _, row, col| schur.place(row, col))
-                    .1;
+                for (position, &(row, col)) in positions.iter_mut().zip(&indices) {
+                    *position = schur.place(row, col).0;
+                }
                 for (factor, blocks) in factors.iter().zip(&mut pattern.factor_blocks) {
                     let offset = |slot: usize| layout.offsets[factor.variables()[slot].0].unwrap_or(0);
                     for block in blocks {
@@ -345,12 +331,14 @@ impl LinearSystem {
                 diagonal_entries[row] = k;
             }
         }
+        let mut dims = Vec::new();
         let factor_runs = factors
             .iter()
             .zip(&pattern.factor_blocks)
             .map(|(factor, blocks)| {
                 let variables = factor.variables();
-                let dims: Vec<usize> = variables.iter().map(|&v| values.tangent_dim(v)).collect();
+                dims.clear();
+                dims.extend(variables.iter().map(|&v| values.tangent_dim(v)));
                 FactorRuns::new(variables, &layout.offsets, &dims, blocks)
             })
             .collect();

@@ -118,7 +118,12 @@ impl SchurLayout {
         if g > 0 && !cholesky_in_place(reduced, g) {
             return false;
         }
-        self.factored = self.values.iter().all(|v| v.is_finite());
+        // Every entry of the factors is finite here, without a scan: a
+        // non-finite `L[i][j]` (`i > j`, of `L_k` or of the reduced system)
+        // enters pivot `i` squared, and a non-finite entry of `W_k` column
+        // `c` enters the reduced pivot `c` squared; a non-finite pivot fails
+        // above (unit test `a_non_finite_entry_anywhere_fails`).
+        self.factored = true;
         self.factored
     }
 
@@ -136,13 +141,9 @@ impl SchurLayout {
             let (d, w) = self.values[base..base + m * m + m * g].split_at(m * m);
             let (global_part, rest) = x.split_at_mut(g);
             let y = &mut rest[start - g..start - g + m];
-            forward_substitute(d, m, y);
-            for (j, bj) in global_part.iter_mut().enumerate() {
-                *bj -= w[j * m..(j + 1) * m]
-                    .iter()
-                    .zip(y.iter())
-                    .map(|(a, b)| a * b)
-                    .sum::<f64>();
+            match (m, g) {
+                (8, 16) => reduce_right_hand_side::<8, 16>(d, w, y, global_part),
+                _ => reduce_right_hand_side::<0, 0>(d, w, y, global_part),
             }
         }
         if g > 0 {
@@ -155,12 +156,10 @@ impl SchurLayout {
             let (d, w) = self.values[base..base + m * m + m * g].split_at(m * m);
             let (global_part, rest) = x.split_at_mut(g);
             let y = &mut rest[start - g..start - g + m];
-            for (j, &xj) in global_part.iter().enumerate() {
-                for (yi, wi) in y.iter_mut().zip(&w[j * m..(j + 1) * m]) {
-                    *yi -= wi * xj;
-                }
+            match (m, g) {
+                (8, 16) => back_substitute_group::<8, 16>(d, w, global_part, y),
+                _ => back_substitute_group::<0, 0>(d, w, global_part, y),
             }
-            backward_substitute(d, m, y);
         }
         x.iter().all(|v| v.is_finite()).then_some(x)
     }
@@ -226,6 +225,38 @@ impl SchurLayout {
         }
         form.is_finite().then_some(form)
     }
+}
+
+/// `y <- L^-1 y` and `b_g -= W^T y` for one group (`L` `m x m`, `W` `m x g`,
+/// column-major); `M`, `G` the sizes when known at compile time (`0`: any).
+#[inline(always)]
+fn reduce_right_hand_side<const M: usize, const G: usize>(
+    l: &[f64],
+    w: &[f64],
+    y: &mut [f64],
+    global_part: &mut [f64],
+) {
+    let m = if M == 0 { y.len() } else { M };
+    let g = if G == 0 { global_part.len() } else { G };
+    let (y, global_part, w) = (&mut y[..m], &mut global_part[..g], &w[..m * g]);
+    forward_substitute(l, m, y);
+    for (bj, wj) in global_part.iter_mut().zip(w.chunks_exact(m)) {
+        *bj -= wj.iter().zip(y.iter()).map(|(a, b)| a * b).sum::<f64>();
+    }
+}
+
+/// `y <- L^-T (y - W x_g)` for one group (see [`reduce_right_hand_side`]).
+#[inline(always)]
+fn back_substitute_group<const M: usize, const G: usize>(l: &[f64], w: &[f64], global_part: &[f64], y: &mut [f64]) {
+    let m = if M == 0 { y.len() } else { M };
+    let g = if G == 0 { global_part.len() } else { G };
+    let (y, global_part, w) = (&mut y[..m], &global_part[..g], &w[..m * g]);
+    for (&xj, wj) in global_part.iter().zip(w.chunks_exact(m)) {
+        for (yi, wi) in y.iter_mut().zip(wj) {
+            *yi -= wi * xj;
+        }
+    }
+    backward_substitute(l, m, y);
 }
 
 /// Factor one group's damped `D` in place (`block` = `D`, then `B`, column-major)
@@ -344,11 +375,8 @@ pub(super) fn backward_substitute(l: &[f64], n: usize, x: &mut [f64]) {
 mod tests {
     use super::*;
 
-    /// The block elimination of `h + diag(damping)`, an arrowhead matrix of
-    /// `g` globals and `n` groups of `m` (`shape` = `(g, m, n)`), factored.
-    fn factored_arrowhead(h: &nalgebra::DMatrix<f64>, shape: (usize, usize, usize), damping: &[f64]) -> SchurLayout {
-        let (g, m, n) = shape;
-        let dim = g + m * n;
+    /// The lower-triangle entries of an arrowhead pattern: `g` globals, groups of `m`, dimension `dim`.
+    fn arrowhead_indices(g: usize, m: usize, dim: usize) -> Vec<(usize, usize)> {
         let mut indices = Vec::new();
         for c in 0..dim {
             for r in c..dim {
@@ -357,6 +385,15 @@ mod tests {
                 }
             }
         }
+        indices
+    }
+
+    /// The block elimination of `h + diag(damping)`, an arrowhead matrix of
+    /// `g` globals and `n` groups of `m` (`shape` = `(g, m, n)`), factored.
+    fn factored_arrowhead(h: &nalgebra::DMatrix<f64>, shape: (usize, usize, usize), damping: &[f64]) -> SchurLayout {
+        let (g, m, n) = shape;
+        let dim = g + m * n;
+        let indices = arrowhead_indices(g, m, dim);
         let groups = (0..n).map(|k| (g + k * m, m)).collect();
         let mut layout = SchurLayout::new(&indices, g, groups).expect("arrowhead");
         let mut entries = vec![0.0; layout.storage_len()];
@@ -442,6 +479,32 @@ mod tests {
             let va = nalgebra::DVector::from_vec(a);
             let dense = (va.transpose() * &inverse * &va)[(0, 0)];
             assert!((form - dense).abs() < 1e-10 * dense.abs(), "{form} vs {dense}");
+        }
+    }
+
+    /// A NaN or an infinity at any stored entry of the lower triangle
+    /// (globals, a group's block, a coupling block) fails the factorisation.
+    #[test]
+    fn a_non_finite_entry_anywhere_fails() {
+        let (g, m, n) = (3usize, 2usize, 3usize);
+        let dim = g + m * n;
+        let indices = arrowhead_indices(g, m, dim);
+        let groups: Vec<(usize, usize)> = (0..n).map(|k| (g + k * m, m)).collect();
+        let mut layout = SchurLayout::new(&indices, g, groups).expect("arrowhead");
+        // A diagonally dominant SPD matrix: factorises as it is.
+        let mut entries = vec![0.0; layout.storage_len()];
+        for &(r, c) in &indices {
+            entries[layout.place(r, c).0] = if r == c { 10.0 } else { 0.1 + 0.01 * (r + c) as f64 };
+        }
+        let damping = vec![0.0; dim];
+        assert!(layout.factorize(&entries, &damping));
+        for &(r, c) in &indices {
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                let mut broken = entries.clone();
+                broken[layout.place(r, c).0] = bad;
+                assert!(!layout.factorize(&broken, &damping), "({r}, {c}) = {bad}");
+                assert!(layout.solve(&vec![1.0; dim]).is_none());
+            }
         }
     }
 

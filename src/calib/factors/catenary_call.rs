@@ -117,29 +117,40 @@ impl CatenaryCall {
         let s = &self.slots;
         self.read(values, jacobians.is_some(), |out| {
             if let Some(blocks) = jacobians {
+                // Column-major blocks of `CABLE_COUNT` rows: entry (cable, c) at `cable + CABLE_COUNT * c`.
+                let n = CABLE_COUNT;
+                let (pose, tension) = (out.pose.as_slice(), out.tension.as_slice());
+                let (anchors, offsets) = (out.anchors.as_slice(), out.offsets.as_slice());
+                // The generated blocks are column-major with 16 rows: (row, c) at `row + 16 * c`.
+                let at = |row: usize, c: usize| row + 16 * c;
                 for (slot, &cable) in s.cables.iter().enumerate() {
                     let row = first + slot;
+                    let pose_block = blocks[0].as_mut_slice();
                     for c in 0..6 {
-                        blocks[0][(cable, c)] = out.pose[(row, c)];
+                        pose_block[cable + n * c] = pose[at(row, c)];
                     }
+                    let tension_block = blocks[1].as_mut_slice();
                     for c in 0..2 {
-                        blocks[1][(cable, c)] = out.tension[(row, c)];
+                        tension_block[cable + n * c] = tension[at(row, c)];
                     }
                     for (anchor_slot, &anchor_cable) in s.cables.iter().enumerate() {
+                        let anchor_block = blocks[2 + anchor_cable].as_mut_slice();
                         for c in 0..3 {
-                            blocks[2 + anchor_cable][(cable, c)] = out.anchors[(row, 3 * anchor_slot + c)];
+                            anchor_block[cable + n * c] = anchors[at(row, 3 * anchor_slot + c)];
                         }
-                        if blocks.len() > 6 {
-                            blocks[6 + anchor_cable][(cable, 0)] = out.offsets[(row, anchor_slot)];
+                        if let Some(offset_block) = blocks.get_mut(6 + anchor_cable) {
+                            offset_block.as_mut_slice()[cable] = offsets[at(row, anchor_slot)];
                         }
                     }
                 }
             }
-            let mut residual = DVector::zeros(CABLE_COUNT);
+            // Filled on the stack, then copied: `DVector::zeros` is a `calloc`,
+            // several times the cost of an allocation for four entries.
+            let mut residual = [0.0; CABLE_COUNT];
             for (slot, &cable) in s.cables.iter().enumerate() {
                 residual[cable] = out.rows[first + slot];
             }
-            residual
+            DVector::from_column_slice(&residual)
         })
     }
 }
