@@ -7,8 +7,11 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use sagcal::experiments::hidden_effects::{case_seed, identifiability, run_case, HiddenEffectOptions};
+use sagcal::experiments::hidden_effects::{
+    case_seed, identifiability, refused_readings, run_case, simulate_case, HiddenEffectOptions,
+};
 use sagcal::model::effects::{EffectKind, Effects};
+use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 
 fn fast() -> HiddenEffectOptions {
@@ -58,6 +61,44 @@ fn hidden_effects_are_named_and_none_is_kept() {
             );
         }
     }
+}
+
+/// A sweep case whose drawn centre-of-mass shift (19 cm on the small robot)
+/// leaves the reference cable at about 0.8 N at one pose: under the paper's
+/// 1 N load-cell noise its reading there is negative, which sagcal refuses
+/// as input (the sweep reports such a case instead of failing). The same
+/// truth without the shift is accepted.
+#[test]
+fn a_case_with_a_negative_load_cell_reading_is_refused_by_name() {
+    let nominal = Robot::builtin("small").expect("built-in robot");
+    let com = [EffectKind::Com];
+    let seed = case_seed(1, 1, &com, 18);
+    assert_eq!(seed, 1_150_021);
+    let paper = HiddenEffectOptions {
+        noise: NoisePreset::Paper,
+        ..HiddenEffectOptions::default()
+    };
+    let (data, truth, _) = simulate_case(&nominal, &com, seed, &paper).expect("simulated");
+    assert!(truth.effects.com_shift_m[1] > 0.18, "{:?}", truth.effects.com_shift_m);
+    let reason = refused_readings(&data).expect("a refused reading");
+    let (pose, reading) = data
+        .iter()
+        .enumerate()
+        .find(|(_, m)| m.reference_tension_n <= 0.0)
+        .expect("a non-positive reading");
+    assert!(reading.reference_tension_n > -1.0, "{}", reading.reference_tension_n);
+    assert_eq!(
+        reason,
+        format!(
+            "pose {}: load-cell reading {:.3} N (sagcal needs a positive reference tension)",
+            pose + 1,
+            reading.reference_tension_n
+        )
+    );
+    // The same truth and poses without the shift: every reading above 5 N.
+    let (data, _, _) = simulate_case(&nominal, &[], seed, &paper).expect("simulated");
+    assert_eq!(refused_readings(&data), None);
+    assert!(data.iter().all(|m| m.reference_tension_n > 5.0));
 }
 
 #[test]

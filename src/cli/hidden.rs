@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use rayon::prelude::*;
 use sagcal::experiments::hidden_effects::{
     effect_ranges, identifiability, mean_reference_tension_n, run_sweep, smallest_effects, EffectRange, HiddenCase,
-    HiddenEffectOptions, Identifiability, PAIRS,
+    HiddenEffectOptions, Identifiability, SweepCases, UnmeasurableCase, PAIRS,
 };
 use sagcal::model::effects::EffectKind;
 use sagcal::model::sensors::NoisePreset;
@@ -69,6 +69,8 @@ struct Report {
     summaries: Vec<Summary>,
     smallest: Vec<Identifiability>,
     cases: Vec<HiddenCase>,
+    /// Cases whose simulated readings sagcal refuses as input: not diagnosed, not scored.
+    unmeasurable: Vec<UnmeasurableCase>,
 }
 
 /// The mean of the finite values; NaN without any.
@@ -97,7 +99,10 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         closure: args.closure,
         ..HiddenEffectOptions::default()
     };
-    let cases = sweep(args, &robots, &options)?;
+    let SweepCases {
+        diagnosed: cases,
+        unmeasurable,
+    } = sweep(args, &robots, &options)?;
     // The identifiability of each robot's smallest effects: independent, in parallel.
     let mut studies = Vec::new();
     for robot in &robots {
@@ -120,6 +125,7 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         scores,
         smallest,
         cases,
+        unmeasurable,
     };
     if args.json {
         return print_json(&report);
@@ -141,7 +147,7 @@ fn hidden_sets() -> Vec<String> {
 }
 
 /// Run every case with a progress bar.
-fn sweep(args: &HiddenEffectsArgs, robots: &[Robot], options: &HiddenEffectOptions) -> sagcal::Result<Vec<HiddenCase>> {
+fn sweep(args: &HiddenEffectsArgs, robots: &[Robot], options: &HiddenEffectOptions) -> sagcal::Result<SweepCases> {
     let total = robots.len() * args.noise.len() * hidden_sets().len() * args.seeds;
     eprintln!(
         "sagcal experiment hidden-effects: seed {}, {} closure, {} seeds x {} hidden sets (none, {} effects, {} pairs) x {} robot(s) x {:?} noise, {} poses",
@@ -258,7 +264,30 @@ fn print_report(args: &HiddenEffectsArgs, report: &Report) {
     }
     print_scores(&report.scores);
     print_summaries(&report.summaries);
+    print_unmeasurable(&report.unmeasurable);
     print_smallest(&report.smallest);
+}
+
+/// The cases left out because sagcal refuses their simulated readings.
+fn print_unmeasurable(cases: &[UnmeasurableCase]) {
+    if cases.is_empty() {
+        return;
+    }
+    println!(
+        "{} case(s) not diagnosed and not scored above: their simulated readings are refused as input, as an operator's file would be (the truth's effects leave the reference cable nearly slack at a pose):",
+        cases.len()
+    );
+    let mut t = Table::new(["robot", "noise", "hidden", "seed", "refused reading"]);
+    for c in cases {
+        t.row([
+            c.robot.clone(),
+            format!("{:?}", c.noise).to_lowercase(),
+            c.hidden.clone(),
+            c.seed.to_string(),
+            c.reason.clone(),
+        ]);
+    }
+    println!("{t}");
 }
 
 /// Per robot, noise reading and hidden set: verdicts, detectability and anchor errors.

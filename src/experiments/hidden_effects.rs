@@ -85,7 +85,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::calib::{calibrate, CalibrationError, CalibrationOptions};
+use crate::calib::{calibrate, validate_measurements, CalibrationError, CalibrationOptions};
 use crate::diagnose::{diagnose, power_against, CandidateFit, DiagnoseOptions};
 use crate::error::{Error, Result};
 use crate::model::effect_ranges::{
@@ -535,10 +535,61 @@ pub fn case_seed(base_seed: u64, robot_index: usize, hidden: &[EffectKind], inde
         .wrapping_add((robot_index as u64) * 100_000 + (effect_index as u64) * 10_000 + index as u64)
 }
 
+/// A case whose simulated readings sagcal refuses as input (a load-cell
+/// reading at or below zero where the truth's effects leave the reference
+/// cable nearly slack): no operator could calibrate from them, so it is
+/// reported, not diagnosed.
+#[derive(Debug, Clone, Serialize)]
+pub struct UnmeasurableCase {
+    /// Robot name.
+    pub robot: String,
+    /// The case's seed.
+    pub seed: u64,
+    /// The sensor noise of the case.
+    pub noise: NoisePreset,
+    /// The hidden effects joined by `+` in sorted order, or `none`.
+    pub hidden: String,
+    /// Which reading sagcal refuses, and why.
+    pub reason: String,
+}
+
+/// What a sweep found: the diagnosed cases and those whose data could not be measured.
+#[derive(Debug, Clone, Default)]
+pub struct SweepCases {
+    /// The diagnosed cases, in the order robot, noise reading, hidden set, seed.
+    pub diagnosed: Vec<HiddenCase>,
+    /// The cases whose simulated readings sagcal refuses, in the same order.
+    pub unmeasurable: Vec<UnmeasurableCase>,
+}
+
+/// One case of a sweep: diagnosed, or its readings refused.
+enum SweepCase {
+    Diagnosed(HiddenCase),
+    Unmeasurable(UnmeasurableCase),
+}
+
+/// Why sagcal refuses `measurements` as input (`validate_measurements`), if
+/// it does: the first non-positive load-cell reading, named by pose, or the
+/// check's own message.
+pub fn refused_readings(measurements: &[PoseMeasurement]) -> Option<String> {
+    let refused = validate_measurements(measurements).err()?;
+    let refused_tension = |m: &PoseMeasurement| m.reference_tension_n.is_nan() || m.reference_tension_n <= 0.0;
+    let reason = match measurements.iter().position(refused_tension) {
+        Some(k) => format!(
+            "pose {}: load-cell reading {:.3} N (sagcal needs a positive reference tension)",
+            k + 1,
+            measurements[k].reference_tension_n
+        ),
+        None => refused.to_string(),
+    };
+    Some(reason)
+}
+
 /// Run `seeds` cases of none, of every effect and of every pair of
 /// [`PAIRS`] on every robot under every noise reading of `noises`, in
-/// parallel. `progress()` is called after each case. A case that fails is an
-/// error naming it.
+/// parallel. `progress()` is called after each case. A case whose readings
+/// sagcal refuses ([`refused_readings`]) is reported as unmeasurable; any
+/// other failure is an error naming the case.
 pub fn run_sweep(
     robots: &[Robot],
     noises: &[NoisePreset],
@@ -546,7 +597,7 @@ pub fn run_sweep(
     base_seed: u64,
     options: &HiddenEffectOptions,
     progress: &(dyn Fn() + Sync),
-) -> Result<Vec<HiddenCase>> {
+) -> Result<SweepCases> {
     let mut sets: Vec<Vec<EffectKind>> = vec![Vec::new()];
     sets.extend(EffectKind::ALL.map(|k| vec![k]));
     sets.extend(PAIRS.map(|p| p.to_vec()));
@@ -565,7 +616,7 @@ pub fn run_sweep(
             set_name(set.iter().map(|k| k.name().to_string()))
         )
     };
-    let done: Vec<Vec<Result<HiddenCase>>> = jobs
+    let done: Vec<Vec<Result<SweepCase>>> = jobs
         .par_iter()
         .map(|(r, set, index)| {
             let seed = case_seed(base_seed, *r, set, *index);
@@ -581,7 +632,18 @@ pub fn run_sweep(
                         .as_ref()
                         .map_err(|e| Error::InvalidInput(e.to_string()))
                         .and_then(|truth| truth.measure(*noise, options.segments))
-                        .and_then(|data| diagnose_case(&robots[*r], set, seed, &case_options, data))
+                        .and_then(|data| match refused_readings(&data.0) {
+                            Some(reason) => Ok(SweepCase::Unmeasurable(UnmeasurableCase {
+                                robot: robots[*r].name.clone(),
+                                seed,
+                                noise: *noise,
+                                hidden: set_name(set.iter().map(|k| k.name().to_string())),
+                                reason,
+                            })),
+                            None => {
+                                diagnose_case(&robots[*r], set, seed, &case_options, data).map(SweepCase::Diagnosed)
+                            }
+                        })
                         .map_err(|e| {
                             Error::InvalidInput(format!("{}: {e}", name(*r, set, format!("{noise:?}"), seed)))
                         });
@@ -592,14 +654,16 @@ pub fn run_sweep(
         })
         .collect();
     // Back in the order robot, noise reading, hidden set, seed.
-    let mut by_job: Vec<std::vec::IntoIter<Result<HiddenCase>>> = done.into_iter().map(Vec::into_iter).collect();
-    let mut cases = Vec::with_capacity(jobs.len() * noises.len());
+    let mut by_job: Vec<std::vec::IntoIter<Result<SweepCase>>> = done.into_iter().map(Vec::into_iter).collect();
+    let mut cases = SweepCases::default();
     for r in 0..robots.len() {
         for _ in noises {
             for (j, job) in jobs.iter().enumerate() {
                 if job.0 == r {
-                    if let Some(case) = by_job[j].next() {
-                        cases.push(case?);
+                    match by_job[j].next().transpose()? {
+                        Some(SweepCase::Diagnosed(case)) => cases.diagnosed.push(case),
+                        Some(SweepCase::Unmeasurable(case)) => cases.unmeasurable.push(case),
+                        None => {}
                     }
                 }
             }
