@@ -44,6 +44,7 @@ mod schur;
 use local::LocalGroups;
 
 pub use covariance::{marginal_covariance, Covariance, UnobservableDirection};
+use linear_system::fill_zeros;
 pub use linear_system::LinearSystem;
 pub use redundancy::redundancy_numbers;
 
@@ -200,14 +201,9 @@ fn linearize_with(
 ) -> Result<Linearization, String> {
     let (mut hessian, mut gradient) = match work.spare.take() {
         Some(spare) => (spare.hessian, spare.gradient),
-        None => (system.zero_hessian(), vec![0.0; system.dim]),
+        None => (Vec::new(), Vec::new()),
     };
-    hessian.resize(system.zero_hessian_len(), 0.0);
-    // Zeroed in cache-sized pieces (a single `memset` of a large buffer is a
-    // `rep stosb`, which also costs the most under callgrind's count).
-    for piece in hessian.chunks_mut(128) {
-        piece.fill(0.0);
-    }
+    fill_zeros(&mut hessian, system.zero_hessian_len());
     gradient.clear();
     gradient.resize(system.dim, 0.0);
     let mut cost = 0.0;

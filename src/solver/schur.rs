@@ -59,7 +59,7 @@ impl SchurLayout {
             groups,
             group_base,
             group_of,
-            values: vec![0.0; size],
+            values: super::linear_system::zeroed(size),
             factored: false,
         };
         let coupled = indices.iter().any(|&(row, col)| {
