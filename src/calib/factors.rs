@@ -249,6 +249,10 @@ impl Factor for CatenaryLengthFactor {
     fn kind(&self) -> &'static str {
         "catenary_length"
     }
+    /// Every entry: the four rows of every block, from the shared call.
+    fn writes_every_jacobian_entry(&self) -> bool {
+        true
+    }
 }
 
 /// Cable attachment factor (paper eq. 15): the attachment height minus the
@@ -286,6 +290,10 @@ impl Factor for AttachmentHeightFactor {
     }
     fn kind(&self) -> &'static str {
         "attachment_height"
+    }
+    /// Every entry: the four rows of every block, from the shared call.
+    fn writes_every_jacobian_entry(&self) -> bool {
+        true
     }
 }
 
@@ -493,6 +501,10 @@ impl Factor for ReferenceTensionFactor {
     fn kind(&self) -> &'static str {
         "reference_tension"
     }
+    /// Every entry: its one 1 x 2 block.
+    fn writes_every_jacobian_entry(&self) -> bool {
+        true
+    }
 }
 
 /// Pose prior factor: the localiser's pose. With `orientation` off only the
@@ -566,6 +578,10 @@ impl Factor for PosePriorFactor {
     }
     fn kind(&self) -> &'static str {
         "pose_prior"
+    }
+    /// Every entry: its one block.
+    fn writes_every_jacobian_entry(&self) -> bool {
+        true
     }
 }
 

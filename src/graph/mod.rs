@@ -67,6 +67,13 @@ pub trait Factor: Send + Sync {
     }
     /// A short name of the factor type, for per-type statistics (`"catenary_length"`, ...).
     fn kind(&self) -> &'static str;
+    /// Whether [`Factor::evaluate`] writes every entry of every Jacobian
+    /// block it is given; the solver then skips zeroing its reused blocks
+    /// before the call. `false` (the default) for factors that fill only
+    /// their non-zero entries.
+    fn writes_every_jacobian_entry(&self) -> bool {
+        false
+    }
 }
 
 /// A factor graph: variables with values, and factors between them.
@@ -171,8 +178,10 @@ impl LinearizationBuffers {
         };
         let index = match self.by_shape.iter().position(same_shape) {
             Some(index) => {
-                for jacobian in &mut self.by_shape[index].jacobians {
-                    jacobian.as_mut_slice().fill(0.0);
+                if !factor.writes_every_jacobian_entry() {
+                    for jacobian in &mut self.by_shape[index].jacobians {
+                        jacobian.as_mut_slice().fill(0.0);
+                    }
                 }
                 index
             }
@@ -216,25 +225,29 @@ fn linearize_into(factor: &dyn Factor, values: &Values, out: &mut WhitenedLinear
     out.row_weights.clear();
     out.row_weights.extend(sigmas.iter().map(|sigma| scale / sigma));
     // One pass over the entries: weighted, then checked for a non-finite
-    // entry (an error) and for all zero (nothing to add). `v * 0.0` is NaN
-    // exactly when `v` is not finite, and a sum of `|v|` is zero exactly
-    // when every `v` is: two running sums instead of two branches per entry.
+    // entry (an error) and, only when the residual is all zero, for all zero
+    // (nothing to add: an inactive guard). `v * 0.0` is NaN exactly when `v`
+    // is not finite, and a sum of `|v|` is zero exactly when every `v` is:
+    // running sums instead of branches per entry.
+    let residual_zero = out.residual.iter().all(|&r| r == 0.0);
     let mut not_finite = 0.0;
-    let mut magnitude: f64 = out.residual.iter().map(|r| r.abs()).sum();
+    let mut magnitude = 0.0;
     for jac in &mut out.jacobians {
         for column in jac.as_mut_slice().chunks_exact_mut(rows) {
             for (entry, weight) in column.iter_mut().zip(&out.row_weights) {
                 let v = *entry * weight;
                 *entry = v;
                 not_finite += v * 0.0;
-                magnitude += v.abs();
+                if residual_zero {
+                    magnitude += v.abs();
+                }
             }
         }
     }
-    if not_finite.is_nan() {
+    if f64::is_nan(not_finite) {
         return Err("non-finite Jacobian");
     }
-    let all_zero = magnitude == 0.0;
+    let all_zero = residual_zero && magnitude == 0.0;
     out.is_zero = all_zero;
     out.cost = 0.5 * kernel.rho(s);
     Ok(())

@@ -271,21 +271,39 @@ impl BlockPattern {
     }
 
     /// Scalar `(row, col)` of every entry of the lower triangle, block by
-    /// block, with its position in the block-wise storage (each block
-    /// column-major from its start, the rows of the block apart).
-    fn entry_indices(&self, values: &Values, offsets: &[Option<usize>]) -> (Vec<(usize, usize)>, Vec<usize>) {
+    /// block (each column-major, a diagonal block's lower triangle only).
+    fn entry_indices(&self, values: &Values, offsets: &[Option<usize>]) -> Vec<(usize, usize)> {
         let mut indices = Vec::with_capacity(self.entry_count);
-        let mut positions = Vec::with_capacity(self.entry_count);
-        for &(a, b, start) in &self.block_order {
+        for &(a, b, _) in &self.block_order {
             let (oa, ob) = (offsets[a.0].unwrap_or(0), offsets[b.0].unwrap_or(0));
             let (da, db) = (values.tangent_dim(a), values.tangent_dim(b));
             for j in 0..db {
                 let first = if a == b { j } else { 0 };
                 indices.extend((first..da).map(|i| (oa + i, ob + j)));
-                positions.extend((first..da).map(|i| start + i + j * da));
             }
         }
-        (indices, positions)
+        indices
+    }
+
+    /// The storage position of every entry, in the order of
+    /// [`BlockPattern::entry_indices`]: block `(a, b)`, stored block-wise
+    /// from `start`, is placed by `place(a, b, start)` = (position of its
+    /// first entry, stride between its columns).
+    fn entry_positions(
+        &self,
+        values: &Values,
+        place: impl Fn(VariableId, VariableId, usize) -> (usize, usize),
+    ) -> Vec<usize> {
+        let mut positions = Vec::with_capacity(self.entry_count);
+        for &(a, b, start) in &self.block_order {
+            let (first_position, stride) = place(a, b, start);
+            let (da, db) = (values.tangent_dim(a), values.tangent_dim(b));
+            for j in 0..db {
+                let first = if a == b { j } else { 0 };
+                positions.extend((first..da).map(|i| first_position + i + j * stride));
+            }
+        }
+        positions
     }
 }
 
@@ -302,28 +320,37 @@ impl LinearSystem {
             return Err("every variable is fixed: nothing to solve".into());
         }
         let mut pattern = BlockPattern::new(values, factors, &layout.offsets);
-        let (indices, mut positions) = pattern.entry_indices(values, &layout.offsets);
+        let indices = pattern.entry_indices(values, &layout.offsets);
+        let offset = |v: VariableId| layout.offsets[v.0].unwrap_or(0);
+        // A block's entries all couple the same two variables: its first
+        // entry stands for it in the test of whether two groups are coupled.
+        let corners: Vec<(usize, usize)> = pattern
+            .block_order
+            .iter()
+            .map(|&(a, b, _)| (offset(a), offset(b)))
+            .collect();
         // The reduced system of the elimination is dense: worth it while it is small.
         let schur = (!layout.group_ranges.is_empty() && layout.globals <= MAX_SCHUR_GLOBALS)
-            .then(|| SchurLayout::new(&indices, layout.globals, layout.group_ranges))
+            .then(|| SchurLayout::new(&corners, layout.globals, layout.group_ranges))
             .flatten();
-        let mut storage_len = pattern.entry_count;
-        let factorization = match schur {
+        let (positions, storage_len, factorization) = match schur {
             Some(schur) => {
                 // Accumulate straight into the elimination's dense blocks.
-                for (position, &(row, col)) in positions.iter_mut().zip(&indices) {
-                    *position = schur.place(row, col).0;
-                }
+                let positions = pattern.entry_positions(values, |a, b, _| schur.place(offset(a), offset(b)));
                 for (factor, blocks) in factors.iter().zip(&mut pattern.factor_blocks) {
                     let offset = |slot: usize| layout.offsets[factor.variables()[slot].0].unwrap_or(0);
                     for block in blocks {
                         (block.start, block.stride) = schur.place(offset(block.slot_a), offset(block.slot_b));
                     }
                 }
-                storage_len = schur.storage_len();
-                Factorization::Schur(schur)
+                (positions, schur.storage_len(), Factorization::Schur(schur))
             }
-            None => Factorization::Sparse(Box::new(SparseCholesky::new(&indices, layout.dim)?)),
+            None => {
+                // Block-wise: each block column-major from its start.
+                let positions = pattern.entry_positions(values, |a, _, start| (start, values.tangent_dim(a)));
+                let sparse = SparseCholesky::new(&indices, layout.dim)?;
+                (positions, pattern.entry_count, Factorization::Sparse(Box::new(sparse)))
+            }
         };
         let mut diagonal_entries = vec![0; layout.dim];
         for (k, &(row, col)) in indices.iter().enumerate() {

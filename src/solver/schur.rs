@@ -39,9 +39,10 @@ pub(super) struct SchurLayout {
 
 impl SchurLayout {
     /// A layout for `H` whose lower triangle has entries at `indices`
-    /// (`(row, col)`, `row >= col`, tangent indices with the globals first),
-    /// with `groups` `(first index, dimension)`. `None` if an entry couples
-    /// two groups.
+    /// (`(row, col)`, `row >= col`, tangent indices with the globals first;
+    /// one entry per block between two variables is enough, it stands for
+    /// the block), with `groups` `(first index, dimension)`. `None` if an
+    /// entry couples two groups.
     pub(super) fn new(indices: &[(usize, usize)], globals: usize, groups: Vec<(usize, usize)>) -> Option<Self> {
         let mut group_base = Vec::with_capacity(groups.len());
         let mut size = globals * globals;
