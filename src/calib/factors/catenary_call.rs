@@ -8,8 +8,8 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector4};
 
 use super::{
-    gather_anchors, gather_offsets, pose_arguments, tension_argument, CalibrationVariables, PoseVariables, SlotOrder,
-    EPSILON,
+    gather_anchors, gather_offsets, pose_arguments, slots_to_cables, tension_argument, CalibrationVariables,
+    PoseVariables, SlotOrder, EPSILON,
 };
 use crate::generated;
 use crate::graph::{SharedEvaluation, Values, VariableId};
@@ -144,13 +144,7 @@ impl CatenaryCall {
                     }
                 }
             }
-            // Filled on the stack, then copied: `DVector::zeros` is a `calloc`,
-            // several times the cost of an allocation for four entries.
-            let mut residual = [0.0; CABLE_COUNT];
-            for (slot, &cable) in s.cables.iter().enumerate() {
-                residual[cable] = out.rows[first + slot];
-            }
-            DVector::from_column_slice(&residual)
+            slots_to_cables(s, &Vector4::from_fn(|slot, _| out.rows[first + slot]))
         })
     }
 }
