@@ -1,7 +1,7 @@
 //! `sagcal verify` end to end: the target on the shared RecurDyn data, and
 //! clear errors with a non-zero exit on bad input.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 fn sagcal(args: &[&str]) -> Output {
@@ -12,18 +12,9 @@ fn sagcal(args: &[&str]) -> Output {
         .expect("the sagcal binary runs")
 }
 
-fn shared_data() -> Option<PathBuf> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/recurdyn-large/recurdyn_large.csv");
-    if path.exists() {
-        Some(path)
-    } else {
-        eprintln!(
-            "skipped: {} not found (the shared RecurDyn data is not beside this checkout)",
-            path.display()
-        );
-        None
-    }
-}
+#[path = "common/shared_data.rs"]
+mod shared_data;
+use shared_data::recurdyn_log as shared_data;
 
 #[test]
 fn verify_beats_table_one_on_the_recurdyn_data() {

@@ -14,6 +14,9 @@ use sagcal::model::{Robot, CABLE_COUNT};
 use sagcal::sim::closed_form::{sample_equilibria, Workspace};
 use sagcal::Error;
 
+#[path = "common/shared_data.rs"]
+mod shared_data;
+
 const OFFSETS_M: [f64; CABLE_COUNT] = [1.25, -0.75, 3.5, 0.125];
 
 fn robot(name: &str) -> Robot {
@@ -396,7 +399,9 @@ fn cli_localizes_a_simulated_file() {
 #[test]
 fn recurdyn_log_accuracy() {
     use sagcal::io::recurdyn::{read_recurdyn, LoadOptions};
-    let log_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/recurdyn-large/recurdyn_large.csv");
+    let Some(log_path) = shared_data::recurdyn_log() else {
+        return;
+    };
     let log = read_recurdyn(&log_path, &LoadOptions::default()).unwrap();
     let robot = Robot::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("robots/large.toml")).unwrap();
     let localizer = localizer(&robot);
