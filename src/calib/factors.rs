@@ -320,55 +320,70 @@ impl TensionSource {
         }
     }
 
-    /// The tensions (slot order) and, if `jacobians`, their pose, tension and
-    /// anchor Jacobians (8 x 20, columns `[pose 6, tension 2, anchors 12]`).
-    fn tensions(&self, values: &Values, jacobians: bool) -> (SVector<f64, 8>, SMatrix<f64, 8, 20>) {
+    /// The tensions (slot order), `[f_h0, f_v0, ..., f_h3, f_v3]`.
+    fn tensions(&self, values: &Values) -> SVector<f64, 8> {
+        match self {
+            TensionSource::Shared(call) => call.read(values, false, |out| out.rows.fixed_rows::<8>(8).into_owned()),
+            TensionSource::Own { .. } => self.own_tensions(values, None),
+        }
+    }
+
+    /// The Jacobian of [`TensionSource::tensions`] (8 x 20, columns
+    /// `[pose 6, tension 2, anchors 12]`).
+    fn tension_jacobian(&self, values: &Values) -> SMatrix<f64, 8, 20> {
         let mut jacobian = SMatrix::<f64, 8, 20>::zeros();
         match self {
-            TensionSource::Shared(call) => call.read(values, jacobians, |out| {
-                if jacobians {
-                    jacobian
-                        .fixed_columns_mut::<6>(0)
-                        .copy_from(&out.pose.fixed_rows::<8>(8));
-                    jacobian
-                        .fixed_columns_mut::<2>(6)
-                        .copy_from(&out.tension.fixed_rows::<8>(8));
-                    jacobian
-                        .fixed_columns_mut::<12>(8)
-                        .copy_from(&out.anchors.fixed_rows::<8>(8));
-                }
-                (out.rows.fixed_rows::<8>(8).into_owned(), jacobian)
+            TensionSource::Shared(call) => call.read(values, true, |out| {
+                jacobian
+                    .fixed_columns_mut::<6>(0)
+                    .copy_from(&out.pose.fixed_rows::<8>(8));
+                jacobian
+                    .fixed_columns_mut::<2>(6)
+                    .copy_from(&out.tension.fixed_rows::<8>(8));
+                jacobian
+                    .fixed_columns_mut::<12>(8)
+                    .copy_from(&out.anchors.fixed_rows::<8>(8));
             }),
-            TensionSource::Own {
-                slots: s,
-                globals,
-                pose,
-            } => {
-                let (position, rotation) = pose_arguments(values, pose.pose);
-                let tension = tension_argument(values, pose.reference_tension);
-                let anchors = gather_anchors(values, s, globals);
-                let mut j_pose = SMatrix::<f64, 8, 6>::zeros();
-                let mut j_tension = SMatrix::<f64, 8, 2>::zeros();
-                let mut j_anchors = SMatrix::<f64, 8, 12>::zeros();
-                let tensions = generated::cable_tensions_from_reference(
-                    &position,
-                    &rotation,
-                    &tension,
-                    &anchors,
-                    &s.attachments_m,
-                    &s.com_offset_m,
-                    s.platform_weight_n,
-                    EPSILON,
-                    jacobians.then_some(&mut j_pose),
-                    jacobians.then_some(&mut j_tension),
-                    jacobians.then_some(&mut j_anchors),
-                );
-                jacobian.fixed_columns_mut::<6>(0).copy_from(&j_pose);
-                jacobian.fixed_columns_mut::<2>(6).copy_from(&j_tension);
-                jacobian.fixed_columns_mut::<12>(8).copy_from(&j_anchors);
-                (tensions, jacobian)
+            TensionSource::Own { .. } => {
+                self.own_tensions(values, Some(&mut jacobian));
             }
         }
+        jacobian
+    }
+
+    /// [`generated::cable_tensions_from_reference`] for a guard without a
+    /// shared call, with its Jacobian into `jacobian` if given.
+    fn own_tensions(&self, values: &Values, jacobian: Option<&mut SMatrix<f64, 8, 20>>) -> SVector<f64, 8> {
+        let (s, globals, pose) = match self {
+            TensionSource::Own { slots, globals, pose } => (&**slots, globals, pose),
+            TensionSource::Shared(call) => (&*call.slots, &call.globals, &call.pose),
+        };
+        let (position, rotation) = pose_arguments(values, pose.pose);
+        let tension = tension_argument(values, pose.reference_tension);
+        let anchors = gather_anchors(values, s, globals);
+        let mut j_pose = SMatrix::<f64, 8, 6>::zeros();
+        let mut j_tension = SMatrix::<f64, 8, 2>::zeros();
+        let mut j_anchors = SMatrix::<f64, 8, 12>::zeros();
+        let want = jacobian.is_some();
+        let tensions = generated::cable_tensions_from_reference(
+            &position,
+            &rotation,
+            &tension,
+            &anchors,
+            &s.attachments_m,
+            &s.com_offset_m,
+            s.platform_weight_n,
+            EPSILON,
+            want.then_some(&mut j_pose),
+            want.then_some(&mut j_tension),
+            want.then_some(&mut j_anchors),
+        );
+        if let Some(jacobian) = jacobian {
+            jacobian.fixed_columns_mut::<6>(0).copy_from(&j_pose);
+            jacobian.fixed_columns_mut::<2>(6).copy_from(&j_tension);
+            jacobian.fixed_columns_mut::<12>(8).copy_from(&j_anchors);
+        }
+        tensions
     }
 }
 
@@ -406,7 +421,7 @@ impl Factor for TensionGuardFactor {
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
         // Values first: the Jacobian is needed only where a row is active
         // (rarely: the guard is zero while every cable is taut).
-        let (tensions, _) = self.source.tensions(values, false);
+        let tensions = self.source.tensions(values);
         let (_, _, s) = self.source.pose();
         let mut residual = Vector4::zeros();
         let mut active = [false; CABLE_COUNT];
@@ -427,7 +442,7 @@ impl Factor for TensionGuardFactor {
             if !active.contains(&true) {
                 return Some(slots_to_cables(s, &residual));
             }
-            let (_, jacobian) = self.source.tensions(values, true);
+            let jacobian = self.source.tension_jacobian(values);
             for slot in (0..CABLE_COUNT).filter(|&k| active[k]) {
                 let row = 2 * slot;
                 for c in 0..6 {
@@ -451,6 +466,10 @@ impl Factor for TensionGuardFactor {
     }
     fn kind(&self) -> &'static str {
         "tension_guard"
+    }
+    /// Every block is zeroed first, then its active rows written.
+    fn writes_every_jacobian_entry(&self) -> bool {
+        true
     }
 }
 

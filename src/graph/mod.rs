@@ -152,7 +152,7 @@ pub fn linearize_factor(factor: &dyn Factor, values: &Values) -> Result<Whitened
         is_zero: false,
         row_weights: Vec::with_capacity(rows),
     };
-    linearize_into(factor, values, &mut linearized)?;
+    linearize_into(factor, values, &mut linearized, SlotMask::ALL)?;
     Ok(linearized)
 }
 
@@ -167,6 +167,22 @@ pub struct LinearizationBuffers {
 impl LinearizationBuffers {
     /// Linearise `factor` at `values` into the buffers of its shape (see [`linearize_factor`]).
     pub fn linearize(&mut self, factor: &dyn Factor, values: &Values) -> Result<&WhitenedLinearization, &'static str> {
+        self.linearize_slots(factor, values, SlotMask::ALL)
+    }
+
+    /// [`LinearizationBuffers::linearize`] for a reader of the Jacobian
+    /// blocks in `wanted` only (the solver's per-pose refinement reads the
+    /// pose's blocks, not the anchors'): only those blocks are zeroed before
+    /// the call, whitened and checked, and `is_zero` looks at them alone; the
+    /// others are left as the factor wrote them and must not be read. The
+    /// residual, the cost and the wanted blocks are bit for bit those of
+    /// [`LinearizationBuffers::linearize`].
+    pub fn linearize_slots(
+        &mut self,
+        factor: &dyn Factor,
+        values: &Values,
+        wanted: SlotMask,
+    ) -> Result<&WhitenedLinearization, &'static str> {
         let rows = factor.residual_dim();
         let variables = factor.variables();
         let same_shape = |l: &WhitenedLinearization| {
@@ -179,8 +195,10 @@ impl LinearizationBuffers {
         let index = match self.by_shape.iter().position(same_shape) {
             Some(index) => {
                 if !factor.writes_every_jacobian_entry() {
-                    for jacobian in &mut self.by_shape[index].jacobians {
-                        jacobian.as_mut_slice().fill(0.0);
+                    for (slot, jacobian) in self.by_shape[index].jacobians.iter_mut().enumerate() {
+                        if wanted.contains(slot) {
+                            jacobian.as_mut_slice().fill(0.0);
+                        }
                     }
                 }
                 index
@@ -200,14 +218,42 @@ impl LinearizationBuffers {
             }
         };
         let linearized = &mut self.by_shape[index];
-        linearize_into(factor, values, linearized)?;
+        linearize_into(factor, values, linearized, wanted)?;
         Ok(linearized)
     }
 }
 
+/// Which Jacobian blocks (variable slots) of a factor a linearisation is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SlotMask(u64);
+
+impl SlotMask {
+    /// Every slot.
+    pub const ALL: SlotMask = SlotMask(u64::MAX);
+
+    /// The slots in `slots` (slots from 64 on are always included).
+    pub fn of(slots: impl IntoIterator<Item = usize>) -> Self {
+        SlotMask(
+            slots
+                .into_iter()
+                .fold(0, |mask, slot| mask | 1u64.checked_shl(slot as u32).unwrap_or(0)),
+        )
+    }
+
+    /// Whether `slot` is in the mask.
+    pub fn contains(self, slot: usize) -> bool {
+        slot >= 64 || self.0 >> slot & 1 == 1
+    }
+}
+
 /// Evaluate, whiten and reweight one factor into `out`, whose Jacobian
-/// blocks are zeroed and sized for the factor.
-fn linearize_into(factor: &dyn Factor, values: &Values, out: &mut WhitenedLinearization) -> Result<(), &'static str> {
+/// blocks are sized for the factor and, where `wanted`, zeroed.
+fn linearize_into(
+    factor: &dyn Factor,
+    values: &Values,
+    out: &mut WhitenedLinearization,
+    wanted: SlotMask,
+) -> Result<(), &'static str> {
     let rows = factor.residual_dim();
     let residual = factor
         .evaluate(values, Some(&mut out.jacobians))
@@ -232,7 +278,12 @@ fn linearize_into(factor: &dyn Factor, values: &Values, out: &mut WhitenedLinear
     let residual_zero = out.residual.iter().all(|&r| r == 0.0);
     let mut not_finite = 0.0;
     let mut magnitude = 0.0;
-    for jac in &mut out.jacobians {
+    for (_, jac) in out
+        .jacobians
+        .iter_mut()
+        .enumerate()
+        .filter(|(slot, _)| wanted.contains(*slot))
+    {
         for column in jac.as_mut_slice().chunks_exact_mut(rows) {
             for (entry, weight) in column.iter_mut().zip(&out.row_weights) {
                 let v = *entry * weight;
@@ -251,4 +302,129 @@ fn linearize_into(factor: &dyn Factor, values: &Values, out: &mut WhitenedLinear
     out.is_zero = all_zero;
     out.cost = 0.5 * kernel.rho(s);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `r = [x0 y0 - 1, x1 + y0^2] * k` on `x` (2) and `y` (1); with
+    /// `nan_in_y`, `y`'s Jacobian block is NaN (a block no reader wants).
+    struct Product {
+        variables: [VariableId; 2],
+        sigmas: DVector<f64>,
+        k: f64,
+        nan_in_y: bool,
+    }
+
+    impl Factor for Product {
+        fn variables(&self) -> &[VariableId] {
+            &self.variables
+        }
+        fn residual_dim(&self) -> usize {
+            2
+        }
+        fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+            let (x, y) = (values.vector(self.variables[0]), values.vector(self.variables[1])[0]);
+            if let Some(blocks) = jacobians {
+                blocks[0][(0, 0)] = self.k * y;
+                blocks[0][(1, 1)] = self.k;
+                blocks[1][(0, 0)] = if self.nan_in_y { f64::NAN } else { self.k * x[0] };
+                blocks[1][(1, 0)] = self.k * 2.0 * y;
+            }
+            Some(DVector::from_vec(vec![
+                self.k * (x[0] * y - 1.0),
+                self.k * (x[1] + y * y),
+            ]))
+        }
+        fn sigmas(&self) -> &DVector<f64> {
+            &self.sigmas
+        }
+        fn kind(&self) -> &'static str {
+            "product"
+        }
+    }
+
+    fn setup(k: f64, nan_in_y: bool) -> (Values, Product) {
+        let mut values = Values::default();
+        let x = values.insert("x", VariableValue::Vector(DVector::from_vec(vec![0.7, -0.3])));
+        let y = values.insert("y", VariableValue::Vector(DVector::from_vec(vec![1.9])));
+        let factor = Product {
+            variables: [x, y],
+            sigmas: DVector::from_vec(vec![0.1, 0.3]),
+            k,
+            nan_in_y,
+        };
+        (values, factor)
+    }
+
+    #[test]
+    fn slot_masks_hold_the_slots_named_and_every_slot_from_64_on() {
+        let mask = SlotMask::of([0, 2, 63]);
+        let held: Vec<usize> = (0..70).filter(|&s| mask.contains(s)).collect();
+        assert_eq!(held, [0, 2, 63, 64, 65, 66, 67, 68, 69]);
+        assert!((0..100).all(|s| SlotMask::ALL.contains(s)));
+        assert!(!SlotMask::of([]).contains(0));
+    }
+
+    /// The wanted block, the residual and the cost are bit for bit those of
+    /// the full linearisation (here, after the same buffers held another
+    /// factor's blocks), and hand-computed.
+    #[test]
+    fn a_masked_linearisation_gives_the_wanted_blocks_bit_for_bit() {
+        let (values, factor) = setup(2.0, false);
+        let mut buffers = LinearizationBuffers::default();
+        let full = buffers.linearize(&factor, &values).unwrap();
+        let (full_residual, full_cost, full_x) = (full.residual.clone(), full.cost, full.jacobians[0].clone());
+        let mut masked_buffers = LinearizationBuffers::default();
+        let (_, other) = setup(5.0, false);
+        masked_buffers.linearize(&other, &values).unwrap();
+        let masked = masked_buffers
+            .linearize_slots(&factor, &values, SlotMask::of([0]))
+            .unwrap();
+        assert_eq!(masked.residual, full_residual);
+        assert_eq!(masked.cost.to_bits(), full_cost.to_bits());
+        assert_eq!(masked.jacobians[0], full_x);
+        // r / sigma and J / sigma by hand.
+        let r0 = 2.0 * (0.7 * 1.9 - 1.0) / 0.1;
+        assert!((masked.residual[0] - r0).abs() < 1e-12);
+        assert!((masked.jacobians[0][(0, 0)] - 2.0 * 1.9 / 0.1).abs() < 1e-12);
+        assert!((masked.jacobians[0][(1, 1)] - 2.0 / 0.3).abs() < 1e-12);
+        assert_eq!(masked.jacobians[0][(0, 1)], 0.0);
+    }
+
+    /// A non-finite entry in a block nobody asked for does not fail the
+    /// masked linearisation; in a wanted block (or unmasked) it does.
+    #[test]
+    fn only_wanted_blocks_are_checked_for_finite_entries() {
+        let (values, factor) = setup(1.0, true);
+        let mut buffers = LinearizationBuffers::default();
+        assert_eq!(buffers.linearize(&factor, &values).err(), Some("non-finite Jacobian"));
+        assert!(buffers.linearize_slots(&factor, &values, SlotMask::of([0])).is_ok());
+        assert_eq!(
+            buffers.linearize_slots(&factor, &values, SlotMask::of([1])).err(),
+            Some("non-finite Jacobian")
+        );
+    }
+
+    /// At `k = 0` the residual and every block are zero: an inactive factor, masked or not.
+    #[test]
+    fn a_zero_factor_is_zero_in_its_wanted_blocks() {
+        let (values, factor) = setup(0.0, false);
+        let mut buffers = LinearizationBuffers::default();
+        assert!(buffers.linearize(&factor, &values).unwrap().is_zero);
+        assert!(
+            buffers
+                .linearize_slots(&factor, &values, SlotMask::of([1]))
+                .unwrap()
+                .is_zero
+        );
+        let (values, factor) = setup(1.0, false);
+        assert!(
+            !buffers
+                .linearize_slots(&factor, &values, SlotMask::of([0]))
+                .unwrap()
+                .is_zero
+        );
+    }
 }

@@ -16,7 +16,7 @@
 
 use super::linear_system::dot;
 use super::schur::{backward_substitute, cholesky_in_place, forward_substitute};
-use crate::graph::{FactorGraph, LinearizationBuffers, Values, VariableId};
+use crate::graph::{FactorGraph, LinearizationBuffers, SlotMask, Values, VariableId};
 
 /// Gauss-Newton iterations per group and refinement.
 const MAX_ITERATIONS: usize = 8;
@@ -34,6 +34,8 @@ struct Group {
     /// Per factor of `factors`: its variable slots that belong to the group,
     /// with the variable's tangent offset within the group.
     factor_slots: Vec<Vec<(usize, usize)>>,
+    /// Per factor of `factors`: its slots of `factor_slots` as a mask.
+    factor_masks: Vec<SlotMask>,
 }
 
 /// The graph's local groups, resolved against its factors.
@@ -65,6 +67,7 @@ impl LocalGroups {
                 offsets,
                 factors: Vec::new(),
                 factor_slots: Vec::new(),
+                factor_masks: Vec::new(),
             });
         }
         for (index, factor) in graph.factors.iter().enumerate() {
@@ -73,7 +76,7 @@ impl LocalGroups {
             touched.dedup();
             for g in touched {
                 let group = &mut groups[g];
-                let slots = factor
+                let slots: Vec<(usize, usize)> = factor
                     .variables()
                     .iter()
                     .enumerate()
@@ -83,6 +86,9 @@ impl LocalGroups {
                     })
                     .collect();
                 group.factors.push(index);
+                group
+                    .factor_masks
+                    .push(SlotMask::of(slots.iter().map(|&(slot, _)| slot)));
                 group.factor_slots.push(slots);
             }
         }
@@ -109,84 +115,125 @@ impl LocalGroups {
     }
 }
 
-/// Buffers reused across groups: factor linearisations, `H`, `g`, the step.
+/// Buffers reused across groups: factor linearisations, the group's system
+/// at the current point and at the trial point, the damped matrix, the step.
 #[derive(Default)]
 struct Workspace {
     buffers: LinearizationBuffers,
-    hessian: Vec<f64>,
-    gradient: Vec<f64>,
+    current: GroupSystem,
+    trial: GroupSystem,
     damped: Vec<f64>,
     step: Vec<f64>,
-}
-
-fn group_cost(graph: &FactorGraph, group: &Group, values: &Values) -> Option<f64> {
-    group
-        .factors
-        .iter()
-        .map(|&f| FactorGraph::factor_cost(graph.factors[f].as_ref(), values))
-        .sum()
+    /// The group's tangent index of each column in `gathered`.
+    columns: Vec<usize>,
+    /// The group's Jacobian columns of the factor being added, column-major.
+    gathered: Vec<f64>,
 }
 
 /// `H` (column-major `dim x dim`, lower triangle and diagonal filled) and `g`
-/// of the group's factors with respect to the group's variables, and the
-/// group's cost; `None` if a factor is undefined or not finite.
-fn linearize_group(graph: &FactorGraph, group: &Group, values: &Values, work: &mut Workspace) -> Option<f64> {
+/// of a group's factors with respect to the group's variables.
+#[derive(Default)]
+struct GroupSystem {
+    hessian: Vec<f64>,
+    gradient: Vec<f64>,
+}
+
+/// Linearise the group's factors at `values` into `out` (only their blocks
+/// of the group's variables, [`LinearizationBuffers::linearize_slots`]); the
+/// group's cost, or `None` if a factor is undefined or not finite.
+fn linearize_group(
+    graph: &FactorGraph,
+    group: &Group,
+    values: &Values,
+    buffers: &mut LinearizationBuffers,
+    columns: &mut Vec<usize>,
+    gathered: &mut Vec<f64>,
+    out: &mut GroupSystem,
+) -> Option<f64> {
     let dim = group.offsets[group.offsets.len() - 1];
-    work.hessian.clear();
-    work.hessian.resize(dim * dim, 0.0);
-    work.gradient.clear();
-    work.gradient.resize(dim, 0.0);
+    out.hessian.clear();
+    out.hessian.resize(dim * dim, 0.0);
+    out.gradient.clear();
+    out.gradient.resize(dim, 0.0);
     let mut cost = 0.0;
-    for (&f, slots) in group.factors.iter().zip(&group.factor_slots) {
-        let Ok(linearized) = work.buffers.linearize(graph.factors[f].as_ref(), values) else {
+    for ((&f, slots), &mask) in group.factors.iter().zip(&group.factor_slots).zip(&group.factor_masks) {
+        let Ok(linearized) = buffers.linearize_slots(graph.factors[f].as_ref(), values, mask) else {
             return None;
         };
         cost += linearized.cost;
         if linearized.is_zero {
             continue;
         }
+        // The group's columns of this factor, gathered contiguous (column-major, `rows` each).
         let rows = linearized.residual.len();
-        for &(slot_a, offset_a) in slots {
-            let ja = linearized.jacobians[slot_a].as_slice();
-            for (c, column) in ja.chunks_exact(rows).enumerate() {
-                work.gradient[offset_a + c] += dot::<0>(column, &linearized.residual);
-            }
-            for &(slot_b, offset_b) in slots {
-                if offset_a < offset_b {
-                    continue;
-                }
-                let jb = linearized.jacobians[slot_b].as_slice();
-                for (i, column_a) in ja.chunks_exact(rows).enumerate() {
-                    for (j, column_b) in jb.chunks_exact(rows).enumerate() {
-                        let (row, col) = (offset_a + i, offset_b + j);
-                        if row >= col {
-                            work.hessian[row + col * dim] += dot::<0>(column_a, column_b);
-                        }
-                    }
-                }
-            }
+        columns.clear();
+        gathered.clear();
+        for &(slot, offset) in slots {
+            let block = &linearized.jacobians[slot];
+            columns.extend((0..block.ncols()).map(|c| offset + c));
+            gathered.extend_from_slice(block.as_slice());
+        }
+        let residual = &linearized.residual;
+        match rows {
+            1 => add_normal_equations::<1>(columns, gathered, residual, dim, out),
+            4 => add_normal_equations::<4>(columns, gathered, residual, dim, out),
+            6 => add_normal_equations::<6>(columns, gathered, residual, dim, out),
+            _ => add_normal_equations::<0>(columns, gathered, residual, dim, out),
         }
     }
-    work.hessian
+    out.hessian
         .iter()
-        .chain(&work.gradient)
+        .chain(&out.gradient)
         .all(|v| v.is_finite())
         .then_some(cost)
 }
 
+/// Add one factor's `J^T J` (lower triangle) and `J^T r` over the group's
+/// columns (`gathered`: column-major, the residual's length each; column `k`
+/// is the group's tangent index `columns[k]`), `R` rows (`R = 0`: any
+/// number): one dot product per entry, summed over the rows in order and
+/// added to the entry once per factor.
+#[inline(always)]
+fn add_normal_equations<const R: usize>(
+    columns: &[usize],
+    gathered: &[f64],
+    residual: &[f64],
+    dim: usize,
+    out: &mut GroupSystem,
+) {
+    let rows = residual.len();
+    for (&a, ja) in columns.iter().zip(gathered.chunks_exact(rows)) {
+        out.gradient[a] += dot::<R>(ja, residual);
+        for (&b, jb) in columns.iter().zip(gathered.chunks_exact(rows)) {
+            if a >= b {
+                out.hessian[a + b * dim] += dot::<R>(ja, jb);
+            }
+        }
+    }
+}
+
+/// Re-minimise one group with everything else held: damped Gauss-Newton on
+/// the group's dense system. Every trial point is linearised whole (its cost
+/// is the same sum as a value-only pass), so an accepted trial needs no
+/// second pass over the group's factors.
 fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &mut Workspace) {
     let dim = group.offsets[group.offsets.len() - 1];
     let mut damping = 1e-8;
+    let Workspace {
+        buffers,
+        current,
+        trial,
+        damped,
+        step,
+        columns,
+        gathered,
+    } = work;
     // The cost at the current values: the linearisation's at the start, then
     // that of the last accepted trial.
-    let mut cost = f64::NAN;
-    for iteration in 0..MAX_ITERATIONS {
-        let Some(linearized_cost) = linearize_group(graph, group, values, work) else {
-            return;
-        };
-        if iteration == 0 {
-            cost = linearized_cost;
-        }
+    let Some(mut cost) = linearize_group(graph, group, values, buffers, columns, gathered, current) else {
+        return;
+    };
+    for _ in 0..MAX_ITERATIONS {
         let originals: Vec<_> = group
             .variables
             .iter()
@@ -194,41 +241,42 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &
             .collect();
         let mut improved = false;
         while damping < 1e8 {
-            work.damped.clone_from(&work.hessian);
+            damped.clone_from(&current.hessian);
             for i in 0..dim {
-                work.damped[i + i * dim] += damping * work.hessian[i + i * dim].max(1e-12);
+                damped[i + i * dim] += damping * current.hessian[i + i * dim].max(1e-12);
             }
-            if !cholesky_in_place(&mut work.damped, dim) {
+            if !cholesky_in_place(damped, dim) {
                 damping *= 10.0;
                 continue;
             }
-            work.step.clear();
-            work.step.extend(work.gradient.iter().map(|g| -g));
-            forward_substitute(&work.damped, dim, &mut work.step);
-            backward_substitute(&work.damped, dim, &mut work.step);
+            step.clear();
+            step.extend(current.gradient.iter().map(|g| -g));
+            forward_substitute(damped, dim, step);
+            backward_substitute(damped, dim, step);
             // Predicted decrease of the damped Gauss-Newton step,
             // 1/2 dx.(lambda D dx - g): below the tolerance the group is at
             // its minimum and the trial evaluation is saved.
             let predicted: f64 = 0.5
                 * (0..dim)
                     .map(|i| {
-                        let dx = work.step[i];
-                        dx * (damping * work.hessian[i + i * dim].max(1e-12) * dx - work.gradient[i])
+                        let dx = step[i];
+                        dx * (damping * current.hessian[i + i * dim].max(1e-12) * dx - current.gradient[i])
                     })
                     .sum::<f64>();
             if predicted < RELATIVE_TOLERANCE * cost {
                 return;
             }
             for (k, &v) in group.variables.iter().enumerate() {
-                let slice = &work.step[group.offsets[k]..group.offsets[k + 1]];
+                let slice = &step[group.offsets[k]..group.offsets[k + 1]];
                 values.set(v, originals[k].retract(slice));
             }
-            match group_cost(graph, group, values) {
+            match linearize_group(graph, group, values, buffers, columns, gathered, trial) {
                 Some(new_cost) if new_cost < cost => {
                     let decrease = (cost - new_cost) / cost.max(f64::MIN_POSITIVE);
                     cost = new_cost;
                     damping = (damping / 10.0).max(1e-12);
                     improved = decrease > RELATIVE_TOLERANCE;
+                    std::mem::swap(current, trial);
                     break;
                 }
                 _ => {
