@@ -39,13 +39,18 @@ struct Args {
     /// Seed of the benchmark problem (data and initial guess).
     #[arg(long, default_value_t = 7)]
     seed: u64,
-    /// Rounds up to 1000 poses; each round solves with every solver in turn (interleaved).
+    /// Rounds from 101 to 1000 poses; each round solves with every solver in
+    /// turn (interleaved), the first solver of the round rotating.
     #[arg(long, default_value_t = 9)]
     repeats: usize,
+    /// Rounds up to 100 poses, where a round takes milliseconds and a few
+    /// rounds leave the median at the mercy of the machine's noise.
+    #[arg(long, default_value_t = 41)]
+    small_repeats: usize,
     /// Rounds above 1000 poses.
     #[arg(long, default_value_t = 5)]
     large_repeats: usize,
-    /// A check in under a minute: 5 rounds up to 1000 poses, 2 above.
+    /// A check in under a minute: 15 rounds up to 100 poses, 5 up to 1000, 2 above.
     #[arg(long)]
     quick: bool,
     /// Instead of the table: one solve of this solver (`sagcal`, `apex-solver`,
@@ -191,27 +196,39 @@ fn counted_floor(problem: &BenchmarkProblem, fused: bool) -> f64 {
 }
 
 fn run(args: &Args) -> Result<(), String> {
-    let (repeats, large_repeats) = if args.quick {
-        (5, 2)
+    let (small_repeats, repeats, large_repeats) = if args.quick {
+        (15, 5, 2)
     } else {
-        (args.repeats, args.large_repeats)
+        (args.small_repeats, args.repeats, args.large_repeats)
     };
     eprintln!(
-        "sagcal-peers: seed {}, poses {:?}, {repeats} rounds ({large_repeats} above 1000 poses), solvers interleaved in each round, one thread per solve",
+        "sagcal-peers: seed {}, poses {:?}, {small_repeats} rounds up to 100 poses, {repeats} up to 1000, {large_repeats} above, after one untimed warm-up round; solvers interleaved in each round (the first one rotating), one thread per solve",
         args.seed, args.poses
     );
     let max_iterations = BenchmarkProblem::stopping().max_iterations;
     let mut rows: Vec<Row> = Vec::new();
     for &poses in &args.poses {
         let problem = BenchmarkProblem::new(poses, args.seed).map_err(|e| e.to_string())?;
-        let rounds = if poses > 1000 { large_repeats } else { repeats }.max(1);
+        let rounds = match poses {
+            0..=100 => small_repeats,
+            101..=1000 => repeats,
+            _ => large_repeats,
+        }
+        .max(1);
         let mut times = vec![Vec::with_capacity(rounds); SOLVERS.len()];
         let mut last: Vec<Option<PeerRun>> = vec![None; SOLVERS.len()];
-        for _ in 0..rounds {
-            for (k, (name, solve)) in SOLVERS.iter().enumerate() {
+        // Round 0 warms up (first use of the allocator, the caches, apex's
+        // thread pool) and is not timed; from round 1 on, round r starts with
+        // solver r mod 3, so that no solver always runs first or after the same one.
+        for round in 0..=rounds {
+            for step in 0..SOLVERS.len() {
+                let k = (round + step) % SOLVERS.len();
+                let (name, solve) = SOLVERS[k];
                 let run = solve(&problem, max_iterations).map_err(|e| format!("{name} at {poses} poses: {e}"))?;
-                times[k].push(run.solve_seconds);
-                last[k] = Some(run);
+                if round > 0 {
+                    times[k].push(run.solve_seconds);
+                    last[k] = Some(run);
+                }
             }
         }
         let reference_cost = last[0].as_ref().expect("a round").reported_final_cost;
@@ -251,6 +268,7 @@ fn run(args: &Args) -> Result<(), String> {
     std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
     let json = serde_json::json!({
         "seed": args.seed,
+        "small_rounds": small_repeats,
         "rounds": repeats,
         "large_rounds": large_repeats,
         "threads": 1,

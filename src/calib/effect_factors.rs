@@ -40,7 +40,7 @@ use super::factors::{
     tension_argument, variable_list, CalibrationVariables, PoseVariables, SlotOrder, EPSILON,
 };
 use crate::generated;
-use crate::graph::{Factor, RobustKernel, SharedEvaluation, Values, VariableId};
+use crate::graph::{evaluate_through_into, Factor, RobustKernel, SharedEvaluation, Values, VariableId};
 use crate::model::effects::EffectKind;
 use crate::model::robot::CABLE_COUNT;
 
@@ -583,6 +583,9 @@ impl Factor for LoadCellFactor {
         1
     }
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        evaluate_through_into(self, values, jacobians)
+    }
+    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
         let tension = tension_argument(values, self.variables[0]);
         let cell = values.vector(self.variables[1]);
         let mut j_tension = SMatrix::<f64, 1, 2>::zeros();
@@ -604,7 +607,8 @@ impl Factor for LoadCellFactor {
             blocks[1][(0, 0)] = j_bias[(0, 0)];
             blocks[1][(0, 1)] = j_gain[(0, 0)];
         }
-        Some(DVector::from_element(1, r[0]))
+        residual[0] = r[0];
+        true
     }
     fn sigmas(&self) -> &DVector<f64> {
         &self.sigmas

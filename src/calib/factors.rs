@@ -55,7 +55,7 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, SVector, Vector2, Vector3, Vector4};
 
 use crate::generated;
-use crate::graph::{Factor, RobustKernel, Values, VariableId};
+use crate::graph::{evaluate_through_into, Factor, RobustKernel, Values, VariableId};
 use crate::model::robot::{Robot, CABLE_COUNT};
 
 mod catenary_call;
@@ -238,7 +238,11 @@ impl Factor for CatenaryLengthFactor {
         CABLE_COUNT
     }
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
-        Some(self.call.four_rows(values, 0, jacobians))
+        evaluate_through_into(self, values, jacobians)
+    }
+    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
+        self.call.four_rows(values, 0, residual, jacobians);
+        true
     }
     fn sigmas(&self) -> &DVector<f64> {
         &self.sigmas
@@ -283,7 +287,11 @@ impl Factor for AttachmentHeightFactor {
         CABLE_COUNT
     }
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
-        Some(self.call.four_rows(values, 4, jacobians))
+        evaluate_through_into(self, values, jacobians)
+    }
+    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
+        self.call.four_rows(values, 4, residual, jacobians);
+        true
     }
     fn sigmas(&self) -> &DVector<f64> {
         &self.sigmas
@@ -419,6 +427,9 @@ impl Factor for TensionGuardFactor {
         CABLE_COUNT
     }
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        evaluate_through_into(self, values, jacobians)
+    }
+    fn evaluate_into(&self, values: &Values, out: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
         // Values first: the Jacobian is needed only where a row is active
         // (rarely: the guard is zero while every cable is taut).
         let tensions = self.source.tensions(values);
@@ -428,38 +439,42 @@ impl Factor for TensionGuardFactor {
         for slot in 0..CABLE_COUNT {
             let f_h = tensions[2 * slot];
             if !(f_h.is_finite() && f_h > 0.0) {
-                return None;
+                return false;
             }
             if f_h < self.minimum_horizontal_tension_n {
                 residual[slot] = f_h - self.minimum_horizontal_tension_n;
                 active[slot] = true;
             }
         }
-        if let Some(blocks) = jacobians {
-            for block in blocks.iter_mut() {
-                block.fill(0.0);
-            }
-            if !active.contains(&true) {
-                return Some(slots_to_cables(s, &residual));
-            }
-            let jacobian = self.source.tension_jacobian(values);
-            for slot in (0..CABLE_COUNT).filter(|&k| active[k]) {
-                let row = 2 * slot;
-                for c in 0..6 {
-                    blocks[0][(slot, c)] = jacobian[(row, c)];
-                }
-                for c in 0..2 {
-                    blocks[1][(slot, c)] = jacobian[(row, 6 + c)];
-                }
-                for (anchor_slot, &cable) in s.cables.iter().enumerate() {
-                    for c in 0..3 {
-                        blocks[2 + cable][(slot, c)] = jacobian[(row, 8 + 3 * anchor_slot + c)];
-                    }
-                }
-            }
-            rows_to_cables(s, blocks);
+        for (slot, &cable) in s.cables.iter().enumerate() {
+            out[cable] = residual[slot];
         }
-        Some(slots_to_cables(s, &residual))
+        let Some(blocks) = jacobians else {
+            return true;
+        };
+        for block in blocks.iter_mut() {
+            block.fill(0.0);
+        }
+        if !active.contains(&true) {
+            return true;
+        }
+        let jacobian = self.source.tension_jacobian(values);
+        for slot in (0..CABLE_COUNT).filter(|&k| active[k]) {
+            let row = 2 * slot;
+            for c in 0..6 {
+                blocks[0][(slot, c)] = jacobian[(row, c)];
+            }
+            for c in 0..2 {
+                blocks[1][(slot, c)] = jacobian[(row, 6 + c)];
+            }
+            for (anchor_slot, &cable) in s.cables.iter().enumerate() {
+                for c in 0..3 {
+                    blocks[2 + cable][(slot, c)] = jacobian[(row, 8 + 3 * anchor_slot + c)];
+                }
+            }
+        }
+        rows_to_cables(s, blocks);
+        true
     }
     fn sigmas(&self) -> &DVector<f64> {
         &self.sigmas
@@ -501,6 +516,9 @@ impl Factor for ReferenceTensionFactor {
         1
     }
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        evaluate_through_into(self, values, jacobians)
+    }
+    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
         let tension = tension_argument(values, self.variables[0]);
         let mut j = SMatrix::<f64, 1, 2>::zeros();
         let want = jacobians.is_some();
@@ -509,7 +527,8 @@ impl Factor for ReferenceTensionFactor {
         if let Some(blocks) = jacobians {
             blocks[0].copy_from(&j);
         }
-        Some(DVector::from_element(1, r[0]))
+        residual[0] = r[0];
+        true
     }
     fn sigmas(&self) -> &DVector<f64> {
         &self.sigmas
@@ -572,6 +591,9 @@ impl Factor for PosePriorFactor {
         self.sigmas.len()
     }
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+        evaluate_through_into(self, values, jacobians)
+    }
+    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
         let (position, rotation) = pose_arguments(values, self.variables[0]);
         let mut j = SMatrix::<f64, 6, 6>::zeros();
         let want = jacobians.is_some();
@@ -587,7 +609,8 @@ impl Factor for PosePriorFactor {
         if let Some(blocks) = jacobians {
             blocks[0].copy_from(&j.rows(first, 6 - first));
         }
-        Some(DVector::from_iterator(6 - first, r.iter().skip(first).copied()))
+        residual.copy_from_slice(&r.as_slice()[first..]);
+        true
     }
     fn sigmas(&self) -> &DVector<f64> {
         &self.sigmas

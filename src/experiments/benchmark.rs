@@ -133,6 +133,7 @@ impl BenchmarkProblem {
         }
         let mut options = CalibrationOptions::new(noise);
         options.orientation_prior = OrientationPrior::On;
+        options.lm = Self::stopping();
         Ok(Self {
             truth,
             initial,

@@ -59,6 +59,20 @@ pub trait Factor: Send + Sync {
     /// per variable (`residual_dim x tangent_dim`, already sized). `None` where
     /// the model is undefined (e.g. a slack cable): the solver rejects such steps.
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>>;
+    /// [`Factor::evaluate`] into `residual` (`residual_dim` entries) instead
+    /// of a new vector; `false` where the model is undefined. The solver calls
+    /// this one. The default calls [`Factor::evaluate`] and copies; factors
+    /// evaluated thousands of times per iteration override it to allocate
+    /// nothing (and then implement `evaluate` by [`evaluate_through_into`]).
+    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
+        match self.evaluate(values, jacobians) {
+            Some(r) => {
+                residual.copy_from_slice(r.as_slice());
+                true
+            }
+            None => false,
+        }
+    }
     /// Standard deviation of every residual component (same units as the residual).
     fn sigmas(&self) -> &DVector<f64>;
     /// The robust kernel applied to the whitened squared norm.
@@ -74,6 +88,19 @@ pub trait Factor: Send + Sync {
     fn writes_every_jacobian_entry(&self) -> bool {
         false
     }
+}
+
+/// [`Factor::evaluate`] of a factor that implements [`Factor::evaluate_into`]:
+/// the residual in a new vector.
+pub fn evaluate_through_into(
+    factor: &(impl Factor + ?Sized),
+    values: &Values,
+    jacobians: Option<&mut [DMatrix<f64>]>,
+) -> Option<DVector<f64>> {
+    let mut residual = DVector::zeros(factor.residual_dim());
+    factor
+        .evaluate_into(values, residual.as_mut_slice(), jacobians)
+        .then_some(residual)
 }
 
 /// A factor graph: variables with values, and factors between them.
@@ -104,8 +131,20 @@ impl FactorGraph {
     /// Whitened residual of one factor at `values`, with the robust kernel's
     /// cost `1/2 rho(s)`; `None` if the model is undefined there.
     pub fn factor_cost(factor: &dyn Factor, values: &Values) -> Option<f64> {
-        let residual = factor.evaluate(values, None)?;
-        let s = whitened_squared_norm(&residual, factor.sigmas());
+        // Short residuals on the stack (every factor of the calibration).
+        let rows = factor.residual_dim();
+        let mut stack = [0.0; 16];
+        let mut heap = Vec::new();
+        let residual = if rows <= stack.len() {
+            &mut stack[..rows]
+        } else {
+            heap.resize(rows, 0.0);
+            &mut heap[..]
+        };
+        if !factor.evaluate_into(values, residual, None) {
+            return None;
+        }
+        let s = squared_norm_over(residual, factor.sigmas());
         s.is_finite().then(|| 0.5 * factor.robust_kernel().rho(s))
     }
 
@@ -117,6 +156,11 @@ impl FactorGraph {
 
 /// `|r / sigma|^2`.
 pub fn whitened_squared_norm(residual: &DVector<f64>, sigmas: &DVector<f64>) -> f64 {
+    squared_norm_over(residual.as_slice(), sigmas)
+}
+
+/// [`whitened_squared_norm`] of a residual slice.
+fn squared_norm_over(residual: &[f64], sigmas: &DVector<f64>) -> f64 {
     residual.iter().zip(sigmas.iter()).map(|(r, s)| (r / s) * (r / s)).sum()
 }
 
@@ -135,6 +179,8 @@ pub struct WhitenedLinearization {
     pub is_zero: bool,
     /// Scratch: `sqrt(w) / sigma_r` per row.
     row_weights: Vec<f64>,
+    /// Scratch: the unwhitened residual.
+    raw_residual: Vec<f64>,
 }
 
 /// Linearise one factor at `values`; `Err` names what went wrong (the model is
@@ -151,6 +197,7 @@ pub fn linearize_factor(factor: &dyn Factor, values: &Values) -> Result<Whitened
         cost: 0.0,
         is_zero: false,
         row_weights: Vec::with_capacity(rows),
+        raw_residual: Vec::with_capacity(rows),
     };
     linearize_into(factor, values, &mut linearized, SlotMask::ALL)?;
     Ok(linearized)
@@ -213,6 +260,7 @@ impl LinearizationBuffers {
                     cost: 0.0,
                     is_zero: false,
                     row_weights: Vec::with_capacity(rows),
+                    raw_residual: Vec::with_capacity(rows),
                 });
                 self.by_shape.len() - 1
             }
@@ -255,11 +303,15 @@ fn linearize_into(
     wanted: SlotMask,
 ) -> Result<(), &'static str> {
     let rows = factor.residual_dim();
-    let residual = factor
-        .evaluate(values, Some(&mut out.jacobians))
-        .ok_or("model undefined (slack cable)")?;
+    out.raw_residual.clear();
+    out.raw_residual.resize(rows, 0.0);
+    let defined = factor.evaluate_into(values, &mut out.raw_residual, Some(&mut out.jacobians));
+    let residual = &out.raw_residual;
+    if !defined {
+        return Err("model undefined (slack cable)");
+    }
     let sigmas = factor.sigmas();
-    let s = whitened_squared_norm(&residual, sigmas);
+    let s = squared_norm_over(residual, sigmas);
     if !s.is_finite() {
         return Err("non-finite residual");
     }
@@ -272,36 +324,78 @@ fn linearize_into(
     out.row_weights.extend(sigmas.iter().map(|sigma| scale / sigma));
     // One pass over the entries: weighted, then checked for a non-finite
     // entry (an error) and, only when the residual is all zero, for all zero
-    // (nothing to add: an inactive guard). `v * 0.0` is NaN exactly when `v`
-    // is not finite, and a sum of `|v|` is zero exactly when every `v` is:
-    // running sums instead of branches per entry.
+    // (nothing to add: an inactive guard).
     let residual_zero = out.residual.iter().all(|&r| r == 0.0);
-    let mut not_finite = 0.0;
-    let mut magnitude = 0.0;
-    for (_, jac) in out
+    let wanted_blocks = out
         .jacobians
         .iter_mut()
         .enumerate()
         .filter(|(slot, _)| wanted.contains(*slot))
-    {
-        for column in jac.as_mut_slice().chunks_exact_mut(rows) {
-            for (entry, weight) in column.iter_mut().zip(&out.row_weights) {
+        .map(|(_, jacobian)| jacobian.as_mut_slice());
+    let weights = &out.row_weights;
+    let (finite, zero) = match (rows, residual_zero) {
+        (4, false) => weigh_columns::<4, false>(wanted_blocks, weights),
+        (4, true) => weigh_columns::<4, true>(wanted_blocks, weights),
+        (6, false) => weigh_columns::<6, false>(wanted_blocks, weights),
+        (1, _) => weigh_columns::<1, true>(wanted_blocks, weights),
+        (_, false) => weigh_columns::<0, false>(wanted_blocks, weights),
+        (_, true) => weigh_columns::<0, true>(wanted_blocks, weights),
+    };
+    if !finite {
+        return Err("non-finite Jacobian");
+    }
+    out.is_zero = residual_zero && zero;
+    out.cost = 0.5 * kernel.rho(s);
+    Ok(())
+}
+
+/// Multiply every column of `blocks` (column-major, `weights.len()` rows)
+/// by the row weights, entry by entry; returns whether every weighted entry
+/// is finite and (only computed when `ZERO`, else `false`) whether all are
+/// zero. `R` rows known at compile time (`R = 0`: any), so that the rows of
+/// a column are multiplied side by side; the checks keep one running sum per
+/// row (`v * 0.0` is NaN exactly when `v` is not finite, a sum of `|v|` is
+/// zero exactly when every `v` is), whose order does not change the answer.
+#[inline(always)]
+fn weigh_columns<'a, const R: usize, const ZERO: bool>(
+    blocks: impl Iterator<Item = &'a mut [f64]>,
+    weights: &[f64],
+) -> (bool, bool) {
+    let rows = weights.len();
+    if R != 0 && rows == R {
+        let weights: [f64; R] = std::array::from_fn(|r| weights[r]);
+        let mut not_finite = [0.0; R];
+        let mut magnitude = [0.0; R];
+        for block in blocks {
+            for column in block.chunks_exact_mut(R) {
+                for r in 0..R {
+                    let v = column[r] * weights[r];
+                    column[r] = v;
+                    not_finite[r] += v * 0.0;
+                    if ZERO {
+                        magnitude[r] += v.abs();
+                    }
+                }
+            }
+        }
+        let finite = !not_finite.iter().any(|v| v.is_nan());
+        return (finite, ZERO && magnitude.iter().all(|&m| m == 0.0));
+    }
+    let mut not_finite = 0.0;
+    let mut magnitude = 0.0;
+    for block in blocks {
+        for column in block.chunks_exact_mut(rows) {
+            for (entry, weight) in column.iter_mut().zip(weights) {
                 let v = *entry * weight;
                 *entry = v;
                 not_finite += v * 0.0;
-                if residual_zero {
+                if ZERO {
                     magnitude += v.abs();
                 }
             }
         }
     }
-    if f64::is_nan(not_finite) {
-        return Err("non-finite Jacobian");
-    }
-    let all_zero = residual_zero && magnitude == 0.0;
-    out.is_zero = all_zero;
-    out.cost = 0.5 * kernel.rho(s);
-    Ok(())
+    (!f64::is_nan(not_finite), ZERO && magnitude == 0.0)
 }
 
 #[cfg(test)]
@@ -426,5 +520,39 @@ mod tests {
                 .unwrap()
                 .is_zero
         );
+    }
+
+    /// The fixed-row kernels weigh exactly as the general loop and agree on
+    /// finiteness and all-zero, for finite, infinite, NaN and zero entries.
+    #[test]
+    fn fixed_row_weighing_matches_the_general_loop() {
+        fn check<const R: usize>(entries: &[f64], weights: &[f64]) {
+            let (mut fixed, mut general) = (entries.to_vec(), entries.to_vec());
+            let a = weigh_columns::<R, true>(std::iter::once(fixed.as_mut_slice()), weights);
+            let b = weigh_columns::<0, true>(std::iter::once(general.as_mut_slice()), weights);
+            assert_eq!(a, b, "{entries:?}");
+            assert!(fixed.iter().zip(&general).all(|(x, y)| x.to_bits() == y.to_bits()));
+            let expected_finite = entries
+                .iter()
+                .zip(weights.iter().cycle())
+                .all(|(e, w)| (e * w).is_finite());
+            assert_eq!(a.0, expected_finite);
+            assert_eq!(a.1, entries.iter().all(|&e| e == 0.0));
+            assert!(!weigh_columns::<R, false>(std::iter::once(entries.to_vec().as_mut_slice()), weights).1);
+        }
+        let weights4 = [0.5, 3.0, 1e-3, 7.0];
+        let mut entries: Vec<f64> = (0..24).map(|k| (k as f64 * 0.37).sin()).collect();
+        check::<4>(&entries, &weights4);
+        entries[13] = f64::INFINITY;
+        check::<4>(&entries, &weights4);
+        entries[13] = f64::NAN;
+        check::<4>(&entries, &weights4);
+        check::<4>(&[0.0; 24], &weights4);
+        check::<4>(&[-0.0; 8], &weights4);
+        let weights6 = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let entries6: Vec<f64> = (0..36).map(|k| k as f64 - 17.0).collect();
+        check::<6>(&entries6, &weights6);
+        check::<1>(&[2.0, f64::NEG_INFINITY], &[0.25]);
+        check::<1>(&[0.0, 0.0], &[0.25]);
     }
 }

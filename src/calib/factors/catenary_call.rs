@@ -5,11 +5,11 @@
 
 use std::sync::Arc;
 
-use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector4};
+use nalgebra::{DMatrix, SMatrix, SVector, Vector4};
 
 use super::{
-    gather_anchors, gather_offsets, pose_arguments, slots_to_cables, tension_argument, CalibrationVariables,
-    PoseVariables, SlotOrder, EPSILON,
+    gather_anchors, gather_offsets, pose_arguments, tension_argument, CalibrationVariables, PoseVariables, SlotOrder,
+    EPSILON,
 };
 use crate::generated;
 use crate::graph::{SharedEvaluation, Values, VariableId};
@@ -107,13 +107,14 @@ impl CatenaryCall {
     }
 
     /// Four rows from `first` of the call as a factor's residual (robot cable
-    /// order), with its blocks `[pose, tension, anchors (4), offsets (4)?]`.
+    /// order) into `residual`, with its blocks `[pose, tension, anchors (4), offsets (4)?]`.
     pub(super) fn four_rows(
         &self,
         values: &Values,
         first: usize,
+        residual: &mut [f64],
         jacobians: Option<&mut [DMatrix<f64>]>,
-    ) -> DVector<f64> {
+    ) {
         let s = &self.slots;
         self.read(values, jacobians.is_some(), |out| {
             if let Some(blocks) = jacobians {
@@ -144,7 +145,9 @@ impl CatenaryCall {
                     }
                 }
             }
-            slots_to_cables(s, &Vector4::from_fn(|slot, _| out.rows[first + slot]))
+            for (slot, &cable) in s.cables.iter().enumerate() {
+                residual[cable] = out.rows[first + slot];
+            }
         })
     }
 }
