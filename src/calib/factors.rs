@@ -453,7 +453,7 @@ impl Factor for TensionGuardFactor {
             return true;
         };
         for block in blocks.iter_mut() {
-            block.fill(0.0);
+            block.as_mut_slice().fill(0.0);
         }
         if !active.contains(&true) {
             return true;

@@ -250,6 +250,11 @@ impl PoseFactors<'_> {
                     &m.encoder_lengths_m,
                     self.catenary_memo(),
                 );
+                let call = if self.catenary_memo.is_none() {
+                    call.comparing_inputs()
+                } else {
+                    call
+                };
                 self.add_catenary(graph, &call, m);
                 self.add_tension_guard(graph, TensionSource::Shared(call));
             }

@@ -39,6 +39,9 @@ pub struct SharedEvaluation<const N: usize, T> {
 struct Memo<const N: usize, T> {
     /// The inputs' bits; `None`: nothing evaluated yet.
     key: Option<[u64; N]>,
+    /// The stamp under which `result` was last read by
+    /// [`SharedEvaluation::read_stamped`] or made by [`SharedEvaluation::read_by_stamp`].
+    stamp: Option<[u64; 2]>,
     /// Whether `result` holds the Jacobians too.
     jacobians: bool,
     result: T,
@@ -49,6 +52,7 @@ impl<const N: usize, T: Default> Default for SharedEvaluation<N, T> {
         Self {
             last: Mutex::new(Memo {
                 key: None,
+                stamp: None,
                 jacobians: false,
                 result: T::default(),
             }),
@@ -73,9 +77,65 @@ impl<const N: usize, T: Default> SharedEvaluation<N, T> {
         if memo.key != Some(key) || (jacobians && !memo.jacobians) {
             // Invalid until the call returns (a panic inside leaves no stale key).
             memo.key = None;
+            memo.stamp = None;
             evaluate(&mut memo.result, jacobians);
             memo.key = Some(key);
             memo.jacobians = jacobians;
+        }
+        read(&memo.result)
+    }
+
+    /// [`SharedEvaluation::read`] keyed by a `stamp` alone (equal stamps
+    /// must mean equal inputs): for a memo whose calls are never repeated at
+    /// equal inputs under another stamp, where comparing the inputs would
+    /// only cost.
+    pub fn read_by_stamp<R>(
+        &self,
+        stamp: [u64; 2],
+        jacobians: bool,
+        evaluate: impl FnOnce(&mut T, bool),
+        read: impl FnOnce(&T) -> R,
+    ) -> R {
+        let mut memo = self.last.lock().unwrap_or_else(PoisonError::into_inner);
+        if memo.stamp != Some(stamp) || (jacobians && !memo.jacobians) {
+            memo.key = None;
+            memo.stamp = None;
+            evaluate(&mut memo.result, jacobians);
+            memo.stamp = Some(stamp);
+            memo.jacobians = jacobians;
+        }
+        read(&memo.result)
+    }
+
+    /// [`SharedEvaluation::read`] with a cheaper first test: `stamp` stands
+    /// for the inputs (equal stamps must mean equal inputs, e.g. a
+    /// [`crate::graph::Values::stamp`] and the variable the call is for).
+    /// When it matches the remembered one the inputs are not even gathered;
+    /// otherwise `inputs()` are compared bit for bit as by `read` (so a call
+    /// made at equal values under another stamp is still found), and a new
+    /// call is made from them: `evaluate(result, jacobians, inputs)`.
+    pub fn read_stamped<R>(
+        &self,
+        stamp: [u64; 2],
+        inputs: impl FnOnce() -> [f64; N],
+        jacobians: bool,
+        evaluate: impl FnOnce(&mut T, bool, &[f64; N]),
+        read: impl FnOnce(&T) -> R,
+    ) -> R {
+        let mut memo = self.last.lock().unwrap_or_else(PoisonError::into_inner);
+        let covered = !jacobians || memo.jacobians;
+        if !(covered && memo.key.is_some() && memo.stamp == Some(stamp)) {
+            let inputs = inputs();
+            let key = inputs.map(f64::to_bits);
+            if memo.key != Some(key) || !covered {
+                // Invalid until the call returns (a panic inside leaves no stale key).
+                memo.key = None;
+                memo.stamp = None;
+                evaluate(&mut memo.result, jacobians, &inputs);
+                memo.key = Some(key);
+                memo.jacobians = jacobians;
+            }
+            memo.stamp = Some(stamp);
         }
         read(&memo.result)
     }
@@ -106,5 +166,49 @@ mod tests {
         let y = [3.0, -0.0];
         assert_eq!(shared.read(&y, false, |o, j| call(o, j, y), |r| *r), -0.0);
         assert_eq!(calls.get(), 3);
+    }
+
+    /// A stamp hit reads without gathering the inputs; a new stamp with equal
+    /// inputs is found by comparing them (no call); new inputs call again.
+    /// By stamp alone, every new stamp calls.
+    #[test]
+    fn stamped_reads_skip_the_inputs_and_fall_back_to_them() {
+        let shared = SharedEvaluation::<2, f64>::default();
+        let (calls, gathers) = (Cell::new(0), Cell::new(0));
+        let read = |stamp: u64, x: [f64; 2]| {
+            let inputs = || {
+                gathers.set(gathers.get() + 1);
+                x
+            };
+            let evaluate = |out: &mut f64, _: bool, x: &[f64; 2]| {
+                calls.set(calls.get() + 1);
+                *out = x[0] + x[1];
+            };
+            shared.read_stamped([stamp, 7], inputs, false, evaluate, |r| *r)
+        };
+        assert_eq!(read(1, [1.0, 2.0]), 3.0);
+        assert_eq!((calls.get(), gathers.get()), (1, 1));
+        assert_eq!(read(1, [1.0, 2.0]), 3.0);
+        assert_eq!((calls.get(), gathers.get()), (1, 1));
+        assert_eq!(read(2, [1.0, 2.0]), 3.0);
+        assert_eq!((calls.get(), gathers.get()), (1, 2));
+        assert_eq!(read(2, [1.0, 2.0]), 3.0);
+        assert_eq!((calls.get(), gathers.get()), (1, 2));
+        assert_eq!(read(3, [1.0, 5.0]), 6.0);
+        assert_eq!((calls.get(), gathers.get()), (2, 3));
+        let by_stamp = SharedEvaluation::<2, f64>::default();
+        let count = Cell::new(0);
+        let evaluate = |out: &mut f64, _: bool| {
+            count.set(count.get() + 1);
+            *out = count.get() as f64;
+        };
+        assert_eq!(by_stamp.read_by_stamp([4, 1], false, evaluate, |r| *r), 1.0);
+        assert_eq!(
+            by_stamp.read_by_stamp([4, 1], false, |_, _| unreachable!(), |r| *r),
+            1.0
+        );
+        assert_eq!(by_stamp.read_by_stamp([4, 2], false, evaluate, |r| *r), 2.0);
+        // Jacobians not held: called again under the same stamp.
+        assert_eq!(by_stamp.read_by_stamp([4, 2], true, evaluate, |r| *r), 3.0);
     }
 }

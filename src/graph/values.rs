@@ -19,6 +19,8 @@
 //! assert!(values.variable(anchor).fixed && !values.variable(pose).fixed);
 //! ```
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use nalgebra::{DVector, Vector6};
 
 use crate::model::pose::{PlatformPose, POSE_TANGENT_DIM};
@@ -78,9 +80,34 @@ pub struct Variable {
 }
 
 /// All variables of a graph.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Values {
     variables: Vec<Variable>,
+    /// See [`Values::stamp`].
+    stamp: u64,
+}
+
+/// The source of [`Values::stamp`]s: never the same number twice in a process.
+static NEXT_STAMP: AtomicU64 = AtomicU64::new(1);
+
+fn fresh_stamp() -> u64 {
+    NEXT_STAMP.fetch_add(1, Ordering::Relaxed)
+}
+
+impl Default for Values {
+    fn default() -> Self {
+        Self {
+            variables: Vec::new(),
+            stamp: fresh_stamp(),
+        }
+    }
+}
+
+/// Equal variables (names, values, fixed flags); the stamps do not enter.
+impl PartialEq for Values {
+    fn eq(&self, other: &Self) -> bool {
+        self.variables == other.variables
+    }
 }
 
 impl Values {
@@ -89,8 +116,20 @@ impl Values {
         Self::default()
     }
 
+    /// A number that changes whenever the container may have changed: every
+    /// method that takes `&mut self` draws a new one (from a process-wide
+    /// counter), a clone keeps its original's, and [`Values::copy_from`]
+    /// takes its source's. Equal stamps therefore mean equal contents, which
+    /// lets an evaluation shared by several factors
+    /// ([`crate::graph::SharedEvaluation`]) be recognised without comparing
+    /// its inputs.
+    pub fn stamp(&self) -> u64 {
+        self.stamp
+    }
+
     /// Add a variable, returning its id.
     pub fn insert(&mut self, name: impl Into<String>, value: VariableValue) -> VariableId {
+        self.stamp = fresh_stamp();
         self.variables.push(Variable {
             name: name.into(),
             value,
@@ -121,12 +160,14 @@ impl Values {
 
     /// Hold `id` constant (or release it).
     pub fn set_fixed(&mut self, id: VariableId, fixed: bool) {
+        self.stamp = fresh_stamp();
         self.variables[id.0].fixed = fixed;
     }
 
     /// Overwrite every variable with `other`'s (names, values, fixed flags),
     /// reusing this set's allocations where the shapes agree.
     pub fn copy_from(&mut self, other: &Values) {
+        self.stamp = other.stamp;
         if self.variables.len() != other.variables.len() {
             self.variables.clone_from(&other.variables);
             return;
@@ -143,11 +184,13 @@ impl Values {
 
     /// The value of `id`, to change in place.
     pub fn value_mut(&mut self, id: VariableId) -> &mut VariableValue {
+        self.stamp = fresh_stamp();
         &mut self.variables[id.0].value
     }
 
     /// Replace the value of `id`.
     pub fn set(&mut self, id: VariableId, value: VariableValue) {
+        self.stamp = fresh_stamp();
         self.variables[id.0].value = value;
     }
 
@@ -170,5 +213,47 @@ impl Values {
     /// Tangent dimension of `id`.
     pub fn tangent_dim(&self, id: VariableId) -> usize {
         self.variables[id.0].value.tangent_dim()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every `&mut self` method draws a new stamp, a clone and a copy carry
+    /// their source's, and two containers never share one otherwise.
+    #[test]
+    fn stamps_change_with_every_mutation_and_only_then() {
+        let mut a = Values::new();
+        assert_ne!(a.stamp(), Values::new().stamp());
+        let mut seen = vec![a.stamp()];
+        let mut changed = |values: &Values| {
+            assert!(!seen.contains(&values.stamp()), "a stamp reused");
+            seen.push(values.stamp());
+        };
+        let x = a.insert("x", VariableValue::Vector(DVector::from_vec(vec![1.0])));
+        changed(&a);
+        a.set(x, VariableValue::Vector(DVector::from_vec(vec![2.0])));
+        changed(&a);
+        a.value_mut(x).retract_in_place(&[0.5]);
+        changed(&a);
+        a.set_fixed(x, true);
+        changed(&a);
+        let (stamp, _) = (a.stamp(), a.vector(x));
+        assert_eq!(a.stamp(), stamp, "reading changes nothing");
+        let b = a.clone();
+        assert_eq!((b.stamp(), &b), (a.stamp(), &a));
+        let mut c = Values::new();
+        c.copy_from(&a);
+        assert_eq!((c.stamp(), &c), (a.stamp(), &a));
+        c.set(x, VariableValue::Vector(DVector::from_vec(vec![9.0])));
+        assert_ne!(c.stamp(), a.stamp());
+        assert_ne!(c, a);
+        // Equality is by content, not by stamp.
+        let mut d = Values::new();
+        d.insert("x", VariableValue::Vector(DVector::from_vec(vec![2.5])));
+        d.set_fixed(x, true);
+        assert_eq!(d, a);
+        assert_ne!(d.stamp(), a.stamp());
     }
 }

@@ -16,7 +16,9 @@
 
 use super::linear_system::dot;
 use super::schur::{backward_substitute, cholesky_in_place, forward_substitute};
-use crate::graph::{FactorGraph, LinearizationBuffers, SlotMask, Values, VariableId};
+use std::cell::RefCell;
+
+use crate::graph::{FactorGraph, LinearizationBuffers, SlotMask, Values, VariableId, VariableValue};
 
 /// Gauss-Newton iterations per group and refinement.
 const MAX_ITERATIONS: usize = 8;
@@ -41,6 +43,8 @@ struct Group {
 /// The graph's local groups, resolved against its factors.
 pub(crate) struct LocalGroups {
     groups: Vec<Group>,
+    /// Buffers reused by every refinement of the solve.
+    workspace: RefCell<Workspace>,
 }
 
 impl LocalGroups {
@@ -92,12 +96,18 @@ impl LocalGroups {
                 group.factor_slots.push(slots);
             }
         }
-        Self { groups }
+        Self {
+            groups,
+            workspace: RefCell::default(),
+        }
     }
 
     /// No groups: nothing to refine.
     pub(crate) fn none() -> Self {
-        Self { groups: Vec::new() }
+        Self {
+            groups: Vec::new(),
+            workspace: RefCell::default(),
+        }
     }
 
     /// Whether there is anything to refine.
@@ -108,7 +118,7 @@ impl LocalGroups {
     /// Re-minimise every group in place. A group whose model is undefined
     /// keeps its values.
     pub(crate) fn refine(&self, graph: &FactorGraph, values: &mut Values) {
-        let mut workspace = Workspace::default();
+        let mut workspace = self.workspace.borrow_mut();
         for group in &self.groups {
             refine_group(graph, group, values, &mut workspace);
         }
@@ -124,6 +134,8 @@ struct Workspace {
     trial: GroupSystem,
     damped: Vec<f64>,
     step: Vec<f64>,
+    /// The group's values before a step, restored when the step is rejected.
+    originals: Vec<VariableValue>,
     /// The group's tangent index of each column in `gathered`.
     columns: Vec<usize>,
     /// The group's Jacobian columns of the factor being added, column-major.
@@ -174,10 +186,14 @@ fn linearize_group(
             gathered.extend_from_slice(block.as_slice());
         }
         let residual = &linearized.residual;
-        match rows {
-            1 => add_normal_equations::<1>(columns, gathered, residual, dim, out),
-            4 => add_normal_equations::<4>(columns, gathered, residual, dim, out),
-            6 => add_normal_equations::<6>(columns, gathered, residual, dim, out),
+        match (rows, columns.len()) {
+            // A pose's catenary rows on its pose and tension; its pose prior.
+            (4, 8) => add_normal_equations_by_rows::<4, 8>(columns, gathered, residual, dim, out),
+            (6, 6) => add_normal_equations_by_rows::<6, 6>(columns, gathered, residual, dim, out),
+            (3, 6) => add_normal_equations_by_rows::<3, 6>(columns, gathered, residual, dim, out),
+            (1, _) => add_normal_equations::<1>(columns, gathered, residual, dim, out),
+            (4, _) => add_normal_equations::<4>(columns, gathered, residual, dim, out),
+            (6, _) => add_normal_equations::<6>(columns, gathered, residual, dim, out),
             _ => add_normal_equations::<0>(columns, gathered, residual, dim, out),
         }
     }
@@ -212,6 +228,48 @@ fn add_normal_equations<const R: usize>(
     }
 }
 
+/// [`add_normal_equations`] for `R` rows and `C` columns known at compile
+/// time: the columns transposed to rows first, so that the entries of one
+/// column of `J^T J` (and of `J^T r`) are summed side by side; each entry is
+/// still `sum_r a_r b_r` in row order, added once, so the sums are bit for
+/// bit those of the dot products (test).
+#[inline(always)]
+fn add_normal_equations_by_rows<const R: usize, const C: usize>(
+    columns: &[usize],
+    gathered: &[f64],
+    residual: &[f64],
+    dim: usize,
+    out: &mut GroupSystem,
+) {
+    let columns: &[usize; C] = columns.try_into().expect("C columns");
+    let residual: &[f64; R] = residual.try_into().expect("R rows");
+    let gathered = &gathered[..R * C];
+    let rows: [[f64; C]; R] = std::array::from_fn(|r| std::array::from_fn(|c| gathered[c * R + r]));
+    let mut gradient: [f64; C] = std::array::from_fn(|a| rows[0][a] * residual[0]);
+    for r in 1..R {
+        for a in 0..C {
+            gradient[a] += rows[r][a] * residual[r];
+        }
+    }
+    for a in 0..C {
+        out.gradient[columns[a]] += gradient[a];
+    }
+    for b in 0..C {
+        let mut sums: [f64; C] = std::array::from_fn(|a| rows[0][a] * rows[0][b]);
+        for row in &rows[1..] {
+            for a in 0..C {
+                sums[a] += row[a] * row[b];
+            }
+        }
+        let column_b = columns[b] * dim;
+        for a in 0..C {
+            if columns[a] >= columns[b] {
+                out.hessian[columns[a] + column_b] += sums[a];
+            }
+        }
+    }
+}
+
 /// Re-minimise one group with everything else held: damped Gauss-Newton on
 /// the group's dense system. Every trial point is linearised whole (its cost
 /// is the same sum as a value-only pass), so an accepted trial needs no
@@ -225,6 +283,7 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &
         trial,
         damped,
         step,
+        originals,
         columns,
         gathered,
     } = work;
@@ -234,11 +293,10 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &
         return;
     };
     for _ in 0..MAX_ITERATIONS {
-        let originals: Vec<_> = group
-            .variables
-            .iter()
-            .map(|&v| values.variable(v).value.clone())
-            .collect();
+        originals.resize_with(group.variables.len(), || VariableValue::Vector(Default::default()));
+        for (original, &v) in originals.iter_mut().zip(&group.variables) {
+            assign(original, &values.variable(v).value);
+        }
         let mut improved = false;
         while damping < 1e8 {
             damped.clone_from(&current.hessian);
@@ -268,7 +326,9 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &
             }
             for (k, &v) in group.variables.iter().enumerate() {
                 let slice = &step[group.offsets[k]..group.offsets[k + 1]];
-                values.set(v, originals[k].retract(slice));
+                let value = values.value_mut(v);
+                assign(value, &originals[k]);
+                value.retract_in_place(slice);
             }
             match linearize_group(graph, group, values, buffers, columns, gathered, trial) {
                 Some(new_cost) if new_cost < cost => {
@@ -281,7 +341,7 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &
                 }
                 _ => {
                     for (k, &v) in group.variables.iter().enumerate() {
-                        values.set(v, originals[k].clone());
+                        assign(values.value_mut(v), &originals[k]);
                     }
                     damping *= 10.0;
                 }
@@ -290,5 +350,47 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &
         if !improved {
             return;
         }
+    }
+}
+
+/// `*to = from.clone()`, reusing `to`'s vector where the lengths agree.
+fn assign(to: &mut VariableValue, from: &VariableValue) {
+    match (to, from) {
+        (VariableValue::Vector(a), VariableValue::Vector(b)) if a.len() == b.len() => a.copy_from(b),
+        (to, from) => *to = from.clone(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The row-wise kernel adds bit for bit what the dot products add, for
+    /// the shapes it serves, with columns in an order that is not the
+    /// group's (a factor listing its tension before its pose).
+    #[test]
+    fn the_row_wise_kernel_matches_the_dot_products() {
+        fn check<const R: usize, const C: usize>(columns: &[usize]) {
+            let dim = 9;
+            let gathered: Vec<f64> = (0..R * C)
+                .map(|k| ((k * 7 % 13) as f64 - 6.0) * 0.37 + 1e-3 * k as f64)
+                .collect();
+            let residual: Vec<f64> = (0..R).map(|r| 0.3 - 0.71 * r as f64).collect();
+            let start = || GroupSystem {
+                hessian: (0..dim * dim).map(|k| 0.01 * k as f64).collect(),
+                gradient: (0..dim).map(|k| -0.5 * k as f64).collect(),
+            };
+            let (mut by_rows, mut by_dots) = (start(), start());
+            add_normal_equations_by_rows::<R, C>(columns, &gathered, &residual, dim, &mut by_rows);
+            add_normal_equations::<0>(columns, &gathered, &residual, dim, &mut by_dots);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&by_rows.hessian), bits(&by_dots.hessian), "{R} x {C}");
+            assert_eq!(bits(&by_rows.gradient), bits(&by_dots.gradient), "{R} x {C}");
+            assert_ne!(bits(&by_rows.hessian), bits(&start().hessian));
+        }
+        check::<4, 8>(&[6, 7, 0, 1, 2, 3, 4, 5]);
+        check::<4, 8>(&[1, 2, 3, 4, 5, 6, 7, 8]);
+        check::<6, 6>(&[0, 1, 2, 3, 4, 5]);
+        check::<3, 6>(&[3, 4, 5, 6, 7, 8]);
     }
 }

@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::{DMatrix, SMatrix, SVector, Vector4};
+use nalgebra::{DMatrix, Matrix3x4, SMatrix, SVector, Vector2, Vector3, Vector4};
 
 use super::{
     gather_anchors, gather_offsets, pose_arguments, tension_argument, CalibrationVariables, PoseVariables, SlotOrder,
@@ -33,7 +33,8 @@ const CATENARY_INPUTS: usize = 29;
 
 /// The generated call that a pose's length, height and tension-guard factors
 /// share ([`SharedEvaluation`]: the first factor evaluated at a point makes
-/// it, the others read its rows). One per graph, shared by every pose.
+/// it, the others read its rows). One per graph, shared by every pose, or
+/// one per pose (see `calib::graph`).
 pub type CatenaryMemo = SharedEvaluation<CATENARY_INPUTS, CatenaryRows>;
 
 /// What one pose's catenary factors need to make the shared call.
@@ -45,6 +46,8 @@ pub struct CatenaryCall {
     /// Encoder readings, slot order, metres.
     encoder_lengths_m: Vector4<f64>,
     memo: Arc<CatenaryMemo>,
+    /// Whether a memo miss by stamp compares the inputs (see [`CatenaryCall::comparing_inputs`]).
+    compare_inputs: bool,
 }
 
 impl CatenaryCall {
@@ -62,7 +65,18 @@ impl CatenaryCall {
             globals,
             pose,
             memo,
+            compare_inputs: false,
         }
+    }
+
+    /// This call with a memo that, when the values' stamp has changed,
+    /// compares the inputs before calling again: for a memo of its own,
+    /// which then finds its last call after the values were copied or other
+    /// poses moved (the solver's local refinement). A memo shared by every
+    /// pose never meets its inputs again under another stamp.
+    pub fn comparing_inputs(mut self) -> Self {
+        self.compare_inputs = true;
+        self
     }
 
     /// The pose's reference-tension variable.
@@ -71,20 +85,33 @@ impl CatenaryCall {
     }
 
     /// `read` of the call's outputs at `values` (with Jacobians if `jacobians`).
+    /// The memo is tested first by the values' stamp and the pose
+    /// ([`Values::stamp`]: equal stamps, equal values), so the factors that
+    /// read a call made in the same pass do not gather its inputs; then by
+    /// the inputs themselves ([`SharedEvaluation::read_stamped`]).
     pub(super) fn read<R>(&self, values: &Values, jacobians: bool, read: impl FnOnce(&CatenaryRows) -> R) -> R {
-        let (position, rotation) = pose_arguments(values, self.pose.pose);
-        let tension = tension_argument(values, self.pose.reference_tension);
-        let anchors = gather_anchors(values, &self.slots, &self.globals);
-        let offsets = gather_offsets(values, &self.slots, &self.globals);
-        let mut inputs = [0.0; CATENARY_INPUTS];
-        inputs[..3].copy_from_slice(position.as_slice());
-        inputs[3..7].copy_from_slice(rotation.as_slice());
-        inputs[7..9].copy_from_slice(tension.as_slice());
-        inputs[9..21].copy_from_slice(anchors.as_slice());
-        inputs[21..25].copy_from_slice(offsets.as_slice());
-        inputs[25..].copy_from_slice(self.encoder_lengths_m.as_slice());
+        let stamp = [values.stamp(), self.pose.pose.0 as u64];
         let s = &self.slots;
-        let evaluate = |out: &mut CatenaryRows, want: bool| {
+        let inputs = || {
+            let (position, rotation) = pose_arguments(values, self.pose.pose);
+            let tension = tension_argument(values, self.pose.reference_tension);
+            let anchors = gather_anchors(values, s, &self.globals);
+            let offsets = gather_offsets(values, s, &self.globals);
+            let mut inputs = [0.0; CATENARY_INPUTS];
+            inputs[..3].copy_from_slice(position.as_slice());
+            inputs[3..7].copy_from_slice(rotation.as_slice());
+            inputs[7..9].copy_from_slice(tension.as_slice());
+            inputs[9..21].copy_from_slice(anchors.as_slice());
+            inputs[21..25].copy_from_slice(offsets.as_slice());
+            inputs[25..].copy_from_slice(self.encoder_lengths_m.as_slice());
+            inputs
+        };
+        let evaluate = |out: &mut CatenaryRows, want: bool, inputs: &[f64; CATENARY_INPUTS]| {
+            let position = Vector3::from_column_slice(&inputs[..3]);
+            let rotation = Vector4::from_column_slice(&inputs[3..7]);
+            let tension = Vector2::from_column_slice(&inputs[7..9]);
+            let anchors = Matrix3x4::from_column_slice(&inputs[9..21]);
+            let offsets = Vector4::from_column_slice(&inputs[21..25]);
             out.rows = generated::catenary_cable_residuals(
                 &position,
                 &rotation,
@@ -103,7 +130,12 @@ impl CatenaryCall {
                 want.then_some(&mut out.offsets),
             );
         };
-        self.memo.read(&inputs, jacobians, evaluate, read)
+        if self.compare_inputs {
+            self.memo.read_stamped(stamp, inputs, jacobians, evaluate, read)
+        } else {
+            let evaluate = |out: &mut CatenaryRows, want: bool| evaluate(out, want, &inputs());
+            self.memo.read_by_stamp(stamp, jacobians, evaluate, read)
+        }
     }
 
     /// Four rows from `first` of the call as a factor's residual (robot cable
