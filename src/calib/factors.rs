@@ -55,7 +55,7 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, SVector, Vector2, Vector3, Vector4};
 
 use crate::generated;
-use crate::graph::{evaluate_through_into, Factor, RobustKernel, Values, VariableId};
+use crate::graph::{evaluate_through_into, Factor, RobustKernel, SlotMask, Values, VariableId};
 use crate::model::robot::{Robot, CABLE_COUNT};
 
 mod catenary_call;
@@ -241,7 +241,17 @@ impl Factor for CatenaryLengthFactor {
         evaluate_through_into(self, values, jacobians)
     }
     fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
-        self.call.four_rows(values, 0, residual, jacobians);
+        self.call.four_rows(values, 0, residual, jacobians, SlotMask::ALL);
+        true
+    }
+    fn evaluate_slots(
+        &self,
+        values: &Values,
+        residual: &mut [f64],
+        jacobians: Option<&mut [DMatrix<f64>]>,
+        wanted: SlotMask,
+    ) -> bool {
+        self.call.four_rows(values, 0, residual, jacobians, wanted);
         true
     }
     fn sigmas(&self) -> &DVector<f64> {
@@ -290,7 +300,17 @@ impl Factor for AttachmentHeightFactor {
         evaluate_through_into(self, values, jacobians)
     }
     fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
-        self.call.four_rows(values, 4, residual, jacobians);
+        self.call.four_rows(values, 4, residual, jacobians, SlotMask::ALL);
+        true
+    }
+    fn evaluate_slots(
+        &self,
+        values: &Values,
+        residual: &mut [f64],
+        jacobians: Option<&mut [DMatrix<f64>]>,
+        wanted: SlotMask,
+    ) -> bool {
+        self.call.four_rows(values, 4, residual, jacobians, wanted);
         true
     }
     fn sigmas(&self) -> &DVector<f64> {

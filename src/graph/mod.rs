@@ -73,6 +73,19 @@ pub trait Factor: Send + Sync {
             None => false,
         }
     }
+    /// [`Factor::evaluate_into`] for a caller that reads only the Jacobian
+    /// blocks in `wanted` ([`LinearizationBuffers::linearize_slots`]); the
+    /// others may be left as they were. The default fills every block.
+    fn evaluate_slots(
+        &self,
+        values: &Values,
+        residual: &mut [f64],
+        jacobians: Option<&mut [DMatrix<f64>]>,
+        wanted: SlotMask,
+    ) -> bool {
+        let _ = wanted;
+        self.evaluate_into(values, residual, jacobians)
+    }
     /// Standard deviation of every residual component (same units as the residual).
     fn sigmas(&self) -> &DVector<f64>;
     /// The robust kernel applied to the whitened squared norm.
@@ -305,7 +318,7 @@ fn linearize_into(
     let rows = factor.residual_dim();
     out.raw_residual.clear();
     out.raw_residual.resize(rows, 0.0);
-    let defined = factor.evaluate_into(values, &mut out.raw_residual, Some(&mut out.jacobians));
+    let defined = factor.evaluate_slots(values, &mut out.raw_residual, Some(&mut out.jacobians), wanted);
     let residual = &out.raw_residual;
     if !defined {
         return Err("model undefined (slack cable)");

@@ -12,7 +12,7 @@ use super::{
     EPSILON,
 };
 use crate::generated;
-use crate::graph::{SharedEvaluation, Values, VariableId};
+use crate::graph::{SharedEvaluation, SlotMask, Values, VariableId};
 use crate::model::robot::CABLE_COUNT;
 
 /// The outputs of [`generated::catenary_cable_residuals`] at one point, slot
@@ -139,40 +139,33 @@ impl CatenaryCall {
     }
 
     /// Four rows from `first` of the call as a factor's residual (robot cable
-    /// order) into `residual`, with its blocks `[pose, tension, anchors (4), offsets (4)?]`.
+    /// order) into `residual`, with its blocks `[pose, tension, anchors (4),
+    /// offsets (4)?]`: the pose's and the tension's always, the anchors' and
+    /// offsets' where `wanted` holds any of them (else they are left as they were).
     pub(super) fn four_rows(
         &self,
         values: &Values,
         first: usize,
         residual: &mut [f64],
         jacobians: Option<&mut [DMatrix<f64>]>,
+        wanted: SlotMask,
     ) {
         let s = &self.slots;
         self.read(values, jacobians.is_some(), |out| {
             if let Some(blocks) = jacobians {
-                // Column-major blocks of `CABLE_COUNT` rows: entry (cable, c) at `cable + CABLE_COUNT * c`.
-                let n = CABLE_COUNT;
-                let (pose, tension) = (out.pose.as_slice(), out.tension.as_slice());
-                let (anchors, offsets) = (out.anchors.as_slice(), out.offsets.as_slice());
-                // The generated blocks are column-major with 16 rows: (row, c) at `row + 16 * c`.
-                let at = |row: usize, c: usize| row + 16 * c;
-                for (slot, &cable) in s.cables.iter().enumerate() {
-                    let row = first + slot;
-                    let pose_block = blocks[0].as_mut_slice();
-                    for c in 0..6 {
-                        pose_block[cable + n * c] = pose[at(row, c)];
-                    }
-                    let tension_block = blocks[1].as_mut_slice();
-                    for c in 0..2 {
-                        tension_block[cable + n * c] = tension[at(row, c)];
-                    }
-                    for (anchor_slot, &anchor_cable) in s.cables.iter().enumerate() {
-                        let anchor_block = blocks[2 + anchor_cable].as_mut_slice();
-                        for c in 0..3 {
-                            anchor_block[cable + n * c] = anchors[at(row, 3 * anchor_slot + c)];
-                        }
-                        if let Some(offset_block) = blocks.get_mut(6 + anchor_cable) {
-                            offset_block.as_mut_slice()[cable] = offsets[at(row, anchor_slot)];
+                let cables = &s.cables;
+                copy_rows(out.pose.as_slice(), first, 6, blocks[0].as_mut_slice(), cables);
+                copy_rows(out.tension.as_slice(), first, 2, blocks[1].as_mut_slice(), cables);
+                // The anchors' and offsets' blocks only for a reader that
+                // wants one of them (the refinement reads the pose's alone).
+                if (2..blocks.len()).any(|slot| wanted.contains(slot)) {
+                    let (anchors, offsets) = (out.anchors.as_slice(), out.offsets.as_slice());
+                    for (anchor_slot, &cable) in cables.iter().enumerate() {
+                        let columns = &anchors[3 * ROWS * anchor_slot..];
+                        copy_rows(columns, first, 3, blocks[2 + cable].as_mut_slice(), cables);
+                        if let Some(offset_block) = blocks.get_mut(6 + cable) {
+                            let column = &offsets[ROWS * anchor_slot..];
+                            copy_rows(column, first, 1, offset_block.as_mut_slice(), cables);
                         }
                     }
                 }
@@ -181,5 +174,25 @@ impl CatenaryCall {
                 residual[cable] = out.rows[first + slot];
             }
         })
+    }
+}
+
+/// Rows of the generated call's outputs ([`CatenaryRows`]).
+const ROWS: usize = 16;
+
+// `copy_rows` masks cable indices with `CABLE_COUNT - 1`.
+const _: () = assert!(CABLE_COUNT.is_power_of_two());
+
+/// Copy rows `first..first + 4` (slot order) of the first `columns` columns
+/// of a generated block (`from`: column-major, [`ROWS`] rows) into a
+/// factor's block (`to`: column-major, one row per cable, robot order).
+#[inline(always)]
+fn copy_rows(from: &[f64], first: usize, columns: usize, to: &mut [f64], cables: &[usize; CABLE_COUNT]) {
+    for (c, to) in to.chunks_exact_mut(CABLE_COUNT).take(columns).enumerate() {
+        let from = &from[first + ROWS * c..][..CABLE_COUNT];
+        for (slot, &value) in from.iter().enumerate() {
+            // `cables` is a permutation of 0..4: the mask only spares the bounds check.
+            to[cables[slot] & (CABLE_COUNT - 1)] = value;
+        }
     }
 }
