@@ -208,6 +208,29 @@ pub(super) fn rows_to_cables(slots: &SlotOrder, blocks: &mut [DMatrix<f64>]) {
     }
 }
 
+/// The evaluation methods of a factor whose residual is four rows of its
+/// pose's shared call ([`CatenaryCall::four_rows`]), from row `$first`.
+macro_rules! four_rows_evaluation {
+    ($first:literal) => {
+        fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+            evaluate_through_into(self, values, jacobians)
+        }
+        fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
+            self.evaluate_slots(values, residual, jacobians, SlotMask::ALL)
+        }
+        fn evaluate_slots(
+            &self,
+            values: &Values,
+            residual: &mut [f64],
+            jacobians: Option<&mut [DMatrix<f64>]>,
+            wanted: SlotMask,
+        ) -> bool {
+            self.call.four_rows(values, $first, residual, jacobians, wanted);
+            true
+        }
+    };
+}
+
 /// Catenary length factor (paper eq. 14): `l_C,i + l_i^0 - z_i^enc` for the four
 /// cables of one pose, the tensions of the non-reference cables from eq. (11).
 /// Rows 0..4 of the pose's shared [`CatenaryCall`].
@@ -237,23 +260,7 @@ impl Factor for CatenaryLengthFactor {
     fn residual_dim(&self) -> usize {
         CABLE_COUNT
     }
-    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
-        evaluate_through_into(self, values, jacobians)
-    }
-    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
-        self.call.four_rows(values, 0, residual, jacobians, SlotMask::ALL);
-        true
-    }
-    fn evaluate_slots(
-        &self,
-        values: &Values,
-        residual: &mut [f64],
-        jacobians: Option<&mut [DMatrix<f64>]>,
-        wanted: SlotMask,
-    ) -> bool {
-        self.call.four_rows(values, 0, residual, jacobians, wanted);
-        true
-    }
+    four_rows_evaluation!(0);
     fn sigmas(&self) -> &DVector<f64> {
         &self.sigmas
     }
@@ -296,23 +303,7 @@ impl Factor for AttachmentHeightFactor {
     fn residual_dim(&self) -> usize {
         CABLE_COUNT
     }
-    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
-        evaluate_through_into(self, values, jacobians)
-    }
-    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
-        self.call.four_rows(values, 4, residual, jacobians, SlotMask::ALL);
-        true
-    }
-    fn evaluate_slots(
-        &self,
-        values: &Values,
-        residual: &mut [f64],
-        jacobians: Option<&mut [DMatrix<f64>]>,
-        wanted: SlotMask,
-    ) -> bool {
-        self.call.four_rows(values, 4, residual, jacobians, wanted);
-        true
-    }
+    four_rows_evaluation!(4);
     fn sigmas(&self) -> &DVector<f64> {
         &self.sigmas
     }
