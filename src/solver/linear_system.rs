@@ -40,15 +40,40 @@ pub struct LinearSystem {
     factor_runs: Vec<FactorRuns>,
     /// Per tangent index, the storage position of its diagonal entry.
     diagonal_slots: Vec<usize>,
-    /// Per tangent index, the index in `indices` of its diagonal entry.
+    /// Per tangent index, the index in `indices` of its diagonal entry
+    /// (faer's sparse Cholesky only; empty for the block elimination).
     diagonal_entries: Vec<usize>,
     /// Length of the storage of `H`.
     storage_len: usize,
-    /// `(row, col)` tangent indices (`row >= col`) of every entry of the lower triangle.
-    indices: Vec<(usize, usize)>,
-    /// Storage position of every entry of `indices`.
+    /// Storage position of every entry of the lower triangle, in the order
+    /// of the sparse Cholesky's pattern (faer's sparse Cholesky only).
     positions: Vec<usize>,
+    /// Every stored block of the lower triangle and where it is stored.
+    blocks: Vec<StoredBlock>,
     factorization: Factorization,
+}
+
+/// One stored block of `H`: rows `row..row + rows`, columns `col..col + cols`
+/// of the tangent vector (a diagonal block: its lower triangle), entry
+/// `(i, j)` at `first + i + j * stride` of the storage.
+struct StoredBlock {
+    row: usize,
+    col: usize,
+    rows: usize,
+    cols: usize,
+    first: usize,
+    stride: usize,
+}
+
+impl StoredBlock {
+    /// `(tangent row, tangent column, storage position)` of each stored entry.
+    fn entries(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+        let diagonal = self.row == self.col;
+        (0..self.cols).flat_map(move |j| {
+            let first = if diagonal { j } else { 0 };
+            (first..self.rows).map(move |i| (self.row + i, self.col + j, self.first + i + j * self.stride))
+        })
+    }
 }
 
 /// Largest tangent dimension of the global variables for block elimination
@@ -320,7 +345,6 @@ impl LinearSystem {
             return Err("every variable is fixed: nothing to solve".into());
         }
         let mut pattern = BlockPattern::new(values, factors, &layout.offsets);
-        let indices = pattern.entry_indices(values, &layout.offsets);
         let offset = |v: VariableId| layout.offsets[v.0].unwrap_or(0);
         // A block's entries all couple the same two variables: its first
         // entry stands for it in the test of whether two groups are coupled.
@@ -333,29 +357,56 @@ impl LinearSystem {
         let schur = (!layout.group_ranges.is_empty() && layout.globals <= MAX_SCHUR_GLOBALS)
             .then(|| SchurLayout::new(&corners, layout.globals, layout.group_ranges))
             .flatten();
-        let (positions, storage_len, factorization) = match schur {
+        let stored_blocks = |place: &dyn Fn(VariableId, VariableId, usize) -> (usize, usize)| -> Vec<StoredBlock> {
+            let block = |&(a, b, start): &(VariableId, VariableId, usize)| {
+                let (first, stride) = place(a, b, start);
+                let (rows, cols) = (values.tangent_dim(a), values.tangent_dim(b));
+                let (row, col) = (offset(a), offset(b));
+                StoredBlock {
+                    row,
+                    col,
+                    rows,
+                    cols,
+                    first,
+                    stride,
+                }
+            };
+            pattern.block_order.iter().map(block).collect()
+        };
+        let (blocks, positions, diagonal_entries, storage_len, factorization) = match schur {
             Some(schur) => {
                 // Accumulate straight into the elimination's dense blocks.
-                let positions = pattern.entry_positions(values, |a, b, _| schur.place(offset(a), offset(b)));
+                let blocks = stored_blocks(&|a, b, _| schur.place(offset(a), offset(b)));
                 for (factor, blocks) in factors.iter().zip(&mut pattern.factor_blocks) {
                     let offset = |slot: usize| layout.offsets[factor.variables()[slot].0].unwrap_or(0);
                     for block in blocks {
                         (block.start, block.stride) = schur.place(offset(block.slot_a), offset(block.slot_b));
                     }
                 }
-                (positions, schur.storage_len(), Factorization::Schur(schur))
+                let storage_len = schur.storage_len();
+                (blocks, Vec::new(), Vec::new(), storage_len, Factorization::Schur(schur))
             }
             None => {
                 // Block-wise: each block column-major from its start.
+                let blocks = stored_blocks(&|a, _, start| (start, values.tangent_dim(a)));
+                let indices = pattern.entry_indices(values, &layout.offsets);
                 let positions = pattern.entry_positions(values, |a, _, start| (start, values.tangent_dim(a)));
+                let mut diagonal_entries = vec![0; layout.dim];
+                for (k, &(row, col)) in indices.iter().enumerate() {
+                    if row == col {
+                        diagonal_entries[row] = k;
+                    }
+                }
                 let sparse = SparseCholesky::new(&indices, layout.dim)?;
-                (positions, pattern.entry_count, Factorization::Sparse(Box::new(sparse)))
+                let storage_len = pattern.entry_count;
+                let factorization = Factorization::Sparse(Box::new(sparse));
+                (blocks, positions, diagonal_entries, storage_len, factorization)
             }
         };
-        let mut diagonal_entries = vec![0; layout.dim];
-        for (k, &(row, col)) in indices.iter().enumerate() {
-            if row == col {
-                diagonal_entries[row] = k;
+        let mut diagonal_slots = vec![0; layout.dim];
+        for block in blocks.iter().filter(|b| b.row == b.col) {
+            for i in 0..block.rows {
+                diagonal_slots[block.row + i] = block.first + i + i * block.stride;
             }
         }
         let mut dims = Vec::new();
@@ -373,11 +424,11 @@ impl LinearSystem {
             offsets: layout.offsets,
             dim: layout.dim,
             factor_runs,
-            diagonal_slots: diagonal_entries.iter().map(|&k| positions[k]).collect(),
+            diagonal_slots,
             diagonal_entries,
             storage_len,
-            indices,
             positions,
+            blocks,
             factorization,
         })
     }
@@ -495,7 +546,7 @@ impl LinearSystem {
     /// `H` as a dense symmetric matrix (for the rank analysis of small problems).
     pub fn dense(&self, hessian: &[f64]) -> DMatrix<f64> {
         let mut dense = DMatrix::zeros(self.dim, self.dim);
-        for (&(row, col), &position) in self.indices.iter().zip(&self.positions) {
+        for (row, col, position) in self.blocks.iter().flat_map(StoredBlock::entries) {
             dense[(row, col)] = hessian[position];
             dense[(col, row)] = hessian[position];
         }
@@ -580,5 +631,120 @@ mod tests {
             }
         }
         assert_eq!(zeroed(257), vec![0.0; 257]);
+    }
+
+    /// A linear residual `r = A [x_v1; x_v2; ...]` on vector variables.
+    struct Linear {
+        variables: Vec<VariableId>,
+        a: DMatrix<f64>,
+        sigmas: nalgebra::DVector<f64>,
+    }
+
+    impl Factor for Linear {
+        fn variables(&self) -> &[VariableId] {
+            &self.variables
+        }
+        fn residual_dim(&self) -> usize {
+            self.a.nrows()
+        }
+        fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<nalgebra::DVector<f64>> {
+            let x: Vec<f64> = self
+                .variables
+                .iter()
+                .flat_map(|&v| values.vector(v).iter().copied())
+                .collect();
+            if let Some(blocks) = jacobians {
+                let mut column = 0;
+                for block in blocks.iter_mut() {
+                    let width = block.ncols();
+                    block.copy_from(&self.a.columns(column, width));
+                    column += width;
+                }
+            }
+            Some(&self.a * nalgebra::DVector::from_vec(x))
+        }
+        fn sigmas(&self) -> &nalgebra::DVector<f64> {
+            &self.sigmas
+        }
+        fn kind(&self) -> &'static str {
+            "linear"
+        }
+    }
+
+    /// `H` read back densely is the same `J^T J` whether it is stored for the
+    /// block elimination or for faer's sparse Cholesky, and equals the
+    /// product of the dense Jacobian (two globals of sizes 3 and 1, two
+    /// local groups of sizes 2 + 1 and 2).
+    #[test]
+    fn dense_h_is_j_transpose_j_in_both_storages() {
+        let mut values = Values::new();
+        let vector =
+            |n: usize, k: f64| crate::graph::VariableValue::Vector(nalgebra::DVector::from_fn(n, |i, _| k + i as f64));
+        let g1 = values.insert("g1", vector(3, 0.5));
+        let g2 = values.insert("g2", vector(1, -1.0));
+        let l1 = values.insert("l1", vector(2, 2.0));
+        let l2 = values.insert("l2", vector(1, 0.25));
+        let l3 = values.insert("l3", vector(2, -0.75));
+        let specs: Vec<(Vec<VariableId>, DMatrix<f64>)> = [
+            (vec![l1, l2, g1, g2], 4, 0.1),
+            (vec![l3, g1], 3, 0.7),
+            (vec![g2, l3], 2, 1.3),
+            (vec![g1], 3, 2.1),
+        ]
+        .into_iter()
+        .map(|(variables, rows, seed)| {
+            let cols: usize = variables.iter().map(|&v| values.tangent_dim(v)).sum();
+            let a = DMatrix::from_fn(rows, cols, |i, j| ((i * 7 + j * 3) as f64 * 0.61 + seed).sin());
+            (variables, a)
+        })
+        .collect();
+        let mut graph = crate::graph::FactorGraph::new();
+        graph.values = values.clone();
+        for (variables, a) in &specs {
+            graph.factors.push(Box::new(Linear {
+                variables: variables.clone(),
+                a: a.clone(),
+                sigmas: nalgebra::DVector::from_element(a.nrows(), 0.5),
+            }));
+        }
+        let mut by_storage = Vec::new();
+        for (local_groups, schur) in [(vec![vec![l1, l2], vec![l3]], true), (Vec::new(), false)] {
+            let system = LinearSystem::new(&values, &graph.factors, &local_groups).unwrap();
+            assert_eq!(system.uses_block_elimination(), schur);
+            let linearized = crate::solver::linearize(&graph, &values, &system).unwrap();
+            let dense = system.dense(&linearized.hessian);
+            // The whitened dense Jacobian in the system's column order.
+            let rows: usize = specs.iter().map(|(_, a)| a.nrows()).sum();
+            let mut j = DMatrix::zeros(rows, system.dim);
+            let mut row = 0;
+            for (variables, a) in &specs {
+                let mut column = 0;
+                for &v in variables {
+                    let width = values.tangent_dim(v);
+                    let offset = system.offsets[v.0].unwrap();
+                    j.view_mut((row, offset), (a.nrows(), width))
+                        .copy_from(&(a.columns(column, width) / 0.5));
+                    column += width;
+                }
+                row += a.nrows();
+            }
+            let expected = j.transpose() * &j;
+            assert!((&dense - &expected).abs().max() < 1e-12, "{dense} {expected}");
+            by_storage.push((dense, system.offsets.clone()));
+        }
+        // The same entries, bit for bit, up to the order of the tangent vector.
+        let (schur_h, schur_offsets) = &by_storage[0];
+        let (sparse_h, sparse_offsets) = &by_storage[1];
+        for &a in &[g1, g2, l1, l2, l3] {
+            for &b in &[g1, g2, l1, l2, l3] {
+                for i in 0..values.tangent_dim(a) {
+                    for k in 0..values.tangent_dim(b) {
+                        let s = schur_h[(schur_offsets[a.0].unwrap() + i, schur_offsets[b.0].unwrap() + k)];
+                        let t = sparse_h[(sparse_offsets[a.0].unwrap() + i, sparse_offsets[b.0].unwrap() + k)];
+                        assert_eq!(s.to_bits(), t.to_bits());
+                    }
+                }
+            }
+        }
     }
 }
