@@ -16,18 +16,11 @@
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::cholesky::llt::factor::{LltParams, LltRegularization};
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
-};
-use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::{Conj, MatMut, Par, Side, Spec};
 use nalgebra::DMatrix;
 
 use super::accumulate::{FactorRuns, SlotBlock};
 use super::schur::SchurLayout;
+use super::sparse_cholesky::SparseCholesky;
 use crate::graph::{Factor, Values, VariableId};
 
 /// Where the free variables sit in the tangent vector, and the pattern of `H`.
@@ -86,68 +79,6 @@ enum Factorization {
     Schur(SchurLayout),
     /// faer's supernodal sparse Cholesky of the whole pattern.
     Sparse(Box<SparseCholesky>),
-}
-
-/// faer's sparse Cholesky: the symbolic analysis (AMD ordering, supernodal)
-/// done once, and numerical buffers reused by every factorisation.
-struct SparseCholesky {
-    /// The lower triangle of `H`, compressed columns.
-    pattern: SymbolicSparseColMat<usize>,
-    /// Per entry of the lower triangle (`LinearSystem::indices`), its index in the compressed-column values.
-    csc_position: Vec<usize>,
-    symbolic: SymbolicCholesky<usize>,
-    /// `H + damping` in compressed-column order.
-    matrix_values: Vec<f64>,
-    /// Values of the Cholesky factor.
-    factor_values: Vec<f64>,
-    /// Scratch memory of faer's factorisation and triangular solves.
-    scratch: MemBuffer,
-    /// Whether `factor_values` holds a valid factorisation.
-    factored: bool,
-}
-
-impl SparseCholesky {
-    fn new(indices: &[(usize, usize)], dim: usize) -> Result<Self, String> {
-        let entry_count = indices.len();
-        // Compressed columns: sort the entries by (column, row).
-        let order = column_major_order(indices, dim);
-        let mut col_ptr = vec![0usize; dim + 1];
-        let mut row_idx = Vec::with_capacity(entry_count);
-        let mut csc_position = vec![0usize; entry_count];
-        for (position, &k) in order.iter().enumerate() {
-            let (row, col) = indices[k];
-            col_ptr[col + 1] += 1;
-            row_idx.push(row);
-            csc_position[k] = position;
-        }
-        for col in 0..dim {
-            col_ptr[col + 1] += col_ptr[col];
-        }
-        let pattern = SymbolicSparseColMat::new_checked(dim, dim, col_ptr, None, row_idx);
-        let symbolic = factorize_symbolic_cholesky(
-            pattern.as_ref(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
-        let scratch = StackReq::any_of(&[
-            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Spec::<LltParams, f64>::default()),
-            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
-        ]);
-        Ok(Self {
-            matrix_values: vec![0.0; entry_count],
-            factor_values: vec![0.0; symbolic.len_val()],
-            scratch: MemBuffer::try_new(scratch).map_err(|_| "out of memory for the Cholesky workspace".to_string())?,
-            factored: false,
-            symbolic,
-            pattern,
-            csc_position,
-        })
-    }
 }
 
 /// Block starts by `(row variable, column variable)` index.
@@ -470,28 +401,7 @@ impl LinearSystem {
             Factorization::Schur(layout) => return layout.factorize(hessian, damping),
             Factorization::Sparse(sparse) => sparse,
         };
-        sparse.factored = false;
-        for (&csc, &position) in sparse.csc_position.iter().zip(&self.positions) {
-            sparse.matrix_values[csc] = hessian[position];
-        }
-        for (i, &k) in self.diagonal_entries.iter().enumerate() {
-            sparse.matrix_values[sparse.csc_position[k]] += damping[i];
-        }
-        if sparse.matrix_values.iter().any(|v| !v.is_finite()) {
-            return false;
-        }
-        let matrix = SparseColMatRef::new(sparse.pattern.as_ref(), &sparse.matrix_values);
-        let factored = sparse.symbolic.factorize_numeric_llt(
-            &mut sparse.factor_values,
-            matrix,
-            Side::Lower,
-            LltRegularization::default(),
-            Par::Seq,
-            MemStack::new(&mut sparse.scratch),
-            Spec::default(),
-        );
-        sparse.factored = factored.is_ok();
-        sparse.factored
+        sparse.factorize(hessian, &self.positions, &self.diagonal_entries, damping)
     }
 
     /// Solve with the last successful [`LinearSystem::factorize`]; `None` if
@@ -501,18 +411,7 @@ impl LinearSystem {
             Factorization::Schur(layout) => return layout.solve(rhs),
             Factorization::Sparse(sparse) => sparse,
         };
-        if !sparse.factored {
-            return None;
-        }
-        let mut solution = rhs.to_vec();
-        let llt = LltRef::new(&sparse.symbolic, &sparse.factor_values);
-        llt.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(&mut solution, self.dim, 1),
-            Par::Seq,
-            MemStack::new(&mut sparse.scratch),
-        );
-        solution.iter().all(|v| v.is_finite()).then_some(solution)
+        sparse.solve(rhs)
     }
 
     /// `a^T (H + damping)^-1 a` with the last successful
@@ -588,30 +487,6 @@ pub(super) fn dot<const R: usize>(a: &[f64], b: &[f64]) -> f64 {
         sum += a[r] * b[r];
     }
     sum
-}
-
-/// The permutation that sorts `(row, col)` entries by column, then row: two
-/// stable counting sorts (by row, then by column), linear in the entries.
-fn column_major_order(indices: &[(usize, usize)], dim: usize) -> Vec<usize> {
-    let counting_sort = |order: &[usize], key: &dyn Fn(usize) -> usize| -> Vec<usize> {
-        let mut start = vec![0usize; dim + 1];
-        for &k in order {
-            start[key(k) + 1] += 1;
-        }
-        for i in 0..dim {
-            start[i + 1] += start[i];
-        }
-        let mut sorted = vec![0usize; order.len()];
-        for &k in order {
-            let slot = &mut start[key(k)];
-            sorted[*slot] = k;
-            *slot += 1;
-        }
-        sorted
-    };
-    let identity: Vec<usize> = (0..indices.len()).collect();
-    let by_row = counting_sort(&identity, &|k| indices[k].0);
-    counting_sort(&by_row, &|k| indices[k].1)
 }
 
 #[cfg(test)]

@@ -40,6 +40,7 @@ mod linear_system;
 mod local;
 mod redundancy;
 mod schur;
+mod sparse_cholesky;
 
 use local::LocalGroups;
 
