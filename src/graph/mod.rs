@@ -67,6 +67,12 @@ pub trait Factor: Send + Sync {
     fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
         match self.evaluate(values, jacobians) {
             Some(r) => {
+                assert_eq!(
+                    r.len(),
+                    residual.len(),
+                    "a {} factor returned a residual of another length than its residual_dim",
+                    self.kind()
+                );
                 residual.copy_from_slice(r.as_slice());
                 true
             }
