@@ -47,6 +47,26 @@ struct Memo<const N: usize, T> {
     result: T,
 }
 
+impl<const N: usize, T> Memo<N, T> {
+    /// `evaluate` into the result, then remember it under `key` and `stamp`
+    /// (invalid until the call returns: a panic inside leaves no stale key).
+    #[inline(always)]
+    fn remake(
+        &mut self,
+        key: Option<[u64; N]>,
+        stamp: Option<[u64; 2]>,
+        jacobians: bool,
+        evaluate: impl FnOnce(&mut T, bool),
+    ) {
+        self.key = None;
+        self.stamp = None;
+        evaluate(&mut self.result, jacobians);
+        self.key = key;
+        self.stamp = stamp;
+        self.jacobians = jacobians;
+    }
+}
+
 impl<const N: usize, T: Default> Default for SharedEvaluation<N, T> {
     fn default() -> Self {
         Self {
@@ -75,12 +95,7 @@ impl<const N: usize, T: Default> SharedEvaluation<N, T> {
         let key = inputs.map(f64::to_bits);
         let mut memo = self.last.lock().unwrap_or_else(PoisonError::into_inner);
         if memo.key != Some(key) || (jacobians && !memo.jacobians) {
-            // Invalid until the call returns (a panic inside leaves no stale key).
-            memo.key = None;
-            memo.stamp = None;
-            evaluate(&mut memo.result, jacobians);
-            memo.key = Some(key);
-            memo.jacobians = jacobians;
+            memo.remake(Some(key), None, jacobians, evaluate);
         }
         read(&memo.result)
     }
@@ -98,11 +113,7 @@ impl<const N: usize, T: Default> SharedEvaluation<N, T> {
     ) -> R {
         let mut memo = self.last.lock().unwrap_or_else(PoisonError::into_inner);
         if memo.stamp != Some(stamp) || (jacobians && !memo.jacobians) {
-            memo.key = None;
-            memo.stamp = None;
-            evaluate(&mut memo.result, jacobians);
-            memo.stamp = Some(stamp);
-            memo.jacobians = jacobians;
+            memo.remake(None, Some(stamp), jacobians, evaluate);
         }
         read(&memo.result)
     }
@@ -128,12 +139,9 @@ impl<const N: usize, T: Default> SharedEvaluation<N, T> {
             let inputs = inputs();
             let key = inputs.map(f64::to_bits);
             if memo.key != Some(key) || !covered {
-                // Invalid until the call returns (a panic inside leaves no stale key).
-                memo.key = None;
-                memo.stamp = None;
-                evaluate(&mut memo.result, jacobians, &inputs);
-                memo.key = Some(key);
-                memo.jacobians = jacobians;
+                memo.remake(Some(key), None, jacobians, |result, want| {
+                    evaluate(result, want, &inputs)
+                });
             }
             memo.stamp = Some(stamp);
         }

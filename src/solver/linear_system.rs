@@ -33,7 +33,7 @@ pub struct LinearSystem {
     factor_runs: Vec<FactorRuns>,
     /// Per tangent index, the storage position of its diagonal entry.
     diagonal_slots: Vec<usize>,
-    /// Per tangent index, the index in `indices` of its diagonal entry
+    /// Per tangent index, the index in `positions` of its diagonal entry
     /// (faer's sparse Cholesky only; empty for the block elimination).
     diagonal_entries: Vec<usize>,
     /// Length of the storage of `H`.
@@ -225,42 +225,6 @@ impl BlockPattern {
             start
         })
     }
-
-    /// Scalar `(row, col)` of every entry of the lower triangle, block by
-    /// block (each column-major, a diagonal block's lower triangle only).
-    fn entry_indices(&self, values: &Values, offsets: &[Option<usize>]) -> Vec<(usize, usize)> {
-        let mut indices = Vec::with_capacity(self.entry_count);
-        for &(a, b, _) in &self.block_order {
-            let (oa, ob) = (offsets[a.0].unwrap_or(0), offsets[b.0].unwrap_or(0));
-            let (da, db) = (values.tangent_dim(a), values.tangent_dim(b));
-            for j in 0..db {
-                let first = if a == b { j } else { 0 };
-                indices.extend((first..da).map(|i| (oa + i, ob + j)));
-            }
-        }
-        indices
-    }
-
-    /// The storage position of every entry, in the order of
-    /// [`BlockPattern::entry_indices`]: block `(a, b)`, stored block-wise
-    /// from `start`, is placed by `place(a, b, start)` = (position of its
-    /// first entry, stride between its columns).
-    fn entry_positions(
-        &self,
-        values: &Values,
-        place: impl Fn(VariableId, VariableId, usize) -> (usize, usize),
-    ) -> Vec<usize> {
-        let mut positions = Vec::with_capacity(self.entry_count);
-        for &(a, b, start) in &self.block_order {
-            let (first_position, stride) = place(a, b, start);
-            let (da, db) = (values.tangent_dim(a), values.tangent_dim(b));
-            for j in 0..db {
-                let first = if a == b { j } else { 0 };
-                positions.extend((first..da).map(|i| first_position + i + j * stride));
-            }
-        }
-        positions
-    }
 }
 
 impl LinearSystem {
@@ -320,8 +284,9 @@ impl LinearSystem {
             None => {
                 // Block-wise: each block column-major from its start.
                 let blocks = stored_blocks(&|a, _, start| (start, values.tangent_dim(a)));
-                let indices = pattern.entry_indices(values, &layout.offsets);
-                let positions = pattern.entry_positions(values, |a, _, start| (start, values.tangent_dim(a)));
+                let entries = blocks.iter().flat_map(StoredBlock::entries);
+                let (indices, positions): (Vec<(usize, usize)>, Vec<usize>) =
+                    entries.map(|(row, col, position)| ((row, col), position)).unzip();
                 let mut diagonal_entries = vec![0; layout.dim];
                 for (k, &(row, col)) in indices.iter().enumerate() {
                     if row == col {
