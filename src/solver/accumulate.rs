@@ -18,6 +18,9 @@ use nalgebra::DMatrix;
 
 use crate::graph::VariableId;
 
+#[cfg(target_arch = "x86_64")]
+use super::gram_avx2;
+
 /// Consecutive factor slots `first_slot..end_slot` whose tangent columns are
 /// `offset..offset + width` of the step vector.
 #[derive(Clone, Copy, Debug)]
@@ -199,7 +202,7 @@ impl FactorRuns {
             unsafe { self.accumulate_avx2(jacobians, residual, hessian, gradient, rows_buffer) };
             return;
         }
-        self.accumulate_any(jacobians, residual, hessian, gradient, rows_buffer);
+        self.accumulate_any::<false>(jacobians, residual, hessian, gradient, rows_buffer);
     }
 
     /// [`FactorRuns::accumulate_any`] compiled with AVX2 (a closure-taking
@@ -214,12 +217,14 @@ impl FactorRuns {
         gradient: &mut [f64],
         rows_buffer: &mut Vec<f64>,
     ) {
-        self.accumulate_any(jacobians, residual, hessian, gradient, rows_buffer);
+        self.accumulate_any::<true>(jacobians, residual, hessian, gradient, rows_buffer);
     }
 
-    /// [`FactorRuns::accumulate`] for the instruction set it is inlined into.
+    /// [`FactorRuns::accumulate`] for the instruction set it is inlined into
+    /// (`AVX2`: only from [`FactorRuns::accumulate_avx2`], whose products go
+    /// to the intrinsic kernel of `gram_avx2`).
     #[inline(always)]
-    fn accumulate_any(
+    fn accumulate_any<const AVX2: bool>(
         &self,
         jacobians: &[DMatrix<f64>],
         residual: &[f64],
@@ -228,16 +233,16 @@ impl FactorRuns {
         rows_buffer: &mut Vec<f64>,
     ) {
         match residual.len() {
-            1 => self.accumulate_rows::<1>(jacobians, residual, hessian, gradient, rows_buffer),
-            4 => self.accumulate_rows::<4>(jacobians, residual, hessian, gradient, rows_buffer),
-            6 => self.accumulate_rows::<6>(jacobians, residual, hessian, gradient, rows_buffer),
-            _ => self.accumulate_rows::<0>(jacobians, residual, hessian, gradient, rows_buffer),
+            1 => self.accumulate_rows::<1, AVX2>(jacobians, residual, hessian, gradient, rows_buffer),
+            4 => self.accumulate_rows::<4, AVX2>(jacobians, residual, hessian, gradient, rows_buffer),
+            6 => self.accumulate_rows::<6, AVX2>(jacobians, residual, hessian, gradient, rows_buffer),
+            _ => self.accumulate_rows::<0, AVX2>(jacobians, residual, hessian, gradient, rows_buffer),
         }
     }
 
     /// [`FactorRuns::accumulate`] for `R`-row factors (`R = 0`: any row count).
     #[inline(always)]
-    fn accumulate_rows<const R: usize>(
+    fn accumulate_rows<const R: usize, const AVX2: bool>(
         &self,
         jacobians: &[DMatrix<f64>],
         residual: &[f64],
@@ -252,6 +257,11 @@ impl FactorRuns {
         }
         let mut base = 0;
         for run in &self.runs {
+            if AVX2 && R == 4 && gather_four_rows_avx2(run, jacobians, &mut rows_buffer[base..base + 4 * run.width]) {
+                add_run_gradient::<R, AVX2>(&rows_buffer[base..base + rows * run.width], run, residual, gradient);
+                base += rows * run.width;
+                continue;
+            }
             let mut column = 0;
             for jacobian in &jacobians[run.first_slot..run.end_slot] {
                 let data = jacobian.as_slice();
@@ -263,14 +273,7 @@ impl FactorRuns {
                 column += data.len() / rows;
             }
             // (2) J^T r for the run's columns.
-            let run_rows = &rows_buffer[base..base + rows * run.width];
-            for (c, g) in gradient[run.offset..run.offset + run.width].iter_mut().enumerate() {
-                let mut sum = run_rows[c] * residual[0];
-                for r in 1..rows {
-                    sum += run_rows[r * run.width + c] * residual[r];
-                }
-                *g += sum;
-            }
+            add_run_gradient::<R, AVX2>(&rows_buffer[base..base + rows * run.width], run, residual, gradient);
             base += rows * run.width;
         }
         // (3) J_a^T J_b for every pair of runs, one dense block each.
@@ -278,7 +281,7 @@ impl FactorRuns {
             let (a, b) = (&self.runs[block.run_a], &self.runs[block.run_b]);
             let rows_a = &rows_buffer[self.base(block.run_a, rows)..][..rows * a.width];
             let rows_b = &rows_buffer[self.base(block.run_b, rows)..][..rows * b.width];
-            add_run_product::<R>(
+            add_run_product::<R, AVX2>(
                 RunRows {
                     data: rows_a,
                     width: a.width,
@@ -298,6 +301,66 @@ impl FactorRuns {
     /// Start of run `k`'s rows in the gathered buffer.
     fn base(&self, k: usize, rows: usize) -> usize {
         rows * self.runs[..k].iter().map(|r| r.width).sum::<usize>()
+    }
+}
+
+/// `J^T r` of one run (its columns gathered row by row in `run_rows`) added
+/// to the run's entries of `gradient`, each entry summed over the rows in order.
+#[inline(always)]
+fn add_run_gradient<const R: usize, const AVX2: bool>(
+    run_rows: &[f64],
+    run: &Run,
+    residual: &[f64],
+    gradient: &mut [f64],
+) {
+    let run_gradient = &mut gradient[run.offset..run.offset + run.width];
+    let rows = residual.len();
+    let columns = RunRows {
+        data: run_rows,
+        width: run.width,
+    };
+    if AVX2
+        && add_gram_avx2::<R>(
+            columns,
+            RunRows {
+                data: residual,
+                width: 1,
+            },
+            false,
+            0,
+            run_gradient,
+        )
+    {
+        return;
+    }
+    for (c, g) in run_gradient.iter_mut().enumerate() {
+        let mut sum = run_rows[c] * residual[0];
+        for r in 1..rows {
+            sum += run_rows[r * run.width + c] * residual[r];
+        }
+        *g += sum;
+    }
+}
+
+/// A four-row factor's run gathered row by row by the AVX2 copy; `false`
+/// (nothing written) where there is no AVX2 build. Only called from code
+/// compiled for AVX2.
+#[inline(always)]
+fn gather_four_rows_avx2(run: &Run, jacobians: &[DMatrix<f64>], rows: &mut [f64]) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let mut column = 0;
+        for jacobian in &jacobians[run.first_slot..run.end_slot] {
+            // SAFETY: reached only from `accumulate_avx2`, which runs only where the CPU has AVX2.
+            unsafe { gram_avx2::scatter_four_rows(jacobian.as_slice(), rows, run.width, column) };
+            column += jacobian.ncols();
+        }
+        true
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = (run, jacobians, rows);
+        false
     }
 }
 
@@ -324,6 +387,16 @@ fn merged_runs(variables: &[VariableId], offsets: &[Option<usize>], dims: &[usiz
     runs
 }
 
+/// Calls `$kernels!` with the run shapes `(columns of a, columns of b,
+/// diagonal block)` of a calibration graph's catenary factors (a pose with
+/// its tension 8 columns, the anchors and offsets 16, the anchors 12; `1`:
+/// the gradient of a run) and the `$extra` ones.
+macro_rules! run_shapes {
+    ($kernels:ident $(, $extra:tt)*) => {
+        $kernels!((8, 8, true), (8, 16, false), (16, 16, true), (8, 12, false), (12, 12, true), (8, 1, false) $(, $extra)*)
+    };
+}
+
 /// A run's Jacobian columns stored row by row: entry `(r, c)` at `data[r * width + c]`.
 #[derive(Clone, Copy)]
 struct RunRows<'a> {
@@ -340,7 +413,17 @@ struct RunRows<'a> {
 /// go to kernels whose sizes are known at compile time (unrolled,
 /// vectorised, no bounds checks); the rest to the general loop.
 #[inline(always)]
-fn add_run_product<const R: usize>(a: RunRows, b: RunRows, same: bool, rows: usize, stride: usize, block: &mut [f64]) {
+fn add_run_product<const R: usize, const AVX2: bool>(
+    a: RunRows,
+    b: RunRows,
+    same: bool,
+    rows: usize,
+    stride: usize,
+    block: &mut [f64],
+) {
+    if AVX2 && add_gram_avx2::<R>(a, b, same, stride, block) {
+        return;
+    }
     if R != 0 {
         macro_rules! kernels {
             ($(($ca:literal, $cb:literal, $same:literal)),*) => {
@@ -350,17 +433,7 @@ fn add_run_product<const R: usize>(a: RunRows, b: RunRows, same: bool, rows: usi
                 }
             };
         }
-        kernels!(
-            (8, 8, true),
-            (8, 16, false),
-            (16, 16, true),
-            (8, 12, false),
-            (12, 12, true),
-            (6, 6, true),
-            (2, 2, true),
-            (8, 1, false),
-            (1, 1, true)
-        );
+        run_shapes!(kernels, (6, 6, true), (2, 2, true), (1, 1, true));
     }
     for j in 0..b.width {
         let first = if same { j } else { 0 };
@@ -374,6 +447,34 @@ fn add_run_product<const R: usize>(a: RunRows, b: RunRows, same: bool, rows: usi
             *h += sum;
         }
     }
+}
+
+/// [`add_run_product`] by the AVX2 kernel for the shapes of a calibration
+/// graph with four rows (the catenary length and height factors): `true` if
+/// it took the product, `false` for a shape it has no kernel for. Only
+/// called from code compiled for AVX2 (`accumulate_any::<true>`).
+#[inline(always)]
+fn add_gram_avx2<const R: usize>(a: RunRows, b: RunRows, same: bool, stride: usize, block: &mut [f64]) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        macro_rules! kernels {
+            ($(($ca:literal, $cb:literal, $same:literal)),*) => {
+                match (a.width, b.width, same) {
+                    $(($ca, $cb, $same) => {
+                        // SAFETY: reached only from `accumulate_avx2`, which runs only where the CPU has AVX2.
+                        unsafe { gram_avx2::gram_block::<4, $ca, $cb, $same, false>(a.data, b.data, stride, block) };
+                        return true;
+                    })*
+                    _ => {}
+                }
+            };
+        }
+        if R == 4 {
+            run_shapes!(kernels, (16, 1, false), (12, 1, false));
+        }
+    }
+    let _ = (a, b, same, stride, block);
+    false
 }
 
 /// [`add_run_product`] for `R` rows and runs of `CA` and `CB` columns.
@@ -449,7 +550,7 @@ mod tests {
             assert_eq!(g_merged, g_single, "{rows} rows");
             // The build for the CPU's instruction set (AVX2 where it has it) and the portable one agree bit for bit.
             let (mut h_any, mut g_any) = (vec![0.0; n * n], vec![0.0; n]);
-            merged.accumulate_any(&jacobians, &residual, &mut h_any, &mut g_any, &mut run_buffer);
+            merged.accumulate_any::<false>(&jacobians, &residual, &mut h_any, &mut g_any, &mut run_buffer);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&h_any), bits(&h_merged), "{rows} rows");
             assert_eq!(bits(&g_any), bits(&g_merged), "{rows} rows");

@@ -36,6 +36,7 @@
 
 mod accumulate;
 mod covariance;
+mod gram_avx2;
 mod linear_system;
 mod local;
 mod redundancy;

@@ -102,19 +102,20 @@ impl SchurLayout {
             // SAFETY: `factorize_avx2` only needs AVX2, which the CPU has (checked just above).
             return unsafe { self.factorize_avx2(hessian, damping) };
         }
-        self.factorize_any(hessian, damping)
+        self.factorize_any::<false>(hessian, damping)
     }
 
     /// [`SchurLayout::factorize_any`] compiled with AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn factorize_avx2(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
-        self.factorize_any(hessian, damping)
+        self.factorize_any::<true>(hessian, damping)
     }
 
-    /// [`SchurLayout::factorize`] for the instruction set it is inlined into.
+    /// [`SchurLayout::factorize`] for the instruction set it is inlined into
+    /// (`AVX2`: only from [`SchurLayout::factorize_avx2`]).
     #[inline(always)]
-    fn factorize_any(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
+    fn factorize_any<const AVX2: bool>(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
         self.factored = false;
         let g = self.globals;
         // Each block is copied from `hessian` just before it is factored
@@ -129,9 +130,9 @@ impl SchurLayout {
             let block = &mut blocks[base..base + m * m + m * g];
             block.copy_from_slice(&hessian[g * g + base..g * g + base + m * m + m * g]);
             let eliminated = match m {
-                8 => eliminate_group::<8>(block, &damping[start..start + m], reduced, g),
-                6 => eliminate_group::<6>(block, &damping[start..start + m], reduced, g),
-                _ => eliminate_group::<0>(block, &damping[start..start + m], reduced, g),
+                8 => eliminate_group::<8, AVX2>(block, &damping[start..start + m], reduced, g),
+                6 => eliminate_group::<6, AVX2>(block, &damping[start..start + m], reduced, g),
+                _ => eliminate_group::<0, AVX2>(block, &damping[start..start + m], reduced, g),
             };
             if !eliminated {
                 return false;
@@ -286,7 +287,12 @@ fn back_substitute_group<const M: usize, const G: usize>(l: &[f64], w: &[f64], g
 /// reduced system's lower triangle. `M` is the group dimension when known at
 /// compile time (the loops then unroll), `0` for any.
 #[inline(always)]
-fn eliminate_group<const M: usize>(block: &mut [f64], damping: &[f64], reduced: &mut [f64], g: usize) -> bool {
+fn eliminate_group<const M: usize, const AVX2: bool>(
+    block: &mut [f64],
+    damping: &[f64],
+    reduced: &mut [f64],
+    g: usize,
+) -> bool {
     let m = if M == 0 { damping.len() } else { M };
     let (d, w) = block.split_at_mut(m * m);
     for i in 0..m {
@@ -299,8 +305,8 @@ fn eliminate_group<const M: usize>(block: &mut [f64], damping: &[f64], reduced: 
         forward_substitute(d, m, column);
     }
     match (M, g) {
-        (8, 16) => subtract_gram::<8, 16>(w, reduced),
-        (6, 16) => subtract_gram::<6, 16>(w, reduced),
+        (8, 16) => subtract_gram::<8, 16, AVX2>(w, reduced),
+        (6, 16) => subtract_gram::<6, 16, AVX2>(w, reduced),
         _ => {
             for j in 0..g {
                 let wj = &w[j * m..(j + 1) * m];
@@ -323,7 +329,7 @@ fn eliminate_group<const M: usize>(block: &mut [f64], damping: &[f64], reduced: 
 /// column of `reduced` are neighbouring SIMD lanes; each entry sums its `M`
 /// products in order, as the general loop does.
 #[inline(always)]
-fn subtract_gram<const M: usize, const G: usize>(w: &[f64], reduced: &mut [f64]) {
+fn subtract_gram<const M: usize, const G: usize, const AVX2: bool>(w: &[f64], reduced: &mut [f64]) {
     let w = &w[..M * G];
     let mut rows = [[0.0f64; G]; M];
     for (i, column) in w.chunks_exact(M).enumerate() {
@@ -332,6 +338,13 @@ fn subtract_gram<const M: usize, const G: usize>(w: &[f64], reduced: &mut [f64])
         }
     }
     let reduced = &mut reduced[..G * G];
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 && G == 16 {
+        let rows = rows.as_flattened();
+        // SAFETY: `AVX2` only from `factorize_avx2`, which runs only where the CPU has AVX2.
+        unsafe { super::gram_avx2::gram_block::<M, 16, 16, true, true>(rows, rows, 16, reduced) };
+        return;
+    }
     for j in 0..G {
         let column = &mut reduced[j * G..(j + 1) * G];
         for i in j..G {
@@ -459,7 +472,7 @@ mod tests {
         for &(r, c) in &arrowhead_indices(g, m, dim) {
             entries[layout.place(r, c).0] = h[(r, c)];
         }
-        assert!(layout.factorize_any(&entries, &damping));
+        assert!(layout.factorize_any::<false>(&entries, &damping));
         assert_eq!(layout.values.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), factors);
         let rhs: Vec<f64> = (0..dim).map(|i| (i as f64).sin()).collect();
         let x = layout.solve(&rhs).expect("solution");
