@@ -18,6 +18,15 @@ use std::arch::x86_64::{
     _mm256_mul_pd, _mm256_set1_pd, _mm256_storeu_pd, _mm256_sub_pd, _mm_storeh_pd, _mm_storel_pd,
 };
 
+/// Whether this CPU runs the kernels (x86-64 with AVX2; the check is cached by std).
+#[inline]
+pub(super) fn available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    false
+}
+
 /// Lane masks of the diagonal lane group of a lower triangle: entry `k`
 /// selects lanes `l >= k` (sign bit set) for column `j` with `j % 4 == k`.
 #[cfg(target_arch = "x86_64")]

@@ -14,6 +14,7 @@
 //! nonlinear elimination (Lanzkron, Rose & Wilkes, 1996). At a minimum of the
 //! full problem the refinement changes nothing.
 
+use super::gram_avx2;
 use super::linear_system::dot;
 use super::schur::{backward_substitute, cholesky_in_place, forward_substitute};
 use std::cell::RefCell;
@@ -168,6 +169,7 @@ fn linearize_group(
     out.gradient.clear();
     out.gradient.resize(dim, 0.0);
     let mut cost = 0.0;
+    let mut rows_buffer = [0.0; 32];
     for ((&f, slots), &mask) in group.factors.iter().zip(&group.factor_slots).zip(&group.factor_masks) {
         let Ok(linearized) = buffers.linearize_slots(graph.factors[f].as_ref(), values, mask) else {
             return None;
@@ -188,6 +190,9 @@ fn linearize_group(
         let residual = &linearized.residual;
         match (rows, columns.len()) {
             // A pose's catenary rows on its pose and tension; its pose prior.
+            (4, 8) if contiguous(columns) && gram_avx2::available() => {
+                add_normal_equations_avx2(columns[0], gathered, residual, dim, out, &mut rows_buffer)
+            }
             (4, 8) => add_normal_equations_by_rows::<4, 8>(columns, gathered, residual, dim, out),
             (6, 6) => add_normal_equations_by_rows::<6, 6>(columns, gathered, residual, dim, out),
             (3, 6) => add_normal_equations_by_rows::<3, 6>(columns, gathered, residual, dim, out),
@@ -197,11 +202,54 @@ fn linearize_group(
             _ => add_normal_equations::<0>(columns, gathered, residual, dim, out),
         }
     }
-    out.hessian
-        .iter()
-        .chain(&out.gradient)
-        .all(|v| v.is_finite())
-        .then_some(cost)
+    all_finite(&out.hessian, &out.gradient).then_some(cost)
+}
+
+/// Whether every entry of both is finite: `v * 0.0` is NaN exactly when `v`
+/// is not finite, and a sum with a NaN term is NaN in any order, so four
+/// running sums side by side give the answer of the entry-by-entry test.
+fn all_finite(a: &[f64], b: &[f64]) -> bool {
+    let mut lanes = [0.0f64; 4];
+    for part in [a, b] {
+        let mut chunks = part.chunks_exact(4);
+        for chunk in &mut chunks {
+            for (lane, v) in lanes.iter_mut().zip(chunk) {
+                *lane += v * 0.0;
+            }
+        }
+        for v in chunks.remainder() {
+            lanes[0] += v * 0.0;
+        }
+    }
+    !lanes.iter().any(|v| v.is_nan())
+}
+
+/// Whether `columns` are consecutive tangent indices.
+fn contiguous(columns: &[usize]) -> bool {
+    columns.iter().enumerate().all(|(k, &c)| c == columns[0] + k)
+}
+
+/// [`add_normal_equations_by_rows`] for four rows on eight consecutive
+/// columns from `first`, by the AVX2 kernels of the full solve: the same
+/// sums in the same order, bit for bit (test). The caller checked that the
+/// CPU has AVX2.
+fn add_normal_equations_avx2(
+    first: usize,
+    gathered: &[f64],
+    residual: &[f64],
+    dim: usize,
+    out: &mut GroupSystem,
+    rows: &mut [f64; 32],
+) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: the caller checked `gram_avx2::available()`.
+    unsafe {
+        gram_avx2::scatter_four_rows(&gathered[..32], rows, 8, 0);
+        gram_avx2::gram_block::<4, 8, 1, false, false>(rows, residual, 0, &mut out.gradient[first..]);
+        gram_avx2::gram_block::<4, 8, 8, true, false>(rows, rows, dim, &mut out.hessian[first + first * dim..]);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (first, gathered, residual, dim, out, rows);
 }
 
 /// Add one factor's `J^T J` (lower triangle) and `J^T r` over the group's
@@ -303,14 +351,12 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &
             for i in 0..dim {
                 damped[i + i * dim] += damping * current.hessian[i + i * dim].max(1e-12);
             }
-            if !cholesky_in_place(damped, dim) {
+            step.clear();
+            step.extend(current.gradient.iter().map(|g| -g));
+            if !solve_in_place(damped, dim, step) {
                 damping *= 10.0;
                 continue;
             }
-            step.clear();
-            step.extend(current.gradient.iter().map(|g| -g));
-            forward_substitute(damped, dim, step);
-            backward_substitute(damped, dim, step);
             // Predicted decrease of the damped Gauss-Newton step,
             // 1/2 dx.(lambda D dx - g): below the tolerance the group is at
             // its minimum and the trial evaluation is saved.
@@ -353,6 +399,28 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &
     }
 }
 
+/// `x <- A^-1 x` by the Cholesky factorisation of `a` (column-major
+/// `dim x dim`, overwritten by its factor); `false` if `a` is not positive
+/// definite. A pose's group (eight columns: the pose and its tension) goes
+/// through the same code with the size known at compile time (unrolled, no
+/// bounds checks; the same operations in the same order).
+fn solve_in_place(a: &mut [f64], dim: usize, x: &mut [f64]) -> bool {
+    #[inline(always)]
+    fn solve(a: &mut [f64], dim: usize, x: &mut [f64]) -> bool {
+        let (a, x) = (&mut a[..dim * dim], &mut x[..dim]);
+        if !cholesky_in_place(a, dim) {
+            return false;
+        }
+        forward_substitute(a, dim, x);
+        backward_substitute(a, dim, x);
+        true
+    }
+    match dim {
+        8 => solve(a, 8, x),
+        _ => solve(a, dim, x),
+    }
+}
+
 /// `*to = from.clone()`, reusing `to`'s vector where the lengths agree.
 fn assign(to: &mut VariableValue, from: &VariableValue) {
     match (to, from) {
@@ -387,10 +455,38 @@ mod tests {
             assert_eq!(bits(&by_rows.hessian), bits(&by_dots.hessian), "{R} x {C}");
             assert_eq!(bits(&by_rows.gradient), bits(&by_dots.gradient), "{R} x {C}");
             assert_ne!(bits(&by_rows.hessian), bits(&start().hessian));
+            if R == 4 && C == 8 && contiguous(columns) && gram_avx2::available() {
+                let mut by_avx2 = start();
+                add_normal_equations_avx2(columns[0], &gathered, &residual, dim, &mut by_avx2, &mut [0.0; 32]);
+                assert_eq!(bits(&by_avx2.hessian), bits(&by_dots.hessian), "AVX2 {R} x {C}");
+                assert_eq!(bits(&by_avx2.gradient), bits(&by_dots.gradient), "AVX2 {R} x {C}");
+            }
         }
         check::<4, 8>(&[6, 7, 0, 1, 2, 3, 4, 5]);
         check::<4, 8>(&[1, 2, 3, 4, 5, 6, 7, 8]);
         check::<6, 6>(&[0, 1, 2, 3, 4, 5]);
         check::<3, 6>(&[3, 4, 5, 6, 7, 8]);
+    }
+
+    /// The lane-wise finiteness test finds a NaN or an infinity anywhere in
+    /// either slice (in a full lane group and in the remainder) and passes
+    /// finite values, however large.
+    #[test]
+    fn all_finite_finds_every_non_finite_entry() {
+        let a: Vec<f64> = (0..11).map(|k| 1e300 * (k as f64 - 5.0)).collect();
+        let b = vec![0.5; 6];
+        assert!(all_finite(&a, &b));
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            for k in 0..a.len() {
+                let mut a = a.clone();
+                a[k] = bad;
+                assert!(!all_finite(&a, &b), "{bad} at a[{k}]");
+            }
+            for k in 0..b.len() {
+                let mut b = b.clone();
+                b[k] = bad;
+                assert!(!all_finite(&a, &b), "{bad} at b[{k}]");
+            }
+        }
     }
 }
