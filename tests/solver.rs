@@ -207,3 +207,52 @@ fn factors_that_claim_to_write_every_jacobian_entry_do() {
     ];
     assert_eq!(kinds.into_iter().collect::<Vec<_>>(), expected);
 }
+
+/// A solve (and a covariance) through a `SystemCache` that already holds the
+/// system of a graph with the same structure ends bit for bit where a fresh
+/// one ends; graphs of another structure (more poses, an offset held fixed)
+/// in between get systems of their own and match fresh solves too.
+#[test]
+fn a_kept_linear_system_solves_exactly_as_a_new_one() {
+    use sagcal::experiments::benchmark::BenchmarkProblem;
+    use sagcal::solver::{marginal_covariance_cached, optimize_cached, SystemCache};
+    let params = LmParams {
+        max_iterations: 6,
+        ..BenchmarkProblem::stopping()
+    };
+    let fresh = |poses: usize, fix_first: bool| {
+        let mut built = BenchmarkProblem::new(poses, 3).unwrap().graph();
+        if fix_first {
+            built.graph.values.set_fixed(built.globals.length_offsets[0], true);
+        }
+        built
+    };
+    let mut cache = SystemCache::default();
+    assert!(cache.is_empty());
+    for (poses, fix_first) in [(9, false), (9, false), (12, false), (12, true), (12, true), (9, false)] {
+        let mut cached = fresh(poses, fix_first);
+        let with_cache = optimize_cached(&mut cached.graph, &params, &mut cache).unwrap();
+        assert!(!cache.is_empty());
+        let mut alone = fresh(poses, fix_first);
+        let without = optimize(&mut alone.graph, &params).unwrap();
+        let what = format!("{poses} poses, first offset fixed: {fix_first}");
+        assert_eq!(with_cache.final_cost.to_bits(), without.final_cost.to_bits(), "{what}");
+        assert_eq!(with_cache.iterations, without.iterations, "{what}");
+        assert!(
+            with_cache.final_cost < 1e-2 * with_cache.initial_cost,
+            "{what}: the solve did its job"
+        );
+        for ((_, a), (_, b)) in cached.graph.values.iter().zip(alone.graph.values.iter()) {
+            assert_eq!(a.value, b.value, "{what}");
+        }
+        let anchors = &cached.globals.anchors;
+        let kept = marginal_covariance_cached(&cached.graph, anchors, &mut cache).unwrap();
+        let new = marginal_covariance(&alone.graph, anchors).unwrap();
+        match (kept, new) {
+            (Covariance::Full(a), Covariance::Full(b)) => assert_eq!(a, b, "{what}"),
+            other => panic!("{what}: {other:?}"),
+        }
+    }
+    cache.clear();
+    assert!(cache.is_empty());
+}

@@ -107,13 +107,14 @@ mod prepared;
 pub mod report;
 mod result;
 mod snooping;
+mod system_scope;
 mod uncertainty;
 
 use crate::error::{Error, Result};
 use crate::model::effects::{EffectKind, Effects};
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
-use crate::solver::{optimize, LmParams};
+use crate::solver::{optimize_cached, LmParams};
 use uncertainty::effect_estimate;
 
 pub use graph::{
@@ -142,6 +143,7 @@ pub fn calibrate(
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
 ) -> Result<CalibrationResult> {
+    let _shared_system = system_scope::Scope::enter();
     validate_measurements(measurements)?;
     if options.orientation_prior == OrientationPrior::Auto && options.model == CableModel::Catenary {
         return orientation::calibrate_testing_orientation(initial, measurements, options);
@@ -421,7 +423,8 @@ fn rigid_calibration(
 
 /// Solve one stage; errors name the stage.
 fn solve_stage(name: &str, built: &mut CalibrationGraph, lm: &LmParams) -> Result<StageSummary> {
-    let summary = optimize(&mut built.graph, lm).map_err(|e| Error::InvalidInput(format!("{name} stage: {e}")))?;
+    let summary = system_scope::with_system_cache(|cache| optimize_cached(&mut built.graph, lm, cache))
+        .map_err(|e| Error::InvalidInput(format!("{name} stage: {e}")))?;
     Ok(StageSummary {
         name: name.to_string(),
         summary,
@@ -473,6 +476,7 @@ pub fn refine_with_effects(
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
 ) -> Result<CalibrationResult> {
+    let _shared_system = system_scope::Scope::enter();
     let kinds = options.free_effects;
     let used: Vec<PoseMeasurement> = (0..measurements.len())
         .filter(|k| !baseline.excluded_poses.contains(k))

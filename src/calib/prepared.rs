@@ -34,6 +34,7 @@ pub struct PreparedCalibration {
 impl PreparedCalibration {
     /// Make the rigid stage and the warm-ups for `initial` and `measurements` under `options`.
     pub fn new(initial: &Robot, measurements: &[PoseMeasurement], options: &CalibrationOptions) -> Self {
+        let _shared_system = super::system_scope::Scope::enter();
         let prepared = (options.model == CableModel::Catenary && validate_measurements(measurements).is_ok())
             .then(|| CatenaryPreparation::new(initial, measurements, options).ok())
             .flatten();
@@ -50,6 +51,7 @@ impl PreparedCalibration {
     /// made with only in the orientation prior and the free effects, else
     /// from the start.
     pub fn calibrate(&self, options: &CalibrationOptions) -> Result<CalibrationResult> {
+        let _shared_system = super::system_scope::Scope::enter();
         let shared = CalibrationOptions {
             orientation_prior: options.orientation_prior,
             free_effects: options.free_effects,

@@ -15,7 +15,7 @@ use crate::model::measurement::PoseMeasurement;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::statics::{CableTension, Equilibrium};
-use crate::solver::{marginal_covariance, Covariance};
+use crate::solver::{marginal_covariance, marginal_covariance_cached, Covariance};
 
 /// The fitted parameters of `kind` in `built` with 1-sigma from the marginal covariance.
 pub(super) fn effect_estimate(built: &CalibrationGraph, kind: EffectKind) -> Result<EffectEstimate> {
@@ -50,7 +50,9 @@ pub fn parameter_uncertainty(built: &CalibrationGraph) -> Result<ParameterUncert
         .chain(&built.globals.length_offsets)
         .copied()
         .collect();
-    let covariance = marginal_covariance(&built.graph, &selected).map_err(Error::InvalidInput)?;
+    let covariance =
+        super::system_scope::with_system_cache(|cache| marginal_covariance_cached(&built.graph, &selected, cache))
+            .map_err(Error::InvalidInput)?;
     Ok(match covariance {
         Covariance::Full(c) => uncertainty_from_covariance(&c),
         Covariance::RankDeficient(directions) => ParameterUncertainty::RankDeficient { directions },

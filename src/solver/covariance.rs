@@ -11,7 +11,7 @@
 use nalgebra::{DMatrix, SymmetricEigen};
 use serde::Serialize;
 
-use super::{linearize, LinearSystem};
+use super::{linearize, LinearSystem, SystemCache};
 use crate::graph::{FactorGraph, VariableId};
 
 /// A direction in parameter space the data cannot determine.
@@ -44,8 +44,19 @@ pub enum Covariance {
 ///    (rounding noise made `H` look positive definite), reported with its
 ///    components in the selected variables.
 pub fn marginal_covariance(graph: &FactorGraph, selected: &[VariableId]) -> Result<Covariance, String> {
-    let mut system = LinearSystem::new(&graph.values, &graph.factors, &graph.local_groups)?;
-    let hessian = linearize(graph, &graph.values, &system)
+    marginal_covariance_cached(graph, selected, &mut SystemCache::default())
+}
+
+/// [`marginal_covariance`] with the linear system of `cache` when it was
+/// built for a graph of the same structure (see [`SystemCache`]): the same
+/// result, bit for bit.
+pub fn marginal_covariance_cached(
+    graph: &FactorGraph,
+    selected: &[VariableId],
+    cache: &mut SystemCache,
+) -> Result<Covariance, String> {
+    let system = cache.system(&graph.values, &graph.factors, &graph.local_groups)?;
+    let hessian = linearize(graph, &graph.values, system)
         .map_err(|e| format!("covariance at the solution: {e}"))?
         .hessian;
     let mut columns = Vec::new();
@@ -59,14 +70,14 @@ pub fn marginal_covariance(graph: &FactorGraph, selected: &[VariableId]) -> Resu
     }
     let zero_damping = vec![0.0; system.dim];
     if !system.factorize(&hessian, &zero_damping) {
-        return Ok(Covariance::RankDeficient(null_space(graph, &system, &hessian)));
+        return Ok(Covariance::RankDeficient(null_space(graph, system, &hessian)));
     }
     let mut covariance = DMatrix::zeros(columns.len(), columns.len());
     for (k, &col) in columns.iter().enumerate() {
         let mut unit = vec![0.0; system.dim];
         unit[col] = 1.0;
         let Some(x) = system.solve_factored(&unit) else {
-            return Ok(Covariance::RankDeficient(null_space(graph, &system, &hessian)));
+            return Ok(Covariance::RankDeficient(null_space(graph, system, &hessian)));
         };
         for (m, &row) in columns.iter().enumerate() {
             covariance[(m, k)] = x[row];

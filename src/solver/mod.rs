@@ -42,13 +42,15 @@ mod local;
 mod redundancy;
 mod schur;
 mod sparse_cholesky;
+mod system_cache;
 
 use local::LocalGroups;
 
-pub use covariance::{marginal_covariance, Covariance, UnobservableDirection};
+pub use covariance::{marginal_covariance, marginal_covariance_cached, Covariance, UnobservableDirection};
 use linear_system::fill_zeros;
 pub use linear_system::LinearSystem;
 pub use redundancy::redundancy_numbers;
+pub use system_cache::SystemCache;
 
 use serde::Serialize;
 
@@ -252,7 +254,18 @@ fn retract_all(values: &Values, system: &LinearSystem, step: &[f64], next: &mut 
 
 /// Minimise the graph's cost from its current values; the values are updated in place.
 pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSummary, String> {
-    let mut system = LinearSystem::new(&graph.values, &graph.factors, &graph.local_groups)?;
+    optimize_cached(graph, params, &mut SystemCache::default())
+}
+
+/// [`optimize`] with the linear system taken from `cache` when it was built
+/// for a graph of the same structure (and kept there for the next solve):
+/// the same result, bit for bit, without a second pattern analysis.
+pub fn optimize_cached(
+    graph: &mut FactorGraph,
+    params: &LmParams,
+    cache: &mut SystemCache,
+) -> Result<SolveSummary, String> {
+    let system = cache.system(&graph.values, &graph.factors, &graph.local_groups)?;
     let groups = if params.local_refinement {
         LocalGroups::new(graph)
     } else {
@@ -263,7 +276,7 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
         groups.refine(graph, &mut values);
     }
     let mut work = Workspace::default();
-    let Ok(mut linearization) = linearize_with(graph, &values, &system, &mut work) else {
+    let Ok(mut linearization) = linearize_with(graph, &values, system, &mut work) else {
         return Ok(SolveSummary {
             initial_cost: f64::NAN,
             final_cost: f64::NAN,
@@ -287,15 +300,7 @@ pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSumma
             termination = Termination::GradientConverged;
             break;
         }
-        let (accepted, trials) = damped_step(
-            graph,
-            &groups,
-            &mut system,
-            &values,
-            &linearization,
-            &mut damping,
-            &mut work,
-        );
+        let (accepted, trials) = damped_step(graph, &groups, system, &values, &linearization, &mut damping, &mut work);
         let Some(Accepted {
             step,
             linearization: next,
