@@ -41,6 +41,7 @@ mod linear_system;
 mod local;
 mod redundancy;
 mod schur;
+mod schur_avx2;
 mod sparse_cholesky;
 mod system_cache;
 

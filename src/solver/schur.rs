@@ -294,10 +294,15 @@ fn eliminate_group<const M: usize, const AVX2: bool>(
     g: usize,
 ) -> bool {
     let m = if M == 0 { damping.len() } else { M };
-    let (d, w) = block.split_at_mut(m * m);
     for i in 0..m {
-        d[i + i * m] += damping[i];
+        block[i + i * m] += damping[i];
     }
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 && M == 8 && g == 16 {
+        // SAFETY: `AVX2` only from `factorize_avx2`, which runs only where the CPU has AVX2.
+        return unsafe { super::schur_avx2::eliminate_group(block, reduced) };
+    }
+    let (d, w) = block.split_at_mut(m * m);
     if !cholesky_in_place(d, m) {
         return false;
     }
