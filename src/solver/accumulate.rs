@@ -74,12 +74,49 @@ impl FactorRuns {
     ) -> Self {
         let distinct = variables.iter().enumerate().all(|(k, v)| !variables[..k].contains(v));
         if distinct {
-            let merged = Self::from_runs(merged_runs(variables, offsets, dims), variables, offsets, slot_blocks);
+            let merged = Self::from_runs(
+                merged_runs(variables, offsets, dims, |_, _| true),
+                variables,
+                offsets,
+                slot_blocks,
+            );
             if let Some(merged) = merged {
                 return merged;
             }
         }
         Self::singletons(variables, offsets, dims, slot_blocks)
+    }
+
+    /// The runs of a factor whose variables are distinct, in the block
+    /// elimination's storage (`schur`): consecutive free slots with
+    /// consecutive tangent columns inside one zone (the globals, or one
+    /// group) form a run, and the product of two runs is the dense block
+    /// at `schur.place` of their first columns.
+    pub(super) fn in_zones(
+        variables: &[VariableId],
+        offsets: &[Option<usize>],
+        dims: &[usize],
+        schur: &super::schur::SchurLayout,
+    ) -> Self {
+        let runs = merged_runs(variables, offsets, dims, |run, offset| {
+            offset < schur.zone_end(run.offset)
+        });
+        let mut blocks = Vec::with_capacity(runs.len() * (runs.len() + 1) / 2);
+        for (ka, a) in runs.iter().enumerate() {
+            for (kb, b) in runs.iter().enumerate() {
+                if a.offset >= b.offset {
+                    let (start, stride) = schur.place(a.offset, b.offset);
+                    blocks.push(RunBlock {
+                        run_a: ka,
+                        run_b: kb,
+                        start,
+                        stride,
+                    });
+                }
+            }
+        }
+        let columns = runs.iter().map(|r| r.width).sum();
+        Self { runs, blocks, columns }
     }
 
     /// Every free slot a run of its own: the slot pairs' blocks as they are.
@@ -364,15 +401,22 @@ fn gather_four_rows_avx2(run: &Run, jacobians: &[DMatrix<f64>], rows: &mut [f64]
     }
 }
 
-/// The runs of consecutive free slots whose tangent columns follow each other.
-fn merged_runs(variables: &[VariableId], offsets: &[Option<usize>], dims: &[usize]) -> Vec<Run> {
+/// The runs of consecutive free slots whose tangent columns follow each
+/// other (and that `may_join(run, offset)` lets a run take the next slot's
+/// columns at `offset`).
+fn merged_runs(
+    variables: &[VariableId],
+    offsets: &[Option<usize>],
+    dims: &[usize],
+    may_join: impl Fn(&Run, usize) -> bool,
+) -> Vec<Run> {
     let mut runs: Vec<Run> = Vec::new();
     for (slot, v) in variables.iter().enumerate() {
         let Some(offset) = offsets[v.0] else {
             continue;
         };
         match runs.last_mut() {
-            Some(run) if run.end_slot == slot && run.offset + run.width == offset => {
+            Some(run) if run.end_slot == slot && run.offset + run.width == offset && may_join(run, offset) => {
                 run.end_slot += 1;
                 run.width += dims[slot];
             }

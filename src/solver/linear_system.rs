@@ -158,6 +158,8 @@ impl TangentLayout {
     }
 }
 
+mod block_elimination;
+
 /// The stored blocks of the lower triangle of `H`, in storage order, and
 /// where each factor's slot pairs accumulate.
 struct BlockPattern {
@@ -239,66 +241,56 @@ impl LinearSystem {
         if layout.dim == 0 {
             return Err("every variable is fixed: nothing to solve".into());
         }
-        let mut pattern = BlockPattern::new(values, factors, &layout.offsets);
-        let offset = |v: VariableId| layout.offsets[v.0].unwrap_or(0);
-        // A block's entries all couple the same two variables: its first
-        // entry stands for it in the test of whether two groups are coupled.
-        let corners: Vec<(usize, usize)> = pattern
-            .block_order
-            .iter()
-            .map(|&(a, b, _)| (offset(a), offset(b)))
-            .collect();
+        // `J^T J` is added by variable pairs: a variable named twice by one
+        // factor would need the cross products of its two slots.
+        for (index, factor) in factors.iter().enumerate() {
+            let variables = factor.variables();
+            if let Some((k, v)) = variables.iter().enumerate().find(|(k, v)| variables[..*k].contains(v)) {
+                return Err(format!(
+                    "factor {index} ({}) names variable '{}' twice (slot {k}): a factor's variables must be distinct",
+                    factor.kind(),
+                    values.variable(*v).name
+                ));
+            }
+        }
         // The reduced system of the elimination is dense: worth it while it is small.
-        let schur = (!layout.group_ranges.is_empty() && layout.globals <= MAX_SCHUR_GLOBALS)
-            .then(|| SchurLayout::new(&corners, layout.globals, layout.group_ranges))
-            .flatten();
-        let stored_blocks = |place: &dyn Fn(VariableId, VariableId, usize) -> (usize, usize)| -> Vec<StoredBlock> {
-            let block = |&(a, b, start): &(VariableId, VariableId, usize)| {
-                let (first, stride) = place(a, b, start);
-                let (rows, cols) = (values.tangent_dim(a), values.tangent_dim(b));
-                let (row, col) = (offset(a), offset(b));
-                StoredBlock {
-                    row,
-                    col,
-                    rows,
-                    cols,
-                    first,
-                    stride,
-                }
-            };
-            pattern.block_order.iter().map(block).collect()
+        if !layout.group_ranges.is_empty()
+            && layout.globals <= MAX_SCHUR_GLOBALS
+            && !block_elimination::couples_two_groups(factors, &layout)
+        {
+            return Ok(Self::with_block_elimination(values, factors, layout));
+        }
+        Self::with_sparse_cholesky(values, factors, layout)
+    }
+
+    /// The pattern for faer's sparse Cholesky: every block a factor touches,
+    /// stored column-major from its start, in the order first touched.
+    fn with_sparse_cholesky(
+        values: &Values,
+        factors: &[Box<dyn Factor>],
+        layout: TangentLayout,
+    ) -> Result<Self, String> {
+        let pattern = BlockPattern::new(values, factors, &layout.offsets);
+        let offset = |v: VariableId| layout.offsets[v.0].unwrap_or(0);
+        let block = |&(a, b, start): &(VariableId, VariableId, usize)| StoredBlock {
+            row: offset(a),
+            col: offset(b),
+            rows: values.tangent_dim(a),
+            cols: values.tangent_dim(b),
+            first: start,
+            stride: values.tangent_dim(a),
         };
-        let (blocks, positions, diagonal_entries, storage_len, factorization) = match schur {
-            Some(schur) => {
-                // Accumulate straight into the elimination's dense blocks.
-                let blocks = stored_blocks(&|a, b, _| schur.place(offset(a), offset(b)));
-                for (factor, blocks) in factors.iter().zip(&mut pattern.factor_blocks) {
-                    let offset = |slot: usize| layout.offsets[factor.variables()[slot].0].unwrap_or(0);
-                    for block in blocks {
-                        (block.start, block.stride) = schur.place(offset(block.slot_a), offset(block.slot_b));
-                    }
-                }
-                let storage_len = schur.storage_len();
-                (blocks, Vec::new(), Vec::new(), storage_len, Factorization::Schur(schur))
+        let blocks: Vec<StoredBlock> = pattern.block_order.iter().map(block).collect();
+        let entries = blocks.iter().flat_map(StoredBlock::entries);
+        let (indices, positions): (Vec<(usize, usize)>, Vec<usize>) =
+            entries.map(|(row, col, position)| ((row, col), position)).unzip();
+        let mut diagonal_entries = vec![0; layout.dim];
+        for (k, &(row, col)) in indices.iter().enumerate() {
+            if row == col {
+                diagonal_entries[row] = k;
             }
-            None => {
-                // Block-wise: each block column-major from its start.
-                let blocks = stored_blocks(&|a, _, start| (start, values.tangent_dim(a)));
-                let entries = blocks.iter().flat_map(StoredBlock::entries);
-                let (indices, positions): (Vec<(usize, usize)>, Vec<usize>) =
-                    entries.map(|(row, col, position)| ((row, col), position)).unzip();
-                let mut diagonal_entries = vec![0; layout.dim];
-                for (k, &(row, col)) in indices.iter().enumerate() {
-                    if row == col {
-                        diagonal_entries[row] = k;
-                    }
-                }
-                let sparse = SparseCholesky::new(&indices, layout.dim)?;
-                let storage_len = pattern.entry_count;
-                let factorization = Factorization::Sparse(Box::new(sparse));
-                (blocks, positions, diagonal_entries, storage_len, factorization)
-            }
-        };
+        }
+        let sparse = SparseCholesky::new(&indices, layout.dim)?;
         let mut diagonal_slots = vec![0; layout.dim];
         for block in blocks.iter().filter(|b| b.row == b.col) {
             for i in 0..block.rows {
@@ -322,10 +314,10 @@ impl LinearSystem {
             factor_runs,
             diagonal_slots,
             diagonal_entries,
-            storage_len,
+            storage_len: pattern.entry_count,
             positions,
             blocks,
-            factorization,
+            factorization: Factorization::Sparse(Box::new(sparse)),
         })
     }
 
@@ -516,6 +508,33 @@ mod tests {
     /// product of the dense Jacobian (two globals of sizes 3 and 1, two
     /// local groups of sizes 2 + 1 and 2).
     #[test]
+    fn a_factor_naming_a_variable_twice_is_an_error() {
+        let mut values = Values::new();
+        let x = values.insert(
+            "x",
+            crate::graph::VariableValue::Vector(nalgebra::DVector::from_element(2, 1.0)),
+        );
+        let y = values.insert(
+            "y",
+            crate::graph::VariableValue::Vector(nalgebra::DVector::from_element(1, 1.0)),
+        );
+        let factor = |variables: Vec<VariableId>| -> Box<dyn Factor> {
+            let cols = variables.iter().map(|&v| values.tangent_dim(v)).sum();
+            Box::new(Linear {
+                variables,
+                a: DMatrix::from_element(2, cols, 1.0),
+                sigmas: nalgebra::DVector::from_element(2, 1.0),
+            })
+        };
+        let factors = vec![factor(vec![x, y]), factor(vec![y, x, y])];
+        for groups in [Vec::new(), vec![vec![y]]] {
+            let error = LinearSystem::new(&values, &factors, &groups).err().expect("an error");
+            assert!(error.contains("factor 1") && error.contains("'y' twice"), "{error}");
+        }
+        assert!(LinearSystem::new(&values, &factors[..1], &[]).is_ok());
+    }
+
+    #[test]
     fn dense_h_is_j_transpose_j_in_both_storages() {
         let mut values = Values::new();
         let vector =
@@ -562,8 +581,8 @@ mod tests {
                 for &v in variables {
                     let width = values.tangent_dim(v);
                     let offset = system.offsets[v.0].unwrap();
-                    j.view_mut((row, offset), (a.nrows(), width))
-                        .copy_from(&(a.columns(column, width) / 0.5));
+                    let mut block = j.view_mut((row, offset), (a.nrows(), width));
+                    block += a.columns(column, width) / 0.5;
                     column += width;
                 }
                 row += a.nrows();

@@ -43,7 +43,18 @@ impl SchurLayout {
     /// one entry per block between two variables is enough, it stands for
     /// the block), with `groups` `(first index, dimension)`. `None` if an
     /// entry couples two groups.
+    #[cfg(test)]
     pub(super) fn new(indices: &[(usize, usize)], globals: usize, groups: Vec<(usize, usize)>) -> Option<Self> {
+        let layout = Self::zones(globals, groups);
+        let coupled = indices.iter().any(|&(row, col)| {
+            row >= globals && col >= globals && layout.group_of[row - globals] != layout.group_of[col - globals]
+        });
+        (!coupled).then_some(layout)
+    }
+
+    /// The layout of `globals` and `groups` known not to be coupled
+    /// ([`SchurLayout::new`] without the coupling test).
+    pub(super) fn zones(globals: usize, groups: Vec<(usize, usize)>) -> Self {
         let mut group_base = Vec::with_capacity(groups.len());
         let mut size = globals * globals;
         for &(_, m) in &groups {
@@ -55,18 +66,24 @@ impl SchurLayout {
         for (k, &(start, m)) in groups.iter().enumerate() {
             group_of[start - globals..start - globals + m].fill(k);
         }
-        let layout = Self {
+        Self {
             globals,
             groups,
             group_base,
             group_of,
             values: super::linear_system::zeroed(size),
             factored: false,
-        };
-        let coupled = indices.iter().any(|&(row, col)| {
-            row >= globals && col >= globals && layout.group_of[row - globals] != layout.group_of[col - globals]
-        });
-        (!coupled).then_some(layout)
+        }
+    }
+
+    /// One past the last tangent index of the zone of index `i`: the
+    /// globals' end, or its group's.
+    pub(super) fn zone_end(&self, i: usize) -> usize {
+        if i < self.globals {
+            return self.globals;
+        }
+        let (start, m) = self.groups[self.group_of[i - self.globals]];
+        start + m
     }
 
     /// Where the entry `(row, col)` of `H` (`row >= col`, not coupling two
