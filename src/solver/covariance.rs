@@ -73,10 +73,17 @@ pub fn marginal_covariance_cached(
         return Ok(Covariance::RankDeficient(null_space(graph, system, &hessian)));
     }
     let mut covariance = DMatrix::zeros(columns.len(), columns.len());
+    // Columns of globals kept by the block elimination: their block of
+    // H^-1 is the inverse of the reduced system alone.
+    let reduced = system.eliminated_globals().filter(|&g| columns.iter().all(|&c| c < g));
     for (k, &col) in columns.iter().enumerate() {
-        let mut unit = vec![0.0; system.dim];
+        let mut unit = vec![0.0; reduced.unwrap_or(system.dim)];
         unit[col] = 1.0;
-        let Some(x) = system.solve_factored(&unit) else {
+        let solved = match reduced {
+            Some(_) => system.solve_globals(&unit),
+            None => system.solve_factored(&unit),
+        };
+        let Some(x) = solved else {
             return Ok(Covariance::RankDeficient(null_space(graph, system, &hessian)));
         };
         for (m, &row) in columns.iter().enumerate() {

@@ -371,6 +371,27 @@ impl LinearSystem {
         sparse.solve(rhs)
     }
 
+    /// The number of leading tangent indices (the globals) that the block
+    /// elimination keeps in its reduced system; `None` for faer's path.
+    pub(crate) fn eliminated_globals(&self) -> Option<usize> {
+        match &self.factorization {
+            Factorization::Schur(layout) => Some(layout.globals()),
+            Factorization::Sparse(_) => None,
+        }
+    }
+
+    /// The globals' part of the solution of `(H + damping) x = [rhs_globals; 0]`
+    /// with the last successful factorisation, by the block elimination's
+    /// reduced system alone (bit for bit the same part of
+    /// [`LinearSystem::solve_factored`]); `None` without a factorisation, on
+    /// faer's path, or if a value is not finite.
+    pub(crate) fn solve_globals(&self, rhs_globals: &[f64]) -> Option<Vec<f64>> {
+        match &self.factorization {
+            Factorization::Schur(layout) => layout.solve_globals(rhs_globals),
+            Factorization::Sparse(_) => None,
+        }
+    }
+
     /// `a^T (H + damping)^-1 a` with the last successful
     /// [`LinearSystem::factorize`] (a row's leverage when `a` is a whitened
     /// Jacobian row and the damping zero); `None` if there is no

@@ -76,6 +76,11 @@ impl SchurLayout {
         }
     }
 
+    /// The globals' dimension (the reduced system's size).
+    pub(super) fn globals(&self) -> usize {
+        self.globals
+    }
+
     /// One past the last tangent index of the zone of index `i`: the
     /// globals' end, or its group's.
     pub(super) fn zone_end(&self, i: usize) -> usize {
@@ -206,6 +211,24 @@ impl SchurLayout {
 }
 
 impl SchurLayout {
+    /// The globals' part of [`SchurLayout::solve`] for a right-hand side
+    /// that is zero outside the globals (`rhs_globals`): the groups add
+    /// exact zeros to the reduced right-hand side (`b_g - W_k^T L_k^-1 0`
+    /// is `b_g` to the bit), so only the reduced system is solved. `None`
+    /// if there is no factorisation or a value is not finite (the groups'
+    /// part of the solution is not computed, so not checked).
+    pub(super) fn solve_globals(&self, rhs_globals: &[f64]) -> Option<Vec<f64>> {
+        let g = self.globals;
+        if !self.factored || rhs_globals.len() != g {
+            return None;
+        }
+        let mut x = rhs_globals.to_vec();
+        let reduced = &self.values[..g * g];
+        forward_substitute(reduced, g, &mut x);
+        backward_substitute(reduced, g, &mut x);
+        x.iter().all(|v| v.is_finite()).then_some(x)
+    }
+
     /// `a^T (H + damping)^-1 a` with the last successful factorisation, for an
     /// `a` that is zero outside the globals and a few groups (one factor's
     /// row): the groups where `a` is zero contribute exact zeros to the
@@ -545,6 +568,24 @@ mod tests {
             let va = nalgebra::DVector::from_vec(a);
             let dense = (va.transpose() * &inverse * &va)[(0, 0)];
             assert!((form - dense).abs() < 1e-10 * dense.abs(), "{form} vs {dense}");
+        }
+        // A right-hand side zero outside the globals (a covariance's unit
+        // column, and a general one with a negative zero): the reduced
+        // solve gives the globals' part of the full solve, bit for bit.
+        for rhs_globals in [vec![0.0, 1.0, 0.0], vec![0.7, -0.0, -2.5]] {
+            let mut rhs = vec![0.0; dim];
+            rhs[..g].copy_from_slice(&rhs_globals);
+            let full = layout.solve(&rhs).expect("solution");
+            let globals = layout.solve_globals(&rhs_globals).expect("solution");
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&globals), bits(&full[..g]), "{rhs_globals:?}");
+            for (i, x) in globals.iter().enumerate() {
+                let expected: f64 = (0..g).map(|j| inverse[(i, j)] * rhs_globals[j]).sum();
+                assert!(
+                    (x - expected).abs() < 1e-10 * expected.abs().max(1e-3),
+                    "{x} vs {expected}"
+                );
+            }
         }
     }
 
