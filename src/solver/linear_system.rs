@@ -570,6 +570,10 @@ mod tests {
             (vec![l3, g1], 3, 0.7),
             (vec![g2, l3], 2, 1.3),
             (vec![g1], 3, 2.1),
+            // The last global's columns end where the first group's begin:
+            // consecutive in the step vector, but in two zones of the
+            // elimination's storage (two runs, not one).
+            (vec![g2, l1], 2, 0.3),
         ]
         .into_iter()
         .map(|(variables, rows, seed)| {
