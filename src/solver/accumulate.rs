@@ -11,8 +11,8 @@
 //! gathered row by row, so that neighbouring entries of a column of `H` are
 //! neighbouring SIMD lanes; every entry still adds `sum_r a_r b_r` with the
 //! rows in order, so the sums are those of the variable-by-variable loop.
-//! Where the storage does not line up (faer's compressed columns, a factor
-//! naming a variable twice), every variable is a run of its own.
+//! Where the storage does not line up (faer's compressed columns), every
+//! variable is a run of its own.
 
 use nalgebra::DMatrix;
 
@@ -66,25 +66,17 @@ impl FactorRuns {
     /// index, `None`: fixed; `dims` per slot), given where each of its slot
     /// pairs is stored (`slot_blocks`). Slots are merged into runs only where
     /// every merged block's entries land exactly where the slot pairs' would.
+    /// The variables are distinct (`LinearSystem::new` refuses a factor that
+    /// names one twice).
     pub(super) fn new(
         variables: &[VariableId],
         offsets: &[Option<usize>],
         dims: &[usize],
         slot_blocks: &[SlotBlock],
     ) -> Self {
-        let distinct = variables.iter().enumerate().all(|(k, v)| !variables[..k].contains(v));
-        if distinct {
-            let merged = Self::from_runs(
-                merged_runs(variables, offsets, dims, |_, _| true),
-                variables,
-                offsets,
-                slot_blocks,
-            );
-            if let Some(merged) = merged {
-                return merged;
-            }
-        }
-        Self::singletons(variables, offsets, dims, slot_blocks)
+        let runs = merged_runs(variables, offsets, dims, |_, _| true);
+        Self::from_runs(runs, variables, offsets, slot_blocks)
+            .unwrap_or_else(|| Self::singletons(variables, offsets, dims, slot_blocks))
     }
 
     /// The runs of a factor whose variables are distinct, in the block

@@ -524,10 +524,8 @@ mod tests {
         }
     }
 
-    /// `H` read back densely is the same `J^T J` whether it is stored for the
-    /// block elimination or for faer's sparse Cholesky, and equals the
-    /// product of the dense Jacobian (two globals of sizes 3 and 1, two
-    /// local groups of sizes 2 + 1 and 2).
+    /// A factor that names one variable twice is refused with an error that
+    /// names the factor and the variable, on either storage.
     #[test]
     fn a_factor_naming_a_variable_twice_is_an_error() {
         let mut values = Values::new();
@@ -555,6 +553,10 @@ mod tests {
         assert!(LinearSystem::new(&values, &factors[..1], &[]).is_ok());
     }
 
+    /// `H` read back densely is the same `J^T J` whether it is stored for the
+    /// block elimination or for faer's sparse Cholesky, and equals the
+    /// product of the dense Jacobian (two globals of sizes 3 and 1, two
+    /// local groups of sizes 2 + 1 and 2).
     #[test]
     fn dense_h_is_j_transpose_j_in_both_storages() {
         let mut values = Values::new();
@@ -606,8 +608,8 @@ mod tests {
                 for &v in variables {
                     let width = values.tangent_dim(v);
                     let offset = system.offsets[v.0].unwrap();
-                    let mut block = j.view_mut((row, offset), (a.nrows(), width));
-                    block += a.columns(column, width) / 0.5;
+                    j.view_mut((row, offset), (a.nrows(), width))
+                        .copy_from(&(a.columns(column, width) / 0.5));
                     column += width;
                 }
                 row += a.nrows();
