@@ -437,7 +437,12 @@ impl Factor for PosePriorFactor {
         );
         let first = if self.with_orientation { 0 } else { 3 };
         if let Some(blocks) = jacobians {
-            blocks[0].copy_from(&j.rows(first, 6 - first));
+            if first == 0 {
+                // Both column-major 6 x 6: one slice copy.
+                blocks[0].as_mut_slice().copy_from_slice(j.as_slice());
+            } else {
+                blocks[0].copy_from(&j.rows(first, 6 - first));
+            }
         }
         residual.copy_from_slice(&r.as_slice()[first..]);
         true

@@ -233,6 +233,9 @@ pub fn linearize_factor(factor: &dyn Factor, values: &Values) -> Result<Whitened
 #[derive(Default)]
 pub struct LinearizationBuffers {
     by_shape: Vec<WhitenedLinearization>,
+    /// [`LinearizationBuffers::linearize_at`]: the shape of the factor at
+    /// each index (`u32::MAX`: not seen yet).
+    shape_of_factor: Vec<u32>,
 }
 
 impl LinearizationBuffers {
@@ -254,6 +257,51 @@ impl LinearizationBuffers {
         values: &Values,
         wanted: SlotMask,
     ) -> Result<&WhitenedLinearization, &'static str> {
+        let index = self.shape_index(factor, values, wanted);
+        let linearized = &mut self.by_shape[index];
+        linearize_into(factor, values, linearized, wanted)?;
+        Ok(linearized)
+    }
+
+    /// [`LinearizationBuffers::linearize`] of the factor at `index` of a
+    /// graph whose factors do not change while these buffers are used (the
+    /// solver's pass over a graph): the buffers found for `index` the first
+    /// time are taken again without comparing shapes. Bit for bit
+    /// [`LinearizationBuffers::linearize`].
+    pub fn linearize_at(
+        &mut self,
+        index: usize,
+        factor: &dyn Factor,
+        values: &Values,
+    ) -> Result<&WhitenedLinearization, &'static str> {
+        if self.shape_of_factor.len() <= index {
+            self.shape_of_factor.resize(index + 1, u32::MAX);
+        }
+        let shape = match self.shape_of_factor[index] {
+            u32::MAX => {
+                let shape = self.shape_index(factor, values, SlotMask::ALL);
+                self.shape_of_factor[index] = shape as u32;
+                shape
+            }
+            known => {
+                let shape = known as usize;
+                if !factor.writes_every_jacobian_entry() {
+                    for jacobian in &mut self.by_shape[shape].jacobians {
+                        jacobian.as_mut_slice().fill(0.0);
+                    }
+                }
+                shape
+            }
+        };
+        let linearized = &mut self.by_shape[shape];
+        debug_assert_eq!(linearized.jacobians.len(), factor.variables().len());
+        linearize_into(factor, values, linearized, SlotMask::ALL)?;
+        Ok(linearized)
+    }
+
+    /// The buffers of `factor`'s shape (made if new), its `wanted` blocks
+    /// zeroed unless the factor writes every entry.
+    fn shape_index(&mut self, factor: &dyn Factor, values: &Values, wanted: SlotMask) -> usize {
         let rows = factor.residual_dim();
         let variables = factor.variables();
         let same_shape = |l: &WhitenedLinearization| {
@@ -289,9 +337,7 @@ impl LinearizationBuffers {
                 self.by_shape.len() - 1
             }
         };
-        let linearized = &mut self.by_shape[index];
-        linearize_into(factor, values, linearized, wanted)?;
-        Ok(linearized)
+        index
     }
 }
 
@@ -525,6 +571,40 @@ mod tests {
         assert!((masked.jacobians[0][(0, 0)] - 2.0 * 1.9 / 0.1).abs() < 1e-12);
         assert!((masked.jacobians[0][(1, 1)] - 2.0 / 0.3).abs() < 1e-12);
         assert_eq!(masked.jacobians[0][(0, 1)], 0.0);
+    }
+
+    /// The buffers found for a factor index are reused with its blocks
+    /// zeroed again (a factor that writes only its non-zero entries, here
+    /// after the buffers were filled with NaN): bit for bit a fresh
+    /// linearisation, for two factors at two indices, twice.
+    #[test]
+    fn a_linearisation_by_index_is_a_fresh_one() {
+        let (values, first) = setup(2.0, false);
+        let (_, second) = setup(-3.5, false);
+        let fresh: Vec<_> = [&first, &second]
+            .iter()
+            .map(|f| {
+                let l = linearize_factor(*f, &values).unwrap();
+                (l.residual, l.jacobians, l.cost.to_bits())
+            })
+            .collect();
+        let mut buffers = LinearizationBuffers::default();
+        for _ in 0..2 {
+            for (index, factor) in [&first, &second].into_iter().enumerate() {
+                let l = buffers.linearize_at(index, factor, &values).unwrap();
+                assert_eq!(
+                    (&l.residual, &l.jacobians, l.cost.to_bits()),
+                    (&fresh[index].0, &fresh[index].1, fresh[index].2)
+                );
+                assert_eq!(l.jacobians[0][(1, 0)], 0.0);
+            }
+            buffers
+                .by_shape
+                .iter_mut()
+                .flat_map(|l| l.jacobians.iter_mut())
+                .for_each(|j| j.fill(f64::NAN));
+        }
+        assert_eq!(buffers.by_shape.len(), 1);
     }
 
     /// A non-finite entry in a block nobody asked for does not fail the

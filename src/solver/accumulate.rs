@@ -22,13 +22,15 @@ use crate::graph::VariableId;
 use super::gram_avx2;
 
 /// Consecutive factor slots `first_slot..end_slot` whose tangent columns are
-/// `offset..offset + width` of the step vector.
+/// `offset..offset + width` of the step vector, and `column..column + width`
+/// of the factor's gathered columns (the widths of the runs before it).
 #[derive(Clone, Copy, Debug)]
 struct Run {
     first_slot: usize,
     end_slot: usize,
     offset: usize,
     width: usize,
+    column: usize,
 }
 
 /// The product `J_a^T J_b` of runs `a` and `b` (`a`'s columns have the larger
@@ -128,9 +130,11 @@ impl FactorRuns {
                     end_slot: slot + 1,
                     offset,
                     width: dims[slot],
+                    column: 0,
                 });
             }
         }
+        place_columns(&mut runs);
         let blocks = slot_blocks
             .iter()
             .map(|b| RunBlock {
@@ -329,7 +333,7 @@ impl FactorRuns {
 
     /// Start of run `k`'s rows in the gathered buffer.
     fn base(&self, k: usize, rows: usize) -> usize {
-        rows * self.runs[..k].iter().map(|r| r.width).sum::<usize>()
+        rows * self.runs[k].column
     }
 }
 
@@ -417,10 +421,21 @@ fn merged_runs(
                 end_slot: slot + 1,
                 offset,
                 width: dims[slot],
+                column: 0,
             }),
         }
     }
+    place_columns(&mut runs);
     runs
+}
+
+/// Each run's first gathered column: the widths of the runs before it.
+fn place_columns(runs: &mut [Run]) {
+    let mut column = 0;
+    for run in runs {
+        run.column = column;
+        column += run.width;
+    }
 }
 
 /// Calls `$kernels!` with the run shapes `(columns of a, columns of b,

@@ -217,7 +217,7 @@ fn linearize_with(
     } = work;
     for (index, factor) in graph.factors.iter().enumerate() {
         let variables = factor.variables();
-        let linearized = buffers.linearize(factor.as_ref(), values).map_err(|what| {
+        let linearized = buffers.linearize_at(index, factor.as_ref(), values).map_err(|what| {
             let names: Vec<&str> = variables.iter().map(|&v| values.variable(v).name.as_str()).collect();
             format!("{} factor on [{}]: {what}", factor.kind(), names.join(", "))
         })?;

@@ -154,18 +154,24 @@ impl CatenaryCall {
         self.read(values, jacobians.is_some(), |out| {
             if let Some(blocks) = jacobians {
                 let cables = &s.cables;
-                copy_rows(out.pose.as_slice(), first, 6, blocks[0].as_mut_slice(), cables);
-                copy_rows(out.tension.as_slice(), first, 2, blocks[1].as_mut_slice(), cables);
+                // Row `r` of a factor's block (robot cable `r`) is the
+                // generated row of the slot that holds cable `r`.
+                let mut slot_of = [0; CABLE_COUNT];
+                for (slot, &cable) in cables.iter().enumerate() {
+                    slot_of[cable & (CABLE_COUNT - 1)] = slot;
+                }
+                copy_rows::<6>(out.pose.as_slice(), first, blocks[0].as_mut_slice(), &slot_of);
+                copy_rows::<2>(out.tension.as_slice(), first, blocks[1].as_mut_slice(), &slot_of);
                 // The anchors' and offsets' blocks only for a reader that
                 // wants one of them (the refinement reads the pose's alone).
                 if (2..blocks.len()).any(|slot| wanted.contains(slot)) {
                     let (anchors, offsets) = (out.anchors.as_slice(), out.offsets.as_slice());
                     for (anchor_slot, &cable) in cables.iter().enumerate() {
                         let columns = &anchors[3 * ROWS * anchor_slot..];
-                        copy_rows(columns, first, 3, blocks[2 + cable].as_mut_slice(), cables);
+                        copy_rows::<3>(columns, first, blocks[2 + cable].as_mut_slice(), &slot_of);
                         if let Some(offset_block) = blocks.get_mut(6 + cable) {
                             let column = &offsets[ROWS * anchor_slot..];
-                            copy_rows(column, first, 1, offset_block.as_mut_slice(), cables);
+                            copy_rows::<1>(column, first, offset_block.as_mut_slice(), &slot_of);
                         }
                     }
                 }
@@ -180,19 +186,22 @@ impl CatenaryCall {
 /// Rows of the generated call's outputs ([`CatenaryRows`]).
 const ROWS: usize = 16;
 
-// `copy_rows` masks cable indices with `CABLE_COUNT - 1`.
+// `copy_rows` masks slot indices with `CABLE_COUNT - 1`.
 const _: () = assert!(CABLE_COUNT.is_power_of_two());
 
-/// Copy rows `first..first + 4` (slot order) of the first `columns` columns
-/// of a generated block (`from`: column-major, [`ROWS`] rows) into a
-/// factor's block (`to`: column-major, one row per cable, robot order).
+/// Copy rows `first..first + 4` (slot order) of the first `COLUMNS`
+/// columns of a generated block (`from`: column-major, [`ROWS`] rows) into
+/// a factor's block (`to`: column-major, one row per cable, robot order):
+/// row `r` of `to` is row `first + slot_of[r]` of `from`. The sizes known
+/// at compile time, the slices checked once: one load and one store per entry.
 #[inline(always)]
-fn copy_rows(from: &[f64], first: usize, columns: usize, to: &mut [f64], cables: &[usize; CABLE_COUNT]) {
-    for (c, to) in to.chunks_exact_mut(CABLE_COUNT).take(columns).enumerate() {
-        let from = &from[first + ROWS * c..][..CABLE_COUNT];
-        for (slot, &value) in from.iter().enumerate() {
-            // `cables` is a permutation of 0..4: the mask only spares the bounds check.
-            to[cables[slot] & (CABLE_COUNT - 1)] = value;
+fn copy_rows<const COLUMNS: usize>(from: &[f64], first: usize, to: &mut [f64], slot_of: &[usize; CABLE_COUNT]) {
+    let from = &from[first..first + ROWS * (COLUMNS - 1) + CABLE_COUNT];
+    let to = &mut to[..CABLE_COUNT * COLUMNS];
+    for c in 0..COLUMNS {
+        for (r, &slot) in slot_of.iter().enumerate() {
+            // `slot_of` is a permutation of 0..4: the mask only spares the bounds check.
+            to[CABLE_COUNT * c + r] = from[ROWS * c + (slot & (CABLE_COUNT - 1))];
         }
     }
 }
