@@ -116,8 +116,11 @@ pub fn structure_matrix(robot: &Robot, pose: &PlatformPose) -> SMatrix<f64, 6, 8
     for (i, cable) in geometry.iter().enumerate() {
         let r = rotation * robot.attachments_m[i];
         let s = cable.horizontal_direction;
-        let h_column = Vector6::from_iterator((-s).iter().copied().chain((-r.cross(&s)).iter().copied()));
-        let v_column = Vector6::from_iterator(z.iter().copied().chain(r.cross(&z).iter().copied()));
+        // Entry by entry, not through iterator adaptors (whose cost depended
+        // on the compiler's inlining: 3.5x more instructions in one build).
+        let (h_moment, v_moment) = (-r.cross(&s), r.cross(&z));
+        let h_column = Vector6::new(-s.x, -s.y, -s.z, h_moment.x, h_moment.y, h_moment.z);
+        let v_column = Vector6::new(z.x, z.y, z.z, v_moment.x, v_moment.y, v_moment.z);
         jt.set_column(2 * i, &h_column);
         jt.set_column(2 * i + 1, &v_column);
     }
