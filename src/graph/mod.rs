@@ -268,7 +268,7 @@ impl LinearizationBuffers {
     /// solver's pass over a graph): the buffers found for `index` the first
     /// time are taken again without comparing shapes. Bit for bit
     /// [`LinearizationBuffers::linearize`].
-    pub fn linearize_at(
+    pub(crate) fn linearize_at(
         &mut self,
         index: usize,
         factor: &dyn Factor,
