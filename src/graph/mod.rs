@@ -285,11 +285,7 @@ impl LinearizationBuffers {
             }
             known => {
                 let shape = known as usize;
-                if !factor.writes_every_jacobian_entry() {
-                    for jacobian in &mut self.by_shape[shape].jacobians {
-                        jacobian.as_mut_slice().fill(0.0);
-                    }
-                }
+                self.zero_blocks(shape, factor, SlotMask::ALL);
                 shape
             }
         };
@@ -311,15 +307,9 @@ impl LinearizationBuffers {
                     .zip(variables)
                     .all(|(j, &v)| j.nrows() == rows && j.ncols() == values.tangent_dim(v))
         };
-        let index = match self.by_shape.iter().position(same_shape) {
+        match self.by_shape.iter().position(same_shape) {
             Some(index) => {
-                if !factor.writes_every_jacobian_entry() {
-                    for (slot, jacobian) in self.by_shape[index].jacobians.iter_mut().enumerate() {
-                        if wanted.contains(slot) {
-                            jacobian.as_mut_slice().fill(0.0);
-                        }
-                    }
-                }
+                self.zero_blocks(index, factor, wanted);
                 index
             }
             None => {
@@ -336,8 +326,19 @@ impl LinearizationBuffers {
                 });
                 self.by_shape.len() - 1
             }
-        };
-        index
+        }
+    }
+
+    /// Zero the `wanted` blocks of the buffers at `index` for a factor that
+    /// writes only its non-zero entries (the others overwrite every entry).
+    fn zero_blocks(&mut self, index: usize, factor: &dyn Factor, wanted: SlotMask) {
+        if !factor.writes_every_jacobian_entry() {
+            for (slot, jacobian) in self.by_shape[index].jacobians.iter_mut().enumerate() {
+                if wanted.contains(slot) {
+                    jacobian.as_mut_slice().fill(0.0);
+                }
+            }
+        }
     }
 }
 

@@ -284,15 +284,14 @@ impl FactorRuns {
         rows_buffer: &mut Vec<f64>,
     ) {
         let rows = if R == 0 { residual.len() } else { R };
-        // (1) Each run's columns, row by row: run k at `base[k]`, `rows x width`.
+        // (1) Each run's columns, row by row: at `rows * run.column`, `rows x width`.
         if rows_buffer.len() < rows * self.columns {
             rows_buffer.resize(rows * self.columns, 0.0);
         }
-        let mut base = 0;
         for run in &self.runs {
+            let base = rows * run.column;
             if AVX2 && R == 4 && gather_four_rows_avx2(run, jacobians, &mut rows_buffer[base..base + 4 * run.width]) {
                 add_run_gradient::<R, AVX2>(&rows_buffer[base..base + rows * run.width], run, residual, gradient);
-                base += rows * run.width;
                 continue;
             }
             let mut column = 0;
@@ -307,7 +306,6 @@ impl FactorRuns {
             }
             // (2) J^T r for the run's columns.
             add_run_gradient::<R, AVX2>(&rows_buffer[base..base + rows * run.width], run, residual, gradient);
-            base += rows * run.width;
         }
         // (3) J_a^T J_b for every pair of runs, one dense block each.
         for block in &self.blocks {

@@ -349,23 +349,22 @@ fn back_substitute_group<const M: usize, const G: usize>(l: &[f64], w: &[f64], g
     let m = if M == 0 { y.len() } else { M };
     let g = if G == 0 { global_part.len() } else { G };
     let (y, global_part, w) = (&mut y[..m], &global_part[..g], &w[..m * g]);
-    if M != 0 {
-        // The same operations on a local copy, which the compiler keeps in
-        // vector registers (each `y_i` still subtracts the terms in order of `j`).
-        let mut local = [0.0; M];
-        local.copy_from_slice(y);
-        for (&xj, wj) in global_part.iter().zip(w.chunks_exact(M)) {
-            for (yi, wi) in local.iter_mut().zip(wj) {
-                *yi -= wi * xj;
-            }
-        }
-        y.copy_from_slice(&local);
-    } else {
+    // `y_i -= sum_j W_ij x_j`, the terms subtracted in order of `j`.
+    let subtract = |y: &mut [f64]| {
         for (&xj, wj) in global_part.iter().zip(w.chunks_exact(m)) {
             for (yi, wi) in y.iter_mut().zip(wj) {
                 *yi -= wi * xj;
             }
         }
+    };
+    if M != 0 {
+        // On a local copy, which the compiler keeps in vector registers.
+        let mut local = [0.0; M];
+        local.copy_from_slice(y);
+        subtract(&mut local);
+        y.copy_from_slice(&local);
+    } else {
+        subtract(y);
     }
     backward_substitute(l, m, y);
 }
