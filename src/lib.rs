@@ -15,7 +15,7 @@
 //!
 //! | layer | purpose |
 //! |---|---|
-//! | [`error`], [`stats`] | the error type; chi-square quantiles, correlation, BIC |
+//! | [`error`], [`stats`], [`steps`] | the error type; chi-square quantiles, correlation, BIC; the count of work done (tests bound running time by it) |
 //! | [`model`] | cable physics (catenary, elastic, pulley), robot, statics, effects, measurements |
 //! | [`io`] | files (robot TOML; sagcal CSV, RecurDyn logs, the authors' dataset folder) -> `model` types (`model` never sees a file) |
 //! | [`sim`] | closed-form and discretised simulators (the truth of the experiments) |
@@ -65,5 +65,6 @@ pub mod plot;
 pub mod sim;
 pub mod solver;
 pub mod stats;
+pub mod steps;
 
 pub use error::{Error, Result};

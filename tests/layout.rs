@@ -15,12 +15,13 @@ use std::path::{Path, PathBuf};
 /// Each top-level module of `src/` and the crate modules its code may name.
 const ALLOWED: &[(&str, &[&str])] = &[
     ("error", &[]),
+    ("steps", &[]),
     ("stats", &["error"]),
-    ("model", &["error", "stats", "generated"]),
+    ("model", &["error", "steps", "stats", "generated"]),
     ("io", &["error", "model"]),
-    ("sim", &["error", "stats", "generated", "model"]),
+    ("sim", &["error", "steps", "stats", "generated", "model"]),
     ("graph", &["error", "stats", "generated", "model"]),
-    ("solver", &["error", "stats", "model", "graph"]),
+    ("solver", &["error", "steps", "stats", "model", "graph"]),
     ("calib", &["error", "stats", "generated", "model", "graph", "solver"]),
     (
         "diagnose",
@@ -28,11 +29,29 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ),
     (
         "localize",
-        &["error", "stats", "generated", "model", "graph", "solver", "calib"],
+        &[
+            "error",
+            "steps",
+            "stats",
+            "generated",
+            "model",
+            "graph",
+            "solver",
+            "calib",
+        ],
     ),
     (
         "plan",
-        &["error", "stats", "generated", "model", "graph", "solver", "calib"],
+        &[
+            "error",
+            "steps",
+            "stats",
+            "generated",
+            "model",
+            "graph",
+            "solver",
+            "calib",
+        ],
     ),
     (
         "experiments",

@@ -139,6 +139,7 @@ pub fn solve(
     let mut damping = 0.0;
     while iterations < max_iterations {
         iterations += 1;
+        crate::steps::tick();
         let (r, mut j) = whitened(&model, &pose, observation);
         j.column_mut(6).scale_mut(scale_n);
         j.column_mut(7).scale_mut(scale_n);

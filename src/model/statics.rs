@@ -143,6 +143,7 @@ pub fn cable_tensions(
     pose: &PlatformPose,
     reference: CableTension,
 ) -> Result<[CableTension; CABLE_COUNT]> {
+    crate::steps::tick();
     let jt = structure_matrix(robot, pose);
     let wrench = gravity_wrench(robot, pose);
     let r = robot.reference_cable;

@@ -288,6 +288,7 @@ pub fn choose_more_poses(poses: &[PoseInformation], fixed: &[usize], options: &D
         taken[k] = true;
     }
     for _ in 0..options.poses {
+        crate::steps::add(poses.len() as u64);
         let c = covariance_of(&information_sum(poses, &chosen, ridge)).ok_or_else(singular)?;
         let gains = stack.gains(&c, options.criterion);
         let best = best_free(&gains, &taken).ok_or_else(singular)?;
@@ -306,6 +307,7 @@ pub fn choose_more_poses(poses: &[PoseInformation], fixed: &[usize], options: &D
         passes += 1;
         let mut swapped = false;
         for slot in fixed.len()..chosen.len() {
+            crate::steps::add(poses.len() as u64);
             let current = chosen[slot];
             let others: Vec<usize> = chosen.iter().copied().filter(|&k| k != current).collect();
             let c = covariance_of(&information_sum(poses, &others, ridge)).ok_or_else(singular)?;

@@ -516,6 +516,7 @@ struct State {
 
 impl Problem {
     fn evaluate(&self, state: &State) -> Option<(VectorN, MatrixN)> {
+        crate::steps::tick();
         let mut r = VectorN::zeros();
         let mut j = MatrixN::zeros();
         let rotation = *state.pose.rotation_matrix().matrix();

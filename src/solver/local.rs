@@ -341,6 +341,7 @@ fn refine_group(graph: &FactorGraph, group: &Group, values: &mut Values, work: &
         return;
     };
     for _ in 0..MAX_ITERATIONS {
+        crate::steps::tick();
         originals.resize_with(group.variables.len(), || VariableValue::Vector(Default::default()));
         for (original, &v) in originals.iter_mut().zip(&group.variables) {
             assign(original, &values.variable(v).value);

@@ -295,6 +295,7 @@ pub fn optimize_cached(
     let mut history = Vec::new();
     let mut termination = Termination::MaxIterations;
     for iteration in 1..=params.max_iterations {
+        crate::steps::tick();
         let cost = linearization.cost;
         let gradient = &linearization.gradient;
         if gradient.iter().fold(0.0f64, |m, g| m.max(g.abs())) < params.gradient_tolerance {
