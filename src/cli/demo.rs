@@ -7,14 +7,16 @@
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use sagcal::calib::gross_errors::Verdict;
 use sagcal::calib::report::CalibrationReport;
 use sagcal::calib::{anchor_rms_bound_m, calibrate, cramer_rao_bound, CalibrationOptions};
-use sagcal::io::measurements::write_measurements;
+use sagcal::io::measurements::measurements_text;
+use sagcal::io::OutputSet;
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
 
-use super::calibrate::{render, write_plot, write_robot};
+use super::calibrate::{plot_svg, render, robot_text};
 use super::output::print_json;
 use super::DemoArgs;
 
@@ -57,26 +59,43 @@ pub fn run(args: &DemoArgs) -> sagcal::Result<()> {
     let lines: Vec<usize> = (1..=data.len()).collect();
     let report = CalibrationReport::new(&result, &guess, options.model, &lines, Some(&truth));
 
-    std::fs::create_dir_all(&args.out_dir).map_err(|e| sagcal::Error::io(&args.out_dir, e))?;
+    // The folder and its five files: all of them or none.
     let data_path = args.out_dir.join("data.csv");
     let comments = vec![format!(
         "sagcal demo: built-in large robot, {} poses, seed {}, paper noise",
         args.poses, args.seed
     )];
-    write_measurements(&data_path, &comments, &data)?;
-    write_robot(&args.out_dir.join("truth.toml"), &truth)?;
-    write_robot(&args.out_dir.join("guess.toml"), &guess)?;
-    write_robot(&args.out_dir.join("calibrated.toml"), &result.robot)?;
-    let plot_path = args.out_dir.join("anchors.svg");
     let positions: Vec<[f64; 3]> = data.iter().map(|p| p.position_m).collect();
-    write_plot(
-        &plot_path,
-        &guess,
-        Some(&truth),
-        &result,
-        &positions,
-        &format!("sagcal demo --seed {} --poses {}", args.seed, args.poses),
-    )?;
+    let caption = format!("sagcal demo --seed {} --poses {}", args.seed, args.poses);
+    let mut outputs = OutputSet::new();
+    outputs
+        .folder("--out-dir", &args.out_dir)
+        .file(
+            "--out-dir",
+            &data_path,
+            measurements_text(&data_path, &comments, &data)?,
+        )
+        .file(
+            "--out-dir",
+            &args.out_dir.join("truth.toml"),
+            robot_text(&truth, &Verdict::Consistent)?,
+        )
+        .file(
+            "--out-dir",
+            &args.out_dir.join("guess.toml"),
+            robot_text(&guess, &Verdict::Consistent)?,
+        )
+        .file(
+            "--out-dir",
+            &args.out_dir.join("calibrated.toml"),
+            robot_text(&result.robot, &Verdict::Consistent)?,
+        )
+        .file(
+            "--out-dir",
+            &args.out_dir.join("anchors.svg"),
+            plot_svg(&guess, Some(&truth), &result, &positions, &caption),
+        );
+    outputs.write()?;
     if args.json {
         return print_json(&report);
     }
