@@ -4,16 +4,18 @@
 //! calibration starts, as in the paper, from anchors moved 10 m and offsets
 //! moved 80 m; 35 static poses with the paper's noise.
 
+use std::path::PathBuf;
+
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sagcal::calib::gross_errors::Verdict;
 use sagcal::calib::report::CalibrationReport;
-use sagcal::calib::{anchor_rms_bound_m, calibrate, cramer_rao_bound, CalibrationOptions};
+use sagcal::calib::{anchor_rms_bound_m, calibrate, cramer_rao_bound, CalibrationOptions, CalibrationResult};
 use sagcal::io::measurements::measurements_text;
 use sagcal::io::OutputSet;
 use sagcal::model::sensors::NoisePreset;
-use sagcal::model::Robot;
+use sagcal::model::{PoseMeasurement, Robot};
 use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
 
 use super::calibrate::{plot_svg, render, robot_text};
@@ -59,43 +61,7 @@ pub fn run(args: &DemoArgs) -> sagcal::Result<()> {
     let lines: Vec<usize> = (1..=data.len()).collect();
     let report = CalibrationReport::new(&result, &guess, options.model, &lines, Some(&truth));
 
-    // The folder and its five files: all of them or none.
-    let data_path = args.out_dir.join("data.csv");
-    let comments = vec![format!(
-        "sagcal demo: built-in large robot, {} poses, seed {}, paper noise",
-        args.poses, args.seed
-    )];
-    let positions: Vec<[f64; 3]> = data.iter().map(|p| p.position_m).collect();
-    let caption = format!("sagcal demo --seed {} --poses {}", args.seed, args.poses);
-    let mut outputs = OutputSet::new();
-    outputs
-        .folder("--out-dir", &args.out_dir)
-        .file(
-            "--out-dir",
-            &data_path,
-            measurements_text(&data_path, &comments, &data)?,
-        )
-        .file(
-            "--out-dir",
-            &args.out_dir.join("truth.toml"),
-            robot_text(&truth, &Verdict::Consistent)?,
-        )
-        .file(
-            "--out-dir",
-            &args.out_dir.join("guess.toml"),
-            robot_text(&guess, &Verdict::Consistent)?,
-        )
-        .file(
-            "--out-dir",
-            &args.out_dir.join("calibrated.toml"),
-            robot_text(&result.robot, &Verdict::Consistent)?,
-        )
-        .file(
-            "--out-dir",
-            &args.out_dir.join("anchors.svg"),
-            plot_svg(&guess, Some(&truth), &result, &positions, &caption),
-        );
-    outputs.write()?;
+    let data_path = write_files(args, &data, &truth, &guess, &result)?;
     if args.json {
         return print_json(&report);
     }
@@ -129,4 +95,45 @@ pub fn run(args: &DemoArgs) -> sagcal::Result<()> {
         data_path.display()
     );
     Ok(())
+}
+
+/// The demo's folder and its five files, all of them or none; the data file's path.
+fn write_files(
+    args: &DemoArgs,
+    data: &[PoseMeasurement],
+    truth: &Robot,
+    guess: &Robot,
+    result: &CalibrationResult,
+) -> sagcal::Result<PathBuf> {
+    let data_path = args.out_dir.join("data.csv");
+    let comments = vec![format!(
+        "sagcal demo: built-in large robot, {} poses, seed {}, paper noise",
+        args.poses, args.seed
+    )];
+    let positions: Vec<[f64; 3]> = data.iter().map(|p| p.position_m).collect();
+    let caption = format!("sagcal demo --seed {} --poses {}", args.seed, args.poses);
+    let mut outputs = OutputSet::new();
+    outputs.folder("--out-dir", &args.out_dir).file(
+        "--out-dir",
+        &data_path,
+        measurements_text(&data_path, &comments, data)?,
+    );
+    for (name, robot) in [
+        ("truth.toml", truth),
+        ("guess.toml", guess),
+        ("calibrated.toml", &result.robot),
+    ] {
+        outputs.file(
+            "--out-dir",
+            &args.out_dir.join(name),
+            robot_text(robot, &Verdict::Consistent)?,
+        );
+    }
+    outputs.file(
+        "--out-dir",
+        &args.out_dir.join("anchors.svg"),
+        plot_svg(guess, Some(truth), result, &positions, &caption),
+    );
+    outputs.write()?;
+    Ok(data_path)
 }
