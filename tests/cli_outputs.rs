@@ -6,6 +6,7 @@ use std::process::Output;
 use std::sync::OnceLock;
 
 #[path = "common/cli.rs"]
+#[allow(dead_code)] // `robot`: these tests use the demo's robots
 mod cli;
 use cli::sagcal;
 
