@@ -1,13 +1,12 @@
 //! `sagcal calibrate`: anchors and offsets from a measurement file.
 
-use std::path::Path;
-
 use sagcal::calib::gross_errors::{calibrate_checked, GrossErrorOptions, Verdict};
 use sagcal::calib::report::CalibrationReport;
 use sagcal::calib::{CableModel, CalibrationOptions, CalibrationResult, OrientationPrior, ParameterUncertainty};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
+use sagcal::io::OutputSet;
 use sagcal::model::Robot;
-use sagcal::plot::{anchor_plot_svg, write_figure, AnchorPlot, AnchorPlotEntry};
+use sagcal::plot::{anchor_plot_svg, figure_bytes, AnchorPlot, AnchorPlotEntry};
 
 use super::gross_errors::{self, GrossErrorReport};
 use super::output::{print_json, Table};
@@ -55,21 +54,19 @@ pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
             args.data.display()
         )));
     }
-    // Write files only after everything succeeded, each atomically.
+    // Files only after everything succeeded: all of them or none, none over an input.
+    let mut outputs = OutputSet::new();
+    outputs.input("--robot", &args.robot).input("--data", &args.data);
     if let Some(out) = &args.out {
-        write_robot_with_verdict(out, &result.robot, &checked.verdict)?;
+        outputs.file("--out", out, robot_text(&result.robot, &checked.verdict)?);
     }
     if let Some(plot) = &args.plot {
         let positions: Vec<[f64; 3]> = data.poses.iter().map(|p| p.position_m).collect();
-        write_plot(
-            plot,
-            &nominal,
-            None,
-            result,
-            &positions,
-            &format!("sagcal calibrate --data {}", args.data.display()),
-        )?;
+        let caption = format!("sagcal calibrate --data {}", args.data.display());
+        let svg = plot_svg(&nominal, None, result, &positions, &caption);
+        outputs.file("--plot", plot, figure_bytes(plot, &svg)?);
     }
+    outputs.write()?;
     if args.json {
         print_json(&CheckedReport {
             report,
@@ -88,13 +85,8 @@ pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
     }
 }
 
-/// Write a robot TOML atomically.
-pub fn write_robot(path: &Path, robot: &Robot) -> sagcal::Result<()> {
-    write_robot_with_verdict(path, robot, &Verdict::Consistent)
-}
-
-/// Write a robot TOML atomically, with the consistency verdict in its header comment.
-pub fn write_robot_with_verdict(path: &Path, robot: &Robot, verdict: &Verdict) -> sagcal::Result<()> {
+/// A calibrated robot's TOML, with the consistency verdict in its header comment.
+pub fn robot_text(robot: &Robot, verdict: &Verdict) -> sagcal::Result<String> {
     let text = robot.to_file_contents().to_toml()?;
     let mut header =
         "# Calibrated by sagcal: anchors and encoder length offsets estimated from measurements.\n".to_string();
@@ -102,7 +94,7 @@ pub fn write_robot_with_verdict(path: &Path, robot: &Robot, verdict: &Verdict) -
         header +=
             &format!("# WARNING: written with --accept-inconsistent; the fit FAILS its consistency tests: {reason}\n");
     }
-    sagcal::io::write_atomically(path, format!("{header}{text}").as_bytes())
+    Ok(format!("{header}{text}"))
 }
 
 /// The JSON of `sagcal calibrate`: the report and its gross-error tests.
@@ -113,15 +105,14 @@ struct CheckedReport {
     gross_errors: GrossErrorReport,
 }
 
-/// The anchor plot of a calibration: PNG when `path` ends in `.png`, SVG otherwise.
-pub fn write_plot(
-    path: &Path,
+/// The anchor plot of a calibration (SVG).
+pub fn plot_svg(
     nominal: &Robot,
     truth: Option<&Robot>,
     result: &CalibrationResult,
     positions: &[[f64; 3]],
     caption: &str,
-) -> sagcal::Result<()> {
+) -> String {
     let covariances = match &result.uncertainty {
         ParameterUncertainty::Full {
             anchor_covariance_m2, ..
@@ -147,7 +138,7 @@ pub fn write_plot(
             .collect(),
         platform_positions_m: positions.to_vec(),
     };
-    write_figure(path, &anchor_plot_svg(&plot))
+    anchor_plot_svg(&plot)
 }
 
 fn sigma(value: Option<f64>) -> String {

@@ -4,17 +4,21 @@
 //! calibration starts, as in the paper, from anchors moved 10 m and offsets
 //! moved 80 m; 35 static poses with the paper's noise.
 
+use std::path::PathBuf;
+
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use sagcal::calib::gross_errors::Verdict;
 use sagcal::calib::report::CalibrationReport;
-use sagcal::calib::{anchor_rms_bound_m, calibrate, cramer_rao_bound, CalibrationOptions};
-use sagcal::io::measurements::write_measurements;
+use sagcal::calib::{anchor_rms_bound_m, calibrate, cramer_rao_bound, CalibrationOptions, CalibrationResult};
+use sagcal::io::measurements::measurements_text;
+use sagcal::io::OutputSet;
 use sagcal::model::sensors::NoisePreset;
-use sagcal::model::Robot;
+use sagcal::model::{PoseMeasurement, Robot};
 use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
 
-use super::calibrate::{render, write_plot, write_robot};
+use super::calibrate::{plot_svg, render, robot_text};
 use super::output::print_json;
 use super::DemoArgs;
 
@@ -57,26 +61,7 @@ pub fn run(args: &DemoArgs) -> sagcal::Result<()> {
     let lines: Vec<usize> = (1..=data.len()).collect();
     let report = CalibrationReport::new(&result, &guess, options.model, &lines, Some(&truth));
 
-    std::fs::create_dir_all(&args.out_dir).map_err(|e| sagcal::Error::io(&args.out_dir, e))?;
-    let data_path = args.out_dir.join("data.csv");
-    let comments = vec![format!(
-        "sagcal demo: built-in large robot, {} poses, seed {}, paper noise",
-        args.poses, args.seed
-    )];
-    write_measurements(&data_path, &comments, &data)?;
-    write_robot(&args.out_dir.join("truth.toml"), &truth)?;
-    write_robot(&args.out_dir.join("guess.toml"), &guess)?;
-    write_robot(&args.out_dir.join("calibrated.toml"), &result.robot)?;
-    let plot_path = args.out_dir.join("anchors.svg");
-    let positions: Vec<[f64; 3]> = data.iter().map(|p| p.position_m).collect();
-    write_plot(
-        &plot_path,
-        &guess,
-        Some(&truth),
-        &result,
-        &positions,
-        &format!("sagcal demo --seed {} --poses {}", args.seed, args.poses),
-    )?;
+    let data_path = write_files(args, &data, &truth, &guess, &result)?;
     if args.json {
         return print_json(&report);
     }
@@ -110,4 +95,45 @@ pub fn run(args: &DemoArgs) -> sagcal::Result<()> {
         data_path.display()
     );
     Ok(())
+}
+
+/// The demo's folder and its five files, all of them or none; the data file's path.
+fn write_files(
+    args: &DemoArgs,
+    data: &[PoseMeasurement],
+    truth: &Robot,
+    guess: &Robot,
+    result: &CalibrationResult,
+) -> sagcal::Result<PathBuf> {
+    let data_path = args.out_dir.join("data.csv");
+    let comments = vec![format!(
+        "sagcal demo: built-in large robot, {} poses, seed {}, paper noise",
+        args.poses, args.seed
+    )];
+    let positions: Vec<[f64; 3]> = data.iter().map(|p| p.position_m).collect();
+    let caption = format!("sagcal demo --seed {} --poses {}", args.seed, args.poses);
+    let mut outputs = OutputSet::new();
+    outputs.folder("--out-dir", &args.out_dir).file(
+        "--out-dir",
+        &data_path,
+        measurements_text(&data_path, &comments, data)?,
+    );
+    for (name, robot) in [
+        ("truth.toml", truth),
+        ("guess.toml", guess),
+        ("calibrated.toml", &result.robot),
+    ] {
+        outputs.file(
+            "--out-dir",
+            &args.out_dir.join(name),
+            robot_text(robot, &Verdict::Consistent)?,
+        );
+    }
+    outputs.file(
+        "--out-dir",
+        &args.out_dir.join("anchors.svg"),
+        plot_svg(guess, Some(truth), result, &positions, &caption),
+    );
+    outputs.write()?;
+    Ok(data_path)
 }

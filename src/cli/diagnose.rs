@@ -4,6 +4,7 @@ use std::path::Path;
 
 use sagcal::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
+use sagcal::io::OutputSet;
 use sagcal::model::effects::EffectKind;
 use sagcal::model::Robot;
 use sagcal::plot::residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
@@ -46,14 +47,26 @@ pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
         },
     )?;
     bar.finish_and_clear();
-    // Files only after everything succeeded, each atomically.
+    // Files only after everything succeeded: all of them or none, none over an input.
+    let mut outputs = OutputSet::new();
+    outputs.input("--robot", &args.robot).input("--data", &args.data);
+    if let Some(truth) = &args.truth {
+        outputs.input("--truth", truth);
+    }
     let plot_path = match &args.plots {
-        Some(dir) => Some(write_plots(dir, args.plot_format.extension(), &diagnosis, &args.data)?),
+        Some(dir) => Some(add_plots(
+            &mut outputs,
+            dir,
+            args.plot_format.extension(),
+            &diagnosis,
+            &args.data,
+        )?),
         None => None,
     };
     if let Some(out) = &args.out {
-        write_extended_robot(out, &diagnosis)?;
+        outputs.file("--out", out, extended_robot_text(&diagnosis)?);
     }
+    outputs.write()?;
     if args.json {
         print_json(&diagnosis)
     } else {
@@ -68,14 +81,14 @@ pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
     }
 }
 
-/// Write the selected model's robot, with a header naming the verdict.
-fn write_extended_robot(path: &Path, diagnosis: &Diagnosis) -> sagcal::Result<()> {
+/// The selected model's robot (TOML), with a header naming the verdict.
+fn extended_robot_text(diagnosis: &Diagnosis) -> sagcal::Result<String> {
     let text = diagnosis.robot_after.to_file_contents().to_toml()?;
     let header = format!(
         "# Calibrated by sagcal diagnose: anchors, encoder length offsets and the selected model ({}).\n",
         diagnosis.verdict
     );
-    sagcal::io::write_atomically(path, format!("{header}{text}").as_bytes())
+    Ok(format!("{header}{text}"))
 }
 
 /// `text` as a file name: ASCII letters (lower-cased) and digits, each run of anything else one `_`, none at the ends.
@@ -95,12 +108,15 @@ fn file_name(text: &str) -> String {
         .join("_")
 }
 
-/// Write the residual plot against the winning driver (before and after) into
-/// `dir` as `extension` (`svg` or `png`); its path.
-fn write_plots(dir: &Path, extension: &str, diagnosis: &Diagnosis, data: &Path) -> sagcal::Result<std::path::PathBuf> {
-    std::fs::create_dir_all(dir).map_err(|e| {
-        sagcal::Error::InvalidInput(format!("--plots {}: cannot create the folder: {e}", dir.display()))
-    })?;
+/// Add to `outputs` the folder `dir` and the residual plot against the
+/// winning driver (before and after) in it as `extension` (`svg` or `png`); its path.
+fn add_plots(
+    outputs: &mut OutputSet,
+    dir: &Path,
+    extension: &str,
+    diagnosis: &Diagnosis,
+    data: &Path,
+) -> sagcal::Result<std::path::PathBuf> {
     let s = &diagnosis.series;
     let path = dir.join(format!("{}_vs_{}.{extension}", s.residual, file_name(&s.driver)));
     let plot = ResidualPlot {
@@ -126,7 +142,8 @@ fn write_plots(dir: &Path, extension: &str, diagnosis: &Diagnosis, data: &Path) 
             diagnosis.reason
         ),
     };
-    sagcal::plot::write_figure(&path, &residual_plot_svg(&plot))?;
+    let bytes = sagcal::plot::figure_bytes(&path, &residual_plot_svg(&plot))?;
+    outputs.folder("--plots", dir).file("--plots", &path, bytes);
     Ok(path)
 }
 

@@ -97,8 +97,11 @@ pub fn run(args: &LocalizeArgs) -> sagcal::Result<()> {
         !args.fast,
     )?;
     report.covariance = covariance_note(&robot, !args.no_calibration_uncertainty);
+    // All the files or none, none over an input.
+    let mut outputs = sagcal::io::OutputSet::new();
+    outputs.input("--robot", &args.robot).input("--data", &args.data);
     if let Some(out) = &args.out {
-        sagcal::io::write_atomically(out, render_csv(&report).as_bytes())?;
+        outputs.file("--out", out, render_csv(&report));
     }
     if let Some(path) = &args.plot {
         let plot = LocalizePlot {
@@ -108,8 +111,13 @@ pub fn run(args: &LocalizeArgs) -> sagcal::Result<()> {
             reference_label: if args.pose_prior { "prior" } else { "logged" }.into(),
             poses: report.plotted.clone(),
         };
-        sagcal::plot::write_figure(path, &localize_plot_svg(&plot))?;
+        outputs.file(
+            "--plot",
+            path,
+            sagcal::plot::figure_bytes(path, &localize_plot_svg(&plot))?,
+        );
     }
+    outputs.write()?;
     if args.json {
         print_json(&report)
     } else {

@@ -4,14 +4,15 @@
 use std::path::Path;
 
 use sagcal::experiments::pose_plan::{plan_calibration, CandidateSource, PlanProgress, PlanReport, PlanSettings};
-use sagcal::io::measurements::{read_measurements, write_measurements, ReadOptions};
+use sagcal::io::measurements::{measurements_text, read_measurements, ReadOptions};
+use sagcal::io::OutputSet;
 use sagcal::model::robot::Workspace;
 use sagcal::model::statics::Equilibrium;
 use sagcal::model::Robot;
 use sagcal::plan::information::noise_free_reading;
 use sagcal::plan::Plan;
+use sagcal::plot::figure_bytes;
 use sagcal::plot::plan::{plan_plot_svg, PlanPlot};
-use sagcal::plot::write_figure;
 
 use super::output::{print_json, progress_bar, Table};
 use super::PlanArgs;
@@ -72,12 +73,20 @@ pub fn run(args: &PlanArgs) -> sagcal::Result<()> {
     let planned = plan_calibration(&robot, &settings, &mut progress)?;
     let (report, plan) = (&planned.report, &planned.plan);
     let candidates = &report.candidates.equilibria;
+    // All the files or none, none over an input.
+    let mut outputs = OutputSet::new();
+    outputs.input("--robot", &args.robot);
+    if let Some(from) = &args.from {
+        outputs.input("--from", from);
+    }
     if let Some(path) = &args.out {
-        write_plan_csv(path, &robot, candidates, plan, args)?;
+        outputs.file("--out", path, plan_csv(path, &robot, candidates, plan, args)?);
     }
     if let Some(path) = &args.plot {
-        write_plot(path, &robot, candidates, plan, report.workspace, args)?;
+        let svg = plot_svg(&robot, candidates, plan, report.workspace, args);
+        outputs.file("--plot", path, figure_bytes(path, &svg)?);
     }
+    outputs.write()?;
     if args.json {
         return print_json(report);
     }
@@ -85,15 +94,15 @@ pub fn run(args: &PlanArgs) -> sagcal::Result<()> {
     Ok(())
 }
 
-/// The plan as a sagcal measurement CSV in visiting order: commanded
-/// positions with the nominal model's orientation, lengths and tension.
-fn write_plan_csv(
+/// The plan as a sagcal measurement CSV in visiting order (to be written to
+/// `path`): commanded positions with the nominal model's orientation, lengths and tension.
+fn plan_csv(
     path: &Path,
     robot: &Robot,
     candidates: &[Equilibrium],
     plan: &Plan,
     args: &PlanArgs,
-) -> sagcal::Result<()> {
+) -> sagcal::Result<String> {
     let rows: Vec<_> = plan
         .order
         .iter()
@@ -114,7 +123,7 @@ fn write_plan_csv(
         ),
         "orientation, lengths and tension: the nominal model's prediction at each commanded position".into(),
     ];
-    write_measurements(path, &comments, &rows)
+    measurements_text(path, &comments, &rows)
 }
 
 fn print_report(report: &PlanReport, plan: &Plan) {
@@ -161,15 +170,14 @@ fn print_report(report: &PlanReport, plan: &Plan) {
     println!("path length {:.1} m (nearest neighbour + 2-opt)", report.path_length_m);
 }
 
-/// The figure (see `sagcal::plot::plan`).
-fn write_plot(
-    path: &Path,
+/// The figure (SVG; see `sagcal::plot::plan`).
+fn plot_svg(
     robot: &Robot,
     candidates: &[Equilibrium],
     plan: &Plan,
     workspace: Option<Workspace>,
     args: &PlanArgs,
-) -> sagcal::Result<()> {
+) -> String {
     let plot = PlanPlot {
         title: format!(
             "sagcal plan: {} poses for robot {} ({:?}-optimal, {} noise)",
@@ -198,5 +206,5 @@ fn write_plot(
         plan_covariance_m2: plan.bound.anchor_covariance_m2.clone(),
         random_covariance_m2: plan.random.anchor_covariance_m2.clone(),
     };
-    write_figure(path, &plan_plot_svg(&plot))
+    plan_plot_svg(&plot)
 }

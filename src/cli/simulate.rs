@@ -2,11 +2,10 @@
 //! with `--effect` (or a robot file with `[effects]`), from the discretised
 //! simulator with those effects acting.
 
-use std::path::Path;
-
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use sagcal::io::measurements::write_measurements;
+use sagcal::io::measurements::measurements_text;
+use sagcal::io::OutputSet;
 use sagcal::model::statics::Equilibrium;
 use sagcal::model::{PoseMeasurement, Robot};
 use sagcal::sim::closed_form::{measure, sample_equilibria_with, Closure, Workspace};
@@ -22,12 +21,15 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
     let workspace = Workspace::default_for(&truth);
     let equilibria = sample_equilibria_with(&truth, &workspace, args.poses, args.closure, &mut rng)?;
     let data = measure_poses(args, &truth, from_file, &equilibria, &mut rng)?;
-    // Nothing is written unless the measurements can be: no truth file beside a refused data file.
-    sagcal::io::measurements::validate_for_writing(&args.out, &data)?;
+    // Both files or neither (no truth file beside a refused data file), none over the robot file.
+    let mut outputs = OutputSet::new();
+    outputs.input("--robot", &args.robot);
+    let text = measurements_text(&args.out, &comments(args, &truth, &workspace), &data)?;
+    outputs.file("--out", &args.out, text);
     if let Some(path) = &args.truth {
-        write_truth(path, args, &truth)?;
+        outputs.file("--truth", path, truth_text(args, &truth)?);
     }
-    write_measurements(&args.out, &comments(args, &truth, &workspace), &data)?;
+    outputs.write()?;
     print_ranges(&workspace, &equilibria);
     println!(
         "seed {}: {} poses of robot `{}` with {} noise{} written to {}",
@@ -123,24 +125,22 @@ fn comments(args: &SimulateArgs, truth: &Robot, workspace: &Workspace) -> Vec<St
     comments
 }
 
-/// Write the truth (robot TOML with offsets and effects, under a comment
-/// naming the simulation) to `path`, atomically.
-fn write_truth(path: &Path, args: &SimulateArgs, truth: &Robot) -> sagcal::Result<()> {
+/// The truth: robot TOML with offsets and effects, under a comment naming the simulation.
+fn truth_text(args: &SimulateArgs, truth: &Robot) -> sagcal::Result<String> {
     let effects = truth.effects;
     let effects_note = if effects.is_none() {
         String::new()
     } else {
         format!(", effects {effects} ({} segments)", args.segments)
     };
-    let text = format!(
+    Ok(format!(
         "# The truth of a sagcal simulation: seed {}, {} poses, noise {}{}{effects_note}.\n{}",
         args.seed,
         args.poses,
         args.noise,
         closure_note(args.closure),
         truth.to_file_contents().to_toml()?
-    );
-    sagcal::io::write_atomically(path, text.as_bytes())
+    ))
 }
 
 /// `, closure yaw (+-1 deg)` for a closure other than level (whose files and

@@ -33,12 +33,9 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
             path.display()
         )));
     };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let dir = folder_of(path);
 
-    let (temp_path, file) = create_temp(&dir, file_name, path)?;
+    let (temp_path, file) = create_temp(&dir, file_name).map_err(|e| Error::io(path, e))?;
     let result = write_and_sync(file, bytes).and_then(|()| std::fs::rename(&temp_path, path));
     if let Err(e) = result {
         let _ = std::fs::remove_file(&temp_path);
@@ -52,8 +49,16 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
+/// The folder `path` is in (`.` for a bare file name).
+pub(super) fn folder_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
 /// Create a fresh temporary file `.<name>.<pid>.<n>.tmp` in `dir`.
-fn create_temp(dir: &Path, file_name: &std::ffi::OsStr, path: &Path) -> Result<(PathBuf, File)> {
+pub(super) fn create_temp(dir: &Path, file_name: &std::ffi::OsStr) -> std::io::Result<(PathBuf, File)> {
     let mut attempts = 0;
     loop {
         let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
@@ -64,13 +69,13 @@ fn create_temp(dir: &Path, file_name: &std::ffi::OsStr, path: &Path) -> Result<(
         match OpenOptions::new().write(true).create_new(true).open(&temp_path) {
             Ok(file) => return Ok((temp_path, file)),
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && attempts < 100 => attempts += 1,
-            Err(e) => return Err(Error::io(path, e)),
+            Err(e) => return Err(e),
         }
     }
 }
 
 /// Write everything and flush it to disk.
-fn write_and_sync(mut file: File, bytes: &[u8]) -> std::io::Result<()> {
+pub(super) fn write_and_sync(mut file: File, bytes: &[u8]) -> std::io::Result<()> {
     file.write_all(bytes)?;
     file.sync_all()
 }

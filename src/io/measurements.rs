@@ -265,6 +265,13 @@ pub fn read_measurements(path: &Path, options: &ReadOptions) -> Result<Measureme
 /// are written with Rust's shortest round-trip representation, so
 /// [`read_measurements`] gives back bit-identical values.
 pub fn write_measurements(path: &Path, comments: &[String], poses: &[PoseMeasurement]) -> Result<()> {
+    write_atomically(path, measurements_text(path, comments, poses)?.as_bytes())
+}
+
+/// The text [`write_measurements`] writes to `path` (for a command that
+/// writes it with other files, [`crate::io::OutputSet`]): the same checks,
+/// the errors naming `path`; nothing is written.
+pub fn measurements_text(path: &Path, comments: &[String], poses: &[PoseMeasurement]) -> Result<String> {
     validate_for_writing(path, poses)?;
 
     let mut text = String::new();
@@ -292,7 +299,7 @@ pub fn write_measurements(path: &Path, comments: &[String], poses: &[PoseMeasure
         text.push_str(&fields.join(","));
         text.push('\n');
     }
-    write_atomically(path, text.as_bytes())
+    Ok(text)
 }
 
 /// The 11 values of a pose, in [`MEASUREMENT_HEADER`] order (as a file row holds them).

@@ -6,7 +6,9 @@
 //!   CSV, a RecurDyn log ([`recurdyn`]) or the authors' dataset folder
 //!   ([`authors`]), told apart by the header or by being a folder;
 //! - [`readings`]: what `localize` reads (cable readings alone, or any of the above);
-//! - [`atomic`]: every file sagcal writes goes through [`write_atomically`].
+//! - [`atomic`]: a single file written whole or not at all ([`write_atomically`]);
+//! - [`outputs`]: every file of one command written together, all or none,
+//!   never over one of the command's inputs ([`OutputSet`]).
 //!
 //! Errors name the file, the line and the column ([`crate::Error::Field`]).
 //!
@@ -35,8 +37,10 @@
 pub mod atomic;
 pub mod authors;
 pub mod measurements;
+pub mod outputs;
 pub mod readings;
 pub mod recurdyn;
 pub mod robot_file;
 
 pub use atomic::write_atomically;
+pub use outputs::OutputSet;

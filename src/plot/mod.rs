@@ -9,8 +9,9 @@
 //! - [`plan`]: a planned pose set (`sagcal plan --plot`);
 //! - `svg`: the drawing helpers they share (escaping, coordinates, labels,
 //!   the font and colours);
-//! - `png`: [`write_figure`] and [`svg_to_png`], the SVG rendered with `resvg`
-//!   and a bundled font (DejaVu Sans), so PNG needs no system fonts.
+//! - `png`: [`write_figure`] (and [`figure_bytes`], its bytes) and
+//!   [`svg_to_png`], the SVG rendered with `resvg` and a bundled font
+//!   (DejaVu Sans), so PNG needs no system fonts.
 //!
 //! ```
 //! use sagcal::plot::residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
@@ -43,5 +44,5 @@ pub mod residuals;
 mod svg;
 
 pub use anchors::{anchor_plot_svg, AnchorPlot, AnchorPlotEntry};
-pub use png::{is_png_path, svg_to_png, write_figure, PNG_SCALE};
+pub use png::{figure_bytes, is_png_path, svg_to_png, write_figure, PNG_SCALE};
 pub use residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};

@@ -93,10 +93,23 @@ pub fn is_png_path(path: &Path) -> bool {
 /// `.png`, the SVG text otherwise. The file is written atomically
 /// ([`crate::io::write_atomically`]): on any error `path` is left as it was.
 pub fn write_figure(path: &Path, svg: &str) -> Result<()> {
+    crate::io::write_atomically(path, &figure_bytes(path, svg)?)
+}
+
+/// The bytes [`write_figure`] writes to `path`: the PNG rendered at
+/// [`PNG_SCALE`] when `path` ends in `.png`, the SVG text otherwise. For a
+/// figure written with other files ([`crate::io::OutputSet`]).
+///
+/// ```
+/// let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="4" height="2"/>"##;
+/// let png = sagcal::plot::figure_bytes(std::path::Path::new("f.PNG"), svg).unwrap();
+/// assert_eq!(&png[1..4], b"PNG");
+/// assert_eq!(sagcal::plot::figure_bytes(std::path::Path::new("f.svg"), svg).unwrap(), svg.as_bytes());
+/// ```
+pub fn figure_bytes(path: &Path, svg: &str) -> Result<Vec<u8>> {
     if is_png_path(path) {
-        let png = svg_to_png(svg, PNG_SCALE, &path.display().to_string())?;
-        crate::io::write_atomically(path, &png)
+        svg_to_png(svg, PNG_SCALE, &path.display().to_string())
     } else {
-        crate::io::write_atomically(path, svg.as_bytes())
+        Ok(svg.as_bytes().to_vec())
     }
 }
