@@ -196,11 +196,7 @@ fn checked_fit(
             units.join("; ")
         )));
     }
-    if current.len() < super::MIN_POSES && current.len() < measurements.len() {
-        let outside: Vec<usize> = (0..measurements.len()).filter(|k| !rows.contains(k)).collect();
-        return Err(screen::too_few_rows(initial, measurements, &outside, super::MIN_POSES));
-    }
-    screen::check_rows(initial, &current, &rows, &options.noise)?;
+    screen::check_kept_rows(initial, measurements, &current, &rows, &options.noise)?;
     let mut plain = None;
     {
         // Clean data pass at the cost of one fit and its test.
