@@ -180,7 +180,7 @@ fn value_text(value: f64) -> String {
 /// The checks of the rows kept for the fit: `kept[k]` is row `rows[k]` of
 /// `measurements`, the others were left out outside the robot's frame. Fewer
 /// than [`super::MIN_POSES`] kept is [`too_few_rows`]'s error; otherwise
-/// [`check_rows`].
+/// [`super::validate_measurements`], then [`check_rows`].
 pub fn check_kept_rows(
     initial: &Robot,
     measurements: &[PoseMeasurement],
@@ -192,6 +192,8 @@ pub fn check_kept_rows(
         let outside: Vec<usize> = (0..measurements.len()).filter(|k| !rows.contains(k)).collect();
         return Err(too_few_rows(initial, measurements, &outside, super::MIN_POSES));
     }
+    // Too few poses, or all at one place, first: they say more than a duplicate.
+    super::validate_measurements(kept)?;
     check_rows(initial, kept, rows, noise)
 }
 
