@@ -3,12 +3,17 @@
 //! writes nothing; quoted numbers are read as numbers.
 
 use std::path::{Path, PathBuf};
-use std::process::Output;
+use std::process::{Command, Output};
 use std::sync::OnceLock;
 
-#[path = "common/cli.rs"]
-mod common;
-use common::sagcal;
+/// Run `sagcal ARGS` in `dir`.
+fn sagcal(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sagcal"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("sagcal runs")
+}
 
 /// The folder `sagcal demo` writes, made once for every test of this file.
 fn demo() -> &'static Path {

@@ -295,7 +295,7 @@ fn check_load_cell(initial: &Robot, measurements: &[PoseMeasurement], rows: &[us
     let Some(centre) = median(ratios.clone()) else {
         return Ok(());
     };
-    if !(centre > 0.0) {
+    if centre <= 0.0 {
         return Ok(());
     }
     let bad: Vec<String> = measurements
@@ -494,7 +494,7 @@ pub fn undetermined(result: &CalibrationResult, size_m: f64) -> Option<String> {
                 .copied()
                 .enumerate()
                 .max_by(|a, b| a.1.total_cmp(&b.1));
-            let too_large = |s: f64| !(s <= size_m);
+            let too_large = |s: f64| s.is_nan() || s > size_m;
             if let Some((i, s)) = worst_anchor.filter(|(_, s)| too_large(*s)) {
                 return Some(format!(
                     "the data did not determine the anchors: anchor {}'s 1-sigma is {s:.3e} m, larger than the robot \
