@@ -287,3 +287,19 @@ fn a_search_that_gives_up_does_not_contradict_itself() {
         "{stdout}"
     );
 }
+
+#[test]
+fn one_mistyped_roll_in_range_is_that_rows_blunder() {
+    // Roll 40 degrees in row 12 (the others within about 3): the orientation
+    // prior stays for every pose and the row's reading is the one left out.
+    let dir = tempfile::tempdir().unwrap();
+    let data = with_field(dir.path(), "roll40.csv", 12, 3, "40");
+    let out = calibrate(dir.path(), &data, &["--out", "o.toml"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}{stdout}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("rad prior, kept"), "{stdout}");
+    assert!(
+        stdout.contains("1 readings left out as gross errors:\n  row 12 (line 14), localiser orientation about x"),
+        "{stdout}"
+    );
+}
