@@ -404,7 +404,9 @@ fn values_that_are_not_finite_numbers() {
         (9, "1e400", "l4_m", "not a finite number"),
         (3, "", "roll_deg", "empty"),
         (4, "  ", "pitch_deg", "empty"),
-        (10, "\"600\"", "f_ref_n", "not a number"),
+        // Quotes are read around a number (`"600"`), not around anything else.
+        (10, "\"six\"", "f_ref_n", "not a number: `six`"),
+        (10, "\"600", "f_ref_n", "not a number"),
         (2, "1,5", "", ""),
     ];
     for (index, value, field, contains) in cases {

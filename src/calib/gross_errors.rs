@@ -58,6 +58,7 @@ use serde::Serialize;
 use std::collections::HashMap;
 
 use super::mistakes::{self, Mistake};
+use super::screen;
 use super::{calibrate, CalibrationOptions, CalibrationResult, RobustKernels};
 use crate::error::Result;
 use crate::graph::RobustKernel;
@@ -142,7 +143,33 @@ pub struct CheckedCalibration {
 /// leave the most significant flagged reading out and calibrate again until
 /// nothing is flagged, take back what the final fit does not reject, name
 /// what the exclusions look like and give the verdict.
+///
+/// Before any fit, [`super::screen`] refuses sigmas outside a sensor's range,
+/// duplicated rows and readings the robot cannot produce, and says why when
+/// too few rows are inside the frame; after it, a fit whose parameters the
+/// data did not determine ([`super::screen::undetermined`]) is inconsistent.
 pub fn calibrate_checked(
+    initial: &crate::model::Robot,
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+    check: &GrossErrorOptions,
+) -> Result<CheckedCalibration> {
+    screen::check_noise(&options.noise, initial)?;
+    let mut checked = checked_fit(initial, measurements, options, check)?;
+    if let Some(why) = screen::undetermined(&checked.result, screen::robot_size_m(initial)) {
+        checked.verdict = match checked.verdict {
+            Verdict::Consistent => Verdict::Inconsistent { reason: why },
+            Verdict::Inconsistent { reason } => Verdict::Inconsistent {
+                reason: format!("{why}; {reason}"),
+            },
+        };
+    }
+    Ok(checked)
+}
+
+/// [`calibrate_checked`] after its check of the noise, without its check of
+/// what the data determined.
+fn checked_fit(
     initial: &crate::model::Robot,
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
@@ -169,6 +196,7 @@ pub fn calibrate_checked(
             units.join("; ")
         )));
     }
+    screen::check_kept_rows(initial, measurements, &current, &rows, &options.noise)?;
     let mut plain = None;
     {
         // Clean data pass at the cost of one fit and its test.
@@ -223,7 +251,16 @@ pub fn calibrate_checked(
                 step_cable: None,
             };
             let mut reverted = finish(result, all, rows, none, checked.mistakes.clone(), test, &at_fit);
-            reverted.verdict = checked.verdict;
+            reverted.verdict = match checked.verdict {
+                Verdict::Inconsistent { reason } if !checked.excluded.is_empty() => Verdict::Inconsistent {
+                    reason: format!(
+                        "{reason}. The search for gross errors gave up, so the fit reported leaves no reading out \
+                         (the {} it had left out are listed as set aside)",
+                        checked.excluded.len()
+                    ),
+                },
+                verdict => verdict,
+            };
             reverted.set_aside = checked.excluded;
             return Ok(reverted);
         }

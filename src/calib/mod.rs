@@ -106,6 +106,7 @@ mod predict;
 mod prepared;
 pub mod report;
 mod result;
+pub mod screen;
 mod snooping;
 mod system_scope;
 mod uncertainty;

@@ -9,9 +9,9 @@ use super::options::{CableModel, CalibrationOptions, OrientationPrior};
 use super::result::CalibrationResult;
 use super::{calibrate_prepared, finish, solve_stage, CatenaryPreparation};
 use crate::error::Result;
-use crate::model::measurement::PoseMeasurement;
+use crate::model::measurement::{PoseMeasurement, Sensor};
 use crate::model::robot::Robot;
-use crate::stats::chi_square_quantile_999;
+use crate::stats::{chi_square_critical, chi_square_quantile_999};
 
 /// The consistency test of the localiser's orientations with the fitted
 /// statics, and what the calibration did with it.
@@ -35,15 +35,39 @@ pub struct OrientationCheck {
 /// fitted poses of a calibration made with the orientation prior. Conservative: the fitted
 /// orientation is pulled towards the measured one, so consistent data give
 /// less than the `3 N` degrees of freedom tested against.
+///
+/// Rows whose orientation readings were left out as gross errors do not
+/// count. When the test fails because of a few rows alone (each beyond the
+/// chi-square critical value with 3 degrees of freedom at `1e-3 / N`,
+/// Bonferroni over the rows; at most 5 % of them, and at least one), the test
+/// is made without them: one mistyped angle is a blunder of its row, for the
+/// gross-error tests to name, not a localiser at odds with the statics.
 fn orientation_check(result: &CalibrationResult, measurements: &[PoseMeasurement], sigma_rad: f64) -> OrientationCheck {
     let used = (0..measurements.len()).filter(|k| !result.excluded_poses.contains(k));
     // A localiser mounted with a rotation M reads R M: the platform orientation it implies is R_read M^-1.
     let mount = result.robot.effects.localiser_mount_deg.map(f64::to_radians);
     let unmount = nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::from(mount)).inverse();
+    let left_out = |k: usize| (0..3).any(|a| measurements[k].excluded.contains(Sensor::Orientation(a)));
     let angles: Vec<f64> = used
         .zip(&result.poses)
+        .filter(|(k, _)| !left_out(*k))
         .map(|(k, fitted)| (measured_pose(&measurements[k]).rotation * unmount).angle_to(&fitted.rotation))
         .collect();
+    let check = chi_square_of(&angles, sigma_rad);
+    if check.chi_square <= check.limit || angles.is_empty() {
+        return check;
+    }
+    let critical = chi_square_critical(3, 1e-3 / angles.len() as f64);
+    let (outliers, rest): (Vec<f64>, Vec<f64>) = angles.iter().partition(|a| (*a / sigma_rad).powi(2) > critical);
+    let allowed = (angles.len() / 20).max(1);
+    if outliers.is_empty() || outliers.len() > allowed {
+        return check;
+    }
+    chi_square_of(&rest, sigma_rad)
+}
+
+/// The orientation test of these angles between measured and fitted orientations.
+fn chi_square_of(angles: &[f64], sigma_rad: f64) -> OrientationCheck {
     let chi_square = angles.iter().map(|a| (a / sigma_rad).powi(2)).sum();
     let components = 3 * angles.len();
     OrientationCheck {

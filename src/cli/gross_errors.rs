@@ -14,6 +14,10 @@ pub struct GrossErrorReport {
     pub verdict: Verdict,
     /// Readings left out, each with its row, sensor, estimated error, `w` and explanation.
     pub excluded_readings: Vec<ExcludedReading>,
+    /// For an inconsistent fit: the readings the search had left out before
+    /// it gave up (the fit reported uses them; omitted when empty).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub set_aside_readings: Vec<ExcludedReading>,
     /// Common mistakes recognised (units, swapped cables, re-homing, poses outside the frame).
     pub mistakes: Vec<Mistake>,
     /// The tests of the final fit.
@@ -26,6 +30,7 @@ impl GrossErrorReport {
         Self {
             verdict: checked.verdict.clone(),
             excluded_readings: checked.excluded.clone(),
+            set_aside_readings: checked.set_aside.clone(),
             mistakes: checked.mistakes.clone(),
             tests: checked.test.clone(),
         }
@@ -54,7 +59,15 @@ pub fn render(report: &GrossErrorReport) -> String {
     if let Some(largest) = &t.largest {
         out += &format!("largest |w|: {}\n", largest.describe());
     }
-    if report.excluded_readings.is_empty() {
+    if report.excluded_readings.is_empty() && !report.set_aside_readings.is_empty() {
+        out += &format!(
+            "no reading left out of the fit reported: the search for gross errors gave up after leaving out {}:\n",
+            report.set_aside_readings.len()
+        );
+        for x in &report.set_aside_readings {
+            out += &format!("  set aside: {}\n", x.test.describe());
+        }
+    } else if report.excluded_readings.is_empty() {
         out += "no reading left out\n";
     } else {
         out += &format!(

@@ -19,8 +19,9 @@
 //! | `l1_m` .. `l4_m` | encoder reading of cable 1..4: the true cable length plus an unknown per-cable offset | m |
 //! | `f_ref_n` | load-cell tension of the reference cable at the platform attachment | N |
 //!
-//! * Every value is a plain finite number (`12`, `-0.5`, `1.25e-3`; no quotes,
-//!   no `NaN`, no `inf`). Surrounding spaces are ignored.
+//! * Every value is a finite number (`12`, `-0.5`, `1.25e-3`; no `NaN`, no
+//!   `inf`), bare or in double quotes as spreadsheets write them (`"1.25"`).
+//!   Surrounding spaces are ignored.
 //! * Encoder readings carry an unknown offset, so any finite value is allowed,
 //!   zero and negative ones included.
 //! * `f_ref_n` is a tension magnitude and must be positive.
@@ -489,9 +490,11 @@ fn parse_row(text: &[u8], line: usize, path: &Path) -> Result<PoseMeasurement> {
             field: MEASUREMENT_HEADER[index].to_string(),
             message,
         };
-        let text = std::str::from_utf8(raw)
-            .map_err(|_| err("not valid UTF-8 text".to_string()))?
-            .trim();
+        let text = unquote(
+            std::str::from_utf8(raw)
+                .map_err(|_| err("not valid UTF-8 text".to_string()))?
+                .trim(),
+        );
         if text.is_empty() {
             return Err(err("value is empty".to_string()));
         }
@@ -509,6 +512,15 @@ fn parse_row(text: &[u8], line: usize, path: &Path) -> Result<PoseMeasurement> {
         *slot = value;
     }
     Ok(pose_from_values(line, &values))
+}
+
+/// A CSV value without the double quotes around it, if it has them
+/// (`"1.25"` as spreadsheets write numbers), and the spaces inside them.
+pub(crate) fn unquote(text: &str) -> &str {
+    match text.strip_prefix('"').and_then(|t| t.strip_suffix('"')) {
+        Some(inner) => inner.trim(),
+        None => text,
+    }
 }
 
 /// A line holding only whitespace.
@@ -570,5 +582,47 @@ fn pose_from_values(line: usize, values: &[f64; N_COLUMNS]) -> PoseMeasurement {
         encoder_lengths_m: [l1, l2, l3, l4],
         reference_tension_n: f_ref,
         excluded: Default::default(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quoted_numbers_are_numbers() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.csv");
+        std::fs::write(
+            &path,
+            "x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,l1_m,l2_m,l3_m,l4_m,f_ref_n\n\
+             \"1.25\",2,3,0,0,0,\" 10 \",11,12,13,\"698.5\"\n",
+        )
+        .unwrap();
+        let set = read_measurements(&path, &ReadOptions::default()).unwrap();
+        assert_eq!(set.poses[0].position_m, [1.25, 2.0, 3.0]);
+        assert_eq!(set.poses[0].encoder_lengths_m[0], 10.0);
+        assert_eq!(set.poses[0].reference_tension_n, 698.5);
+        // One quote only, or quotes around a non-number: an error naming the field.
+        for bad in ["\"1.25", "\"abc\""] {
+            std::fs::write(
+                &path,
+                format!("x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,l1_m,l2_m,l3_m,l4_m,f_ref_n\n{bad},2,3,0,0,0,10,11,12,13,698\n"),
+            )
+            .unwrap();
+            let message = read_measurements(&path, &ReadOptions::default())
+                .unwrap_err()
+                .to_string();
+            assert!(message.contains("row 2, field `x_m`"), "{message}");
+        }
+    }
+
+    #[test]
+    fn unquote_strips_one_pair() {
+        assert_eq!(unquote("\"1.5\""), "1.5");
+        assert_eq!(unquote("\" 1.5 \""), "1.5");
+        assert_eq!(unquote("1.5"), "1.5");
+        assert_eq!(unquote("\""), "\"");
+        assert_eq!(unquote("\"\""), "");
     }
 }

@@ -121,7 +121,10 @@ pub fn read_readings(path: &Path, reference_cable: usize) -> Result<ReadingsFile
     }
     let mut rows = Vec::new();
     for (line, text) in lines {
-        let values: Vec<&str> = text.split(',').map(str::trim).collect();
+        let values: Vec<&str> = text
+            .split(',')
+            .map(|v| crate::io::measurements::unquote(v.trim()))
+            .collect();
         if values.len() != fields.len() {
             return Err(field_error(
                 path,
@@ -216,4 +219,23 @@ fn read_measurement_rows(path: &Path, reference_cable: usize) -> Result<Readings
         rows,
         rejected: set.rejected,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quoted_numbers_are_numbers() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("r.csv");
+        std::fs::write(&path, "l1_m,l2_m,l3_m,l4_m,f_ref_n\n\"1.25\",\" 2 \",3,4,\"5.5\"\n").unwrap();
+        let file = read_readings(&path, 0).unwrap();
+        assert_eq!(file.rows[0].encoder_lengths_m, [1.25, 2.0, 3.0, 4.0]);
+        assert_eq!(file.rows[0].load_cell_n, Some(5.5));
+        // Quotes around something that is not a number are still an error naming the field.
+        std::fs::write(&path, "l1_m,l2_m,l3_m,l4_m\n1,\"x\",3,4\n").unwrap();
+        let message = read_readings(&path, 0).unwrap_err().to_string();
+        assert!(message.contains("row 2, field `l2_m`"), "{message}");
+    }
 }
