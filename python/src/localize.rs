@@ -222,10 +222,10 @@ fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> Localization {
         };
         match localizer.localize(&readings, warm.as_ref()) {
             Ok(f) => {
-                if f.stable {
+                if f.stable && localizer.frame_allows(&f) {
                     warm = Some(f.pose);
                 }
-                flags.push(flag(&f));
+                flags.push(localizer.flag(&f));
                 found.push(Some(f));
             }
             Err(e) => {
@@ -249,20 +249,6 @@ fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> Localization {
         found,
         flags,
         position_error_m,
-    }
-}
-
-/// Why a solved row is not trusted, in the command's words.
-fn flag(found: &Localized) -> Option<String> {
-    match (found.consistent, found.stable) {
-        (_, false) => {
-            Some("unstable equilibrium (the stiffness at fixed cable lengths is not positive definite)".into())
-        }
-        (false, _) => Some(format!(
-            "inconsistent: chi-square {:.2} with {} degree(s) of freedom",
-            found.chi_square, found.degrees_of_freedom
-        )),
-        _ => None,
     }
 }
 

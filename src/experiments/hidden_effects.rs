@@ -137,6 +137,43 @@ impl Default for HiddenEffectOptions {
     }
 }
 
+impl HiddenEffectOptions {
+    /// The fewest poses a case can have: the diagnosis' cross-validation
+    /// needs two poses per fold (`diagnose`), and a calibration
+    /// [`crate::calib::MIN_POSES`].
+    pub fn min_poses(&self) -> usize {
+        (2 * self.folds).max(crate::calib::MIN_POSES)
+    }
+
+    /// Check the options before any case is drawn, naming the option (and
+    /// its flag of `sagcal experiment hidden-effects`): too few poses would
+    /// leave the mean reference tension, and so the effects drawn from it,
+    /// undefined.
+    pub fn validate(&self) -> Result<()> {
+        if self.folds < 2 {
+            return Err(Error::InvalidInput(format!(
+                "folds: the diagnosis' cross-validation needs at least 2 folds, got {}",
+                self.folds
+            )));
+        }
+        if self.poses < self.min_poses() {
+            return Err(Error::InvalidInput(format!(
+                "poses (--poses): at least {} poses per case are needed (two per fold of the diagnosis' {}-fold cross-validation, and {} for a calibration), got {}",
+                self.min_poses(),
+                self.folds,
+                crate::calib::MIN_POSES,
+                self.poses
+            )));
+        }
+        if self.segments < 1 {
+            return Err(Error::InvalidInput(
+                "segments (--segments): the discretised simulator needs at least 1 segment per cable, got 0".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// One case: what was hidden and what the diagnosis said.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct HiddenCase {
@@ -172,7 +209,14 @@ pub struct HiddenCase {
 }
 
 /// The mean reference-cable tension over `poses` sampled equilibria, newtons.
+///
+/// Errors: no pose to average over.
 pub fn mean_reference_tension_n(robot: &Robot, poses: usize, seed: u64) -> Result<f64> {
+    if poses == 0 {
+        return Err(Error::InvalidInput(
+            "poses (--poses): the mean reference tension needs at least 1 pose, got 0".into(),
+        ));
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let equilibria = sample_equilibria(robot, &Workspace::default_for(robot), poses, &mut rng)?;
     Ok(equilibria
@@ -589,7 +633,9 @@ pub fn refused_readings(measurements: &[PoseMeasurement]) -> Option<String> {
 /// [`PAIRS`] on every robot under every noise reading of `noises`, in
 /// parallel. `progress()` is called after each case. A case whose readings
 /// sagcal refuses ([`refused_readings`]) is reported as unmeasurable; any
-/// other failure is an error naming the case.
+/// other failure is an error naming the case. Options that cannot give a
+/// case (too few poses or seeds, no robot; [`HiddenEffectOptions::validate`])
+/// are an error before any case is run.
 pub fn run_sweep(
     robots: &[Robot],
     noises: &[NoisePreset],
@@ -598,6 +644,17 @@ pub fn run_sweep(
     options: &HiddenEffectOptions,
     progress: &(dyn Fn() + Sync),
 ) -> Result<SweepCases> {
+    options.validate()?;
+    if seeds == 0 {
+        return Err(Error::InvalidInput(
+            "seeds (--seeds): at least 1 case per hidden set is needed, got 0".into(),
+        ));
+    }
+    if robots.is_empty() || noises.is_empty() {
+        return Err(Error::InvalidInput(
+            "the sweep needs at least one robot (--robots) and one noise reading (--noise)".into(),
+        ));
+    }
     let mut sets: Vec<Vec<EffectKind>> = vec![Vec::new()];
     sets.extend(EffectKind::ALL.map(|k| vec![k]));
     sets.extend(PAIRS.map(|p| p.to_vec()));

@@ -65,6 +65,13 @@ pub fn identifiability(
     seed: u64,
     options: &HiddenEffectOptions,
 ) -> Result<Identifiability> {
+    if poses < crate::calib::MIN_POSES || options.segments < 1 {
+        return Err(Error::InvalidInput(format!(
+            "identifiability: at least {} poses (--poses) and 1 segment per cable (--segments) are needed, got {poses} and {}",
+            crate::calib::MIN_POSES,
+            options.segments
+        )));
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let equilibria = sample_equilibria_with(truth, &Workspace::default_for(truth), poses, options.closure, &mut rng)?;
     let solved = solve_with_effects(truth, effects, &equilibria, options.segments)?;
