@@ -12,17 +12,22 @@
   call, ``internal error in sagcal.NAME: ... please report``;
 - runs the call in a worker thread and waits for it in the main thread, so
   that Ctrl-C (SIGINT) raises ``KeyboardInterrupt`` at once, however long the
-  job (the extension releases the GIL while it works).
+  job (the extension releases the GIL while it works), and asks the library
+  to stop the job (``sagcal::cancel``: its long loops check the flag).
 """
 
 import functools
 import re
 import threading
 
+from . import _sagcal
 from ._sagcal import SagcalError
 
 #: Largest seed + 1: seeds are unsigned 64-bit integers.
 SEED_LIMIT = 2**64
+
+#: How long Ctrl-C waits for the job to stop before raising KeyboardInterrupt, seconds.
+STOP_WAIT_S = 2.0
 
 #: How often the waiting main thread wakes up to let Python run its signal handlers, seconds.
 POLL_S = 0.05
@@ -84,17 +89,29 @@ def run_interruptibly(function, args, kwargs):
     if threading.current_thread() is not threading.main_thread():
         return function(*args, **kwargs)
     outcome = {}
+    done = threading.Event()
 
     def work():
         try:
             outcome["value"] = function(*args, **kwargs)
         except BaseException as error:  # handed to the caller's thread
             outcome["error"] = error
+        finally:
+            done.set()
 
     worker = threading.Thread(target=work, name=f"sagcal.{getattr(function, '__name__', 'call')}", daemon=True)
+    _sagcal._reset_cancel()
     worker.start()
-    while worker.is_alive():
-        worker.join(POLL_S)
+    try:
+        while not done.wait(POLL_S):
+            pass
+    except KeyboardInterrupt:
+        # The job stops at its next check (the library's cancellation flag).
+        _sagcal._cancel()
+        if done.wait(STOP_WAIT_S):
+            worker.join(POLL_S)
+        raise
+    worker.join()
     if "error" in outcome:
         raise outcome.pop("error")
     return outcome["value"]

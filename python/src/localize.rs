@@ -119,8 +119,10 @@ impl Localization {
         self.found.iter().map(|f| f.is_some_and(|f| f.stable)).collect()
     }
 
-    /// Per row, why it has no trusted equilibrium (unstable, inconsistent, no
-    /// equilibrium), in the command's words; ``None`` for a good row.
+    /// Per row, why it has no trusted equilibrium (outside the robot's frame:
+    /// below its floor, outside the anchors' hull or above them, or a cable
+    /// lying on the floor; unstable; inconsistent; no equilibrium), in the
+    /// command's words; ``None`` for a good row.
     #[getter]
     fn flags(&self) -> Vec<Option<String>> {
         self.flags.clone()
@@ -215,6 +217,9 @@ fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> Localization {
     let mut found = Vec::with_capacity(input.len());
     let mut flags = Vec::with_capacity(input.len());
     for row in input {
+        if sagcal::cancel::requested() {
+            break;
+        }
         let readings = Readings {
             encoder_lengths_m: row.encoder_lengths_m,
             load_cell_n: row.load_cell_n,
