@@ -106,7 +106,7 @@ fn protocol(args: &Table2Args, truth: &Robot) -> sagcal::Result<Protocol> {
             )));
         }
     }
-    if !(basin_radius_m >= 0.0) {
+    if basin_radius_m.is_nan() || basin_radius_m < 0.0 {
         return Err(sagcal::Error::InvalidInput(format!(
             "--basin-radius-m must be >= 0 m, got {basin_radius_m}"
         )));
