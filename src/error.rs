@@ -55,6 +55,9 @@ pub enum Error {
         /// What is wrong with it.
         message: String,
     },
+    /// The job was stopped on request ([`crate::cancel`]).
+    #[error("cancelled")]
+    Cancelled,
     /// The kineto-static problem has no solution with positive cable tensions.
     #[error("no static equilibrium: {0}")]
     NoEquilibrium(String),

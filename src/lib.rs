@@ -50,6 +50,7 @@
 #![deny(rustdoc::broken_intra_doc_links)]
 
 pub mod calib;
+pub mod cancel;
 pub mod diagnose;
 pub mod error;
 pub mod experiments;

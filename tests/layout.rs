@@ -16,12 +16,13 @@ use std::path::{Path, PathBuf};
 const ALLOWED: &[(&str, &[&str])] = &[
     ("error", &[]),
     ("steps", &[]),
+    ("cancel", &["error"]),
     ("stats", &["error"]),
     ("model", &["error", "steps", "stats", "generated"]),
     ("io", &["error", "model"]),
-    ("sim", &["error", "steps", "stats", "generated", "model"]),
+    ("sim", &["error", "steps", "cancel", "stats", "generated", "model"]),
     ("graph", &["error", "stats", "generated", "model"]),
-    ("solver", &["error", "steps", "stats", "model", "graph"]),
+    ("solver", &["error", "steps", "cancel", "stats", "model", "graph"]),
     ("calib", &["error", "stats", "generated", "model", "graph", "solver"]),
     (
         "diagnose",

@@ -31,6 +31,9 @@ Example::
     print(result.anchors_m - truth.anchors_m)
 """
 
+from . import _sagcal
+from ._boundary import SEED_LIMIT as _SEED_LIMIT
+from ._boundary import entry as _entry
 from ._sagcal import (
     MEASUREMENT_COLUMNS,
     Calibration,
@@ -41,14 +44,19 @@ from ._sagcal import (
     SagcalError,
     Simulation,
     __version__,
-    calibrate,
-    diagnose,
-    localize,
-    plan,
-    read_measurements,
-    simulate,
-    write_measurements,
 )
+
+# Every function through the boundary (sagcal/_boundary.py): arguments
+# checked with errors naming them, no Rust panic crossing into Python as
+# anything but a SagcalError, and Ctrl-C raising KeyboardInterrupt.
+_COUNT = (0, _SEED_LIMIT)
+calibrate = _entry(_sagcal.calibrate)
+diagnose = _entry(_sagcal.diagnose, ints={"folds": _COUNT}, lists=("candidates",))
+localize = _entry(_sagcal.localize)
+plan = _entry(_sagcal.plan, ints={"poses": _COUNT, "seed": _COUNT})
+read_measurements = _entry(_sagcal.read_measurements, ints={"reference_cable": (1, 5)})
+simulate = _entry(_sagcal.simulate, ints={"poses": _COUNT, "seed": _COUNT, "segments": _COUNT}, lists=("effects",))
+write_measurements = _entry(_sagcal.write_measurements, lists=("comments",))
 
 __all__ = [
     "MEASUREMENT_COLUMNS",

@@ -215,7 +215,7 @@ class Localization:
         """Whether each row's equilibrium is stable."""
     @property
     def flags(self) -> list[Optional[str]]:
-        """Why a row is not trusted, or ``None``."""
+        """Why a row is not trusted (outside the robot's frame, a cable on the floor, unstable, inconsistent, no equilibrium), or ``None``."""
     @property
     def position_error_m(self) -> Optional[FloatArray]:
         """Distance from the input's localiser positions, metres: (N,), or ``None``."""

@@ -38,6 +38,18 @@ pub(crate) fn invalid(message: impl Into<String>) -> PyErr {
     to_py(sagcal::Error::InvalidInput(message.into()))
 }
 
+/// Ask the running jobs to stop (`sagcal::cancel::request`): the package calls it on Ctrl-C.
+#[pyfunction]
+fn _cancel() {
+    sagcal::cancel::request();
+}
+
+/// Clear a stop request before a new job (`sagcal::cancel::reset`).
+#[pyfunction]
+fn _reset_cancel() {
+    sagcal::cancel::reset();
+}
+
 /// The module `sagcal._sagcal`.
 #[pymodule]
 fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -60,5 +72,7 @@ fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(data::read_measurements, m)?)?;
     m.add_function(wrap_pyfunction!(data::write_measurements, m)?)?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
+    m.add_function(wrap_pyfunction!(_cancel, m)?)?;
+    m.add_function(wrap_pyfunction!(_reset_cancel, m)?)?;
     Ok(())
 }

@@ -119,8 +119,10 @@ impl Localization {
         self.found.iter().map(|f| f.is_some_and(|f| f.stable)).collect()
     }
 
-    /// Per row, why it has no trusted equilibrium (unstable, inconsistent, no
-    /// equilibrium), in the command's words; ``None`` for a good row.
+    /// Per row, why it has no trusted equilibrium (outside the robot's frame:
+    /// below its floor, outside the anchors' hull or above them, or a cable
+    /// lying on the floor; unstable; inconsistent; no equilibrium), in the
+    /// command's words; ``None`` for a good row.
     #[getter]
     fn flags(&self) -> Vec<Option<String>> {
         self.flags.clone()
@@ -215,6 +217,9 @@ fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> Localization {
     let mut found = Vec::with_capacity(input.len());
     let mut flags = Vec::with_capacity(input.len());
     for row in input {
+        if sagcal::cancel::requested() {
+            break;
+        }
         let readings = Readings {
             encoder_lengths_m: row.encoder_lengths_m,
             load_cell_n: row.load_cell_n,
@@ -222,10 +227,10 @@ fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> Localization {
         };
         match localizer.localize(&readings, warm.as_ref()) {
             Ok(f) => {
-                if f.stable {
+                if f.stable && localizer.frame_allows(&f) {
                     warm = Some(f.pose);
                 }
-                flags.push(flag(&f));
+                flags.push(localizer.flag(&f));
                 found.push(Some(f));
             }
             Err(e) => {
@@ -249,20 +254,6 @@ fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> Localization {
         found,
         flags,
         position_error_m,
-    }
-}
-
-/// Why a solved row is not trusted, in the command's words.
-fn flag(found: &Localized) -> Option<String> {
-    match (found.consistent, found.stable) {
-        (_, false) => {
-            Some("unstable equilibrium (the stiffness at fixed cable lengths is not positive definite)".into())
-        }
-        (false, _) => Some(format!(
-            "inconsistent: chi-square {:.2} with {} degree(s) of freedom",
-            found.chi_square, found.degrees_of_freedom
-        )),
-        _ => None,
     }
 }
 

@@ -181,8 +181,14 @@ impl Robot {
     }
 
     #[setter]
-    fn set_reference_cable(&mut self, value: usize) -> PyResult<()> {
-        self.edit("reference_cable", |f| f.reference_cable = value)
+    fn set_reference_cable(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let Ok(cable) = value.extract::<usize>() else {
+            return Err(crate::invalid(format!(
+                "reference_cable must be a cable number 1..4, got {}",
+                value.repr().map_or_else(|_| "?".into(), |r| r.to_string())
+            )));
+        };
+        self.edit("reference_cable", |f| f.reference_cable = cable)
     }
 
     /// Encoder length offsets ``l_i^0`` of cables 1..4, metres (encoder = cable length + offset): a (4,) array.

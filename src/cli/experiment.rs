@@ -2,7 +2,9 @@
 
 use sagcal::calib::{CableModel, OrientationPrior};
 use sagcal::experiments::selection::{PlanSettings, Selection};
-use sagcal::experiments::table2::{pose_pool, run_selected_protocol, PoolPose, PoseCountResult, Protocol, Source};
+use sagcal::experiments::table2::{
+    check_counts, pose_pool, run_selected_protocol, PoolPose, PoseCountResult, Protocol, Source,
+};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
@@ -57,6 +59,7 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
         },
     )?;
     let pool = pose_pool(&truth, &data.poses, args.source)?;
+    check_counts(&args.poses, args.trials, pool.len())?;
     let protocol = protocol(args, &truth)?;
     let results = run_trials(args, &truth, &pool, &protocol)?;
     let report = Table2Report {
@@ -92,6 +95,22 @@ fn protocol(args: &Table2Args, truth: &Robot) -> sagcal::Result<Protocol> {
         CableModel::Catenary => 0.3 * anchor_perturbation_m,
         CableModel::Rigid => f64::INFINITY,
     });
+    for (flag, value) in [
+        ("--anchor-perturbation-m", anchor_perturbation_m),
+        ("--offset-perturbation-m", offset_perturbation_m),
+        ("--plan-anchor-error-m", args.plan_anchor_error_m),
+    ] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(sagcal::Error::InvalidInput(format!(
+                "{flag} must be a finite distance >= 0 m, got {value}"
+            )));
+        }
+    }
+    if basin_radius_m.is_nan() || basin_radius_m < 0.0 {
+        return Err(sagcal::Error::InvalidInput(format!(
+            "--basin-radius-m must be >= 0 m, got {basin_radius_m}"
+        )));
+    }
     Ok(Protocol {
         noise: args.noise,
         model: args.model,

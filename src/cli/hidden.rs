@@ -84,11 +84,7 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
 
 /// Run the sweep, score it and print the report (or JSON).
 pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
-    let robots: Vec<Robot> = args
-        .robots
-        .split(',')
-        .map(|name| Robot::builtin(name.trim()))
-        .collect::<sagcal::Result<_>>()?;
+    // Every option checked before any case is drawn.
     if args.seeds == 0 {
         return Err(sagcal::Error::InvalidInput("--seeds must be at least 1".into()));
     }
@@ -99,6 +95,22 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         closure: args.closure,
         ..HiddenEffectOptions::default()
     };
+    options.validate()?;
+    let mut names: Vec<&str> = Vec::new();
+    for name in args.robots.split(',').map(str::trim) {
+        if names.contains(&name) {
+            return Err(sagcal::Error::InvalidInput(format!("--robots names `{name}` twice")));
+        }
+        names.push(name);
+    }
+    let robots: Vec<Robot> = names
+        .iter()
+        .map(|name| Robot::builtin(name))
+        .collect::<sagcal::Result<_>>()
+        .map_err(|e| match e {
+            sagcal::Error::InvalidInput(m) => sagcal::Error::InvalidInput(format!("--robots: {m}")),
+            other => other,
+        })?;
     let SweepCases {
         diagnosed: cases,
         unmeasurable,

@@ -158,7 +158,7 @@ fn localize_file(
         let result = localizer.localize(&readings, warm.as_ref());
         let report = match result {
             Ok(found) => {
-                let mut report = row_report(row.line, &found, row.localiser_pose.as_ref());
+                let mut report = row_report(row.line, &found, localizer.flag(&found), row.localiser_pose.as_ref());
                 if search {
                     let reference = warm.or(readings.localiser_pose.filter(|_| pose_prior));
                     let all = localizer.equilibria(&readings, reference.as_ref())?;
@@ -179,7 +179,8 @@ fn localize_file(
                     reference_m: row.localiser_pose.map(|p| p.position_m.into()),
                     flagged: report.flag.is_some(),
                 });
-                if found.stable {
+                // A pose outside the frame is no start for the next row.
+                if found.stable && localizer.frame_allows(&found) {
                     warm = Some(found.pose);
                 }
                 report
@@ -219,18 +220,8 @@ fn rms_of(values: impl Iterator<Item = f64>) -> Option<f64> {
     (n > 0).then(|| (sum / n as f64).sqrt())
 }
 
-fn row_report(line: usize, found: &Localized, localiser: Option<&PlatformPose>) -> RowReport {
+fn row_report(line: usize, found: &Localized, flag: Option<String>, localiser: Option<&PlatformPose>) -> RowReport {
     let (roll, pitch, yaw) = found.pose.roll_pitch_yaw_deg();
-    let flag = match (found.consistent, found.stable) {
-        (_, false) => {
-            Some("unstable equilibrium (the stiffness at fixed cable lengths is not positive definite)".into())
-        }
-        (false, _) => Some(format!(
-            "inconsistent: chi-square {:.2} with {} degree(s) of freedom",
-            found.chi_square, found.degrees_of_freedom
-        )),
-        _ => None,
-    };
     RowReport {
         row: line,
         position_m: Some(found.pose.position_m.into()),

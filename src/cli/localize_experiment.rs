@@ -50,6 +50,16 @@ fn table2_protocol(truth: &Robot, noise: NoisePreset) -> Protocol {
 
 /// Run every (source, noise) case and print the table (or JSON).
 pub fn run_experiment(args: &LocalizeExperimentArgs) -> sagcal::Result<()> {
+    if args.poses < sagcal::calib::MIN_POSES {
+        return Err(sagcal::Error::InvalidInput(format!(
+            "--poses {}: at least {} calibration poses per trial are needed",
+            args.poses,
+            sagcal::calib::MIN_POSES
+        )));
+    }
+    if args.trials == 0 {
+        return Err(sagcal::Error::InvalidInput("--trials must be at least 1".into()));
+    }
     let truth = Robot::from_file(&args.robot)?;
     let data = read_measurements(
         &args.data,

@@ -1,6 +1,6 @@
 //! `sagcal verify`: the model against measured data.
 
-use sagcal::diagnose::verify::{verify, Closure, MeasuredData, VerifyReport};
+use sagcal::diagnose::verify::{verify, Closure, LengthKind, MeasuredData, VerifyReport};
 use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
 use sagcal::io::recurdyn::{read_recurdyn, LoadOptions};
 use sagcal::model::statics::StaticsOptions;
@@ -51,8 +51,12 @@ fn render(report: &VerifyReport) -> String {
         Closure::ReferenceTension => "position + reference-cable tension (load cell)",
         Closure::CableLengths => "position + the four cable lengths",
     };
+    let lengths = match report.lengths {
+        LengthKind::EncoderReadings => "encoder readings (cable length + the robot's length_offsets_m)",
+        LengthKind::Absolute => "absolute cable lengths (no encoder offsets)",
+    };
     out += &format!(
-        "sagcal verify: robot `{}`, data {}\nmodel closed with: {closure}; orientation is predicted, never an input\n\n",
+        "sagcal verify: robot `{}`, data {}\nmodel closed with: {closure}; orientation is predicted, never an input\nlengths compared as: {lengths}\n\n",
         report.robot, report.data
     );
     let mut table = Table::new([

@@ -19,9 +19,17 @@
 //! sagcal measurement file (the encoder readings as lengths, the load cell
 //! as the reference cable's tension).
 //!
+//! What the length columns hold decides what is compared ([`LengthKind`]): a
+//! sagcal measurement file logs encoder readings, the cable length plus the
+//! robot file's `length_offsets_m` (as `sagcal simulate` writes them and
+//! `sagcal calibrate` estimates them), so the model's prediction is its
+//! length plus the offset; a RecurDyn log records the cables' absolute
+//! lengths, so the offsets (an encoder's zero, which the simulation has not)
+//! are not added there.
+//!
 //! ```
 //! use rand::SeedableRng;
-//! use sagcal::diagnose::verify::{paper_table1, verify, Closure, MeasuredData, MeasuredRow};
+//! use sagcal::diagnose::verify::{paper_table1, verify, Closure, LengthKind, MeasuredData, MeasuredRow};
 //! use sagcal::model::robot::PaperRobot;
 //! use sagcal::model::statics::StaticsOptions;
 //! use sagcal::model::Robot;
@@ -46,7 +54,7 @@
 //!     .collect();
 //! // ... but the first row logs cable 2 1 % long.
 //! rows[0].cable_lengths_m[1] *= 1.01;
-//! let data = MeasuredData { path: "model".into(), rows, rejected: Vec::new() };
+//! let data = MeasuredData { path: "model".into(), rows, rejected: Vec::new(), lengths: LengthKind::Absolute };
 //! let report = verify(&robot, &data, Closure::ReferenceTension, &StaticsOptions::default());
 //! assert_eq!(report.rows.len(), 3);
 //! // |L - 1.01 L| / (1.01 L) on that reading, 0 on the other 11.
@@ -112,6 +120,17 @@ pub struct MeasuredRow {
     pub tensions_n: [Option<f64>; CABLE_COUNT],
 }
 
+/// What the length columns of a data file hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LengthKind {
+    /// Encoder readings: the cable length plus the robot's
+    /// `length_offsets_m` (a sagcal measurement file, eq. 14).
+    EncoderReadings,
+    /// Absolute cable lengths, no encoder zero (a RecurDyn log).
+    Absolute,
+}
+
 /// The rows of a data file to verify, and the rows its loader rejected.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeasuredData {
@@ -121,6 +140,8 @@ pub struct MeasuredData {
     pub rows: Vec<MeasuredRow>,
     /// Rows the loader rejected, with reasons.
     pub rejected: Vec<RejectedRow>,
+    /// What `cable_lengths_m` of the rows hold.
+    pub lengths: LengthKind,
 }
 
 impl MeasuredData {
@@ -141,6 +162,7 @@ impl MeasuredData {
             path: log.path.display().to_string(),
             rows,
             rejected: log.rejected.clone(),
+            lengths: LengthKind::Absolute,
         }
     }
 
@@ -162,6 +184,7 @@ impl MeasuredData {
             path: set.path.display().to_string(),
             rows,
             rejected: set.rejected.clone(),
+            lengths: LengthKind::EncoderReadings,
         }
     }
 }
@@ -183,9 +206,10 @@ pub struct RowVerification {
     pub line: usize,
     /// Measured position, metres.
     pub position_m: [f64; 3],
-    /// Measured cable lengths, metres.
+    /// Measured cable lengths (or encoder readings), metres.
     pub measured_length_m: [f64; CABLE_COUNT],
-    /// Predicted catenary lengths, metres.
+    /// Predicted catenary lengths, metres; for encoder readings the
+    /// predicted readings (length plus the robot's offset, [`LengthKind`]).
     pub predicted_length_m: [f64; CABLE_COUNT],
     /// `100 * |predicted - measured| / measured` per cable.
     pub length_error_pct: [f64; CABLE_COUNT],
@@ -247,6 +271,8 @@ pub struct VerifyReport {
     pub data: String,
     /// The closing measurement.
     pub closure: Closure,
+    /// What the data's length columns hold (and so what was compared).
+    pub lengths: LengthKind,
     /// Rows kept by the loader.
     pub rows_kept: usize,
     /// Rows the loader rejected, with reasons.
@@ -286,6 +312,7 @@ pub struct VerifyReport {
 fn solve_row(
     robot: &Robot,
     row: &MeasuredRow,
+    lengths: LengthKind,
     closure: Closure,
     options: &StaticsOptions,
 ) -> crate::Result<Equilibrium> {
@@ -310,7 +337,34 @@ fn solve_row(
             "row {}: the cable-lengths closure does not apply the robot file's [effects] ({}); use the reference-tension closure",
             row.line, robot.effects
         ))),
-        Closure::CableLengths => statics::solve_with_cable_lengths(robot, position, &row.cable_lengths_m, options),
+        Closure::CableLengths => {
+            let cable_lengths = std::array::from_fn(|i| row.cable_lengths_m[i] - offset(robot, lengths, i));
+            statics::solve_with_cable_lengths(robot, position, &cable_lengths, options)
+        }
+    }
+}
+
+/// What cable `i`'s reading adds to its length: the robot's length offset
+/// for encoder readings, nothing for absolute lengths.
+fn offset(robot: &Robot, lengths: LengthKind, i: usize) -> f64 {
+    match lengths {
+        LengthKind::EncoderReadings => robot.length_offsets_m[i],
+        LengthKind::Absolute => 0.0,
+    }
+}
+
+/// The model's prediction of the data's length columns from a solved row:
+/// the closed form's lengths plus the offsets for encoder readings; the
+/// extended model (`[effects]`) predicts encoder readings (gain and offset
+/// applied), turned back into lengths for absolute data.
+fn predicted_lengths(robot: &Robot, lengths: LengthKind, equilibrium: &Equilibrium) -> [f64; CABLE_COUNT] {
+    let l = equilibrium.cable_lengths_m;
+    match (robot.effects.is_none(), lengths) {
+        (true, _) => std::array::from_fn(|i| l[i] + offset(robot, lengths, i)),
+        (false, LengthKind::EncoderReadings) => l,
+        (false, LengthKind::Absolute) => {
+            std::array::from_fn(|i| (l[i] - robot.length_offsets_m[i]) / robot.effects.encoder_gain[i])
+        }
     }
 }
 
@@ -389,7 +443,14 @@ fn median(values: &[f64]) -> Option<f64> {
 }
 
 /// Prediction against measurement for one solved row.
-fn compare_row(robot: &Robot, row: &MeasuredRow, closure: Closure, equilibrium: &Equilibrium) -> RowVerification {
+fn compare_row(
+    robot: &Robot,
+    row: &MeasuredRow,
+    lengths: LengthKind,
+    closure: Closure,
+    equilibrium: &Equilibrium,
+) -> RowVerification {
+    let predicted_length_m = predicted_lengths(robot, lengths, equilibrium);
     let [roll, pitch, yaw] = row.roll_pitch_yaw_deg;
     let measured_rotation = AngleReading::DOCUMENTED.rotation([pitch, roll, yaw]);
     let measured_pose = PlatformPose::new(Vector3::from(row.position_m), measured_rotation);
@@ -407,9 +468,9 @@ fn compare_row(robot: &Robot, row: &MeasuredRow, closure: Closure, equilibrium: 
         line: row.line,
         position_m: row.position_m,
         measured_length_m: row.cable_lengths_m,
-        predicted_length_m: equilibrium.cable_lengths_m,
+        predicted_length_m,
         length_error_pct: std::array::from_fn(|i| {
-            100.0 * (equilibrium.cable_lengths_m[i] - row.cable_lengths_m[i]).abs() / row.cable_lengths_m[i]
+            100.0 * (predicted_length_m[i] - row.cable_lengths_m[i]).abs() / row.cable_lengths_m[i]
         }),
         measured_tension_n,
         predicted_tension_n,
@@ -495,9 +556,9 @@ pub fn verify(robot: &Robot, data: &MeasuredData, closure: Closure, options: &St
     let mut unsolved = Vec::new();
     let mut solved_orientations = Vec::new();
     for row in &data.rows {
-        match solve_row(robot, row, closure, options) {
+        match solve_row(robot, row, data.lengths, closure, options) {
             Ok(equilibrium) => {
-                rows.push(compare_row(robot, row, closure, &equilibrium));
+                rows.push(compare_row(robot, row, data.lengths, closure, &equilibrium));
                 let [roll, pitch, yaw] = row.roll_pitch_yaw_deg;
                 solved_orientations.push((row.line, [pitch, roll, yaw], equilibrium.pose.rotation));
             }
@@ -518,6 +579,7 @@ pub fn verify(robot: &Robot, data: &MeasuredData, closure: Closure, options: &St
         robot: robot.name.clone(),
         data: data.path.clone(),
         closure,
+        lengths: data.lengths,
         rows_kept: data.rows.len(),
         rows_rejected: data.rejected.clone(),
         rows_unsolved: unsolved,

@@ -172,7 +172,14 @@ pub struct HiddenCase {
 }
 
 /// The mean reference-cable tension over `poses` sampled equilibria, newtons.
+///
+/// Errors: no pose to average over.
 pub fn mean_reference_tension_n(robot: &Robot, poses: usize, seed: u64) -> Result<f64> {
+    if poses == 0 {
+        return Err(Error::InvalidInput(
+            "poses (--poses): the mean reference tension needs at least 1 pose, got 0".into(),
+        ));
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let equilibria = sample_equilibria(robot, &Workspace::default_for(robot), poses, &mut rng)?;
     Ok(equilibria
@@ -589,7 +596,9 @@ pub fn refused_readings(measurements: &[PoseMeasurement]) -> Option<String> {
 /// [`PAIRS`] on every robot under every noise reading of `noises`, in
 /// parallel. `progress()` is called after each case. A case whose readings
 /// sagcal refuses ([`refused_readings`]) is reported as unmeasurable; any
-/// other failure is an error naming the case.
+/// other failure is an error naming the case. Options that cannot give a
+/// case (too few poses or seeds, no robot; [`HiddenEffectOptions::validate`])
+/// are an error before any case is run.
 pub fn run_sweep(
     robots: &[Robot],
     noises: &[NoisePreset],
@@ -598,6 +607,17 @@ pub fn run_sweep(
     options: &HiddenEffectOptions,
     progress: &(dyn Fn() + Sync),
 ) -> Result<SweepCases> {
+    options.validate()?;
+    if seeds == 0 {
+        return Err(Error::InvalidInput(
+            "seeds (--seeds): at least 1 case per hidden set is needed, got 0".into(),
+        ));
+    }
+    if robots.is_empty() || noises.is_empty() {
+        return Err(Error::InvalidInput(
+            "the sweep needs at least one robot (--robots) and one noise reading (--noise)".into(),
+        ));
+    }
     let mut sets: Vec<Vec<EffectKind>> = vec![Vec::new()];
     sets.extend(EffectKind::ALL.map(|k| vec![k]));
     sets.extend(PAIRS.map(|p| p.to_vec()));

@@ -54,6 +54,17 @@ pub struct Identifiability {
     pub mimicking_shift_mean_m: f64,
 }
 
+/// At least a calibration's poses and one segment per cable.
+fn check_counts(poses: usize, segments: usize) -> Result<()> {
+    if poses < crate::calib::MIN_POSES || segments < 1 {
+        return Err(Error::InvalidInput(format!(
+            "identifiability: at least {} poses (--poses) and 1 segment per cable (--segments) are needed, got {poses} and {segments}",
+            crate::calib::MIN_POSES
+        )));
+    }
+    Ok(())
+}
+
 /// The identifiability of a pulley radius (or any effect) on `truth`: Fisher
 /// information at the true equilibria of the discretised robot, and the bias
 /// of a baseline calibration of noise-free data.
@@ -65,6 +76,7 @@ pub fn identifiability(
     seed: u64,
     options: &HiddenEffectOptions,
 ) -> Result<Identifiability> {
+    check_counts(poses, options.segments)?;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let equilibria = sample_equilibria_with(truth, &Workspace::default_for(truth), poses, options.closure, &mut rng)?;
     let solved = solve_with_effects(truth, effects, &equilibria, options.segments)?;

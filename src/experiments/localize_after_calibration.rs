@@ -16,7 +16,8 @@
 //!
 //! The position error is the distance to the pool's pose (RecurDyn's logged
 //! position, or the model's equilibrium). A row no stable equilibrium
-//! explains, or that fails its consistency test, is counted as flagged and
+//! explains, that fails its consistency test or lies outside the robot's
+//! frame ([`crate::localize::Frame`]), is counted as flagged and
 //! left out of the error statistics.
 //!
 //! ```
@@ -200,7 +201,7 @@ pub fn run_trial(
             localiser_pose: None,
         };
         match calibrated.localize(&readings, None) {
-            Ok(found) if found.consistent && found.stable => {
+            Ok(found) if calibrated.flag(&found).is_none() => {
                 out.errors_m.push((found.pose.position_m - p.pose.position_m).norm());
                 out.predicted_sigma_m.push(found.position_sigma_m.norm());
             }

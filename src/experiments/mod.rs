@@ -23,6 +23,7 @@
 
 pub mod benchmark;
 pub mod hidden_effects;
+mod hidden_options;
 mod identifiability;
 pub mod localize_after_calibration;
 pub mod plan_candidates;

@@ -567,6 +567,33 @@ pub fn summarise(poses: usize, trials: Vec<TrialResult>) -> PoseCountResult {
     }
 }
 
+/// Check a protocol's counts before any trial runs: at least one pose
+/// count, each of [`crate::calib::MIN_POSES`] poses or more and at most the
+/// `pool` usable poses, and at least one trial (messages name the flags of
+/// `sagcal experiment table2`).
+pub fn check_counts(pose_counts: &[usize], trials: usize, pool: usize) -> Result<()> {
+    if pose_counts.is_empty() {
+        return Err(Error::InvalidInput("--poses: no pose count given".into()));
+    }
+    for &n in pose_counts {
+        if n < crate::calib::MIN_POSES {
+            return Err(Error::InvalidInput(format!(
+                "--poses {n}: at least {} poses per trial are needed to calibrate",
+                crate::calib::MIN_POSES
+            )));
+        }
+        if n > pool {
+            return Err(Error::InvalidInput(format!(
+                "--poses {n}: more poses than the data's {pool} usable poses"
+            )));
+        }
+    }
+    if trials == 0 {
+        return Err(Error::InvalidInput("--trials must be at least 1".into()));
+    }
+    Ok(())
+}
+
 /// Run `trials` trials for every pose count in parallel; `progress` is called once per finished trial.
 pub fn run_protocol(
     truth: &Robot,
@@ -601,20 +628,7 @@ pub fn run_selected_protocol(
     selection: &Selection,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<PoseCountResult>> {
-    for &n in pose_counts {
-        if n > pool.len() {
-            return Err(Error::InvalidInput(format!(
-                "{n} poses requested but the data has only {} usable poses",
-                pool.len()
-            )));
-        }
-        if n < crate::calib::MIN_POSES {
-            return Err(Error::InvalidInput(format!(
-                "{n} poses per trial: at least {} are needed",
-                crate::calib::MIN_POSES
-            )));
-        }
-    }
+    check_counts(pose_counts, trials, pool.len())?;
     let jobs: Vec<(usize, usize)> = pose_counts
         .iter()
         .flat_map(|&n| (0..trials).map(move |t| (n, t)))

@@ -46,6 +46,7 @@
 
 mod equations;
 mod equilibria;
+mod frame;
 mod newton;
 pub mod stiffness;
 
@@ -56,6 +57,7 @@ pub use equations::{
     PARAMETERS, UNKNOWNS,
 };
 pub use equilibria::tilt_deg;
+pub use frame::Frame;
 use newton::{Observation, Solution};
 
 use crate::error::{Error, Result};
@@ -163,6 +165,8 @@ pub struct Localizer {
     critical: [f64; MEASUREMENT_ROWS],
     /// The calibration covariance in slot order ([`PARAMETERS`]), if used.
     calibration: Option<SMatrix<f64, PARAMETERS, PARAMETERS>>,
+    /// Where the platform can hang ([`Frame`]).
+    frame: Frame,
 }
 
 /// The robot-order covariance (anchors of cables 1..4, then offsets) in
@@ -218,6 +222,7 @@ impl Localizer {
             .map(|c| to_slot_order(&slots, &c));
         Ok(Self {
             robot: robot.clone(),
+            frame: Frame::of(robot),
             shifted,
             calibration,
             slots,
@@ -242,6 +247,42 @@ impl Localizer {
     /// The options.
     pub fn options(&self) -> &LocalizeOptions {
         &self.options
+    }
+
+    /// The region the robot's platform can hang in.
+    pub fn frame(&self) -> &Frame {
+        &self.frame
+    }
+
+    /// Whether a solved row lies in the robot's frame ([`Frame::check`]):
+    /// the pose can then warm-start the next row.
+    pub fn frame_allows(&self, found: &Localized) -> bool {
+        self.frame
+            .check(&self.robot, &found.pose, &found.tensions, &found.position_sigma_m)
+            .is_none()
+    }
+
+    /// Why a solved row is not a trusted localisation, in the words `sagcal
+    /// localize` prints, or `None` for a good row: a pose outside the robot's
+    /// frame or with a cable lying on the floor ([`Frame::check`]), an
+    /// unstable equilibrium, or readings that fail their chi-square test.
+    pub fn flag(&self, found: &Localized) -> Option<String> {
+        if let Some(why) = self
+            .frame
+            .check(&self.robot, &found.pose, &found.tensions, &found.position_sigma_m)
+        {
+            return Some(why);
+        }
+        match (found.consistent, found.stable) {
+            (_, false) => {
+                Some("unstable equilibrium (the stiffness at fixed cable lengths is not positive definite)".into())
+            }
+            (false, _) => Some(format!(
+                "inconsistent: chi-square {:.2} with {} degree(s) of freedom",
+                found.chi_square, found.degrees_of_freedom
+            )),
+            _ => None,
+        }
     }
 
     /// The platform pose a localiser reading implies: `R_read M^-1` (the

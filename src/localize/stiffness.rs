@@ -12,6 +12,18 @@
 //! symmetric at an equilibrium up to the finite differences taken of `J^T`
 //! and `w` at fixed tensions).
 //!
+//! A massless cable (`g_c = 0`, the straight-line limit) fixes `paid` and
+//! `drop` through the ratio `f_v / f_h` alone: `d[paid, drop]/d[f_h, f_v]`
+//! is singular and the cable is rigid, an inextensible constraint `c_i xi =
+//! 0` (`c_i = u_2^T [d paid; d drop - dh]/dxi`, `u_2` its left singular
+//! vector of the zero singular value) whose tension is a Lagrange
+//! multiplier. A nearly massless one is the same up to a stiffness along
+//! `c_i` that grows as `1/g_c`. For those cables the stability test is the
+//! limit's: the symmetric part of the finite stiffness restricted to the
+//! motions that keep the rigid cables' lengths must be positive definite
+//! (the second-order condition of the constrained energy; the cables taut,
+//! `f_h > 0`, as every solved model is).
+//!
 //! ```
 //! use nalgebra::{Matrix6, Vector2, Vector3};
 //! use sagcal::localize::stiffness::{smallest_stiffness, stiffness};
@@ -35,7 +47,7 @@
 //! # Ok::<(), sagcal::Error>(())
 //! ```
 
-use nalgebra::{Matrix6, SMatrix, Vector3, Vector6};
+use nalgebra::{Matrix6, RowSVector, SMatrix, Vector3, Vector6};
 
 use super::equations::{ModelAtPose, SlotRobot};
 use crate::model::pose::PlatformPose;
@@ -82,18 +94,93 @@ pub fn stiffness(robot: &Robot, slots: &SlotRobot, pose: &PlatformPose, model: &
         );
     }
     let mut d_f = SMatrix::<f64, 8, 6>::zeros();
+    let mut rigid = [None; CABLE_COUNT];
     for (slot, &cable) in slots.cables.iter().enumerate().take(CABLE_COUNT) {
         let partials = &model.cables[slot];
         let mut b = SMatrix::<f64, 2, 6>::zeros();
         b.set_row(0, &(partials.span_pose * partials.d_span[0]));
         b.set_row(1, &(partials.span_pose * partials.d_span[1] - partials.height_pose));
-        let Some(inverse) = partials.d_tension.try_inverse() else {
+        let svd = partials.d_tension.svd(true, true);
+        let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
             return Matrix6::from_element(f64::NAN);
         };
-        let block = -(inverse * b);
+        // Singular values in decreasing order.
+        let (s1, s2) = (svd.singular_values[0], svd.singular_values[1]);
+        if !(s1 > 0.0 && s1.is_finite()) {
+            return Matrix6::from_element(f64::NAN);
+        }
+        let block = if s2 < RIGID * s1 {
+            // A (nearly) massless cable: keep the finite part and hold the
+            // length along `u2^T b xi = 0` (module docs).
+            rigid[slot] = Some(u.column(1).transpose() * b);
+            -(v_t.row(0).transpose() * (u.column(0).transpose() * b)) / s1
+        } else {
+            let Some(inverse) = partials.d_tension.try_inverse() else {
+                return Matrix6::from_element(f64::NAN);
+            };
+            -(inverse * b)
+        };
         d_f.fixed_view_mut::<2, 6>(2 * cable, 0).copy_from(&block);
     }
-    -(d_q + d_q_d_f * d_f)
+    let k = -(d_q + d_q_d_f * d_f);
+    if rigid.iter().all(Option::is_none) {
+        return k;
+    }
+    restrict_to_rigid_constraints(&k, &rigid)
+}
+
+/// Ratio of `d[paid, drop]/d[f_h, f_v]`'s singular values below which a
+/// cable counts as rigid: its length fixes `paid` and `drop` almost only
+/// through the ratio `f_v / f_h`, the tension's magnitude moving them by
+/// less than 1e-6 of that. Inverting such a matrix would lose the finite
+/// part of the stiffness (relative error ~ eps / ratio^2), while treating the
+/// cable as inextensible errs by about the ratio itself.
+const RIGID: f64 = 1e-6;
+
+/// The stiffness of a platform held by rigid cables (constraint rows
+/// `c_i`, one per rigid cable) and finite parts `k`: `K_eff = Z (Z^T S Z)
+/// Z^T + |S| Y Y^T` with `S` the symmetric part of `k`, `Z` an orthonormal
+/// basis of the motions that keep every rigid cable's length (`c_i xi = 0`)
+/// and `Y` its complement. A taut inextensible cable's stiffness along its
+/// constraint is infinite; `K_eff` puts `|S|` there so the matrix stays
+/// finite: its smallest eigenvalue has the sign of the limit's (those of
+/// `Z^T S Z` and a positive one), which is what the stability test reads.
+fn restrict_to_rigid_constraints(k: &Matrix6<f64>, rigid: &[Option<RowSVector<f64, 6>>; CABLE_COUNT]) -> Matrix6<f64> {
+    if !k.iter().all(|v| v.is_finite()) {
+        return Matrix6::from_element(f64::NAN);
+    }
+    let mut c_t_c = Matrix6::<f64>::zeros();
+    let mut count = 0;
+    for row in rigid.iter().flatten() {
+        let norm = row.norm();
+        if !(norm > 0.0 && norm.is_finite()) {
+            return Matrix6::from_element(f64::NAN);
+        }
+        let unit = row / norm;
+        c_t_c += unit.transpose() * unit;
+        count += 1;
+    }
+    let symmetric = (k + k.transpose()) * 0.5;
+    let scale = symmetric.norm().max(f64::MIN_POSITIVE);
+    let eigen = c_t_c.symmetric_eigen();
+    let mut order: Vec<usize> = (0..6).collect();
+    order.sort_by(|&a, &b| eigen.eigenvalues[a].total_cmp(&eigen.eigenvalues[b]));
+    let mut out = Matrix6::<f64>::zeros();
+    // The 6 - count smallest eigenvalues of C^T C: the motions keeping the lengths.
+    let free = 6 - count;
+    let z = SMatrix::<f64, 6, 6>::from_fn(|r, c| {
+        if c < free {
+            eigen.eigenvectors[(r, order[c])]
+        } else {
+            0.0
+        }
+    });
+    out += z * (z.transpose() * symmetric * z) * z.transpose();
+    for &index in &order[free..] {
+        let y = eigen.eigenvectors.column(index);
+        out += y * y.transpose() * scale;
+    }
+    out
 }
 
 /// The smallest eigenvalue of `K`'s symmetric part (NaN if `K` is not finite);

@@ -202,6 +202,7 @@ pub fn sample_equilibria_with(
     while poses.len() < count {
         let max_yaw_deg = closure.draw(rng);
         loop {
+            crate::cancel::check()?;
             attempts += 1;
             if attempts > 100 * count + 1000 {
                 return Err(Error::InvalidInput(format!(

@@ -296,6 +296,9 @@ pub fn optimize_cached(
     let mut termination = Termination::MaxIterations;
     for iteration in 1..=params.max_iterations {
         crate::steps::tick();
+        if crate::cancel::requested() {
+            return Err("cancelled".into());
+        }
         let cost = linearization.cost;
         let gradient = &linearization.gradient;
         if gradient.iter().fold(0.0f64, |m, g| m.max(g.abs())) < params.gradient_tolerance {
