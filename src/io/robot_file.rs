@@ -55,6 +55,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::model::effects::Effects;
 use crate::model::robot::{PaperRobot, ParameterCovariance, Robot, Workspace, CABLE_COUNT, CALIBRATED_PARAMETERS};
+use crate::model::{geometry, plausibility};
 
 /// One cable of a robot file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -219,6 +220,9 @@ impl Robot {
     }
 
     /// Validate parsed file contents; `path` is only used in error messages.
+    /// Beyond every field's own range, the robot must be a suspended robot
+    /// ([`geometry::check_robot`]: anchors around and above the platform and
+    /// its workspace) of plausible magnitudes ([`plausibility`]).
     pub fn try_from_file_contents(file: RobotFile, path: &Path) -> Result<Self> {
         let fail = |message: String| Error::Robot {
             path: path.to_path_buf(),
@@ -304,7 +308,7 @@ impl Robot {
             .map(CalibrationEntry::covariance)
             .transpose()
             .map_err(fail)?;
-        Ok(Robot {
+        let robot = Robot {
             name: file.name,
             anchors_m,
             attachments_m,
@@ -317,7 +321,12 @@ impl Robot {
             effects,
             paper_robot: file.paper_robot,
             calibration_covariance_m2,
-        })
+        };
+        // What a suspended robot needs and what no real one falls outside (each message says why).
+        plausibility::check_masses(&robot).map_err(fail)?;
+        geometry::check_robot(&robot).map_err(fail)?;
+        plausibility::check_effects(&robot, &robot.effects).map_err(|e| fail(format!("table `effects`: {e}")))?;
+        Ok(robot)
     }
 
     /// The file representation of this robot.
