@@ -211,6 +211,14 @@ impl RobotFile {
     }
 }
 
+/// Effects in their ranges; what a suspended robot needs and what no real one falls outside (each message says why).
+fn suspended_and_plausible(robot: &Robot) -> std::result::Result<(), String> {
+    robot.effects.validate().map_err(|e| format!("table `effects`: {e}"))?;
+    plausibility::check_masses(robot)?;
+    geometry::check_robot(robot)?;
+    plausibility::check_effects(robot, &robot.effects).map_err(|e| format!("table `effects`: {e}"))
+}
+
 /// Conversions between [`Robot`] and its file: reading validates every field
 /// (errors name the file and the field), writing gives the file contents.
 impl Robot {
@@ -219,10 +227,8 @@ impl Robot {
         Self::try_from_file_contents(RobotFile::read(path)?, path)
     }
 
-    /// Validate parsed file contents; `path` is only used in error messages.
-    /// Beyond every field's own range, the robot must be a suspended robot
-    /// ([`geometry::check_robot`]: anchors around and above the platform and
-    /// its workspace) of plausible magnitudes ([`plausibility`]).
+    /// Validate parsed file contents (a suspended robot of plausible magnitudes: [`geometry`], [`plausibility`]);
+    /// `path` is only used in error messages.
     pub fn try_from_file_contents(file: RobotFile, path: &Path) -> Result<Self> {
         let fail = |message: String| Error::Robot {
             path: path.to_path_buf(),
@@ -300,8 +306,6 @@ impl Robot {
             .map(WorkspaceEntry::validated)
             .transpose()
             .map_err(fail)?;
-        let effects = file.effects.unwrap_or_default();
-        effects.validate().map_err(|e| fail(format!("table `effects`: {e}")))?;
         let calibration_covariance_m2 = file
             .calibration
             .as_ref()
@@ -318,14 +322,11 @@ impl Robot {
             reference_cable: file.reference_cable - 1,
             length_offsets_m,
             workspace,
-            effects,
+            effects: file.effects.unwrap_or_default(),
             paper_robot: file.paper_robot,
             calibration_covariance_m2,
         };
-        // What a suspended robot needs and what no real one falls outside (each message says why).
-        plausibility::check_masses(&robot).map_err(fail)?;
-        geometry::check_robot(&robot).map_err(fail)?;
-        plausibility::check_effects(&robot, &robot.effects).map_err(|e| fail(format!("table `effects`: {e}")))?;
+        suspended_and_plausible(&robot).map_err(fail)?;
         Ok(robot)
     }
 
