@@ -183,7 +183,7 @@ fn lowest_anchor(robot: &Robot) -> (usize, f64) {
 /// was found, the rule and why.
 pub fn check_robot(robot: &Robot) -> Result<(), String> {
     let footprint = Footprint::of(robot);
-    if !(footprint.width_m > MIN_FOOTPRINT_WIDTH_FRACTION * footprint.diameter_m) {
+    if footprint.width_m <= MIN_FOOTPRINT_WIDTH_FRACTION * footprint.diameter_m {
         return Err(format!(
             "anchors: their horizontal projections are collinear (the footprint is {:.3} m wide across {:.3} m, less than {} %): \
              a suspended robot's cables pull its platform towards their anchors, and the pulls cancel only inside the anchors' \
@@ -229,7 +229,7 @@ pub fn check_workspace(robot: &Robot, workspace: &Workspace) -> Result<(), Strin
         ));
     }
     let (lowest, z) = lowest_anchor(robot);
-    if !(max_m[2] < z) {
+    if max_m[2] >= z {
         return Err(format!(
             "the box's top z = {} m is not below the anchor of cable {} (z = {z} m): a suspended robot's cables hold \
              the platform up from above, so every position it is asked to reach must be below every anchor",
