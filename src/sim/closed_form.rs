@@ -186,8 +186,8 @@ impl std::fmt::Display for Closure {
 
 /// Draws [`sample_equilibria_with`] makes before it gives up when none of
 /// them had an equilibrium: at a success rate of 1 % the chance of 1000
-/// failures in a row is 4e-5, and the robots' own boxes succeed at over 90 %
-/// (a box that fails this is not where the robot can hang its platform).
+/// failures in a row is 4e-5 (a box that fails this is not where the robot
+/// can hang its platform).
 pub const FIRST_DRAWS: usize = 1000;
 
 /// Draw `count` static equilibria spread over `workspace`, each closed by
