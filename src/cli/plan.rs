@@ -60,13 +60,19 @@ pub fn run(args: &PlanArgs) -> sagcal::Result<()> {
         args.seed, args.poses, args.criterion
     );
     let settings = settings(args, &robot)?;
-    let mut bar = None;
+    let (mut bar, mut what) = (None, String::new());
     let mut progress = |step: PlanProgress<'_>| match step {
         PlanProgress::Drawing(message) => {
             let spinner = progress_bar(1, "{msg} {spinner} {elapsed}");
-            spinner.set_message(message.to_string());
+            what = message.to_string();
+            spinner.set_message(what.clone());
             spinner.enable_steady_tick(std::time::Duration::from_millis(200));
             bar = Some(spinner);
+        }
+        PlanProgress::Found { found, count } => {
+            if let Some(b) = &bar {
+                b.set_message(format!("{what}: {found} of {count} found"));
+            }
         }
         PlanProgress::Drawn => bar.take().into_iter().for_each(|b| b.finish_and_clear()),
     };

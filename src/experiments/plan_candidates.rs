@@ -38,13 +38,14 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::localize::stiffness::{smallest_stiffness, stiffness};
 use crate::localize::{model_at_pose, SlotRobot};
+use crate::model::geometry::check_workspace;
 use crate::model::robot::{Robot, Workspace};
 use crate::model::statics::Equilibrium;
 use crate::plan::Margins;
 use crate::sim::closed_form::sample_equilibria;
 
 /// Draws per candidate before giving up on it (most of a frame is reachable).
-const ATTEMPTS_PER_CANDIDATE: usize = 50;
+pub const ATTEMPTS_PER_CANDIDATE: usize = 50;
 
 /// Candidates and what was left out.
 #[derive(Debug, Clone, Serialize)]
@@ -121,6 +122,52 @@ pub fn filter_candidates(robot: &Robot, equilibria: Vec<Equilibrium>, margins: &
     set
 }
 
+/// What drawing one candidate gave.
+struct Drawn {
+    /// The candidate, if one was found.
+    equilibrium: Option<Equilibrium>,
+    /// Poses drawn that broke a margin, and the first one's reason.
+    margin: usize,
+    first_margin: Option<String>,
+    /// Poses drawn that were unstable.
+    unstable: usize,
+    /// Why no pose could be drawn at all (the box gave no equilibrium).
+    no_equilibrium: Option<String>,
+}
+
+/// Candidate `k` of the stream `seed` (see [`draw_candidates`]).
+fn draw_one(robot: &Robot, slots: &SlotRobot, workspace: &Workspace, margins: &Margins, seed: u64, k: usize) -> Drawn {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ k as u64);
+    let mut drawn = Drawn {
+        equilibrium: None,
+        margin: 0,
+        first_margin: None,
+        unstable: 0,
+        no_equilibrium: None,
+    };
+    for _ in 0..ATTEMPTS_PER_CANDIDATE {
+        let mut one = match sample_equilibria(robot, workspace, 1, &mut rng) {
+            Ok(one) => one,
+            Err(e) => {
+                // FIRST_DRAWS positions in a row without an equilibrium: more would not find one.
+                drawn.no_equilibrium = Some(e.to_string());
+                return drawn;
+            }
+        };
+        let eq = one.remove(0);
+        if let Some(reason) = margins.violation(robot, &eq) {
+            drawn.margin += 1;
+            drawn.first_margin.get_or_insert(reason);
+        } else if !is_stable(robot, slots, &eq) {
+            drawn.unstable += 1;
+        } else {
+            drawn.equilibrium = Some(eq);
+            return drawn;
+        }
+    }
+    drawn
+}
+
 /// Draw `count` candidates in `workspace`: candidate `k` draws level
 /// equilibria ([`sample_equilibria`]) from its own stream `(seed, k)` until
 /// one keeps the margins and is stable, so the set does not depend on the
@@ -128,6 +175,16 @@ pub fn filter_candidates(robot: &Robot, equilibria: Vec<Equilibrium>, margins: &
 /// with a level platform hangs near the most level member of the family (the
 /// member of the straight-cable tension estimate, one solve instead of the
 /// scan, tilts up to 25 degrees at the frame's edges on the large robot).
+///
+/// The box is checked against the robot first
+/// ([`crate::model::geometry::check_workspace`]), and the work is bounded:
+/// a candidate gives up after [`ATTEMPTS_PER_CANDIDATE`] poses that break a
+/// margin or are unstable, or at once when the box gave no equilibrium in
+/// [`crate::sim::closed_form::FIRST_DRAWS`] draws; candidates are drawn in
+/// batches of 1, 4, 16, ... in candidate order, and the first batch with a
+/// candidate that gave up ends the drawing with an error saying why (a
+/// hopeless box fails on its first candidate, within [`ATTEMPTS_PER_CANDIDATE`]
+/// poses).
 pub fn draw_candidates(
     robot: &Robot,
     workspace: &Workspace,
@@ -135,51 +192,68 @@ pub fn draw_candidates(
     margins: &Margins,
     seed: u64,
 ) -> Result<CandidateSet> {
+    draw_candidates_with_progress(robot, workspace, count, margins, seed, &mut |_| {})
+}
+
+/// [`draw_candidates`], calling `progress` with the number of candidates
+/// found after each batch.
+pub fn draw_candidates_with_progress(
+    robot: &Robot,
+    workspace: &Workspace,
+    count: usize,
+    margins: &Margins,
+    seed: u64,
+    progress: &mut dyn FnMut(usize),
+) -> Result<CandidateSet> {
+    check_workspace(robot, workspace)
+        .map_err(|e| Error::InvalidInput(format!("robot `{}`: no candidate pose can be drawn: {e}", robot.name)))?;
     let slots = SlotRobot::new(robot);
-    let drawn: Vec<(Option<Equilibrium>, usize, usize)> = (0..count)
-        .into_par_iter()
-        .map(|k| {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ k as u64);
-            let (mut margin, mut unstable) = (0, 0);
-            for _ in 0..ATTEMPTS_PER_CANDIDATE {
-                let Ok(mut one) = sample_equilibria(robot, workspace, 1, &mut rng) else {
-                    continue;
-                };
-                let eq = one.remove(0);
-                match judge(robot, &slots, margins, &eq) {
-                    Verdict::Kept => return (Some(eq), margin, unstable),
-                    Verdict::Margin => margin += 1,
-                    Verdict::Unstable => unstable += 1,
-                }
-            }
-            (None, margin, unstable)
-        })
-        .collect();
     let mut set = CandidateSet {
         equilibria: Vec::with_capacity(count),
         examined: 0,
         outside_margins: 0,
         unstable: 0,
     };
-    for (eq, margin, unstable) in drawn {
-        set.examined += 1 + margin + unstable;
-        set.outside_margins += margin;
-        set.unstable += unstable;
-        if let Some(eq) = eq {
-            set.equilibria.push(eq);
-        } else {
-            set.examined -= 1;
+    let (mut start, mut batch) = (0, 1);
+    while start < count {
+        let end = count.min(start + batch);
+        let drawn: Vec<Drawn> = (start..end)
+            .into_par_iter()
+            .map(|k| draw_one(robot, &slots, workspace, margins, seed, k))
+            .collect();
+        for (k, d) in (start..end).zip(drawn) {
+            set.examined += d.margin + d.unstable + usize::from(d.equilibrium.is_some());
+            set.outside_margins += d.margin;
+            set.unstable += d.unstable;
+            match d.equilibrium {
+                Some(eq) => set.equilibria.push(eq),
+                None => return Err(gave_up(robot, workspace, count, k, &d)),
+            }
         }
-    }
-    if set.equilibria.len() < count {
-        return Err(Error::InvalidInput(format!(
-            "only {} of {count} candidate poses found in the workspace {:?}..{:?} ({} outside the margins, {} unstable): check the box against the anchors",
-            set.equilibria.len(),
-            workspace.min_m,
-            workspace.max_m,
-            set.outside_margins,
-            set.unstable
-        )));
+        progress(set.equilibria.len());
+        start = end;
+        batch *= 4;
     }
     Ok(set)
+}
+
+/// The error of candidate `k`, which found no pose.
+fn gave_up(robot: &Robot, workspace: &Workspace, count: usize, k: usize, drawn: &Drawn) -> Error {
+    let why = match (&drawn.no_equilibrium, &drawn.first_margin) {
+        (Some(e), _) => e.clone(),
+        (None, first) => format!(
+            "its {ATTEMPTS_PER_CANDIDATE} poses drawn all failed: {} outside the margins{}, {} unstable at fixed cable lengths",
+            drawn.margin,
+            first.as_ref().map_or(String::new(), |r| format!(" (the first: {r})")),
+            drawn.unstable
+        ),
+    };
+    Error::InvalidInput(format!(
+        "no candidate pose for robot `{}` in the box {:?} .. {:?} m: candidate {} of {count} found none ({why}), \
+         so the drawing stopped there: check the box against the anchors",
+        robot.name,
+        workspace.min_m,
+        workspace.max_m,
+        k + 1
+    ))
 }

@@ -26,15 +26,16 @@
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use super::plan_candidates::{draw_candidates, filter_candidates, frame_workspace, CandidateSet};
+use super::plan_candidates::{draw_candidates_with_progress, filter_candidates, frame_workspace, CandidateSet};
 use super::table2::{pose_pool, Source};
-use crate::calib::{CalibrationOptions, OrientationPrior};
+use crate::calib::{CalibrationOptions, OrientationPrior, MIN_POSES};
 use crate::error::{Error, Result};
+use crate::model::geometry::check_workspace;
 use crate::model::robot::{Robot, Workspace};
 use crate::model::sensors::NoisePreset;
 use crate::model::statics::Equilibrium;
 use crate::model::PoseMeasurement;
-use crate::plan::{candidate_information, plan_poses, Criterion, DesignOptions, Margins, Plan};
+use crate::plan::{candidate_information, distinct_poses, plan_poses, Criterion, DesignOptions, Margins, Plan};
 
 /// Candidates drawn when none are given (`sagcal plan --candidates`'s default).
 pub const DEFAULT_CANDIDATES: usize = 1000;
@@ -101,6 +102,13 @@ impl PlanSettings {
 pub enum PlanProgress<'a> {
     /// Drawing candidates (the long part), described in the command's words.
     Drawing(&'a str),
+    /// Candidates found so far, of the count asked for (after each batch of [`draw_candidates_with_progress`]).
+    Found {
+        /// Candidates found.
+        found: usize,
+        /// Candidates asked for.
+        count: usize,
+    },
     /// The candidates are drawn.
     Drawn,
 }
@@ -206,7 +214,13 @@ fn candidates(
     let (workspace, count) = match &settings.candidates {
         CandidateSource::Logged { poses, label } => {
             let pool = pose_pool(robot, poses, Source::Model)?;
-            let set = filter_candidates(robot, pool.into_iter().map(|p| p.equilibrium).collect(), margins);
+            let equilibria: Vec<Equilibrium> = pool.iter().map(|p| p.equilibrium.clone()).collect();
+            let groups = distinct_poses(&equilibria, MIN_POSES);
+            if groups.len() < MIN_POSES {
+                let lines: Vec<usize> = pool.iter().map(|p| p.line).collect();
+                return Err(too_few_distinct(label, &lines, &groups));
+            }
+            let set = filter_candidates(robot, equilibria, margins);
             return Ok((set, None, label.clone()));
         }
         CandidateSource::Drawn { workspace, count } => (*workspace, *count),
@@ -219,13 +233,43 @@ fn candidates(
             "the frame below the anchors (10 % margin, z 5-75 % of the anchors' height)",
         ),
     };
+    // A box the robot cannot hang its platform in is named before any pose is drawn.
+    check_workspace(robot, &workspace).map_err(|e| {
+        Error::InvalidInput(format!(
+            "{from} {:?} .. {:?} m cannot give candidate poses for robot `{}`: {e}",
+            workspace.min_m, workspace.max_m, robot.name
+        ))
+    })?;
     progress(PlanProgress::Drawing(&format!(
         "drawing {count} candidate poses in {from}, seed {}",
         settings.seed
     )));
-    let set = draw_candidates(robot, &workspace, count, margins, settings.seed)?;
+    let set = draw_candidates_with_progress(robot, &workspace, count, margins, settings.seed, &mut |found| {
+        progress(PlanProgress::Found { found, count })
+    })?;
     progress(PlanProgress::Drawn);
     Ok((set, Some(workspace), format!("{count} drawn in {from}")))
+}
+
+/// The error for logged poses of fewer than [`MIN_POSES`] distinct poses
+/// (`groups` from [`distinct_poses`]), naming the lines of each repeated one.
+fn too_few_distinct(label: &str, lines: &[usize], groups: &[Vec<usize>]) -> Error {
+    let repeated: Vec<String> = groups
+        .iter()
+        .filter(|g| g.len() > 1)
+        .map(|g| {
+            let named: Vec<String> = g.iter().map(|&k| lines[k].to_string()).collect();
+            format!("lines {} are the same pose", named.join(", "))
+        })
+        .collect();
+    Error::InvalidInput(format!(
+        "{label}: the {} logged poses are only {} distinct pose{}{}: a plan needs at least {MIN_POSES} distinct poses, \
+         each giving 4 equations for the 12 anchor coordinates and 4 offsets",
+        lines.len(),
+        groups.len(),
+        if groups.len() == 1 { "" } else { "s" },
+        if repeated.is_empty() { String::new() } else { format!(" ({})", repeated.join("; ")) }
+    ))
 }
 
 /// Plan the calibration of `robot` (the nominal model): the candidates of

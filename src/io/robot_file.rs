@@ -55,6 +55,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::model::effects::Effects;
 use crate::model::robot::{PaperRobot, ParameterCovariance, Robot, Workspace, CABLE_COUNT, CALIBRATED_PARAMETERS};
+use crate::model::{geometry, plausibility};
 
 /// One cable of a robot file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -210,6 +211,14 @@ impl RobotFile {
     }
 }
 
+/// Effects in their ranges; what a suspended robot needs and what no real one falls outside (each message says why).
+fn suspended_and_plausible(robot: &Robot) -> std::result::Result<(), String> {
+    robot.effects.validate().map_err(|e| format!("table `effects`: {e}"))?;
+    plausibility::check_masses(robot)?;
+    geometry::check_robot(robot)?;
+    plausibility::check_effects(robot, &robot.effects).map_err(|e| format!("table `effects`: {e}"))
+}
+
 /// Conversions between [`Robot`] and its file: reading validates every field
 /// (errors name the file and the field), writing gives the file contents.
 impl Robot {
@@ -218,7 +227,8 @@ impl Robot {
         Self::try_from_file_contents(RobotFile::read(path)?, path)
     }
 
-    /// Validate parsed file contents; `path` is only used in error messages.
+    /// Validate parsed file contents (a suspended robot of plausible magnitudes: [`geometry`], [`plausibility`]);
+    /// `path` is only used in error messages.
     pub fn try_from_file_contents(file: RobotFile, path: &Path) -> Result<Self> {
         let fail = |message: String| Error::Robot {
             path: path.to_path_buf(),
@@ -296,15 +306,13 @@ impl Robot {
             .map(WorkspaceEntry::validated)
             .transpose()
             .map_err(fail)?;
-        let effects = file.effects.unwrap_or_default();
-        effects.validate().map_err(|e| fail(format!("table `effects`: {e}")))?;
         let calibration_covariance_m2 = file
             .calibration
             .as_ref()
             .map(CalibrationEntry::covariance)
             .transpose()
             .map_err(fail)?;
-        Ok(Robot {
+        let robot = Robot {
             name: file.name,
             anchors_m,
             attachments_m,
@@ -314,10 +322,12 @@ impl Robot {
             reference_cable: file.reference_cable - 1,
             length_offsets_m,
             workspace,
-            effects,
+            effects: file.effects.unwrap_or_default(),
             paper_robot: file.paper_robot,
             calibration_covariance_m2,
-        })
+        };
+        suspended_and_plausible(&robot).map_err(fail)?;
+        Ok(robot)
     }
 
     /// The file representation of this robot.

@@ -3,7 +3,9 @@
 //! parameters ([`robot`]), the statics that balance the four cables against
 //! gravity (eq. 5-11, [`statics`]), the effects the paper's model lacks
 //! ([`effects`]), the sensors and their noise ([`sensors`]) and one pose's
-//! measurements ([`measurement`]). No file format is seen here.
+//! measurements ([`measurement`]); the geometry a suspended robot needs
+//! ([`geometry`]) and the magnitudes no real robot falls outside
+//! ([`plausibility`]). No file format is seen here.
 //!
 //! ```
 //! use nalgebra::Vector3;
@@ -26,7 +28,9 @@
 pub mod catenary;
 pub mod effect_ranges;
 pub mod effects;
+pub mod geometry;
 pub mod measurement;
+pub mod plausibility;
 pub mod pose;
 pub mod robot;
 pub mod sensors;

@@ -1,5 +1,6 @@
 //! Which static poses a plan may use: positive cable tensions with a margin
-//! and every cable inside the frame. (Stability at fixed cable lengths is the
+//! and every cable inside the frame; and which of them are the same pose
+//! ([`distinct_poses`]). (Stability at fixed cable lengths is the
 //! third condition; it needs the localiser's stiffness and is checked where
 //! candidates are drawn, `experiments::plan_candidates`.)
 //!
@@ -17,6 +18,9 @@
 //! // Anchors 48 m up: every cable sags below them, so a 48 m clearance fails.
 //! let high = Margins { min_cable_height_m: 48.0, ..margins };
 //! assert!(high.violation(&robot, &eq).unwrap().contains("sags to"));
+//! // The same pose twice is one distinct pose.
+//! let groups = sagcal::plan::candidates::distinct_poses(&[eq.clone(), eq.clone()], 4);
+//! assert_eq!(groups, vec![vec![0, 1]]);
 //! # Ok::<(), sagcal::Error>(())
 //! ```
 
@@ -79,4 +83,33 @@ fn lowest_height_above_anchor_m(cable: &crate::model::Catenary) -> f64 {
     (0..=64)
         .map(|k| cable.height_above_anchor_m(cable.span_m * k as f64 / 64.0))
         .fold(0.0, f64::min)
+}
+
+/// Two candidates whose positions differ by at most this, metres, and whose
+/// orientations by at most [`SAME_ORIENTATION_RAD`], are the same pose: a
+/// micrometre, below any localiser's resolution.
+pub const SAME_POSITION_M: f64 = 1e-6;
+/// See [`SAME_POSITION_M`]: a microradian, radians.
+pub const SAME_ORIENTATION_RAD: f64 = 1e-6;
+
+/// The candidates grouped by pose ([`SAME_POSITION_M`],
+/// [`SAME_ORIENTATION_RAD`]), each group the indices of one pose in the
+/// order of first appearance; at most `limit` groups are formed (the
+/// candidates beyond them are left out), so asking whether there are at
+/// least `limit` distinct poses costs `limit` comparisons per candidate.
+pub fn distinct_poses(candidates: &[Equilibrium], limit: usize) -> Vec<Vec<usize>> {
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for (k, eq) in candidates.iter().enumerate() {
+        let same = groups.iter().position(|g| {
+            let first = &candidates[g[0]].pose;
+            (first.position_m - eq.pose.position_m).norm() <= SAME_POSITION_M
+                && first.rotation.angle_to(&eq.pose.rotation) <= SAME_ORIENTATION_RAD
+        });
+        match same {
+            Some(g) => groups[g].push(k),
+            None if groups.len() < limit => groups.push(vec![k]),
+            None => {}
+        }
+    }
+    groups
 }

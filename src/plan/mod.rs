@@ -48,12 +48,12 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 pub use bound::{plan_bound, PlanBound};
-pub use candidates::Margins;
+pub use candidates::{distinct_poses, Margins};
 pub use design::{choose_more_poses, choose_poses, Criterion, Design, DesignOptions};
 pub use information::{pose_information, PoseInformation};
 pub use order::{path_length_m, visiting_order};
 
-use crate::calib::CalibrationOptions;
+use crate::calib::{CalibrationOptions, MIN_POSES};
 use crate::error::{Error, Result};
 use crate::model::robot::Robot;
 use crate::model::statics::Equilibrium;
@@ -158,12 +158,7 @@ pub fn plan_poses(
     seed: u64,
 ) -> Result<Plan> {
     let design = choose_poses(information, options)?;
-    let bound = plan_bound(information, &design.chosen).ok_or_else(|| {
-        Error::InvalidInput(format!(
-            "the {} chosen poses do not determine every anchor and offset: choose at least 4",
-            design.chosen.len()
-        ))
-    })?;
+    let bound = plan_bound(information, &design.chosen).ok_or_else(|| undetermined(candidates, &design.chosen))?;
     let points: Vec<Vector3<f64>> = design.chosen.iter().map(|&k| candidates[k].pose.position_m).collect();
     let order: Vec<usize> = visiting_order(&points, start_m)
         .into_iter()
@@ -178,4 +173,23 @@ pub fn plan_poses(
         order,
         design,
     })
+}
+
+/// Why the poses `chosen` do not determine every anchor and offset: too
+/// few, too few distinct, or an arrangement that leaves a direction free.
+fn undetermined(candidates: &[Equilibrium], chosen: &[usize]) -> Error {
+    let poses: Vec<Equilibrium> = chosen.iter().map(|&k| candidates[k].clone()).collect();
+    let distinct = distinct_poses(&poses, MIN_POSES).len();
+    let why = if chosen.len() < MIN_POSES {
+        format!("choose at least {MIN_POSES}")
+    } else if distinct < MIN_POSES {
+        format!("only {distinct} of them are distinct poses, and at least {MIN_POSES} are needed")
+    } else {
+        "their arrangement leaves a direction of the anchors or offsets free: draw the candidates over a wider box"
+            .into()
+    };
+    Error::InvalidInput(format!(
+        "the {} chosen poses do not determine every anchor and offset (each pose gives 4 equations for the 12 anchor coordinates and 4 offsets): {why}",
+        chosen.len()
+    ))
 }

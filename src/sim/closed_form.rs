@@ -35,6 +35,7 @@ use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::model::geometry;
 use crate::model::measurement::PoseMeasurement;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
@@ -183,11 +184,22 @@ impl std::fmt::Display for Closure {
     }
 }
 
+/// Draws [`sample_equilibria_with`] makes before it gives up when none of
+/// them had an equilibrium: at a success rate of 1 % the chance of 1000
+/// failures in a row is 4e-5 (a box that fails this is not where the robot
+/// can hang its platform).
+pub const FIRST_DRAWS: usize = 1000;
+
 /// Draw `count` static equilibria spread over `workspace`, each closed by
 /// `closure`. A pose's closure is chosen first (a [`Closure::Mixed`] draw),
 /// then positions (and yaws) are drawn until one has that equilibrium: a
 /// position without it, or where the family does not reach the drawn yaw, is
 /// redrawn. [`Closure::Level`] draws exactly what [`sample_equilibria`] always did.
+///
+/// The box is checked against the robot first ([`geometry::check_workspace`]:
+/// below every anchor, under their footprint); the draws are bounded: an
+/// error after [`FIRST_DRAWS`] draws without any equilibrium, or after
+/// `100 count + 1000` draws in all, says how many draws failed.
 pub fn sample_equilibria_with(
     robot: &Robot,
     workspace: &Workspace,
@@ -196,18 +208,27 @@ pub fn sample_equilibria_with(
     rng: &mut impl Rng,
 ) -> Result<Vec<Equilibrium>> {
     closure.validate()?;
+    geometry::check_workspace(robot, workspace)
+        .map_err(|e| Error::InvalidInput(format!("robot `{}`: no pose can be drawn: {e}", robot.name)))?;
     let options = StaticsOptions::default();
     let mut poses = Vec::with_capacity(count);
     let mut attempts = 0;
+    let limit = 100 * count + 1000;
     while poses.len() < count {
         let max_yaw_deg = closure.draw(rng);
         loop {
             crate::cancel::check()?;
             attempts += 1;
-            if attempts > 100 * count + 1000 {
+            if attempts > limit || (poses.is_empty() && attempts > FIRST_DRAWS) {
+                let drawn = attempts - 1;
                 return Err(Error::InvalidInput(format!(
-                    "only {} of {count} reachable static poses ({closure} closure) found in the workspace {workspace:?}",
-                    poses.len()
+                    "robot `{}`: only {} of {count} reachable static poses ({closure} closure) found in the box {:?} .. {:?} m \
+                     after {drawn} draws: {:.1} % of the positions drawn had no equilibrium with every cable taut",
+                    robot.name,
+                    poses.len(),
+                    workspace.min_m,
+                    workspace.max_m,
+                    100.0 * (drawn - poses.len()) as f64 / drawn as f64
                 )));
             }
             let position = Vector3::from_fn(|i, _| rng.random_range(workspace.min_m[i]..=workspace.max_m[i]));

@@ -79,6 +79,8 @@ pub fn solve_with_effects(
     effects
         .validate()
         .map_err(|e| Error::InvalidInput(format!("effects: {e}")))?;
+    crate::model::plausibility::check_effects(robot, effects)
+        .map_err(|e| Error::InvalidInput(format!("effects on robot `{}`: {e}", robot.name)))?;
     let options = discretised_options(robot, effects, segments);
     equilibria
         .iter()
