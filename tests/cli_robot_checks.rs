@@ -281,3 +281,65 @@ fn implausible_masses_and_pulleys_are_refused_when_read() {
     );
     assert!(!dir.path().join("x.csv").exists());
 }
+
+/// The work count of a run (`SAGCAL_REPORT_STEPS`): a bound on its time that no clock decides.
+fn steps(out: &Output) -> u64 {
+    String::from_utf8_lossy(&out.stderr)
+        .lines()
+        .find_map(|l| l.strip_prefix("sagcal steps: "))
+        .and_then(|s| s.trim().parse().ok())
+        .expect("the step count is printed")
+}
+
+/// A plan of 0 poses, or of more poses than candidates, is refused before a
+/// single candidate is drawn (found by tests/prop_commands.rs: 26 million
+/// steps of drawing, then "cannot choose 0 poses from 6 candidates").
+#[test]
+fn impossible_plan_counts_are_refused_before_drawing() {
+    let dir = tempfile::tempdir().unwrap();
+    for (poses, candidates, expected) in [
+        ("0", "6", "poses = 0: a plan chooses at least 1 pose"),
+        ("5", "3", "candidates = 3: fewer candidates than the 5 poses"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_sagcal"))
+            .args([
+                "plan",
+                "--robot",
+                &robot("large"),
+                "--poses",
+                poses,
+                "--candidates",
+                candidates,
+                "--out",
+                "p.csv",
+            ])
+            .current_dir(dir.path())
+            .env("SAGCAL_REPORT_STEPS", "1")
+            .output()
+            .unwrap();
+        fails_with(&out, expected);
+        assert_eq!(steps(&out), 0, "no statics evaluated before the refusal");
+        assert!(!dir.path().join("p.csv").exists());
+    }
+}
+
+/// A robot that solves none of the data's rows verifies nothing: exit 1 with
+/// the first row's reason, not exit 0 with "rows verified 0" (found by
+/// tests/prop_commands.rs with random robots against the large robot's data).
+#[test]
+fn a_verification_that_solves_no_row_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = data(dir.path());
+    // A plausible robot 10 m across, whose frame none of the large robot's poses are in.
+    let small = std::fs::read_to_string(robot("small")).unwrap();
+    std::fs::write(dir.path().join("small.toml"), small).unwrap();
+    let out = sagcal(dir.path(), &["verify", "--robot", "small.toml", "--data", &data]);
+    let stderr = fails_with(&out, "nothing verified for robot `small`");
+    assert!(stderr.contains("none of its 4 kept rows"), "{stderr}");
+    let out = sagcal(
+        dir.path(),
+        &["verify", "--robot", "small.toml", "--data", &data, "--json"],
+    );
+    fails_with(&out, "nothing verified");
+    assert!(out.stdout.is_empty(), "no report printed as if verified");
+}

@@ -1,6 +1,6 @@
 //! `sagcal verify`: the model against measured data.
 
-use sagcal::diagnose::verify::{verify, Closure, LengthKind, MeasuredData, VerifyReport};
+use sagcal::diagnose::verify::{nothing_verified, verify, Closure, LengthKind, MeasuredData, VerifyReport};
 use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
 use sagcal::io::recurdyn::{read_recurdyn, LoadOptions};
 use sagcal::model::statics::StaticsOptions;
@@ -18,6 +18,13 @@ pub fn run(args: &VerifyArgs) -> sagcal::Result<()> {
         ClosureArg::CableLengths => Closure::CableLengths,
     };
     let report = verify(&robot, &data, closure, &StaticsOptions::default());
+    if let Some(error) = nothing_verified(&report) {
+        // The rows' reasons go out first (not with --json), then the error.
+        if !args.json {
+            print!("{}", render(&report));
+        }
+        return Err(error);
+    }
     if args.json {
         print_json(&report)
     } else {

@@ -72,6 +72,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 use serde::Serialize;
 
 use crate::calib::predict_with_effects;
+use crate::error::Error;
 use crate::io::measurements::MeasurementSet;
 use crate::io::recurdyn::{RecurDynLog, RejectedRow};
 use crate::model::pose::PlatformPose;
@@ -548,6 +549,36 @@ fn no_tension_reason(robot: &Robot, closure: Closure, solved: usize) -> String {
         ),
         Closure::CableLengths => "no tension to compare: the solved rows log no tension".to_string(),
     }
+}
+
+/// The error of a verification that verified nothing: no row was kept, or
+/// the statics solved none of them (a model that explains no row is not
+/// verified by an empty table). `None` when at least one row was verified.
+pub fn nothing_verified(report: &VerifyReport) -> Option<Error> {
+    if !report.rows.is_empty() {
+        return None;
+    }
+    let why = match report.rows_unsolved.first() {
+        Some(first) => format!(
+            "the statics solved none of its {} kept rows with this robot (line {}: {}{})",
+            report.rows_kept,
+            first.line,
+            first.reason,
+            if report.rows_unsolved.len() > 1 {
+                "; the others alike or listed above"
+            } else {
+                ""
+            }
+        ),
+        None => format!(
+            "no row was kept ({} rejected by the loader)",
+            report.rows_rejected.len()
+        ),
+    };
+    Some(Error::InvalidInput(format!(
+        "{}: nothing verified for robot `{}`: {why}",
+        report.data, report.robot
+    )))
 }
 
 /// Verify the model on every kept row of `data`.

@@ -251,6 +251,23 @@ fn candidates(
     Ok((set, Some(workspace), format!("{count} drawn in {from}")))
 }
 
+/// The counts of a plan, checked before any candidate is drawn: at least one
+/// pose, and no more poses than candidates to choose them from.
+fn check_counts(settings: &PlanSettings) -> Result<()> {
+    if settings.poses == 0 {
+        return Err(Error::InvalidInput("poses = 0: a plan chooses at least 1 pose".into()));
+    }
+    if let CandidateSource::Drawn { count, .. } = settings.candidates {
+        if count < settings.poses {
+            return Err(Error::InvalidInput(format!(
+                "candidates = {count}: fewer candidates than the {} poses to choose from them",
+                settings.poses
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// The error for logged poses of fewer than [`MIN_POSES`] distinct poses
 /// (`groups` from [`distinct_poses`]), naming the lines of each repeated one.
 fn too_few_distinct(label: &str, lines: &[usize], groups: &[Vec<usize>]) -> Error {
@@ -280,6 +297,7 @@ pub fn plan_calibration(
     settings: &PlanSettings,
     progress: &mut dyn FnMut(PlanProgress<'_>),
 ) -> Result<PlannedCalibration> {
+    check_counts(settings)?;
     let margins = Margins::for_robot(robot);
     let (set, workspace, from) = candidates(robot, settings, &margins, progress)?;
     if set.equilibria.len() < settings.poses {
