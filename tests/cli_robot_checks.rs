@@ -299,7 +299,7 @@ fn impossible_plan_counts_are_refused_before_drawing() {
     let dir = tempfile::tempdir().unwrap();
     for (poses, candidates, expected) in [
         ("0", "6", "poses = 0: a plan chooses at least 1 pose"),
-        ("5", "3", "candidates = 3: fewer candidates than the 5 poses"),
+        ("5", "3", "5 poses requested but only 3 candidates to draw"),
     ] {
         let out = Command::new(env!("CARGO_BIN_EXE_sagcal"))
             .args([

@@ -232,7 +232,10 @@ fn an_extension_written_by_diagnose_improves_verify_on_unseen_poses() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let large = format!("{}/robots/large.toml", env!("CARGO_MANIFEST_DIR"));
-    for (seed, out) in [("31", "fit.csv"), ("32", "unseen.csv")] {
+    // The unseen poses without sensor noise: `verify` then measures the model's
+    // own error (with the authors' noise, MPE-L is 0.0037 % even for the truth,
+    // which would mask it: baseline 0.0075 %, extension 0.0037 %).
+    for (seed, out, noise) in [("31", "fit.csv", "authors"), ("32", "unseen.csv", "none")] {
         sagcal(
             d,
             &[
@@ -244,7 +247,7 @@ fn an_extension_written_by_diagnose_improves_verify_on_unseen_poses() {
                 "--seed",
                 seed,
                 "--noise",
-                "authors",
+                noise,
                 "--effect",
                 "elastic:ea_n=2.5e6",
                 "--segments",

@@ -260,7 +260,7 @@ fn check_counts(settings: &PlanSettings) -> Result<()> {
     if let CandidateSource::Drawn { count, .. } = settings.candidates {
         if count < settings.poses {
             return Err(Error::InvalidInput(format!(
-                "candidates = {count}: fewer candidates than the {} poses to choose from them",
+                "{} poses requested but only {count} candidates to draw: a plan chooses its poses among the candidates",
                 settings.poses
             )));
         }
