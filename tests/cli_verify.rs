@@ -252,3 +252,57 @@ fn a_users_own_robot_gets_no_paper_column() {
     assert!(text.contains("no paper Table I column: robot `mine`"), "{text}");
     assert!(json["paper_table1"].is_null(), "{json}");
 }
+
+/// A small square platform (15 cm across, 2.5 N, massless cables) also
+/// balances turned half a turn at the same position and reference tension;
+/// verify must predict the equilibrium the robot was in, so that noise-free
+/// data simulated from the robot verify exactly (found by
+/// tests/prop_commands.rs: MPE-L 0.25 % and an orientation error of 180 degrees).
+#[test]
+fn verify_predicts_the_equilibrium_branch_the_robot_was_in() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = "name = \"small square\"\nreference_cable = 1\nplatform_weight_n = 2.5157588655063035\n\
+        cable_weight_n_per_m = 0.0\ncom_offset_m = [-0.05968985246617843, -0.24173711360225797, 0.05611274338741587]\n\
+        [[cables]]\nanchor_m = [-23.48603197837577, -1.8698531840892016, 11.252741650829643]\n\
+        attachment_m = [-0.07696104400554965, -0.07696104400554965, -0.01]\n\
+        [[cables]]\nanchor_m = [23.565104250231304, -1.877295846548274, 11.205814848144167]\n\
+        attachment_m = [0.07696104400554965, -0.07696104400554965, -0.01]\n\
+        [[cables]]\nanchor_m = [23.442745364995695, 1.8700986177165815, 11.2043167842494]\n\
+        attachment_m = [0.07696104400554965, 0.07696104400554965, -0.01]\n\
+        [[cables]]\nanchor_m = [-23.433264188487144, 1.8703836356260841, 11.2096060988568]\n\
+        attachment_m = [-0.07696104400554965, 0.07696104400554965, -0.01]\n";
+    std::fs::write(dir.path().join("robot.toml"), robot).unwrap();
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_sagcal"))
+            .args(args)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out.stdout
+    };
+    run(&[
+        "simulate",
+        "--robot",
+        "robot.toml",
+        "--poses",
+        "1",
+        "--seed",
+        "15904558065293676026",
+        "--noise",
+        "none",
+        "--closure",
+        "yaw",
+        "--out",
+        "m.csv",
+    ]);
+    let report: serde_json::Value =
+        serde_json::from_slice(&run(&["verify", "--robot", "robot.toml", "--data", "m.csv", "--json"])).unwrap();
+    let mpe = report["mpe_length_pct"].as_f64().unwrap();
+    let turn = report["max_orientation_error_deg"].as_f64().unwrap();
+    assert!(mpe < 1e-6 && turn < 1e-4, "MPE-L {mpe} %, orientation error {turn} deg");
+}
