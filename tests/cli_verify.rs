@@ -253,24 +253,10 @@ fn a_users_own_robot_gets_no_paper_column() {
     assert!(json["paper_table1"].is_null(), "{json}");
 }
 
-/// A small square platform (15 cm across, 2.5 N, massless cables) also
-/// balances turned half a turn at the same position and reference tension;
-/// verify must predict the equilibrium the robot was in, so that noise-free
-/// data simulated from the robot verify exactly (found by
-/// tests/prop_commands.rs: MPE-L 0.25 % and an orientation error of 180 degrees).
-#[test]
-fn verify_predicts_the_equilibrium_branch_the_robot_was_in() {
+/// Simulate `poses` noise-free poses of `robot` (a robot file's text) and
+/// verify them with the same robot: MPE-L and the orientation error must be nil.
+fn verifies_its_own_noise_free_data(robot: &str, seed: &str, closure: &str, poses: &str) {
     let dir = tempfile::tempdir().unwrap();
-    let robot = "name = \"small square\"\nreference_cable = 1\nplatform_weight_n = 2.5157588655063035\n\
-        cable_weight_n_per_m = 0.0\ncom_offset_m = [-0.05968985246617843, -0.24173711360225797, 0.05611274338741587]\n\
-        [[cables]]\nanchor_m = [-23.48603197837577, -1.8698531840892016, 11.252741650829643]\n\
-        attachment_m = [-0.07696104400554965, -0.07696104400554965, -0.01]\n\
-        [[cables]]\nanchor_m = [23.565104250231304, -1.877295846548274, 11.205814848144167]\n\
-        attachment_m = [0.07696104400554965, -0.07696104400554965, -0.01]\n\
-        [[cables]]\nanchor_m = [23.442745364995695, 1.8700986177165815, 11.2043167842494]\n\
-        attachment_m = [0.07696104400554965, 0.07696104400554965, -0.01]\n\
-        [[cables]]\nanchor_m = [-23.433264188487144, 1.8703836356260841, 11.2096060988568]\n\
-        attachment_m = [-0.07696104400554965, 0.07696104400554965, -0.01]\n";
     std::fs::write(dir.path().join("robot.toml"), robot).unwrap();
     let run = |args: &[&str]| {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_sagcal"))
@@ -290,13 +276,13 @@ fn verify_predicts_the_equilibrium_branch_the_robot_was_in() {
         "--robot",
         "robot.toml",
         "--poses",
-        "1",
+        poses,
         "--seed",
-        "15904558065293676026",
+        seed,
         "--noise",
         "none",
         "--closure",
-        "yaw",
+        closure,
         "--out",
         "m.csv",
     ]);
@@ -305,4 +291,85 @@ fn verify_predicts_the_equilibrium_branch_the_robot_was_in() {
     let mpe = report["mpe_length_pct"].as_f64().unwrap();
     let turn = report["max_orientation_error_deg"].as_f64().unwrap();
     assert!(mpe < 1e-6 && turn < 1e-4, "MPE-L {mpe} %, orientation error {turn} deg");
+}
+
+/// A robot file's text: `head` (name, reference cable, weights, com) and four
+/// cables, anchor and attachment each.
+fn robot_text(head: &str, cables: [([f64; 3], [f64; 3]); 4]) -> String {
+    let mut text = head.to_string();
+    for (anchor, attachment) in cables {
+        text += &format!("\n[[cables]]\nanchor_m = {anchor:?}\nattachment_m = {attachment:?}\n");
+    }
+    text
+}
+
+/// A small square platform (15 cm across, 2.5 N, massless cables) also
+/// balances turned half a turn at the same position and reference tension;
+/// verify must predict the equilibrium the robot was in, so that noise-free
+/// data simulated from the robot verify exactly (found by
+/// tests/prop_commands.rs: MPE-L 0.25 % and an orientation error of 180 degrees).
+#[test]
+fn verify_predicts_the_equilibrium_branch_the_robot_was_in() {
+    let a = 0.07696104400554965;
+    let robot = robot_text(
+        "name = \"small square\"\nreference_cable = 1\nplatform_weight_n = 2.5157588655063035\n\
+         cable_weight_n_per_m = 0.0\ncom_offset_m = [-0.05968985246617843, -0.24173711360225797, 0.05611274338741587]\n",
+        [
+            ([-23.48603197837577, -1.8698531840892016, 11.252741650829643], [-a, -a, -0.01]),
+            ([23.565104250231304, -1.877295846548274, 11.205814848144167], [a, -a, -0.01]),
+            ([23.442745364995695, 1.8700986177165815, 11.2043167842494], [a, a, -0.01]),
+            ([-23.433264188487144, 1.8703836356260841, 11.2096060988568], [-a, a, -0.01]),
+        ],
+    );
+    verifies_its_own_noise_free_data(&robot, "15904558065293676026", "yaw", "1");
+}
+
+/// A heavy platform whose centre of mass is 0.2 m above its attachments
+/// hangs pitched by 69 degrees; the search from level found a branch 64
+/// degrees away (MPE-L 1.39 %, found by tests/prop_commands.rs).
+#[test]
+fn verify_finds_a_steeply_tilted_equilibrium() {
+    let a = 0.8328017818451511;
+    let robot = robot_text(
+        "name = \"top heavy\"\nreference_cable = 2\nplatform_weight_n = 7982.636449844636\n\
+         cable_weight_n_per_m = 4.07341685798077\ncom_offset_m = [-0.22726206241315317, -0.1937069600256946, 0.19753434305207979]\n",
+        [
+            ([-4.855662558574157, -1.6745767441496509, 19.368403823265485], [-a, -a, -0.01]),
+            ([4.887202922915904, -1.6944195160031466, 19.884774833397234], [a, -a, -0.01]),
+            ([4.80536142373053, 1.6773369484832223, 19.924845674693895], [a, a, -0.01]),
+            ([-4.8095275177066705, 1.6454776988864641, 19.528860744159715], [-a, a, -0.01]),
+        ],
+    );
+    verifies_its_own_noise_free_data(&robot, "5769148329552452439", "level", "3");
+}
+
+/// Attachments spread over 1.7 m of height and massless cables: the platform
+/// hangs rolled by 71 degrees, and the search from level finds no equilibrium
+/// at all (verify exited 1 on noise-free data, found by tests/prop_commands.rs).
+#[test]
+fn verify_solves_from_the_logged_orientation_where_level_finds_nothing() {
+    let robot = robot_text(
+        "name = \"twisted\"\nreference_cable = 1\nplatform_weight_n = 30.483403161805217\n\
+         cable_weight_n_per_m = 0.0\ncom_offset_m = [-0.035264182602816656, 0.09797190778096147, 0.028476266970573757]\n\
+         length_offsets_m = [88.33661230811333, -46.957905111031934, -11.228149332150878, 87.342865472251]\n",
+        [
+            (
+                [-11.82904952958198, -128.3057876566066, 7.372750337405727],
+                [0.014030498590146514, -0.6152107019115294, -0.9278672501740465],
+            ),
+            (
+                [11.324401315760642, -125.89784023890213, 7.655622629055073],
+                [-0.03342758133589409, 0.6811791746877404, 0.7586908694670168],
+            ),
+            (
+                [11.450984857925633, 118.03558294246665, 7.120638234116873],
+                [0.5920386407385665, -0.09498431615987628, 0.7479850841071591],
+            ),
+            (
+                [-11.628964821791042, 120.41391551106926, 7.152347150669291],
+                [-0.8351604836667208, -0.49393673740927185, 0.6485298690335752],
+            ),
+        ],
+    );
+    verifies_its_own_noise_free_data(&robot, "15506100281112989790", "level", "1");
 }

@@ -800,7 +800,11 @@ fn json_is_sane(text: &str) -> Result<serde_json::Value, String> {
 fn check_answer(job: &Job, dir: &Path, outcome: &Outcome) -> Result<(), String> {
     match job {
         Job::Simulate {
-            poses, noise, effect, ..
+            robot,
+            poses,
+            noise,
+            effect,
+            ..
         } => {
             let rows = sagcal::io::measurements::read_measurements(
                 &dir.join("m.csv"),
@@ -814,14 +818,21 @@ fn check_answer(job: &Job, dir: &Path, outcome: &Outcome) -> Result<(), String> 
             if rows != *poses {
                 return Err(format!("{rows} rows written, {poses} asked for"));
             }
-            // Noise-free closed-form data are the model itself: `verify` must agree to rounding.
+            // Noise-free closed-form data are the model itself: `verify` must
+            // agree to rounding. A pulley in the robot file's `[effects]` sends
+            // the simulation through the discretised simulator (100 elements
+            // per cable), whose lengths differ from the catenary's by a term
+            // of order 1/n^2 = 1e-4 of the sag's share: 0.01 % bounds it (the
+            // property test found 0.0017 % for cables three times as heavy as
+            // the platform).
+            let tolerance_pct = if robot.pulley_radius_m.is_some() { 1e-2 } else { 1e-4 };
             if *noise == "none" && effect.is_none() && rows > 0 {
                 let args: Vec<String> = words("verify --robot t.toml --data m.csv --json");
                 let verified = run(dir, &args);
                 let report = json_is_sane(&verified.stdout)
                     .map_err(|e| format!("verify of the noise-free data failed: {e}: {}", verified.stderr))?;
                 let mpe = report["mpe_length_pct"].as_f64().unwrap_or(f64::NAN);
-                if mpe.is_nan() || mpe >= 1e-4 {
+                if mpe.is_nan() || mpe >= tolerance_pct {
                     return Err(format!("verify of its own noise-free data gives MPE-L {mpe} %"));
                 }
             }

@@ -327,8 +327,7 @@ fn solve_row(
                     robot.reference_cable + 1
                 ))
             })?;
-            let closed = statics::solve_with_reference_tension(robot, position, measured, None, options)?;
-            let closed = logged_branch(robot, row, measured, closed, options);
+            let closed = logged_branch(robot, row, measured, options)?;
             if robot.effects.is_none() {
                 Ok(closed)
             } else {
@@ -346,34 +345,57 @@ fn solve_row(
     }
 }
 
+/// How far (radians) the equilibrium solved from level may turn from the
+/// logged orientation before the statics are solved again from the logged
+/// one: 10 degrees, ten times the localisers' orientation noise and five
+/// times the model error of the RecurDyn log (1.9 degrees), far below the
+/// tens of degrees between two branches.
+const BRANCH_CHECK_RAD: f64 = 10.0 * std::f64::consts::PI / 180.0;
+
+/// Two equilibria closer than this (radians) are the same one.
+const SAME_EQUILIBRIUM_RAD: f64 = 1e-3;
+
 /// The equilibrium of the branch the robot was in. A position and a
 /// reference tension can admit several equilibria (a small square platform
-/// also balances turned half a turn, its cables crossed: found by the
+/// also balances turned half a turn, its cables crossed; a platform whose
+/// centre of mass is above its attachments hangs steeply tilted), and the
+/// search from level may find another one or none (both found by the
 /// property test of whole commands, which verified noise-free simulated data
-/// at 180 degrees and 0.07-0.45 % MPE-L). The localiser saw which one the
-/// robot was in: when the equilibrium `found` from level is more than a
-/// quarter turn from the logged orientation, the statics are solved again
-/// from the logged orientation and the nearer of the two is kept. The
+/// at 64 and 180 degrees and 0.07-1.4 % MPE-L, or not at all at 71 degrees
+/// of roll). The localiser saw which one the robot was in: when the
+/// equilibrium from level is more than [`BRANCH_CHECK_RAD`] from the logged
+/// orientation, or is not found, the statics are solved again from the
+/// logged orientation and the nearer distinct equilibrium is kept. The
 /// orientation stays predicted (the logged one only starts the search), and
-/// rows within a quarter turn keep the solve from level unchanged.
+/// rows near their logged orientation keep the solve from level unchanged.
 fn logged_branch(
     robot: &Robot,
     row: &MeasuredRow,
     reference_tension_n: f64,
-    found: Equilibrium,
     options: &StaticsOptions,
-) -> Equilibrium {
+) -> crate::Result<Equilibrium> {
+    let position = Vector3::from(row.position_m);
     let [roll, pitch, yaw] = row.roll_pitch_yaw_deg;
     let logged = AngleReading::DOCUMENTED.rotation([pitch, roll, yaw]);
     let turn = |eq: &Equilibrium| eq.pose.rotation.angle_to(&logged);
+    let from_logged =
+        || statics::solve_with_reference_tension(robot, position, reference_tension_n, Some(logged), options);
+    let found = match statics::solve_with_reference_tension(robot, position, reference_tension_n, None, options) {
+        Ok(found) => found,
+        Err(level_error) => return from_logged().map_err(|_| level_error),
+    };
     let found_turn = turn(&found);
-    if !found_turn.is_finite() || found_turn <= std::f64::consts::FRAC_PI_2 {
-        return found;
+    if !found_turn.is_finite() || found_turn <= BRANCH_CHECK_RAD {
+        return Ok(found);
     }
-    let position = Vector3::from(row.position_m);
-    match statics::solve_with_reference_tension(robot, position, reference_tension_n, Some(logged), options) {
-        Ok(other) if turn(&other) < found_turn => other,
-        _ => found,
+    match from_logged() {
+        Ok(other)
+            if turn(&other) < found_turn
+                && other.pose.rotation.angle_to(&found.pose.rotation) > SAME_EQUILIBRIUM_RAD =>
+        {
+            Ok(other)
+        }
+        _ => Ok(found),
     }
 }
 
