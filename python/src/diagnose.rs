@@ -23,10 +23,30 @@ pub struct Diagnosis {
 
 #[pymethods]
 impl Diagnosis {
-    /// The hypotheses selected, in the order added, joined by ``+`` (``"elastic+segments"``), or ``"none"``.
+    /// The causes named, joined by ``+`` (``"elastic+encoder-gain"``);
+    /// ``"none"`` when nothing is wrong; ``"unexplained"`` when something is
+    /// wrong that the catalogue does not hold, or the causes and
+    /// ``"+unexplained"`` when they explain part of it; ``"X|Y"`` names one
+    /// of two hypotheses the data do not tell apart.
     #[getter]
     fn verdict(&self) -> String {
         self.inner.verdict.clone()
+    }
+
+    /// Whether the final model explains the data: it passes every sensor's
+    /// chi-square test at the false-alarm rate and holds no stand-in.
+    #[getter]
+    fn explained(&self) -> bool {
+        self.inner.explanation.explained
+    }
+
+    /// The final model's hypotheses that fit only as proxies (an estimate no
+    /// real robot could have, an effect that leaves its own sensor
+    /// inconsistent, or freed orientations), each a sentence saying what it
+    /// stands in for.
+    #[getter]
+    fn stand_ins(&self) -> Vec<String> {
+        self.inner.explanation.stand_ins.iter().map(|s| s.sentence()).collect()
     }
 
     /// Why, in one sentence.
@@ -35,15 +55,15 @@ impl Diagnosis {
         self.inner.reason.clone()
     }
 
-    /// The selected effects: a list of dicts with ``effect`` and ``params``
+    /// The final model's effects (stand-ins included): a list of dicts with ``effect`` and ``params``
     /// (each ``name``, ``value``, ``sigma``).
     #[getter]
     fn effects<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &self.inner.effects)
     }
 
-    /// The selected model's calibrated robot (anchors, offsets and the
-    /// estimated effects); the baseline calibration's for ``"none"``.
+    /// The final model's calibrated robot (anchors, offsets and the
+    /// estimated effects); the baseline calibration's when it has no hypothesis.
     #[getter]
     fn robot(&self) -> Robot {
         Robot::new(self.inner.robot_after.clone())

@@ -22,6 +22,7 @@ def test_diagnose_equals_the_command(cli, problem):
     assert found.report == command
     # Data from the closed-form model: no effect is declared.
     assert found.verdict == "none" == command["verdict"] and found.effects == []
+    assert found.explained and command["explained"] and found.stand_ins == [] == command["stand_ins"]
     assert found.baseline_consistent
     # Progress: every fit announced, the last call says done.
     assert calls[-1][0] == calls[-1][1] and calls[-1][2] == "done" and len(calls) > 3

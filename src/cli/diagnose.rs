@@ -85,8 +85,8 @@ pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
 fn extended_robot_text(diagnosis: &Diagnosis) -> sagcal::Result<String> {
     let text = diagnosis.robot_after.to_file_contents().to_toml()?;
     let header = format!(
-        "# Calibrated by sagcal diagnose: anchors, encoder length offsets and the selected model ({}).\n",
-        diagnosis.verdict
+        "# Calibrated by sagcal diagnose: anchors, encoder length offsets and the final model ({}; verdict {}).\n",
+        diagnosis.explanation.final_model, diagnosis.verdict
     );
     Ok(format!("{header}{text}"))
 }
@@ -131,7 +131,7 @@ fn add_plots(
             points: s.before.clone(),
         },
         after: s.after.as_ref().map(|points| ResidualSeries {
-            label: format!("with {}", diagnosis.verdict),
+            label: format!("with {}", diagnosis.explanation.final_model),
             points: points.clone(),
         }),
         caption: format!(
@@ -273,7 +273,8 @@ fn render_candidates(d: &Diagnosis) -> String {
     out
 }
 
-/// Step 4: the verdict, the selected effects, the gain and the structure left.
+/// Step 4: the verdict, the final model's effects, what it leaves, the gain
+/// and the structure left.
 fn render_verdict(d: &Diagnosis) -> String {
     let mut out = format!("\n4. verdict: {}\n   {}\n", d.verdict, d.reason);
     for e in &d.effects {
@@ -282,8 +283,41 @@ fn render_verdict(d: &Diagnosis) -> String {
             .iter()
             .map(|p| format!("{} {:.5e} +- {:.1e}", p.name, p.value, p.sigma))
             .collect();
-        out += &format!("   {}: {}\n", e.effect, params.join(", "));
+        let stand_in = d.explanation.stand_ins.iter().any(|s| s.hypothesis == e.effect);
+        out += &format!(
+            "   {}{}: {}\n",
+            e.effect,
+            if stand_in { " (stand-in)" } else { "" },
+            params.join(", ")
+        );
     }
+    for s in &d.explanation.stand_ins {
+        out += &format!("   stand-in: {}\n", s.sentence());
+    }
+    for a in &d.explanation.ambiguous {
+        out += &format!(
+            "   ambiguous: {} and {} explain the data about equally (BIC {:.1} apart, below {}): one of the two\n",
+            a.cause,
+            a.rival,
+            a.bic_margin,
+            sagcal::diagnose::AMBIGUOUS_BIC
+        );
+    }
+    let failing = d.explanation.final_tests.iter().filter(|t| !t.consistent).count();
+    out += &format!(
+        "   final model {}: chi-square {:.1} for {} degrees of freedom; {} of {} sensor tests pass at {:.1e} each{}\n",
+        d.explanation.final_model,
+        d.explanation.final_chi_square,
+        d.explanation.final_dof,
+        d.explanation.final_tests.len() - failing,
+        d.explanation.final_tests.len(),
+        d.false_alarm / d.explanation.final_tests.len().max(1) as f64,
+        if d.explanation.explained {
+            ": explained"
+        } else {
+            ": NOT explained by the catalogue"
+        }
+    );
     if !d.undetectable.is_empty() {
         out += &format!(
             "   not detectable at this noise with these poses (power < 0.9 at the smallest plausible magnitude): {}\n",
@@ -308,7 +342,10 @@ fn render_verdict(d: &Diagnosis) -> String {
     }
     out += "\n";
     if !d.drivers_after.is_empty() {
-        out += &format!("\n   residual structure left with {} (strongest first):\n", d.verdict);
+        out += &format!(
+            "\n   residual structure left with {} (strongest first):\n",
+            d.explanation.final_model
+        );
         out += &driver_table(&d.drivers_after, 5);
     }
     out

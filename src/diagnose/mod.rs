@@ -20,10 +20,23 @@
 //!    plausible magnitude comes from the fit's Fisher information, and a
 //!    candidate whose power is below 0.9 is reported as not detectable at
 //!    this noise with these poses;
-//! 4. reports the verdict (the effects in the order added, joined by `+`, or
-//!    `none`), the parameters with 1-sigma, and the gain: held-out residual
-//!    RMS before and after and, given the truth, anchor and offset errors
-//!    before and after.
+//! 4. keeps only what predicts (`prediction`): each effect the selection
+//!    added must lower the held-out residual of the model without it and not
+//!    make the anchors worse by their own covariance, else it is taken out;
+//! 5. asks whether the final model explains the data (`explanation`): it must
+//!    pass every sensor's chi-square test at the false-alarm rate (each
+//!    sensor's expectation its redundancy) and hold no stand-in
+//!    (`stand_ins`: an estimate beyond what any real robot could have,
+//!    [`crate::model::effect_limits`]; an effect whose own sensor stays
+//!    inconsistent; freed orientations). Hypotheses whose BIC is within 2 of
+//!    each other are named together (`X|Y`);
+//! 6. reports the verdict (the causes in the order added, joined by `+`;
+//!    `none` when nothing is wrong; `unexplained`, or the causes and
+//!    `+unexplained`, when the catalogue does not hold what is wrong), the
+//!    parameters with 1-sigma, the stand-ins with what they stand in for,
+//!    what the final model leaves, and the gain: held-out residual RMS before
+//!    and after and, given the truth, anchor and offset errors before and
+//!    after.
 //!
 //! Held-out residual: for each fold the model is re-fitted without the
 //! fold's poses; each held-out pose's own variables (pose, reference tension)
@@ -61,9 +74,12 @@
 
 mod candidates;
 mod drivers;
+mod explanation;
+mod prediction;
 mod report;
 mod residual_tests;
 mod selection;
+mod stand_ins;
 pub mod verify;
 
 use crate::calib::gross_errors::{calibrate_checked, ExcludedReading, GrossErrorOptions, Verdict};
@@ -79,12 +95,17 @@ use crate::stats::{self, chi_square_quantile_999};
 
 pub use candidates::{power_against, CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER};
 pub use drivers::{DriverSeries, DriverTest, DRIVERS, DRIVER_T_LIMIT};
+pub use explanation::{Ambiguity, Explanation, AMBIGUOUS_BIC};
+pub use prediction::NotPredictive;
 pub use report::{error_over_sigma, Diagnosis, EffectFit, Gain};
 pub use residual_tests::{FactorTest, MEASUREMENT_KINDS};
 pub use selection::SelectionStep;
+pub use stand_ins::{StandIn, STAND_IN_SIGMAS};
 
 use candidates::rebuild;
 use drivers::{driver_series, driver_tests, samples};
+use explanation::explain;
+use prediction::predictive_model;
 use residual_tests::{factor_tests, measurement_components, total_chi_square, variance_factor};
 use selection::{cross_validate, first_effect, forward_selection, Search};
 
@@ -269,18 +290,7 @@ pub fn diagnose(
     options: &DiagnoseOptions,
     progress: &mut dyn FnMut(usize, usize, &str),
 ) -> Result<Diagnosis> {
-    if options.folds < 2 {
-        return Err(Error::InvalidInput(format!(
-            "diagnose: at least 2 cross-validation folds are needed, got {}",
-            options.folds
-        )));
-    }
-    if !(options.false_alarm > 0.0 && options.false_alarm < 1.0) {
-        return Err(Error::InvalidInput(format!(
-            "diagnose: the false-alarm rate must be in (0, 1), got {}",
-            options.false_alarm
-        )));
-    }
+    check_options(options)?;
     let mut progress = Progress {
         done: 0,
         total: 3 + 2 * options.folds,
@@ -306,16 +316,12 @@ pub fn diagnose(
         options,
     };
     let selection = forward_selection(&search, &mut progress);
-    let model = &selection.model;
-    let cv_after = if model.hypotheses.is_empty() {
-        baseline_cv
-    } else {
-        cross_validate(&model.result, &base.used, &model.options, options.folds, &mut |what| {
-            progress.step(&format!("{}: {what}", model.name()))
-        })?
-    };
+    // 4. Only what predicts stays: the held-out residual and the anchors.
+    let (model, cv_after, not_predictive) = predictive_model(&search, &selection.model, baseline_cv, &mut progress)?;
+    let model = &model;
     progress.finish();
-    // 4. The report: what the selected extension gains, and the structure left.
+    // 5-6. The report: what the final model gains, whether it explains the
+    // data, and the structure left.
     let gain = report::gain(truth, &base.result.robot, &model.result.robot, baseline_cv, cv_after);
     let (drivers_after, series) = if model.hypotheses.is_empty() {
         (Vec::new(), driver_series(&drivers, &base_samples, None))
@@ -325,7 +331,19 @@ pub fn diagnose(
         let series = driver_series(&drivers, &base_samples, shown);
         (driver_tests(&after_samples), series)
     };
-    let reason = report::reason(&selection, &base, options);
+    let left = if model.hypotheses.is_empty() {
+        &drivers
+    } else {
+        &drivers_after
+    };
+    let explanation = explain(
+        &base,
+        model,
+        left,
+        (&selection.steps, &selection.candidates),
+        options.false_alarm,
+    );
+    let reason = report::reason(&selection, &base, options, &not_predictive, &explanation);
     let undetectable = report::undetectable(&selection);
     Ok(Diagnosis {
         robot: robot.name.clone(),
@@ -342,7 +360,10 @@ pub fn diagnose(
         drivers_after,
         baseline_bic: base.bic,
         baseline_cv_rms: baseline_cv,
-        verdict: model.name(),
+        verdict: explanation.verdict(),
+        selected: selection.model.name(),
+        not_predictive,
+        explanation,
         effects: report::effect_fits(&model.result.effect_estimates),
         steps: selection.steps,
         undetectable,
@@ -355,6 +376,23 @@ pub fn diagnose(
         excluded_readings,
         mistakes,
     })
+}
+
+/// The options' own checks: at least 2 folds, a false-alarm rate in (0, 1).
+fn check_options(options: &DiagnoseOptions) -> Result<()> {
+    if options.folds < 2 {
+        return Err(Error::InvalidInput(format!(
+            "diagnose: at least 2 cross-validation folds are needed, got {}",
+            options.folds
+        )));
+    }
+    if !(options.false_alarm > 0.0 && options.false_alarm < 1.0) {
+        return Err(Error::InvalidInput(format!(
+            "diagnose: the false-alarm rate must be in (0, 1), got {}",
+            options.false_alarm
+        )));
+    }
+    Ok(())
 }
 
 /// Step 0: the gross-error tests of `calibrate`

@@ -4,6 +4,8 @@ use serde::Serialize;
 
 use super::candidates::{parameters, CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER};
 use super::drivers::{DriverSeries, DriverTest};
+use super::explanation::Explanation;
+use super::prediction::NotPredictive;
 use super::residual_tests::FactorTest;
 use super::selection::{Selection, SelectionStep};
 use super::{Baseline, DiagnoseOptions};
@@ -65,9 +67,19 @@ pub struct Diagnosis {
     pub baseline_bic: f64,
     /// Baseline held-out residual RMS.
     pub baseline_cv_rms: f64,
-    /// The hypotheses selected, in the order added, joined by `+`; or `none`.
+    /// The causes named, in the order added, joined by `+`; `none` (nothing
+    /// is wrong), `unexplained` (something is wrong that the catalogue does
+    /// not hold) or the causes and `+unexplained` (they explain part of it).
     pub verdict: String,
-    /// The selected effects with their parameters and 1-sigma.
+    /// The model the forward selection chose, before the prediction checks.
+    pub selected: String,
+    /// Effects the selection added that do not predict, taken out.
+    pub not_predictive: Vec<NotPredictive>,
+    /// Whether the final model explains the data: causes, stand-ins, its
+    /// per-sensor tests, what it leaves.
+    #[serde(flatten)]
+    pub explanation: Explanation,
+    /// The final model's effects with their parameters and 1-sigma (stand-ins included).
     pub effects: Vec<EffectFit>,
     /// The steps of the forward selection that added something.
     pub steps: Vec<SelectionStep>,
@@ -78,12 +90,12 @@ pub struct Diagnosis {
     pub candidates: Vec<CandidateFit>,
     /// Why, in one sentence.
     pub reason: String,
-    /// What the verdict's extension gains.
+    /// What the final model gains.
     pub gain: Gain,
     /// Given the truth: the baseline's anchor error over its stated 1-sigma
     /// ([`error_over_sigma`]); above 1 the model error is visible in the anchors.
     pub baseline_error_over_sigma: Option<f64>,
-    /// The selected model's calibrated robot (anchors, offsets, effects); the baseline's for `none`.
+    /// The final model's calibrated robot (anchors, offsets, effects); the baseline's without hypotheses.
     #[serde(skip)]
     pub robot_after: Robot,
     /// Residual against the winning driver (or the strongest, for `none`).
@@ -144,8 +156,29 @@ pub(super) fn effect_fits(estimates: &[EffectEstimate]) -> Vec<EffectFit> {
         .collect()
 }
 
-/// Why the search selected what it did, in one sentence.
-pub(super) fn reason(selection: &Selection, base: &Baseline, options: &DiagnoseOptions) -> String {
+/// Why the search selected what it did and what the checks after it found, in one paragraph.
+pub(super) fn reason(
+    selection: &Selection,
+    base: &Baseline,
+    options: &DiagnoseOptions,
+    not_predictive: &[NotPredictive],
+    explanation: &Explanation,
+) -> String {
+    let mut text = selection_reason(selection, base, options);
+    for x in not_predictive {
+        text.push_str(&format!(
+            "; {} taken out of {}: {} (held-out residual RMS {:.3} with it, {:.3} without)",
+            x.hypothesis, x.model, x.why, x.cv_rms_with, x.cv_rms_without
+        ));
+    }
+    if !explanation.explained {
+        text.push_str(&format!("; {}", explanation.sentence()));
+    }
+    text
+}
+
+/// Why the forward selection added what it did, in one sentence.
+fn selection_reason(selection: &Selection, base: &Baseline, options: &DiagnoseOptions) -> String {
     let level = format!("false-alarm rate {:.0e}", options.false_alarm);
     if selection.steps.is_empty() {
         let best = selection

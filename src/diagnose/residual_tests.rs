@@ -4,7 +4,8 @@
 use serde::Serialize;
 
 use crate::graph::{whitened_squared_norm, FactorGraph};
-use crate::stats::{chi_square_quantile_001, chi_square_quantile_999};
+use crate::solver::redundancy_numbers;
+use crate::stats::{chi_square_critical, chi_square_quantile_001, chi_square_quantile_999};
 
 /// The factor types that are measurements (the others are model constraints).
 pub const MEASUREMENT_KINDS: [&str; 3] = ["catenary_length", "reference_tension", "pose_prior"];
@@ -18,9 +19,11 @@ pub struct FactorTest {
     pub components: usize,
     /// Sum of `(r / sigma)^2`.
     pub chi_square: f64,
-    /// Its expectation: the components times the fit's overall `dof / components`.
+    /// Its expectation when the model holds: the sensor's redundancy (the
+    /// sum of its rows' redundancy numbers).
     pub expected: f64,
-    /// The 99.9 % quantile of chi-square with `expected` degrees of freedom.
+    /// The critical value of chi-square with `expected` degrees of freedom at
+    /// the test's level (the baseline's: the 99.9 % quantile).
     pub limit: f64,
     /// `chi_square <= limit`.
     pub consistent: bool,
@@ -49,21 +52,53 @@ pub(super) fn total_chi_square(graph: &FactorGraph) -> f64 {
         .sum()
 }
 
-/// The chi-square test of each measurement factor type.
+/// The chi-square test of each measurement factor type at the 99.9 % quantile.
 pub(super) fn factor_tests(graph: &FactorGraph, components: usize, dof: usize) -> Vec<FactorTest> {
+    tests_with_limit(graph, components, dof, chi_square_quantile_999)
+}
+
+/// The chi-square test of each measurement factor type, each at the level
+/// `false_alarm / 3` (Bonferroni over the three sensors: on data the model
+/// describes, the probability that any of them fails is at most `false_alarm`).
+pub(super) fn factor_tests_at(graph: &FactorGraph, components: usize, dof: usize, false_alarm: f64) -> Vec<FactorTest> {
+    let level = false_alarm / MEASUREMENT_KINDS.len() as f64;
+    tests_with_limit(graph, components, dof, |k| chi_square_critical(k, level))
+}
+
+/// The tests with the critical value `quantile(expected)`. A sensor's
+/// expected chi-square is its redundancy, the sum of its rows' redundancy
+/// numbers `r_i = 1 - h_i` ([`crate::solver::redundancy_numbers`]): the
+/// share of the fit's degrees of freedom its residuals keep (the orientation
+/// prior's rows give much of theirs to the poses they fix, the encoders'
+/// keep more). Where the information matrix cannot be factored, the
+/// components' share of the fit's degrees of freedom stands in for it.
+fn tests_with_limit(
+    graph: &FactorGraph,
+    components: usize,
+    dof: usize,
+    quantile: impl Fn(usize) -> f64,
+) -> Vec<FactorTest> {
+    let redundancy = redundancy_numbers(graph, &MEASUREMENT_KINDS).ok();
     MEASUREMENT_KINDS
         .iter()
         .map(|kind| {
             let mut count = 0;
             let mut chi = 0.0;
-            for f in graph.factors.iter().filter(|f| f.kind() == *kind) {
+            let mut kept = 0.0;
+            for (index, f) in graph.factors.iter().enumerate().filter(|(_, f)| f.kind() == *kind) {
                 if let Some(r) = f.evaluate(&graph.values, None) {
                     count += r.len();
                     chi += whitened_squared_norm(&r, f.sigmas());
+                    if let Some(numbers) = redundancy.as_ref().and_then(|all| all[index].as_ref()) {
+                        kept += numbers.iter().sum::<f64>();
+                    }
                 }
             }
-            let expected = count as f64 * dof as f64 / components.max(1) as f64;
-            let limit = chi_square_quantile_999(expected.round().max(1.0) as usize);
+            let expected = match redundancy {
+                Some(_) => kept,
+                None => count as f64 * dof as f64 / components.max(1) as f64,
+            };
+            let limit = quantile(expected.round().max(1.0) as usize);
             FactorTest {
                 kind: kind.to_string(),
                 components: count,

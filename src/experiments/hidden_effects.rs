@@ -88,10 +88,6 @@ use serde::Serialize;
 use crate::calib::{calibrate, validate_measurements, CalibrationError, CalibrationOptions};
 use crate::diagnose::{diagnose, power_against, CandidateFit, DiagnoseOptions};
 use crate::error::{Error, Result};
-use crate::model::effect_ranges::{
-    axial_stiffness_range_n, com_shift_range_m, pulley_radius_range_m, COMMON_GAIN_HIGH, COMMON_GAIN_LOW,
-    LOCALISER_MOUNT_HIGH_DEG, LOCALISER_MOUNT_LOW_DEG, SEGMENTS_HIGH, SEGMENTS_LOW,
-};
 pub use crate::model::effect_ranges::{effect_ranges, EffectRange, CABLE_DENSITY_KG_M3};
 use crate::model::effects::{EffectKind, Effects};
 use crate::model::measurement::PoseMeasurement;
@@ -102,6 +98,7 @@ use crate::sim::closed_form::{sample_equilibria, sample_equilibria_with, Closure
 use crate::sim::effects::measure_with_effects;
 use crate::stats::{chi_square_critical, noncentral_chi_square_survival};
 
+pub use super::hidden_draws::{draw_effects, mid_range_effects, smallest_effects};
 pub use super::identifiability::{identifiability, Identifiability};
 
 /// Settings of the experiment.
@@ -152,8 +149,16 @@ pub struct HiddenCase {
     pub truth: String,
     /// The diagnosis' verdict.
     pub verdict: String,
-    /// Whether the verdict names exactly the hidden effects.
+    /// Whether the verdict names exactly the hidden effects ([`names_exactly`]: an ambiguous pair holding one counts).
     pub correct: bool,
+    /// The diagnosis' final model (stand-ins included).
+    pub final_model: String,
+    /// Whether the final model explains the data.
+    pub explained: bool,
+    /// The final model's sensor tests that fail.
+    pub failing_tests: Vec<String>,
+    /// The stand-ins of the final model.
+    pub stand_ins: Vec<String>,
     /// The smallest power, over the hidden effects, of the diagnosis' first
     /// test at the effect's true magnitude, and for per-drum gains of telling
     /// them from one common gain (`None` for none or a singular information
@@ -187,131 +192,6 @@ pub fn mean_reference_tension_n(robot: &Robot, poses: usize, seed: u64) -> Resul
         .map(|eq| eq.tensions[robot.reference_cable].magnitude_n())
         .sum::<f64>()
         / equilibria.len().max(1) as f64)
-}
-
-/// The smallest magnitude of every scored effect's range (encoder gains with
-/// alternating signs), to check that it moves the anchors by more than their 1-sigma.
-pub fn smallest_effects(robot: &Robot, mean_reference_tension_n: f64) -> Vec<(EffectKind, Effects)> {
-    let (_, ea_high) = axial_stiffness_range_n(robot);
-    let (com_low, _) = com_shift_range_m(robot);
-    vec![
-        (
-            EffectKind::Elastic,
-            Effects {
-                axial_stiffness_n: Some(ea_high),
-                ..Effects::default()
-            },
-        ),
-        (
-            EffectKind::EncoderScale,
-            Effects {
-                encoder_gain: [1.001, 0.999, 1.001, 0.999],
-                ..Effects::default()
-            },
-        ),
-        (
-            EffectKind::LoadCell,
-            Effects {
-                load_cell_bias_n: 0.05 * mean_reference_tension_n,
-                load_cell_gain: 1.02,
-                ..Effects::default()
-            },
-        ),
-        (
-            EffectKind::Com,
-            Effects {
-                com_shift_m: [com_low / 2f64.sqrt(), com_low / 2f64.sqrt(), 0.0],
-                ..Effects::default()
-            },
-        ),
-    ]
-}
-
-/// Mid-range magnitudes of the effects that are candidates for exclusion from
-/// the detection score: the pulley radius and the load-cell bias.
-pub fn mid_range_effects(robot: &Robot, mean_reference_tension_n: f64) -> Vec<(EffectKind, Effects)> {
-    let (low, high) = pulley_radius_range_m(robot);
-    vec![
-        (
-            EffectKind::Pulley,
-            Effects {
-                pulley_radius_m: 0.5 * (low + high),
-                ..Effects::default()
-            },
-        ),
-        (
-            EffectKind::LoadCell,
-            Effects {
-                load_cell_bias_n: 0.085 * mean_reference_tension_n,
-                ..Effects::default()
-            },
-        ),
-    ]
-}
-
-fn signed(rng: &mut impl Rng, low: f64, high: f64) -> f64 {
-    let magnitude = rng.random_range(low..high);
-    if rng.random_bool(0.5) {
-        magnitude
-    } else {
-        -magnitude
-    }
-}
-
-/// Draw the magnitudes of `hidden` for `robot` (empty: no effect), each
-/// from its range ([`effect_ranges`]).
-pub fn draw_effects(
-    robot: &Robot,
-    hidden: &[EffectKind],
-    mean_reference_tension_n: f64,
-    rng: &mut impl Rng,
-) -> Effects {
-    let mut e = Effects::default();
-    for kind in hidden {
-        draw_effect(robot, *kind, mean_reference_tension_n, rng, &mut e);
-    }
-    e
-}
-
-/// Draw `effect`'s magnitude into `e`.
-fn draw_effect(robot: &Robot, effect: EffectKind, mean_reference_tension_n: f64, rng: &mut impl Rng, e: &mut Effects) {
-    match effect {
-        EffectKind::Elastic => {
-            let (low, high) = axial_stiffness_range_n(robot);
-            e.axial_stiffness_n = Some((rng.random_range(low.ln()..high.ln())).exp());
-        }
-        EffectKind::Pulley => {
-            let (low, high) = pulley_radius_range_m(robot);
-            e.pulley_radius_m = rng.random_range(low..high);
-        }
-        EffectKind::EncoderScale => {
-            e.encoder_gain = std::array::from_fn(|_| 1.0 + signed(rng, 0.001, 0.003));
-        }
-        EffectKind::LoadCell => {
-            e.load_cell_bias_n = signed(rng, 0.05, 0.12) * mean_reference_tension_n;
-            e.load_cell_gain = 1.0 + signed(rng, 0.02, 0.05);
-        }
-        EffectKind::Com => {
-            let (low, high) = com_shift_range_m(robot);
-            let magnitude = rng.random_range(low..high);
-            let angle = rng.random_range(0.0..std::f64::consts::TAU);
-            e.com_shift_m = [magnitude * angle.cos(), magnitude * angle.sin(), 0.0];
-        }
-        EffectKind::CommonGain => {
-            e.encoder_gain = [1.0 + signed(rng, COMMON_GAIN_LOW, COMMON_GAIN_HIGH); CABLE_COUNT];
-        }
-        EffectKind::Segments => {
-            e.cable_segments = Some(rng.random_range(SEGMENTS_LOW..SEGMENTS_HIGH).round());
-        }
-        EffectKind::LocaliserMount => {
-            let angle = rng.random_range(LOCALISER_MOUNT_LOW_DEG..LOCALISER_MOUNT_HIGH_DEG);
-            // A uniform direction on the sphere: z uniform in [-1, 1], azimuth uniform.
-            let z: f64 = rng.random_range(-1.0..1.0);
-            let azimuth = rng.random_range(0.0..std::f64::consts::TAU);
-            let r = (1.0 - z * z).sqrt();
-            e.localiser_mount_deg = [angle * r * azimuth.cos(), angle * r * azimuth.sin(), angle * z];
-        }
-    }
 }
 
 /// The anchors of the true robot are drawn this far off the nominal ones,
@@ -452,7 +332,7 @@ fn diagnose_case(
         &mut |_, _, _| {},
     )?;
     let hidden_name = set_name(hidden.iter().map(|k| k.name().to_string()));
-    let verdict_set = set_name(diagnosis.verdict.split('+').map(String::from));
+
     let step_one = |k: EffectKind| {
         diagnosis
             .candidates
@@ -496,7 +376,17 @@ fn diagnose_case(
         noise: options.noise,
         seed,
         truth: truth.effects.to_string(),
-        correct: verdict_set == hidden_name,
+        correct: names_exactly(&diagnosis.verdict, hidden),
+        final_model: diagnosis.explanation.final_model.clone(),
+        explained: diagnosis.explanation.explained,
+        failing_tests: diagnosis
+            .explanation
+            .final_tests
+            .iter()
+            .filter(|t| !t.consistent)
+            .map(|t| format!("{} {:.1} > {:.1}", t.kind, t.chi_square, t.limit))
+            .collect(),
+        stand_ins: diagnosis.explanation.stand_ins.iter().map(|s| s.sentence()).collect(),
         verdict: diagnosis.verdict,
         hidden: hidden_name,
         power: if hidden.is_empty() { None } else { power },
@@ -506,6 +396,28 @@ fn diagnose_case(
         baseline_error_over_sigma: diagnosis.baseline_error_over_sigma.unwrap_or(f64::NAN),
         anchor_mae_known_geometry_m,
     })
+}
+
+/// Whether `verdict` names exactly the `hidden` effects: one term per
+/// hidden effect, each term the effect or an ambiguous pair `X|Y` holding it
+/// (one of two the data do not tell apart), and nothing left unexplained.
+pub fn names_exactly(verdict: &str, hidden: &[EffectKind]) -> bool {
+    if verdict == "none" {
+        return hidden.is_empty();
+    }
+    let terms: Vec<Vec<&str>> = verdict.split('+').map(|t| t.split('|').collect()).collect();
+    let mut left: Vec<&str> = hidden.iter().map(|k| k.name()).collect();
+    terms.len() == hidden.len()
+        && terms.iter().all(|term| {
+            let holds: Vec<&str> = left.iter().copied().filter(|h| term.contains(h)).collect();
+            match holds.as_slice() {
+                [one] => {
+                    left.retain(|h| h != one);
+                    true
+                }
+                _ => false,
+            }
+        })
 }
 
 /// The power of telling `theta` (variable units, `row`'s effect) from the
@@ -690,4 +602,24 @@ pub fn run_sweep(
         }
     }
     Ok(cases)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_verdict_names_the_hidden_set_alone_or_in_an_ambiguous_pair() {
+        let (com, mount, elastic) = (EffectKind::Com, EffectKind::LocaliserMount, EffectKind::Elastic);
+        assert!(names_exactly("none", &[]));
+        assert!(!names_exactly("unexplained", &[]));
+        assert!(names_exactly("com+elastic", &[elastic, com]));
+        assert!(names_exactly("localiser-mount|com", &[mount]));
+        assert!(names_exactly("localiser-mount|com+elastic", &[com, elastic]));
+        assert!(!names_exactly("localiser-mount|com", &[mount, com]));
+        assert!(!names_exactly("com+unexplained", &[com]));
+        assert!(!names_exactly("com", &[com, elastic]));
+        assert!(!names_exactly("elastic|pulley", &[com]));
+        assert!(!names_exactly("none", &[com]));
+    }
 }

@@ -22,6 +22,7 @@
 //! ```
 
 pub mod benchmark;
+mod hidden_draws;
 pub mod hidden_effects;
 mod hidden_options;
 mod identifiability;

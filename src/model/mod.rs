@@ -5,7 +5,9 @@
 //! ([`effects`]), the sensors and their noise ([`sensors`]) and one pose's
 //! measurements ([`measurement`]); the geometry a suspended robot needs
 //! ([`geometry`]) and the magnitudes no real robot falls outside
-//! ([`plausibility`]). No file format is seen here.
+//! ([`plausibility`]); the typical magnitudes of each effect
+//! ([`effect_ranges`]) and the largest any real robot could show
+//! ([`effect_limits`]). No file format is seen here.
 //!
 //! ```
 //! use nalgebra::Vector3;
@@ -26,6 +28,7 @@
 //! ```
 
 pub mod catenary;
+pub mod effect_limits;
 pub mod effect_ranges;
 pub mod effects;
 pub mod geometry;

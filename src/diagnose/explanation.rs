@@ -1,0 +1,217 @@
+//! Step 4b: is everything explained? After the selection the final model
+//! must pass the per-sensor chi-square tests at the stated false-alarm rate
+//! (`false_alarm / 3` per sensor, [`super::residual_tests`]) and hold no
+//! stand-in ([`super::stand_ins`]). The verdict:
+//!
+//! - `none`: nothing is wrong (no hypothesis, and the baseline passes);
+//! - `X` (`X+Y`, ...): the effects named explain the data;
+//! - `unexplained`: something is wrong and the catalogue does not hold it;
+//! - `X+unexplained`: `X` explains part of it.
+//!
+//! A cause is named only when the data prefer it: where another hypothesis
+//! tested at the step that added it comes within [`AMBIGUOUS_BIC`] of its
+//! BIC (`chi^2 / s^2 + k ln n`; a difference below 2 is, on Kass and
+//! Raftery's scale of `2 ln B`, "not worth more than a bare mention"), the
+//! two explain the data about equally and the verdict names them as
+//! `X|Y`, one of the two, not `X`. (An effect and one nested in it, four
+//! drum gains and one common gain, are not rivals: the nested check of the
+//! selection decides between them.)
+//!
+//! With it: the share of the baseline's excess chi-square (above its degrees
+//! of freedom) that the final model leaves, and the residual-driver
+//! correlations that still carry structure.
+
+use serde::Serialize;
+
+use super::candidates::{CandidateFit, Hypothesis, Model};
+use super::drivers::DriverTest;
+use super::residual_tests::{factor_tests_at, measurement_components, FactorTest};
+use super::selection::SelectionStep;
+use super::stand_ins::{orientation_stand_in, own_sensor, partial_stand_in, stand_in, StandIn};
+use super::Baseline;
+use crate::model::effects::EffectKind;
+use crate::model::robot::CABLE_COUNT;
+
+/// The BIC margin below which two hypotheses explain the data about equally (module docs).
+pub const AMBIGUOUS_BIC: f64 = 2.0;
+
+/// A cause the data do not tell from another hypothesis.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Ambiguity {
+    /// The hypothesis the selection added.
+    pub cause: String,
+    /// The hypothesis tested at the same step that comes within [`AMBIGUOUS_BIC`].
+    pub rival: String,
+    /// The rival's BIC less the cause's.
+    pub bic_margin: f64,
+}
+
+/// Whether the final model explains the data, and what it leaves.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Explanation {
+    /// The final model passes every per-sensor test and holds no stand-in.
+    pub explained: bool,
+    /// The effects named as causes (the final model's effects less the stand-ins), in the order added.
+    pub causes: Vec<String>,
+    /// The final model's hypotheses that fit as proxies, not causes.
+    pub stand_ins: Vec<StandIn>,
+    /// Causes the data do not tell from another hypothesis (named `X|Y` in the verdict).
+    pub ambiguous: Vec<Ambiguity>,
+    /// The final model (its hypotheses joined by `+`, stand-ins included; `none`: the baseline).
+    pub final_model: String,
+    /// The final model's chi-square over all factors.
+    pub final_chi_square: f64,
+    /// Its degrees of freedom.
+    pub final_dof: usize,
+    /// The per-sensor tests of the final model at `false_alarm / 3` each.
+    pub final_tests: Vec<FactorTest>,
+    /// The share of the baseline's excess chi-square the final model leaves
+    /// (`None` when the baseline has no excess).
+    pub unexplained_share: Option<f64>,
+    /// The residual-driver correlations of the final model that still carry structure.
+    pub structure_left: Vec<String>,
+}
+
+impl Explanation {
+    /// `none`, the causes joined by `+`, `unexplained`, or the causes and `+unexplained` (module docs).
+    pub fn verdict(&self) -> String {
+        let named: Vec<String> = self
+            .causes
+            .iter()
+            .map(|c| match self.ambiguous.iter().find(|a| &a.cause == c) {
+                Some(a) => format!("{}|{}", a.cause, a.rival),
+                None => c.clone(),
+            })
+            .collect();
+        match (named.is_empty(), self.explained) {
+            (true, true) => "none".into(),
+            (false, true) => named.join("+"),
+            (true, false) => "unexplained".into(),
+            (false, false) => format!("{}+unexplained", named.join("+")),
+        }
+    }
+
+    /// Why the data are not explained, in one sentence (empty when they are).
+    pub fn sentence(&self) -> String {
+        if self.explained {
+            return String::new();
+        }
+        let mut parts = Vec::new();
+        if !self.stand_ins.is_empty() {
+            let names: Vec<&str> = self.stand_ins.iter().map(|s| s.hypothesis.as_str()).collect();
+            parts.push(format!("stand-ins: {}", names.join(", ")));
+        }
+        let failing: Vec<String> = self
+            .final_tests
+            .iter()
+            .filter(|t| !t.consistent)
+            .map(|t| {
+                format!(
+                    "{} chi-square {:.1} above its limit {:.1}",
+                    t.kind, t.chi_square, t.limit
+                )
+            })
+            .collect();
+        if !failing.is_empty() {
+            parts.push(format!(
+                "the final model fails the sensor tests ({})",
+                failing.join(", ")
+            ));
+            if let Some(share) = self.unexplained_share {
+                parts.push(format!(
+                    "it leaves {:.0} % of the baseline's excess chi-square",
+                    share * 100.0
+                ));
+            }
+        }
+        if !self.structure_left.is_empty() {
+            parts.push(format!("structure left: {}", self.structure_left.join("; ")));
+        }
+        format!("not explained by the catalogue: {}", parts.join("; "))
+    }
+}
+
+/// The explanation of `model` (the final model of the search, with its
+/// residual-driver tests `drivers`) against the baseline.
+pub(super) fn explain(
+    base: &Baseline,
+    model: &Model,
+    drivers: &[DriverTest],
+    (steps, candidates): (&[SelectionStep], &[CandidateFit]),
+    false_alarm: f64,
+) -> Explanation {
+    let graph = super::candidates::rebuild(&model.result, &base.used, &model.options);
+    let components = measurement_components(&graph.graph);
+    let effect_parameters = model.options.free_effects.parameter_count();
+    let unknowns = 8 * base.used.len() + 4 * CABLE_COUNT + effect_parameters;
+    let constraints = CABLE_COUNT * base.used.len();
+    let dof = (components + constraints).saturating_sub(unknowns).max(1);
+    let tests = factor_tests_at(&graph.graph, components, dof, false_alarm);
+    let failing = |sensor: &str| tests.iter().find(|t| t.kind == sensor && !t.consistent);
+    let mut stand_ins: Vec<StandIn> = model
+        .result
+        .effect_estimates
+        .iter()
+        .filter_map(|e| {
+            stand_in(e, &base.result.robot, base.mean_reference_tension_n)
+                .or_else(|| failing(own_sensor(e.effect)).map(|t| partial_stand_in(e, t)))
+        })
+        .collect();
+    if model.hypotheses.contains(&Hypothesis::OrientationFree) {
+        stand_ins.push(orientation_stand_in());
+    }
+    let causes: Vec<String> = model
+        .hypotheses
+        .iter()
+        .filter(|h| matches!(h, Hypothesis::Effect(_)))
+        .map(|h| h.name().to_string())
+        .filter(|name| !stand_ins.iter().any(|s| &s.hypothesis == name))
+        .collect();
+    let ambiguous = causes.iter().filter_map(|c| rival(c, steps, candidates)).collect();
+    let excess_before = base.chi_square - base.dof as f64;
+    let excess_after = (model.chi_square - dof as f64).max(0.0);
+    Explanation {
+        explained: stand_ins.is_empty() && tests.iter().all(|t| t.consistent),
+        causes,
+        stand_ins,
+        ambiguous,
+        final_model: model.name(),
+        final_chi_square: model.chi_square,
+        final_dof: dof,
+        final_tests: tests,
+        unexplained_share: (excess_before > 0.0).then(|| (excess_after / excess_before).min(1.0)),
+        structure_left: drivers
+            .iter()
+            .filter(|d| d.significant)
+            .map(|d| format!("{} vs {}, t = {:+.1}", d.residual, d.driver, d.t_statistic))
+            .collect(),
+    }
+}
+
+/// The hypothesis tested at the step that added `cause` whose BIC comes
+/// closest to it, if within [`AMBIGUOUS_BIC`] (a converged, admissible fit).
+fn rival(cause: &str, steps: &[SelectionStep], candidates: &[CandidateFit]) -> Option<Ambiguity> {
+    let step = steps.iter().find(|s| s.added == cause)?.step;
+    let at_step = |c: &&CandidateFit| c.step == step && c.converged && c.inadmissible.is_none();
+    let added = candidates.iter().filter(at_step).find(|c| c.effect == cause)?;
+    candidates
+        .iter()
+        .filter(at_step)
+        .filter(|c| c.effect != cause && c.delta_bic.is_finite() && !nested(cause, &c.effect))
+        .map(|c| (c, c.delta_bic - added.delta_bic))
+        .filter(|(_, margin)| *margin < AMBIGUOUS_BIC)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(c, margin)| Ambiguity {
+            cause: cause.to_string(),
+            rival: c.effect.clone(),
+            bic_margin: margin,
+        })
+}
+
+/// Whether one of two hypotheses is nested in the other.
+fn nested(a: &str, b: &str) -> bool {
+    match (EffectKind::parse(a), EffectKind::parse(b)) {
+        (Ok(a), Ok(b)) => a.nested_in() == Some(b) || b.nested_in() == Some(a),
+        _ => false,
+    }
+}

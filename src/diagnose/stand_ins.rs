@@ -1,0 +1,285 @@
+//! Step 4a: stand-ins. A selected hypothesis whose estimate no real robot
+//! could have (beyond its plausible limit, [`crate::model::effect_limits`])
+//! fits the data only as a proxy for something else: a chain of 2.9 elements
+//! that makes the lengths right is not a cable, it says that something
+//! changes the sag. Freeing every pose's orientation is a stand-in too: it
+//! says that the localiser's orientations disagree with the statics, not why.
+//! The verdict names neither as a cause.
+//!
+//! An effect whose own sensor (the readings it changes directly: the
+//! encoders for the cable and drum effects, the load cell for its bias and
+//! gain, the localiser for the mount and the centre of mass's tilt) still
+//! fails its chi-square test in the final model is a stand-in as well: it
+//! lowers that sensor's misfit without explaining it, so it stands in for
+//! part of something the catalogue lacks.
+//!
+//! The test: an estimate is beyond its limit when its magnitude (the norm of
+//! the limited parameters, in the effect variable's units) exceeds the limit
+//! by more than 3 standard deviations of that magnitude (its covariance
+//! projected on the estimate's direction): a one-sided test at p = 0.00135
+//! that the data put the effect outside what a real robot can have.
+
+use serde::Serialize;
+
+use super::residual_tests::FactorTest;
+use crate::calib::EffectEstimate;
+use crate::model::effect_limits::{plausible_limits, PlausibleLimit};
+use crate::model::effects::EffectKind;
+use crate::model::robot::Robot;
+
+/// How many standard deviations beyond its limit an estimate must be to be a stand-in.
+pub const STAND_IN_SIGMAS: f64 = 3.0;
+
+/// A selected hypothesis that fits the data as a proxy, not as a cause.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StandIn {
+    /// The hypothesis (`segments`, ..., or `orientation`).
+    pub hypothesis: String,
+    /// What was estimated, in the robot's words ("a chain of 2.9 elements").
+    pub estimate: String,
+    /// The plausible limit it is beyond ("at least 10 elements"), empty for `orientation`.
+    pub limit: String,
+    /// Why no real robot goes beyond the limit, empty for `orientation`.
+    pub why: String,
+    /// What it stands in for ("something changes the cables' sag or length").
+    pub stands_for: String,
+}
+
+impl StandIn {
+    /// The report's sentence for it.
+    pub fn sentence(&self) -> String {
+        if self.limit.is_empty() {
+            return format!("{}: {}: {}", self.hypothesis, self.estimate, self.stands_for);
+        }
+        format!(
+            "{}: {}, which no real robot has ({}: {}); it stands in for {}",
+            self.hypothesis, self.estimate, self.limit, self.why, self.stands_for
+        )
+    }
+}
+
+/// The stand-in that freed orientations are.
+pub(super) fn orientation_stand_in() -> StandIn {
+    StandIn {
+        hypothesis: "orientation".into(),
+        estimate: "every pose's orientation is freed from the localiser's reading".into(),
+        limit: String::new(),
+        why: String::new(),
+        stands_for: "the localiser's orientations disagree with the statics, and no effect tested says why \
+                     (something the catalogue lacks tilts the platform or turns the localiser)"
+            .into(),
+    }
+}
+
+/// The stand-in `estimate` is, if it is beyond a plausible limit for `robot` (module docs).
+pub(super) fn stand_in(estimate: &EffectEstimate, robot: &Robot, mean_reference_tension_n: f64) -> Option<StandIn> {
+    let kind = estimate.effect;
+    plausible_limits(kind, robot, mean_reference_tension_n)
+        .into_iter()
+        .find(|limit| beyond(estimate, limit))
+        .map(|limit| StandIn {
+            hypothesis: kind.name().into(),
+            estimate: describe(estimate, &limit),
+            limit: limit.limit.clone(),
+            why: limit.why.clone(),
+            stands_for: stands_for(kind).into(),
+        })
+}
+
+/// The measurement factor kind of the sensor `kind` changes directly
+/// (`catenary_length`, `reference_tension` or `pose_prior`).
+pub(super) fn own_sensor(kind: EffectKind) -> &'static str {
+    match kind {
+        EffectKind::Elastic
+        | EffectKind::Pulley
+        | EffectKind::EncoderScale
+        | EffectKind::CommonGain
+        | EffectKind::Segments => "catenary_length",
+        EffectKind::LoadCell => "reference_tension",
+        EffectKind::Com | EffectKind::LocaliserMount => "pose_prior",
+    }
+}
+
+/// The stand-in an effect is when its own sensor still fails its test in
+/// the final model (module docs).
+pub(super) fn partial_stand_in(estimate: &EffectEstimate, sensor_test: &FactorTest) -> StandIn {
+    let kind = estimate.effect;
+    StandIn {
+        hypothesis: kind.name().into(),
+        estimate: estimate
+            .names
+            .iter()
+            .zip(&estimate.values)
+            .zip(&estimate.sigmas)
+            .map(|((n, v), s)| format!("{n} {v:.5} +- {s:.1e}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        limit: String::new(),
+        why: String::new(),
+        stands_for: format!(
+            "it lowers the misfit of its own sensor but leaves it inconsistent ({} chi-square {:.1} above its limit {:.1}): \
+             it stands in for part of something the catalogue lacks",
+            sensor_test.kind, sensor_test.chi_square, sensor_test.limit
+        ),
+    }
+}
+
+/// A parameter in the effect variable's units (gains as errors).
+fn variable_value(kind: EffectKind, index: usize, value: f64) -> f64 {
+    let gain = matches!(kind, EffectKind::EncoderScale | EffectKind::CommonGain)
+        || (kind == EffectKind::LoadCell && index == 1);
+    if gain {
+        value - 1.0
+    } else {
+        value
+    }
+}
+
+/// The magnitude of the limited parameters and its standard deviation.
+fn magnitude(estimate: &EffectEstimate, limit: &PlausibleLimit) -> (f64, f64) {
+    let theta: Vec<f64> = limit
+        .parameters
+        .iter()
+        .map(|&i| variable_value(estimate.effect, i, estimate.values[i]))
+        .collect();
+    let norm = theta.iter().map(|t| t * t).sum::<f64>().sqrt();
+    if norm == 0.0 {
+        return (0.0, f64::NAN);
+    }
+    let mut variance = 0.0;
+    for (a, &i) in limit.parameters.iter().enumerate() {
+        for (b, &j) in limit.parameters.iter().enumerate() {
+            variance += theta[a] * theta[b] * estimate.covariance[i][j];
+        }
+    }
+    // A NaN covariance (an unidentified estimate) gives a NaN sigma: never beyond.
+    let sigma = if variance.is_nan() {
+        f64::NAN
+    } else {
+        variance.max(0.0).sqrt() / norm
+    };
+    (norm, sigma)
+}
+
+/// Whether the estimate is beyond `limit` by more than [`STAND_IN_SIGMAS`].
+fn beyond(estimate: &EffectEstimate, limit: &PlausibleLimit) -> bool {
+    let (norm, sigma) = magnitude(estimate, limit);
+    sigma.is_finite() && norm - STAND_IN_SIGMAS * sigma > limit.largest
+}
+
+/// The estimate in the robot's words, for the parameters of `limit`.
+fn describe(estimate: &EffectEstimate, limit: &PlausibleLimit) -> String {
+    let (norm, sigma) = magnitude(estimate, limit);
+    let first = limit.parameters[0];
+    let (value, value_sigma) = (estimate.values[first], estimate.sigmas[first]);
+    match estimate.effect {
+        EffectKind::Elastic => format!(
+            "cables of EA {:.3e} N (compliance {value:.4} +- {value_sigma:.1e} per MN)",
+            1e6 / value
+        ),
+        EffectKind::Pulley => format!("a pulley of radius {value:.3} +- {value_sigma:.3} m"),
+        EffectKind::EncoderScale => format!("drum {} read with a gain of {value:.5} +- {value_sigma:.1e}", first + 1),
+        EffectKind::CommonGain => format!("every drum read with a gain of {value:.5} +- {value_sigma:.1e}"),
+        EffectKind::LoadCell if first == 0 => format!("a load cell off by {value:.2} +- {value_sigma:.2} N"),
+        EffectKind::LoadCell => format!("a load cell with a gain of {value:.4} +- {value_sigma:.1e}"),
+        EffectKind::Com => format!(
+            "a centre-of-mass shift of {:.1} +- {:.1} cm",
+            norm * 100.0,
+            sigma * 100.0
+        ),
+        EffectKind::Segments => format!(
+            "cables as chains of {:.1} elements (1/n^2 = {value:.4} +- {value_sigma:.1e})",
+            1.0 / value.sqrt()
+        ),
+        EffectKind::LocaliserMount => format!("a localiser turned by {norm:.2} +- {sigma:.2} deg"),
+    }
+}
+
+/// What an estimate beyond its limit stands in for.
+fn stands_for(kind: EffectKind) -> &'static str {
+    match kind {
+        EffectKind::Elastic => "something that lengthens the cables with their tension",
+        EffectKind::Pulley => "something that changes the cable lengths with the cables' direction at the anchors",
+        EffectKind::EncoderScale | EffectKind::CommonGain => {
+            "something that changes the encoder readings in proportion to the cable lengths"
+        }
+        EffectKind::LoadCell => {
+            "something that changes the tension the load cell sees (the platform's or the cables' weight, friction)"
+        }
+        EffectKind::Com => "something that tilts the platform or moves its load between the cables",
+        EffectKind::Segments => "something that changes the cables' sag or length",
+        EffectKind::LocaliserMount => "something that turns the localiser's orientations",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn estimate(effect: EffectKind, values: Vec<f64>, sigma: f64) -> EffectEstimate {
+        let k = values.len();
+        EffectEstimate {
+            effect,
+            names: effect.parameter_names().iter().map(|s| s.to_string()).collect(),
+            values,
+            sigmas: vec![sigma; k],
+            covariance: (0..k)
+                .map(|r| (0..k).map(|c| if r == c { sigma * sigma } else { 0.0 }).collect())
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn a_chain_of_three_elements_is_a_stand_in_and_one_of_forty_is_not() {
+        let robot = Robot::builtin("large").unwrap();
+        let coarse = stand_in(
+            &estimate(EffectKind::Segments, vec![1.0 / 2.9f64.powi(2)], 1.6e-3),
+            &robot,
+            500.0,
+        )
+        .expect("2.9 elements is no cable");
+        assert!(
+            coarse.estimate.contains("chains of 2.9 elements"),
+            "{}",
+            coarse.estimate
+        );
+        assert!(coarse
+            .sentence()
+            .contains("stands in for something that changes the cables' sag"));
+        assert!(stand_in(&estimate(EffectKind::Segments, vec![1.0 / 1600.0], 1e-4), &robot, 500.0).is_none());
+        // 1/n^2 = 0.0105 +- 0.001: beyond 0.01, but not by 3 sigma.
+        assert!(stand_in(&estimate(EffectKind::Segments, vec![0.0105], 1e-3), &robot, 500.0).is_none());
+    }
+
+    #[test]
+    fn gains_are_tested_as_errors_and_a_shift_by_its_length() {
+        let robot = Robot::builtin("large").unwrap();
+        let gains = |g: f64| estimate(EffectKind::EncoderScale, vec![1.0, 1.0, g, 1.0], 1e-4);
+        assert!(stand_in(&gains(1.003), &robot, 500.0).is_none());
+        let drum = stand_in(&gains(0.93), &robot, 500.0).expect("a 7 % drum error");
+        assert!(
+            drum.estimate.starts_with("drum 3 read with a gain of 0.93000"),
+            "{}",
+            drum.estimate
+        );
+        // A 40 cm shift (0.3 m, 0.265 m) is off the 0.297 m platform; a 22.6 cm one is on it.
+        assert!(stand_in(&estimate(EffectKind::Com, vec![0.3, 0.265], 0.01), &robot, 500.0).is_some());
+        assert!(stand_in(&estimate(EffectKind::Com, vec![0.16, 0.16], 0.01), &robot, 500.0).is_none());
+        // The load cell: a 1.066 gain is within 10 %, a 120 N bias on 500 N is not within 15 %.
+        assert!(stand_in(
+            &estimate(EffectKind::LoadCell, vec![-2.7, 1.066], 3.7e-3),
+            &robot,
+            500.0
+        )
+        .is_none());
+        let bias = stand_in(&estimate(EffectKind::LoadCell, vec![120.0, 1.0], 3.0), &robot, 500.0).unwrap();
+        assert!(bias.estimate.contains("off by 120.00"), "{}", bias.estimate);
+    }
+
+    #[test]
+    fn an_unidentified_estimate_is_not_called_a_stand_in() {
+        let robot = Robot::builtin("large").unwrap();
+        assert!(stand_in(&estimate(EffectKind::Pulley, vec![3.5], f64::NAN), &robot, 500.0).is_none());
+        assert!(stand_in(&estimate(EffectKind::Pulley, vec![3.5], 0.08), &robot, 500.0).is_some());
+    }
+}
