@@ -40,6 +40,10 @@ struct EffectScore {
     anchor_mae_after_m: f64,
     /// Detectable cases whose anchor error the verdict's model at least halved.
     halved: usize,
+    /// Diagnoses of detectable cases with a hidden effect left out of the catalogue.
+    left_out_detectable: usize,
+    /// Honest verdicts among them.
+    left_out_honest: usize,
 }
 
 /// The score of one robot under one noise reading.
@@ -55,6 +59,9 @@ struct Summary {
     none_false_rejection_rate: f64,
     /// Detectable cases (single and pairs) whose anchor error was at least halved.
     halved_rate: f64,
+    /// Honest verdicts among the diagnoses of detectable cases with a hidden
+    /// effect left out of the catalogue (NaN without `--catalogue leave-one-out`).
+    left_out_honest_rate: f64,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -93,6 +100,7 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         noise: args.noise[0],
         segments: args.segments,
         closure: args.closure,
+        catalogue: args.catalogue,
         ..HiddenEffectOptions::default()
     };
     options.validate()?;
@@ -223,6 +231,12 @@ fn score(robot: &str, noise: NoisePreset, hidden: &str, group: &[&HiddenCase]) -
             .filter(detectable)
             .filter(|c| c.anchor_mae_after_m <= 0.5 * c.anchor_mae_before_m)
             .count(),
+        left_out_detectable: group.iter().filter(detectable).map(|c| c.left_out.len()).sum(),
+        left_out_honest: group
+            .iter()
+            .filter(detectable)
+            .map(|c| c.left_out.iter().filter(|x| x.honest).count())
+            .sum(),
     }
 }
 
@@ -250,6 +264,10 @@ fn summaries(robots: &[Robot], noises: &[NoisePreset], scores: &[EffectScore]) -
                 pair_right_rate: rate(sum(&pair, &|s| s.right_detectable), sum(&pair, &|s| s.detectable)),
                 none_false_rejection_rate: 1.0 - rate(sum(&none, &|s| s.right), sum(&none, &|s| s.cases)),
                 halved_rate: rate(sum(&effect, &|s| s.halved), sum(&effect, &|s| s.detectable)),
+                left_out_honest_rate: rate(
+                    sum(&effect, &|s| s.left_out_honest),
+                    sum(&effect, &|s| s.left_out_detectable),
+                ),
             });
         }
     }
@@ -347,6 +365,7 @@ fn print_summaries(summaries: &[Summary]) {
         "right set, detectable pairs",
         "`none` wrongly rejected",
         "anchor error at least halved",
+        "honest with the hidden effect left out",
     ]);
     let pct = |x: f64| {
         if x.is_finite() {
@@ -363,6 +382,7 @@ fn print_summaries(summaries: &[Summary]) {
             pct(s.pair_right_rate),
             pct(s.none_false_rejection_rate),
             pct(s.halved_rate),
+            pct(s.left_out_honest_rate),
         ]);
     }
     println!("{t}");

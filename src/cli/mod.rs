@@ -128,6 +128,11 @@ struct HiddenEffectsArgs {
     /// yaw (a random yaw within +-1 degree) or mixed (about half each).
     #[arg(long, default_value = "mixed", value_parser = sagcal::sim::closed_form::Closure::parse)]
     closure: sagcal::sim::closed_form::Closure,
+    /// The diagnosis' catalogue: full, or leave-one-out (each case is also
+    /// diagnosed with each hidden effect left out of the catalogue, and the
+    /// verdict scored for honesty: `unexplained`, and no wrong cause named).
+    #[arg(long, default_value = "full", value_parser = sagcal::experiments::hidden_effects::Catalogue::parse)]
+    catalogue: sagcal::experiments::hidden_effects::Catalogue,
     /// Print JSON (with every case).
     #[arg(long)]
     json: bool,

@@ -100,6 +100,8 @@ use crate::stats::{chi_square_critical, noncentral_chi_square_survival};
 
 pub use super::hidden_draws::{draw_effects, mid_range_effects, smallest_effects};
 pub use super::identifiability::{identifiability, Identifiability};
+use super::leave_one_out::{honest, left_out_with};
+pub use super::leave_one_out::{Catalogue, LeftOut};
 
 /// Settings of the experiment.
 #[derive(Debug, Clone, PartialEq)]
@@ -115,6 +117,8 @@ pub struct HiddenEffectOptions {
     /// How each pose closes its family of equilibria: the most level member
     /// or one of a random yaw ([`Closure`]).
     pub closure: Closure,
+    /// The diagnosis' catalogue: every effect, or also each hidden effect left out.
+    pub catalogue: Catalogue,
 }
 
 impl Default for HiddenEffectOptions {
@@ -130,6 +134,7 @@ impl Default for HiddenEffectOptions {
                 yaw_fraction: 0.5,
                 max_yaw_deg: DEFAULT_MAX_YAW_DEG,
             },
+            catalogue: Catalogue::Full,
         }
     }
 }
@@ -159,6 +164,9 @@ pub struct HiddenCase {
     pub failing_tests: Vec<String>,
     /// The stand-ins of the final model.
     pub stand_ins: Vec<String>,
+    /// With [`Catalogue::LeaveOneOut`]: per hidden effect, the diagnosis
+    /// without it in the catalogue.
+    pub left_out: Vec<LeftOut>,
     /// The smallest power, over the hidden effects, of the diagnosis' first
     /// test at the effect's true magnitude, and for per-drum gains of telling
     /// them from one common gain (`None` for none or a singular information
@@ -331,6 +339,10 @@ fn diagnose_case(
         &diagnose_options,
         &mut |_, _, _| {},
     )?;
+    let left_out = match options.catalogue {
+        Catalogue::Full => Vec::new(),
+        Catalogue::LeaveOneOut => leave_each_out(&guess, &measurements, &truth, hidden, &diagnose_options)?,
+    };
     let hidden_name = set_name(hidden.iter().map(|k| k.name().to_string()));
 
     let step_one = |k: EffectKind| {
@@ -387,6 +399,7 @@ fn diagnose_case(
             .map(|t| format!("{} {:.1} > {:.1}", t.kind, t.chi_square, t.limit))
             .collect(),
         stand_ins: diagnosis.explanation.stand_ins.iter().map(|s| s.sentence()).collect(),
+        left_out,
         verdict: diagnosis.verdict,
         hidden: hidden_name,
         power: if hidden.is_empty() { None } else { power },
@@ -396,6 +409,31 @@ fn diagnose_case(
         baseline_error_over_sigma: diagnosis.baseline_error_over_sigma.unwrap_or(f64::NAN),
         anchor_mae_known_geometry_m,
     })
+}
+
+/// Per hidden effect, the diagnosis of the case with it (and its nested
+/// relatives) left out of the catalogue, and whether its verdict is honest.
+fn leave_each_out(
+    guess: &Robot,
+    measurements: &[PoseMeasurement],
+    truth: &Robot,
+    hidden: &[EffectKind],
+    options: &DiagnoseOptions,
+) -> Result<Vec<LeftOut>> {
+    hidden
+        .iter()
+        .map(|&k| {
+            let out = left_out_with(k);
+            let mut blind = options.clone();
+            blind.candidates.retain(|c| !out.contains(c));
+            let diagnosis = diagnose(guess, measurements, Some(truth), &blind, &mut |_, _, _| {})?;
+            Ok(LeftOut {
+                left_out: set_name(out.iter().map(|k| k.name().to_string())),
+                honest: honest(&diagnosis.verdict, hidden, &out),
+                verdict: diagnosis.verdict,
+            })
+        })
+        .collect()
 }
 
 /// Whether `verdict` names exactly the `hidden` effects: one term per
