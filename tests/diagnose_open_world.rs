@@ -127,6 +127,28 @@ fn an_encoder_drift_is_unexplained_not_two_effects() {
         );
     }
     assert!(d.gain.residual_rms_after <= d.gain.residual_rms_before);
+    // The rows are the order the poses were taken: the drift shows against the row.
+    let strongest = &d.drivers[0];
+    assert_eq!(
+        (strongest.residual.as_str(), strongest.driver.as_str()),
+        ("encoder", "row (order taken)")
+    );
+    assert!(strongest.t_statistic.abs() > 10.0, "{strongest:?}");
+    assert!(d
+        .explanation
+        .structure_left
+        .iter()
+        .any(|s| s.starts_with("encoder vs row")));
+    // Taken out of time order (a RecurDyn log), the row is no driver.
+    let (truth, measurements, guess) = case(seed, |_| {}, &[]);
+    let sigmas = NoisePreset::Authors.sigmas(truth.platform_weight_n);
+    let mut options = DiagnoseOptions::new(CalibrationOptions::new(sigmas));
+    options.rows_in_time_order = false;
+    let d = diagnose(&guess, &measurements, Some(&truth), &options, &mut |_, _, _| {}).unwrap();
+    assert!(!d
+        .drivers
+        .iter()
+        .any(|t| t.driver.starts_with("row") || t.driver.starts_with("direction")));
 }
 
 /// Leave one out: an effect of the catalogue hidden in the data and removed

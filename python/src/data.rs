@@ -4,7 +4,9 @@
 use std::path::PathBuf;
 
 use pyo3::prelude::*;
-use sagcal::io::measurements::{measurement_from_values, pose_values, ReadOptions, MEASUREMENT_HEADER};
+use sagcal::io::measurements::{
+    measurement_from_values, pose_values, MeasurementFormat, ReadOptions, MEASUREMENT_HEADER,
+};
 use sagcal::model::PoseMeasurement;
 
 use crate::arrays::{out2, rows};
@@ -19,6 +21,9 @@ pub struct Data {
     pub poses: Vec<PoseMeasurement>,
     /// The file (as given), or [`ARRAY_LABEL`] for an array.
     pub label: PathBuf,
+    /// Whether the rows are in the order the poses were taken: a sagcal
+    /// measurement file or an array (not a RecurDyn log or an authors' folder).
+    pub rows_in_time_order: bool,
 }
 
 impl Data {
@@ -46,6 +51,7 @@ pub fn measurements(value: &Bound<'_, PyAny>, reference_cable: usize) -> PyResul
         )
         .map_err(to_py)?;
         return Ok(Data {
+            rows_in_time_order: set.format == MeasurementFormat::Sagcal,
             poses: set.poses,
             label: path,
         });
@@ -53,6 +59,7 @@ pub fn measurements(value: &Bound<'_, PyAny>, reference_cable: usize) -> PyResul
     Ok(Data {
         poses: from_rows(&rows::<11>(value, ARRAY_LABEL)?)?,
         label: PathBuf::from(ARRAY_LABEL),
+        rows_in_time_order: true,
     })
 }
 

@@ -182,6 +182,7 @@ pub fn diagnose(
     options.folds = folds;
     options.false_alarm = false_alarm;
     options.orientation_hypothesis = orientation_hypothesis;
+    options.rows_in_time_order = data.rows_in_time_order;
     if let Some(list) = candidates {
         options.candidates = list
             .iter()

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use sagcal::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
-use sagcal::io::measurements::{read_measurements, ReadOptions};
+use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
 use sagcal::io::OutputSet;
 use sagcal::model::effects::EffectKind;
 use sagcal::model::Robot;
@@ -27,6 +27,7 @@ pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
     options.folds = args.folds;
     options.false_alarm = args.false_alarm;
     options.orientation_hypothesis = !args.no_orientation_hypothesis;
+    options.rows_in_time_order = data.format == MeasurementFormat::Sagcal;
     if let Some(list) = &args.candidates {
         options.candidates = list
             .split(',')
@@ -156,6 +157,10 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
     out += &render_gross_errors(d);
     out += &render_residual_tests(d);
     out += "\n2. residual structure (baseline): correlation with physical drivers, strongest first\n";
+    if !d.rows_in_time_order {
+        out += "   the rows are not in the order the poses were taken (a RecurDyn log or an authors' folder): \
+                no drift over the rows or direction of motion is tested\n";
+    }
     out += &driver_table(&d.drivers, 8);
     out += &format!(
         "\n3. forward selection at a false-alarm rate of {:.0e} (baseline: held-out residual RMS {:.3})\n",

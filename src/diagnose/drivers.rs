@@ -1,6 +1,10 @@
 //! Step 2: the residuals against the physical drivers of each cable and pose
 //! (tension, tension x length, cable length, sag, elevation, pulley wrap
-//! angle, platform position), by correlation.
+//! angle, platform position), by correlation. Where the rows are in the
+//! order they were taken, two drivers of time and motion join them: the row
+//! (a drift over time: an encoder or load cell creeping) and, per cable, the
+//! direction of its last motion (+1 paid out, -1 reeled in since the
+//! previous row: pulley friction at a load cell, backlash, hysteresis).
 
 use nalgebra::Vector3;
 use serde::Serialize;
@@ -62,6 +66,11 @@ pub(super) struct PoseSample {
     load_cell: f64,
     /// Localiser position residual / sigma.
     position: [f64; 3],
+    /// The row, counted from 1 in the order the poses were taken.
+    row: f64,
+    /// Per cable: +1 when its encoder reading grew since the previous row
+    /// (paid out), -1 when it shrank (reeled in), NaN for the first row.
+    direction: [f64; CABLE_COUNT],
 }
 
 const CABLE_DRIVER_COUNT: usize = 7;
@@ -76,6 +85,11 @@ pub const DRIVERS: [&str; CABLE_DRIVER_COUNT] = [
     "pulley wrap angle (deg)",
     "platform height (m)",
 ];
+
+/// The driver of time: the row in the order taken.
+pub const ROW_DRIVER: &str = "row (order taken)";
+/// The driver of motion, per cable.
+pub const DIRECTION_DRIVER: &str = "direction of last motion (+1 out, -1 in)";
 
 /// The driver and residual that show `effect` best.
 pub(super) fn winning_driver(effect: EffectKind) -> (&'static str, &'static str) {
@@ -154,7 +168,13 @@ pub(super) fn samples(
             let position_rows = prior.len() - 3;
             let out = used[k].excluded;
             let unless = |sensor: Sensor, value: f64| if out.contains(sensor) { f64::NAN } else { value };
+            let direction = std::array::from_fn(|i| match k {
+                0 => f64::NAN,
+                _ => (used[k].encoder_lengths_m[i] - used[k - 1].encoder_lengths_m[i]).signum(),
+            });
             Ok(PoseSample {
+                row: (k + 1) as f64,
+                direction,
                 cable_drivers,
                 position_m: pose.position_m,
                 measured_tension_n: used[k].reference_tension_n,
@@ -174,15 +194,21 @@ pub(super) fn series_of(samples: &[PoseSample], residual: &str, driver: &str) ->
             "measured tension (N)" => Some(s.measured_tension_n),
             "platform x (m)" => Some(s.position_m.x),
             "platform y (m)" => Some(s.position_m.y),
+            ROW_DRIVER => Some(s.row),
             _ => None,
+        };
+        let cable_driver = |i: usize| -> Option<f64> {
+            if driver == DIRECTION_DRIVER {
+                return Some(s.direction[i]);
+            }
+            DRIVERS.iter().position(|d| *d == driver).map(|d| s.cable_drivers[i][d])
         };
         match residual {
             "encoder" => {
                 for i in 0..CABLE_COUNT {
-                    let x = pose_driver
-                        .or_else(|| DRIVERS.iter().position(|d| *d == driver).map(|d| s.cable_drivers[i][d]));
+                    let x = pose_driver.or_else(|| cable_driver(i));
                     if let Some(x) = x {
-                        if s.encoder[i].is_finite() {
+                        if x.is_finite() && s.encoder[i].is_finite() {
                             points.push((x, s.encoder[i]));
                         }
                     }
@@ -196,12 +222,13 @@ pub(super) fn series_of(samples: &[PoseSample], residual: &str, driver: &str) ->
                     _ => s.position[2],
                 };
                 let x = pose_driver.or_else(|| {
-                    DRIVERS
-                        .iter()
-                        .position(|d| *d == driver)
-                        .map(|d| s.cable_drivers.iter().map(|c| c[d]).sum::<f64>() / CABLE_COUNT as f64)
+                    let values: Option<Vec<f64>> = (0..CABLE_COUNT).map(cable_driver).collect();
+                    values.map(|v| v.iter().sum::<f64>() / CABLE_COUNT as f64)
                 });
                 if let (Some(x), true) = (x, y.is_finite()) {
+                    if !x.is_finite() {
+                        continue;
+                    }
                     points.push((x, y));
                 }
             }
@@ -210,11 +237,16 @@ pub(super) fn series_of(samples: &[PoseSample], residual: &str, driver: &str) ->
     points
 }
 
-/// Every residual against every driver, strongest correlation first.
-pub(super) fn driver_tests(samples: &[PoseSample]) -> Vec<DriverTest> {
+/// Every residual against every driver, strongest correlation first; the
+/// row and the direction of motion only where `time_order` (the rows are in
+/// the order the poses were taken).
+pub(super) fn driver_tests(samples: &[PoseSample], time_order: bool) -> Vec<DriverTest> {
     let residuals = ["encoder", "load_cell", "position_x", "position_y", "position_z"];
     let mut drivers: Vec<&str> = DRIVERS.to_vec();
     drivers.extend(["measured tension (N)", "platform x (m)", "platform y (m)"]);
+    if time_order {
+        drivers.extend([ROW_DRIVER, DIRECTION_DRIVER]);
+    }
     let mut tests = Vec::new();
     for residual in residuals {
         for driver in &drivers {

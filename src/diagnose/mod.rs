@@ -124,6 +124,12 @@ pub struct DiagnoseOptions {
     /// The false-alarm rate of the whole search: the probability of
     /// declaring an effect on data the baseline describes (module docs).
     pub false_alarm: f64,
+    /// Whether the rows are in the order the poses were taken (a sagcal
+    /// measurement file): only then are the row (a drift over time) and each
+    /// cable's direction of last motion drivers of step 2. A RecurDyn log or
+    /// an authors' folder holds poses whose order is not the order a robot
+    /// took them in.
+    pub rows_in_time_order: bool,
 }
 
 impl DiagnoseOptions {
@@ -136,6 +142,7 @@ impl DiagnoseOptions {
             orientation_hypothesis: true,
             folds: 5,
             false_alarm: 1e-3,
+            rows_in_time_order: true,
         }
     }
 }
@@ -304,7 +311,7 @@ pub fn diagnose(
     let factor_tests = factor_tests(&base.graph.graph, base.components, base.dof);
     // 2. The residuals against the physical drivers.
     let base_samples = samples(&base.result, &base.used, &base.options)?;
-    let drivers = driver_tests(&base_samples);
+    let drivers = driver_tests(&base_samples, options.rows_in_time_order);
     let baseline_cv = cross_validate(&base.result, &base.used, &base.options, options.folds, &mut |what| {
         progress.step(&format!("baseline: {what}"))
     })?;
@@ -329,7 +336,7 @@ pub fn diagnose(
         let after_samples = samples(&model.result, &base.used, &model.options)?;
         let shown = first_effect(model).map(|kind| (kind, after_samples.as_slice()));
         let series = driver_series(&drivers, &base_samples, shown);
-        (driver_tests(&after_samples), series)
+        (driver_tests(&after_samples, options.rows_in_time_order), series)
     };
     let left = if model.hypotheses.is_empty() {
         &drivers
@@ -356,6 +363,7 @@ pub fn diagnose(
         orientation_prior: base.options.orientation_prior,
         false_alarm: options.false_alarm,
         factor_tests,
+        rows_in_time_order: options.rows_in_time_order,
         drivers,
         drivers_after,
         baseline_bic: base.bic,

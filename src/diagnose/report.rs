@@ -59,6 +59,9 @@ pub struct Diagnosis {
     pub false_alarm: f64,
     /// Per factor type.
     pub factor_tests: Vec<FactorTest>,
+    /// Whether the rows were taken in their order (the row and direction
+    /// drivers are tested only then, [`super::DiagnoseOptions::rows_in_time_order`]).
+    pub rows_in_time_order: bool,
     /// Residual-driver correlations of the baseline, strongest first.
     pub drivers: Vec<DriverTest>,
     /// The same with the verdict's model (empty for `none`): the structure left.

@@ -26,7 +26,7 @@ mod hidden_draws;
 pub mod hidden_effects;
 mod hidden_options;
 mod identifiability;
-pub mod leave_one_out;
+mod leave_one_out;
 pub mod localize_after_calibration;
 pub mod plan_candidates;
 pub mod pose_plan;
