@@ -31,6 +31,7 @@ use super::stand_ins::{orientation_stand_in, own_sensor, partial_stand_in, stand
 use super::Baseline;
 use crate::model::effects::EffectKind;
 use crate::model::robot::CABLE_COUNT;
+use crate::stats::chi_square_critical;
 
 /// The BIC margin below which two hypotheses explain the data about equally (module docs).
 pub const AMBIGUOUS_BIC: f64 = 2.0;
@@ -68,8 +69,15 @@ pub struct Explanation {
     /// The share of the baseline's excess chi-square the final model leaves
     /// (`None` when the baseline has no excess).
     pub unexplained_share: Option<f64>,
-    /// The residual-driver correlations of the final model that still carry structure.
+    /// The residual-driver correlations of the final model that still carry
+    /// structure (`|t| > 3.29`, each at p < 0.001).
     pub structure_left: Vec<String>,
+    /// The `|t|` above which a correlation of the final model's residuals
+    /// with a driver is structure the model does not explain: two-sided
+    /// `p < false_alarm / m` over its `m` correlations (Bonferroni).
+    pub structure_limit_t: f64,
+    /// The correlations beyond it: the final model misses a structured effect.
+    pub structure_unexplained: Vec<String>,
 }
 
 impl Explanation {
@@ -124,7 +132,13 @@ impl Explanation {
                 ));
             }
         }
-        if !self.structure_left.is_empty() {
+        if !self.structure_unexplained.is_empty() {
+            parts.push(format!(
+                "the final model's residuals follow a driver (|t| above {:.2}, p < the false-alarm rate over every correlation): {}",
+                self.structure_limit_t,
+                self.structure_unexplained.join("; ")
+            ));
+        } else if !self.structure_left.is_empty() {
             parts.push(format!("structure left: {}", self.structure_left.join("; ")));
         }
         format!("not explained by the catalogue: {}", parts.join("; "))
@@ -170,8 +184,15 @@ pub(super) fn explain(
     let ambiguous = causes.iter().filter_map(|c| rival(c, steps, candidates)).collect();
     let excess_before = base.chi_square - base.dof as f64;
     let excess_after = (model.chi_square - dof as f64).max(0.0);
+    let structure_limit_t = chi_square_critical(1, false_alarm / drivers.len().max(1) as f64).sqrt();
+    let describe = |d: &DriverTest| format!("{} vs {}, t = {:+.1}", d.residual, d.driver, d.t_statistic);
+    let structure_unexplained: Vec<String> = drivers
+        .iter()
+        .filter(|d| d.t_statistic.abs() > structure_limit_t)
+        .map(describe)
+        .collect();
     Explanation {
-        explained: stand_ins.is_empty() && tests.iter().all(|t| t.consistent),
+        explained: stand_ins.is_empty() && tests.iter().all(|t| t.consistent) && structure_unexplained.is_empty(),
         causes,
         stand_ins,
         ambiguous,
@@ -180,11 +201,9 @@ pub(super) fn explain(
         final_dof: dof,
         final_tests: tests,
         unexplained_share: (excess_before > 0.0).then(|| (excess_after / excess_before).min(1.0)),
-        structure_left: drivers
-            .iter()
-            .filter(|d| d.significant)
-            .map(|d| format!("{} vs {}, t = {:+.1}", d.residual, d.driver, d.t_statistic))
-            .collect(),
+        structure_left: drivers.iter().filter(|d| d.significant).map(describe).collect(),
+        structure_limit_t,
+        structure_unexplained,
     }
 }
 
