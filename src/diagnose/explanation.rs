@@ -17,6 +17,14 @@
 //! drum gains and one common gain, are not rivals: the nested check of the
 //! selection decides between them.)
 //!
+//! The correlations of the final model's residuals with the physical drivers
+//! beyond two-sided `p < false_alarm / m` (`m` correlations, Bonferroni) are
+//! reported as structure the model misses, but do not decide `explained`:
+//! the correlations' t statistics count every cable's residual at a pose as
+//! an independent point, and as a test they rejected 1 in 10 `none` cases of
+//! the small robot (`experiment hidden-effects --seeds 10`), far above the
+//! stated rate.
+//!
 //! With it: the share of the baseline's excess chi-square (above its degrees
 //! of freedom) that the final model leaves, and the residual-driver
 //! correlations that still carry structure.
@@ -76,7 +84,8 @@ pub struct Explanation {
     /// with a driver is structure the model does not explain: two-sided
     /// `p < false_alarm / m` over its `m` correlations (Bonferroni).
     pub structure_limit_t: f64,
-    /// The correlations beyond it: the final model misses a structured effect.
+    /// The correlations beyond it: structure the final model misses
+    /// (reported; not part of `explained`, module docs).
     pub structure_unexplained: Vec<String>,
 }
 
@@ -134,7 +143,7 @@ impl Explanation {
         }
         if !self.structure_unexplained.is_empty() {
             parts.push(format!(
-                "the final model's residuals follow a driver (|t| above {:.2}, p < the false-alarm rate over every correlation): {}",
+                "its residuals follow a driver (|t| above {:.2}): {}",
                 self.structure_limit_t,
                 self.structure_unexplained.join("; ")
             ));
@@ -192,7 +201,7 @@ pub(super) fn explain(
         .map(describe)
         .collect();
     Explanation {
-        explained: stand_ins.is_empty() && tests.iter().all(|t| t.consistent) && structure_unexplained.is_empty(),
+        explained: stand_ins.is_empty() && tests.iter().all(|t| t.consistent),
         causes,
         stand_ins,
         ambiguous,
