@@ -160,16 +160,22 @@ class Diagnosis:
 
     @property
     def verdict(self) -> str:
-        """The effects selected, joined by ``+``, or ``"none"``."""
+        """The causes named, joined by ``+``; ``"none"``, ``"unexplained"``, or ``"X+unexplained"``; ``"X|Y"`` for one of two."""
+    @property
+    def explained(self) -> bool:
+        """Whether the final model passes every sensor's test and holds no stand-in."""
+    @property
+    def stand_ins(self) -> list[str]:
+        """The final model's hypotheses that fit only as proxies, each with what it stands in for."""
     @property
     def reason(self) -> str:
         """Why, in one sentence."""
     @property
     def effects(self) -> list[dict[str, Any]]:
-        """The selected effects with their parameters and 1-sigma."""
+        """The final model's effects with their parameters and 1-sigma."""
     @property
     def robot(self) -> Robot:
-        """The selected model's calibrated robot."""
+        """The final model's calibrated robot."""
     @property
     def baseline_consistent(self) -> bool:
         """Whether the baseline model passes its chi-square test."""
