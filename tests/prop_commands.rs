@@ -22,7 +22,9 @@
 //! minute here); `SAGCAL_PROPERTY_SEED` the seed (printed); `SAGCAL_BIN` runs
 //! another binary (e.g. the release build for long runs); with
 //! `SAGCAL_PROPERTY_COLLECT=DIR` every failing case is written to DIR and the
-//! run goes on (a search for faults rather than a test).
+//! run goes on (a search for faults rather than a test); with
+//! `SAGCAL_PROPERTY_ONLY=N` only case N of the seed is run (to reproduce a
+//! collected case: the cases are drawn the same, the others are not run).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -940,6 +942,18 @@ fn check(job: &Job) -> Result<(), String> {
     for (name, text) in &prepared.inputs {
         std::fs::write(dir.path().join(name), text).expect("an input is written");
     }
+    if let (Ok(_), Some(keep)) = (
+        std::env::var("SAGCAL_PROPERTY_ONLY"),
+        std::env::var_os("SAGCAL_PROPERTY_COLLECT"),
+    ) {
+        // The one case being reproduced: keep its inputs and command.
+        let keep = PathBuf::from(keep).join("inputs");
+        std::fs::create_dir_all(&keep).ok();
+        for (name, text) in &prepared.inputs {
+            std::fs::write(keep.join(name), text).ok();
+        }
+        std::fs::write(keep.join("command.txt"), prepared.args.join(" ")).ok();
+    }
     let outcome = run(dir.path(), &prepared.args);
     *TALLY.lock().unwrap().entry((kind(job), outcome.code)).or_default() += 1;
     if let Some(dir) = std::env::var_os("SAGCAL_PROPERTY_COLLECT") {
@@ -1015,6 +1029,7 @@ fn no_command_panics_hangs_loses_an_input_or_exits_zero_unchecked() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(20_261_126);
     let collect = std::env::var_os("SAGCAL_PROPERTY_COLLECT").map(PathBuf::from);
+    let only: Option<usize> = std::env::var("SAGCAL_PROPERTY_ONLY").ok().and_then(|s| s.parse().ok());
     println!("property seed {seed}, {cases} cases, binary {}", binary().display());
     let mut seed_bytes = [0u8; 32];
     seed_bytes[..8].copy_from_slice(&seed.to_le_bytes());
@@ -1031,6 +1046,9 @@ fn no_command_panics_hangs_loses_an_input_or_exits_zero_unchecked() {
     let failures = std::sync::atomic::AtomicUsize::new(0);
     let result = runner.run(&job(), |job| {
         let n = counter.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        if only.is_some_and(|only| only != n) {
+            return Ok(());
+        }
         match (check(&job), &collect) {
             (Ok(()), _) => Ok(()),
             (Err(what), Some(dir)) => {

@@ -327,11 +327,13 @@ fn solve_row(
                     robot.reference_cable + 1
                 ))
             })?;
-            let closed = logged_branch(robot, row, measured, options)?;
-            if robot.effects.is_none() {
-                Ok(closed)
-            } else {
-                predict_with_effects(robot, &closed, measured)
+            let closed = logged_branch(robot, row, measured, options);
+            match closed {
+                Ok(closed) if robot.effects.is_none() => Ok(closed),
+                Err(error) if robot.effects.is_none() => Err(error),
+                Ok(closed) => predict_with_effects(robot, &closed, measured)
+                    .or_else(|error| extended_from_logged(robot, row, measured).map_err(|_| error)),
+                Err(error) => extended_from_logged(robot, row, measured).map_err(|_| error),
             }
         }
         Closure::CableLengths if !robot.effects.is_none() => Err(crate::Error::InvalidInput(format!(
@@ -345,29 +347,25 @@ fn solve_row(
     }
 }
 
-/// How far (radians) the equilibrium solved from level may turn from the
-/// logged orientation before the statics are solved again from the logged
-/// one: 10 degrees, ten times the localisers' orientation noise and five
-/// times the model error of the RecurDyn log (1.9 degrees), far below the
-/// tens of degrees between two branches.
-const BRANCH_CHECK_RAD: f64 = 10.0 * std::f64::consts::PI / 180.0;
-
 /// Two equilibria closer than this (radians) are the same one.
 const SAME_EQUILIBRIUM_RAD: f64 = 1e-3;
 
 /// The equilibrium of the branch the robot was in. A position and a
 /// reference tension can admit several equilibria (a small square platform
 /// also balances turned half a turn, its cables crossed; a platform whose
-/// centre of mass is above its attachments hangs steeply tilted), and the
-/// search from level may find another one or none (both found by the
-/// property test of whole commands, which verified noise-free simulated data
-/// at 64 and 180 degrees and 0.07-1.4 % MPE-L, or not at all at 71 degrees
-/// of roll). The localiser saw which one the robot was in: when the
-/// equilibrium from level is more than [`BRANCH_CHECK_RAD`] from the logged
-/// orientation, or is not found, the statics are solved again from the
-/// logged orientation and the nearer distinct equilibrium is kept. The
-/// orientation stays predicted (the logged one only starts the search), and
-/// rows near their logged orientation keep the solve from level unchanged.
+/// centre of mass is above its attachments hangs steeply tilted; a long,
+/// heavy, slack cable lets two equilibria lie a few degrees apart), and the
+/// search from level may find another one or none (all found by the property
+/// test of whole commands, which verified noise-free simulated data at 64,
+/// 180 and 6.7 degrees and 0.07-20 % length error, or not at all at 71 degrees
+/// of roll). The localiser saw which one the robot was in: unless the
+/// equilibrium from level is the logged orientation itself (within
+/// [`SAME_EQUILIBRIUM_RAD`]), the statics are solved again from the logged
+/// orientation and, of two distinct equilibria, the one nearer the logged
+/// orientation is kept (the most likely branch under any orientation noise
+/// that is the same in every direction). The orientation stays predicted (the
+/// logged one only starts the search); where the equilibrium is unique both
+/// searches end at it and the answer is the solve from level.
 fn logged_branch(
     robot: &Robot,
     row: &MeasuredRow,
@@ -375,8 +373,7 @@ fn logged_branch(
     options: &StaticsOptions,
 ) -> crate::Result<Equilibrium> {
     let position = Vector3::from(row.position_m);
-    let [roll, pitch, yaw] = row.roll_pitch_yaw_deg;
-    let logged = AngleReading::DOCUMENTED.rotation([pitch, roll, yaw]);
+    let logged = logged_rotation(row);
     let turn = |eq: &Equilibrium| eq.pose.rotation.angle_to(&logged);
     let from_logged =
         || statics::solve_with_reference_tension(robot, position, reference_tension_n, Some(logged), options);
@@ -385,7 +382,7 @@ fn logged_branch(
         Err(level_error) => return from_logged().map_err(|_| level_error),
     };
     let found_turn = turn(&found);
-    if !found_turn.is_finite() || found_turn <= BRANCH_CHECK_RAD {
+    if !found_turn.is_finite() || found_turn <= SAME_EQUILIBRIUM_RAD {
         return Ok(found);
     }
     match from_logged() {
@@ -397,6 +394,22 @@ fn logged_branch(
         }
         _ => Ok(found),
     }
+}
+
+/// The row's logged orientation, read with the documented convention.
+fn logged_rotation(row: &MeasuredRow) -> UnitQuaternion<f64> {
+    let [roll, pitch, yaw] = row.roll_pitch_yaw_deg;
+    AngleReading::DOCUMENTED.rotation([pitch, roll, yaw])
+}
+
+/// The extended model's equilibrium for a row whose closed form has none
+/// (a pulley can make a position reachable that the closed form cannot
+/// reach): the search starts at the logged pose, with the reference
+/// tension along its sag-corrected chord.
+fn extended_from_logged(robot: &Robot, row: &MeasuredRow, reference_tension_n: f64) -> crate::Result<Equilibrium> {
+    let pose = PlatformPose::new(Vector3::from(row.position_m), logged_rotation(row));
+    let start = statics::unsolved_at(robot, pose, reference_tension_n)?;
+    predict_with_effects(robot, &start, reference_tension_n)
 }
 
 /// What cable `i`'s reading adds to its length: the robot's length offset

@@ -53,7 +53,7 @@ mod solve;
 
 pub use solve::{
     feasible_start, reference_tension_magnitude_guess, scan_family, solve_forward, solve_level,
-    solve_with_cable_lengths, solve_with_reference_tension, solve_with_yaw, YAW_TOLERANCE_RAD,
+    solve_with_cable_lengths, solve_with_reference_tension, solve_with_yaw, unsolved_at, YAW_TOLERANCE_RAD,
 };
 
 /// Tension of one cable at its platform attachment, paper eq. (7).

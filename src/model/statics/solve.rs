@@ -103,6 +103,26 @@ fn reference_tension_guess(robot: &Robot, pose: &PlatformPose, magnitude_n: f64)
     (geometry.height_difference_m / geometry.span_m - half_lambda).atan()
 }
 
+/// The state at `pose` with a reference tension of magnitude
+/// `reference_tension_n` along its sag-corrected chord (as the search of
+/// [`solve_with_reference_tension`] starts), not solved: the attachment
+/// heights are generally not met (`height_residuals_m` says by how much). A
+/// start for a model that extends the closed form. An error where the
+/// tensions of eq. (11) cannot be formed at this pose.
+pub fn unsolved_at(robot: &Robot, pose: PlatformPose, reference_tension_n: f64) -> Result<Equilibrium> {
+    if !(reference_tension_n.is_finite() && reference_tension_n > 0.0) {
+        return Err(Error::InvalidInput(format!(
+            "reference-cable tension must be positive, got {reference_tension_n} N"
+        )));
+    }
+    let phi = reference_tension_guess(robot, &pose, reference_tension_n);
+    let reference = CableTension {
+        horizontal_n: reference_tension_n * phi.cos(),
+        vertical_n: reference_tension_n * phi.sin(),
+    };
+    Equilibrium::evaluate(robot, pose, reference, 0)
+}
+
 /// Problem (a): position and the load cell's reference-tension magnitude
 /// (paper eq. 16) -> orientation, all four tensions, catenary lengths.
 ///
