@@ -39,8 +39,8 @@ use sagcal::model::{PlatformPose, Robot};
 mod generated_calls;
 
 use generated_calls::{
-    attachment_height, catenary_cable, catenary_length, dynamic, extended, extended_blocks, geometry, load_cell,
-    mounted_pose_prior, pose_prior, reference_tension, rigid_length, tensions, Point,
+    attachment_height, catenary_cable, catenary_length, dynamic, extended, extended_blocks, geometry, geometry_blocks,
+    load_cell, mounted_pose_prior, pose_prior, reference_tension, rigid_length, tensions, Point,
 };
 
 /// A large-robot operating point where all four cables pull.
@@ -291,17 +291,24 @@ fn jacobians(c: &mut Criterion) {
         c,
         "cable_geometry",
         &p,
-        &[Pose, reference, anchors, com],
+        &[
+            Pose,
+            reference,
+            anchors,
+            com,
+            Additive(|q| std::slice::from_mut(&mut q.platform_weight_n)),
+        ],
         geometry,
-        |j| vec![dynamic(&j.0), dynamic(&j.1), dynamic(&j.2), dynamic(&j.3)],
+        geometry_blocks,
     );
-    let per_cable: [Block; 6] = [
+    let per_cable: [Block; 7] = [
         Additive(|q| q.cable_spans_m.as_mut_slice()),
         Additive(|q| q.cable_horizontal_tensions_n.as_mut_slice()),
         Additive(|q| q.cable_vertical_tensions_n.as_mut_slice()),
         Additive(|q| std::slice::from_mut(&mut q.axial_compliance_per_mn)),
         Additive(|q| std::slice::from_mut(&mut q.pulley_radius_m)),
         Additive(|q| std::slice::from_mut(&mut q.inverse_segments_squared)),
+        Additive(|q| std::slice::from_mut(&mut q.cable_weight_n_per_m)),
     ];
     group(c, "extended_cable", &p, &per_cable, extended, extended_blocks);
     let load_cell_blocks: [Block; 3] = [

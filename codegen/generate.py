@@ -281,6 +281,8 @@ JACOBIAN_BLOCKS: dict[str, tuple[str, str]] = {
     "anchors_m": ("jacobian_anchors", "`anchors_m`, columns `[slot 0 x, y, z, slot 1 x, y, z, ...]`"),
     "length_offsets_m": ("jacobian_length_offsets", "`length_offsets_m`, columns in slot order"),
     "com_offset_m": ("jacobian_com_offset", "`com_offset_m`, columns `[x, y, z]`"),
+    "platform_weight_n": ("jacobian_platform_weight", "`platform_weight_n`"),
+    "cable_weight_n_per_m": ("jacobian_cable_weight", "`cable_weight_n_per_m`"),
     "axial_compliance_per_mn": ("jacobian_axial_compliance", "`axial_compliance_per_mn`"),
     "pulley_radius_m": ("jacobian_pulley_radius", "`pulley_radius_m`"),
     "inverse_segments_squared": ("jacobian_inverse_segments_squared", "`inverse_segments_squared`"),
@@ -327,7 +329,7 @@ FUNCTIONS = (
     FunctionSpec(
         factors.cable_geometry,
         "geometry",
-        ("pose", "reference_tension_n", "anchors_m", "com_offset_m"),
+        ("pose", "reference_tension_n", "anchors_m", "com_offset_m", "platform_weight_n"),
     ),
     FunctionSpec(
         factors.extended_cable,
@@ -339,6 +341,7 @@ FUNCTIONS = (
             "axial_compliance_per_mn",
             "pulley_radius_m",
             "inverse_segments_squared",
+            "cable_weight_n_per_m",
         ),
     ),
     FunctionSpec(

@@ -23,6 +23,7 @@
 /// * `jacobian_reference_tension` (16x2): derivative of `geometry` with respect to `reference_tension_n`, columns `[f_h, f_v]`.
 /// * `jacobian_anchors` (16x12): derivative of `geometry` with respect to `anchors_m`, columns `[slot 0 x, y, z, slot 1 x, y, z, ...]`.
 /// * `jacobian_com_offset` (16x3): derivative of `geometry` with respect to `com_offset_m`, columns `[x, y, z]`.
+/// * `jacobian_platform_weight` (16x1): derivative of `geometry` with respect to `platform_weight_n`.
 #[allow(clippy::too_many_arguments)]
 pub fn cable_geometry(
     position_m: &nalgebra::SVector<f64, 3>,
@@ -37,17 +38,18 @@ pub fn cable_geometry(
     jacobian_reference_tension: Option<&mut nalgebra::SMatrix<f64, 16, 2>>,
     jacobian_anchors: Option<&mut nalgebra::SMatrix<f64, 16, 12>>,
     jacobian_com_offset: Option<&mut nalgebra::SMatrix<f64, 16, 3>>,
+    jacobian_platform_weight: Option<&mut nalgebra::SVector<f64, 16>>,
 ) -> nalgebra::SVector<f64, 16> {
-    // Total ops: 1609
+    // Total ops: 1623
 
-    // Intermediate terms (431)
+    // Intermediate terms (437)
     let tmp0: f64 = 2.0_f64 * rotation_xyzw[3];
     let tmp1: f64 = tmp0 * rotation_xyzw[1];
-    let tmp2: f64 = 2.0_f64 * rotation_xyzw[2];
-    let tmp3: f64 = tmp2 * rotation_xyzw[0];
+    let tmp2: f64 = 2.0_f64 * rotation_xyzw[0];
+    let tmp3: f64 = tmp2 * rotation_xyzw[2];
     let tmp4: f64 = tmp1 + tmp3;
-    let tmp5: f64 = tmp2 * rotation_xyzw[3];
-    let tmp6: f64 = 2.0_f64 * rotation_xyzw[0] * rotation_xyzw[1];
+    let tmp5: f64 = tmp0 * rotation_xyzw[2];
+    let tmp6: f64 = tmp2 * rotation_xyzw[1];
     let tmp7: f64 = -tmp5 + tmp6;
     let tmp8: f64 = -2.0_f64 * (rotation_xyzw[2] * rotation_xyzw[2]);
     let tmp9: f64 = 1.0_f64 - 2.0_f64 * (rotation_xyzw[1] * rotation_xyzw[1]);
@@ -55,8 +57,8 @@ pub fn cable_geometry(
     let tmp11: f64 = tmp10 * attachments_m[(0, 0)] + tmp4 * attachments_m[(2, 0)] + tmp7 * attachments_m[(1, 0)];
     let tmp12: f64 = tmp11 - anchors_m[(0, 0)] + position_m[0];
     let tmp13: f64 = tmp12 * tmp12;
-    let tmp14: f64 = tmp0 * rotation_xyzw[0];
-    let tmp15: f64 = tmp2 * rotation_xyzw[1];
+    let tmp14: f64 = tmp2 * rotation_xyzw[3];
+    let tmp15: f64 = 2.0_f64 * rotation_xyzw[1] * rotation_xyzw[2];
     let tmp16: f64 = -tmp14 + tmp15;
     let tmp17: f64 = tmp5 + tmp6;
     let tmp18: f64 = -2.0_f64 * (rotation_xyzw[0] * rotation_xyzw[0]);
@@ -118,10 +120,10 @@ pub fn cable_geometry(
     let tmp74: f64 = tmp63 * tmp73;
     let tmp75: f64 = tmp40 * tmp74;
     let tmp76: f64 = tmp69 * tmp73;
-    let tmp77: f64 = tmp38 * reference_tension_n[0];
+    let tmp77: f64 = tmp38 * tmp76;
     let tmp78: f64 = tmp66 * tmp73;
     let tmp79: f64 = tmp39 * reference_tension_n[0];
-    let tmp80: f64 = tmp75 * reference_tension_n[0] + tmp76 * tmp77 + tmp78 * tmp79;
+    let tmp80: f64 = tmp75 * reference_tension_n[0] + tmp77 * reference_tension_n[0] + tmp78 * tmp79;
     let tmp81: f64 = platform_weight_n - reference_tension_n[1];
     let tmp82: f64 = -tmp41 * tmp51 + tmp43 * tmp54;
     let tmp83: f64 = -tmp41 + tmp54;
@@ -132,561 +134,562 @@ pub fn cable_geometry(
     let tmp88: f64 = tmp28 * tmp39;
     let tmp89: f64 = tmp62 * tmp71 - tmp65 * tmp68;
     let tmp90: f64 = tmp73 * tmp89;
-    let tmp91: f64 = tmp73 * (-tmp50 * tmp71 + tmp65 * tmp70);
-    let tmp92: f64 = tmp39 * tmp91;
-    let tmp93: f64 = tmp73 * (tmp50 * tmp68 - tmp62 * tmp70);
-    let tmp94: f64 = tmp40 * tmp93;
-    let tmp95: f64 = tmp77 * tmp90 + tmp92 * reference_tension_n[0] + tmp94 * reference_tension_n[0];
-    let tmp96: f64 = tmp25 * attachments_m[(1, 3)] + tmp26 * attachments_m[(0, 3)] + tmp27 * attachments_m[(2, 3)];
-    let tmp97: f64 = tmp95 * tmp96;
-    let tmp98: f64 = tmp25 * attachments_m[(1, 1)] + tmp26 * attachments_m[(0, 1)] + tmp27 * attachments_m[(2, 1)];
-    let tmp99: f64 = tmp80 * tmp98;
-    let tmp100: f64 = tmp73 * (tmp60 * tmp70 - tmp61 * tmp68);
-    let tmp101: f64 = tmp100 * tmp40;
-    let tmp102: f64 = -tmp60 * tmp71 + tmp64 * tmp68;
-    let tmp103: f64 = tmp102 * tmp73;
-    let tmp104: f64 = tmp73 * (tmp61 * tmp71 - tmp64 * tmp70);
-    let tmp105: f64 = tmp104 * tmp39;
-    let tmp106: f64 = tmp101 * reference_tension_n[0] + tmp103 * tmp77 + tmp105 * reference_tension_n[0];
-    let tmp107: f64 = tmp25 * attachments_m[(1, 2)] + tmp26 * attachments_m[(0, 2)] + tmp27 * attachments_m[(2, 2)];
-    let tmp108: f64 = tmp106 * tmp107;
-    let tmp109: f64 = tmp108 * tmp62
-        + tmp11 * reference_tension_n[1]
-        + tmp60 * tmp97
-        + tmp68 * tmp99
-        + tmp88 * reference_tension_n[0]
-        - platform_weight_n * (tmp10 * com_offset_m[0] + tmp4 * com_offset_m[2] + tmp7 * com_offset_m[1]);
-    let tmp110: f64 = tmp83 * tmp86;
-    let tmp111: f64 = tmp28 * tmp38;
-    let tmp112: f64 = -tmp108 * tmp50
-        - tmp111 * reference_tension_n[0]
-        - tmp20 * reference_tension_n[1]
-        - tmp61 * tmp97
-        - tmp70 * tmp99
-        + platform_weight_n * (tmp16 * com_offset_m[2] + tmp17 * com_offset_m[0] + tmp19 * com_offset_m[1]);
-    let tmp113: f64 = tmp84 * tmp86;
-    let tmp114: f64 = tmp109 * tmp110 + tmp112 * tmp113 + tmp81 * tmp87;
-    let tmp115: f64 = tmp86 * (-tmp29 * tmp54 + tmp32 * tmp51);
-    let tmp116: f64 = tmp32 - tmp54;
-    let tmp117: f64 = tmp116 * tmp86;
-    let tmp118: f64 = tmp86 * (tmp29 - tmp51);
-    let tmp119: f64 = tmp109 * tmp117 + tmp112 * tmp118 + tmp115 * tmp81;
-    let tmp120: f64 = -tmp32 + tmp41;
-    let tmp121: f64 = tmp120 * tmp86;
-    let tmp122: f64 = tmp86 * (tmp29 * tmp41 - tmp32 * tmp43);
-    let tmp123: f64 = tmp86 * (-tmp29 + tmp43);
-    let tmp124: f64 = tmp109 * tmp121 + tmp112 * tmp123 + tmp122 * tmp81;
-    let tmp125: f64 = tmp4 * attachments_m[(1, 0)] - tmp7 * attachments_m[(2, 0)];
-    let tmp126: f64 = tmp16 * attachments_m[(1, 0)] - tmp19 * attachments_m[(2, 0)];
-    let tmp127: f64 = tmp125 * tmp39 + tmp126 * tmp38;
-    let tmp128: f64 = -tmp25 * attachments_m[(2, 0)] + tmp27 * attachments_m[(1, 0)];
-    let tmp129: f64 = tmp4 * attachments_m[(1, 1)] - tmp7 * attachments_m[(2, 1)];
-    let tmp130: f64 = tmp16 * attachments_m[(1, 1)] - tmp19 * attachments_m[(2, 1)];
-    let tmp131: f64 = tmp129 * tmp68 + tmp130 * tmp70;
-    let tmp132: f64 = 1.0_f64 / tmp23;
-    let tmp133: f64 = tmp132 * tmp21;
-    let tmp134: f64 = tmp126 * tmp37;
-    let tmp135: f64 = reference_tension_n[0] * (-tmp127 * tmp133 + tmp134);
-    let tmp136: f64 = tmp130 * tmp67;
-    let tmp137: f64 = 1.0_f64 / tmp35;
-    let tmp138: f64 = tmp137 * tmp30;
-    let tmp139: f64 = tmp129 * tmp67 - tmp131 * tmp138;
-    let tmp140: f64 = tmp137 * tmp33;
-    let tmp141: f64 = -tmp131 * tmp140 + tmp136;
-    let tmp142: f64 = tmp16 * attachments_m[(1, 2)] - tmp19 * attachments_m[(2, 2)];
-    let tmp143: f64 = tmp142 * tmp49;
-    let tmp144: f64 = 1.0_f64 / tmp47;
-    let tmp145: f64 = tmp4 * attachments_m[(1, 2)] - tmp7 * attachments_m[(2, 2)];
-    let tmp146: f64 = tmp142 * tmp50 + tmp145 * tmp62;
-    let tmp147: f64 = tmp144 * tmp146;
-    let tmp148: f64 = tmp143 - tmp147 * tmp42;
-    let tmp149: f64 = tmp145 * tmp49 - tmp147 * tmp44;
-    let tmp150: f64 = tmp4 * attachments_m[(1, 3)] - tmp7 * attachments_m[(2, 3)];
-    let tmp151: f64 = tmp16 * attachments_m[(1, 3)] - tmp19 * attachments_m[(2, 3)];
-    let tmp152: f64 = tmp150 * tmp60 + tmp151 * tmp61;
-    let tmp153: f64 = 1.0_f64 / tmp57;
-    let tmp154: f64 = tmp153 * tmp55;
-    let tmp155: f64 = tmp151 * tmp59;
-    let tmp156: f64 = -tmp152 * tmp154 + tmp155;
-    let tmp157: f64 = tmp153 * tmp52;
-    let tmp158: f64 = tmp150 * tmp59 - tmp152 * tmp157;
-    let tmp159: f64 = tmp12 * tmp132;
-    let tmp160: f64 = reference_tension_n[0] * (tmp125 * tmp37 - tmp127 * tmp159);
-    let tmp161: f64 = tmp12 * reference_tension_n[0];
-    let tmp162: f64 =
-        -tmp106 * (tmp143 * tmp44 - tmp145 * tmp50 - tmp148 * tmp43 + tmp149 * tmp41) + tmp11 * tmp135 + tmp125 * tmp77
-            - tmp134 * tmp161
-            - tmp160 * tmp20
-            - tmp80 * (-tmp129 * tmp70 + tmp136 * tmp30 + tmp139 * tmp32 - tmp141 * tmp29)
-            - tmp95 * (-tmp150 * tmp61 + tmp155 * tmp52 - tmp156 * tmp51 + tmp158 * tmp54);
-    let tmp163: f64 = tmp139 * tmp80;
-    let tmp164: f64 = tmp158 * tmp95;
-    let tmp165: f64 = tmp106 * tmp149;
-    let tmp166: f64 = tmp160 + tmp163 + tmp164 + tmp165;
-    let tmp167: f64 = tmp106 * tmp148;
-    let tmp168: f64 = tmp141 * tmp80;
-    let tmp169: f64 = tmp156 * tmp95;
-    let tmp170: f64 = tmp135 + tmp167 + tmp168 + tmp169;
-    let tmp171: f64 = tmp162 * tmp74 + tmp166 * tmp78 + tmp170 * tmp76;
-    let tmp172: f64 = tmp68 * tmp98;
-    let tmp173: f64 = -tmp25 * attachments_m[(2, 2)] + tmp27 * attachments_m[(1, 2)];
-    let tmp174: f64 = tmp106 * tmp62;
-    let tmp175: f64 = tmp162 * tmp93 + tmp166 * tmp91 + tmp170 * tmp90;
-    let tmp176: f64 = tmp60 * tmp96;
-    let tmp177: f64 = tmp100 * tmp162 + tmp103 * tmp170 + tmp104 * tmp166;
-    let tmp178: f64 = tmp107 * tmp62;
-    let tmp179: f64 = -tmp25 * attachments_m[(2, 1)] + tmp27 * attachments_m[(1, 1)];
-    let tmp180: f64 = tmp68 * tmp80;
-    let tmp181: f64 = -tmp25 * attachments_m[(2, 3)] + tmp27 * attachments_m[(1, 3)];
-    let tmp182: f64 = tmp60 * tmp95;
-    let tmp183: f64 = tmp107 * tmp165
-        + tmp114 * tmp129
-        + tmp119 * tmp145
-        + tmp124 * tmp150
-        + tmp125 * reference_tension_n[1]
-        + tmp128 * tmp79
-        + tmp160 * tmp28
-        + tmp163 * tmp98
-        + tmp164 * tmp96
-        + tmp171 * tmp172
-        + tmp173 * tmp174
-        + tmp175 * tmp176
-        + tmp177 * tmp178
-        + tmp179 * tmp180
-        + tmp181 * tmp182
+    let tmp91: f64 = tmp38 * reference_tension_n[0];
+    let tmp92: f64 = -tmp50 * tmp71 + tmp65 * tmp70;
+    let tmp93: f64 = tmp73 * tmp92;
+    let tmp94: f64 = tmp39 * tmp93;
+    let tmp95: f64 = tmp50 * tmp68 - tmp62 * tmp70;
+    let tmp96: f64 = tmp73 * tmp95;
+    let tmp97: f64 = tmp40 * tmp96;
+    let tmp98: f64 = tmp90 * tmp91 + tmp94 * reference_tension_n[0] + tmp97 * reference_tension_n[0];
+    let tmp99: f64 = tmp25 * attachments_m[(1, 3)] + tmp26 * attachments_m[(0, 3)] + tmp27 * attachments_m[(2, 3)];
+    let tmp100: f64 = tmp98 * tmp99;
+    let tmp101: f64 = tmp25 * attachments_m[(1, 1)] + tmp26 * attachments_m[(0, 1)] + tmp27 * attachments_m[(2, 1)];
+    let tmp102: f64 = tmp101 * tmp80;
+    let tmp103: f64 = tmp60 * tmp70 - tmp61 * tmp68;
+    let tmp104: f64 = tmp103 * tmp73;
+    let tmp105: f64 = tmp104 * tmp40;
+    let tmp106: f64 = -tmp60 * tmp71 + tmp64 * tmp68;
+    let tmp107: f64 = tmp106 * tmp73;
+    let tmp108: f64 = tmp61 * tmp71 - tmp64 * tmp70;
+    let tmp109: f64 = tmp108 * tmp73;
+    let tmp110: f64 = tmp109 * tmp39;
+    let tmp111: f64 = tmp105 * reference_tension_n[0] + tmp107 * tmp91 + tmp110 * reference_tension_n[0];
+    let tmp112: f64 = tmp25 * attachments_m[(1, 2)] + tmp26 * attachments_m[(0, 2)] + tmp27 * attachments_m[(2, 2)];
+    let tmp113: f64 = tmp111 * tmp112;
+    let tmp114: f64 = tmp10 * com_offset_m[0] + tmp4 * com_offset_m[2] + tmp7 * com_offset_m[1];
+    let tmp115: f64 = tmp100 * tmp60 + tmp102 * tmp68 + tmp11 * reference_tension_n[1] + tmp113 * tmp62
+        - tmp114 * platform_weight_n
+        + tmp88 * reference_tension_n[0];
+    let tmp116: f64 = tmp83 * tmp86;
+    let tmp117: f64 = tmp16 * com_offset_m[2] + tmp17 * com_offset_m[0] + tmp19 * com_offset_m[1];
+    let tmp118: f64 = tmp28 * tmp38;
+    let tmp119: f64 = -tmp100 * tmp61 - tmp102 * tmp70 - tmp113 * tmp50 + tmp117 * platform_weight_n
+        - tmp118 * reference_tension_n[0]
+        - tmp20 * reference_tension_n[1];
+    let tmp120: f64 = tmp84 * tmp86;
+    let tmp121: f64 = tmp115 * tmp116 + tmp119 * tmp120 + tmp81 * tmp87;
+    let tmp122: f64 = tmp86 * (-tmp29 * tmp54 + tmp32 * tmp51);
+    let tmp123: f64 = tmp86 * (tmp32 - tmp54);
+    let tmp124: f64 = tmp86 * (tmp29 - tmp51);
+    let tmp125: f64 = tmp115 * tmp123 + tmp119 * tmp124 + tmp122 * tmp81;
+    let tmp126: f64 = tmp86 * (-tmp32 + tmp41);
+    let tmp127: f64 = tmp86 * (tmp29 * tmp41 - tmp32 * tmp43);
+    let tmp128: f64 = tmp86 * (-tmp29 + tmp43);
+    let tmp129: f64 = tmp115 * tmp126 + tmp119 * tmp128 + tmp127 * tmp81;
+    let tmp130: f64 = tmp4 * attachments_m[(1, 0)] - tmp7 * attachments_m[(2, 0)];
+    let tmp131: f64 = tmp16 * attachments_m[(1, 0)] - tmp19 * attachments_m[(2, 0)];
+    let tmp132: f64 = tmp130 * tmp39 + tmp131 * tmp38;
+    let tmp133: f64 = -tmp25 * attachments_m[(2, 0)] + tmp27 * attachments_m[(1, 0)];
+    let tmp134: f64 = tmp4 * attachments_m[(1, 1)] - tmp7 * attachments_m[(2, 1)];
+    let tmp135: f64 = tmp16 * attachments_m[(1, 1)] - tmp19 * attachments_m[(2, 1)];
+    let tmp136: f64 = tmp134 * tmp68 + tmp135 * tmp70;
+    let tmp137: f64 = 1.0_f64 / tmp23;
+    let tmp138: f64 = tmp137 * tmp21;
+    let tmp139: f64 = tmp131 * tmp37;
+    let tmp140: f64 = reference_tension_n[0] * (-tmp132 * tmp138 + tmp139);
+    let tmp141: f64 = tmp135 * tmp67;
+    let tmp142: f64 = 1.0_f64 / tmp35;
+    let tmp143: f64 = tmp142 * tmp30;
+    let tmp144: f64 = tmp134 * tmp67 - tmp136 * tmp143;
+    let tmp145: f64 = tmp142 * tmp33;
+    let tmp146: f64 = -tmp136 * tmp145 + tmp141;
+    let tmp147: f64 = tmp16 * attachments_m[(1, 2)] - tmp19 * attachments_m[(2, 2)];
+    let tmp148: f64 = tmp147 * tmp49;
+    let tmp149: f64 = 1.0_f64 / tmp47;
+    let tmp150: f64 = tmp4 * attachments_m[(1, 2)] - tmp7 * attachments_m[(2, 2)];
+    let tmp151: f64 = tmp147 * tmp50 + tmp150 * tmp62;
+    let tmp152: f64 = tmp149 * tmp151;
+    let tmp153: f64 = tmp148 - tmp152 * tmp42;
+    let tmp154: f64 = tmp150 * tmp49 - tmp152 * tmp44;
+    let tmp155: f64 = tmp4 * attachments_m[(1, 3)] - tmp7 * attachments_m[(2, 3)];
+    let tmp156: f64 = tmp16 * attachments_m[(1, 3)] - tmp19 * attachments_m[(2, 3)];
+    let tmp157: f64 = tmp155 * tmp60 + tmp156 * tmp61;
+    let tmp158: f64 = 1.0_f64 / tmp57;
+    let tmp159: f64 = tmp158 * tmp55;
+    let tmp160: f64 = tmp156 * tmp59;
+    let tmp161: f64 = -tmp157 * tmp159 + tmp160;
+    let tmp162: f64 = tmp158 * tmp52;
+    let tmp163: f64 = tmp155 * tmp59 - tmp157 * tmp162;
+    let tmp164: f64 = tmp12 * tmp137;
+    let tmp165: f64 = reference_tension_n[0] * (tmp130 * tmp37 - tmp132 * tmp164);
+    let tmp166: f64 = tmp12 * reference_tension_n[0];
+    let tmp167: f64 = tmp11 * tmp140 - tmp111 * (tmp148 * tmp44 - tmp150 * tmp50 - tmp153 * tmp43 + tmp154 * tmp41)
+        + tmp130 * tmp91
+        - tmp139 * tmp166
+        - tmp165 * tmp20
+        - tmp80 * (-tmp134 * tmp70 + tmp141 * tmp30 + tmp144 * tmp32 - tmp146 * tmp29)
+        - tmp98 * (-tmp155 * tmp61 + tmp160 * tmp52 - tmp161 * tmp51 + tmp163 * tmp54);
+    let tmp168: f64 = tmp144 * tmp80;
+    let tmp169: f64 = tmp163 * tmp98;
+    let tmp170: f64 = tmp111 * tmp154;
+    let tmp171: f64 = tmp73 * (tmp165 + tmp168 + tmp169 + tmp170);
+    let tmp172: f64 = tmp111 * tmp153;
+    let tmp173: f64 = tmp146 * tmp80;
+    let tmp174: f64 = tmp161 * tmp98;
+    let tmp175: f64 = tmp140 + tmp172 + tmp173 + tmp174;
+    let tmp176: f64 = tmp167 * tmp74 + tmp171 * tmp66 + tmp175 * tmp76;
+    let tmp177: f64 = tmp101 * tmp68;
+    let tmp178: f64 = -tmp25 * attachments_m[(2, 2)] + tmp27 * attachments_m[(1, 2)];
+    let tmp179: f64 = tmp111 * tmp62;
+    let tmp180: f64 = tmp167 * tmp96 + tmp171 * tmp92 + tmp175 * tmp90;
+    let tmp181: f64 = tmp60 * tmp99;
+    let tmp182: f64 = tmp104 * tmp167 + tmp107 * tmp175 + tmp108 * tmp171;
+    let tmp183: f64 = tmp112 * tmp62;
+    let tmp184: f64 = -tmp25 * attachments_m[(2, 1)] + tmp27 * attachments_m[(1, 1)];
+    let tmp185: f64 = tmp68 * tmp80;
+    let tmp186: f64 = -tmp25 * attachments_m[(2, 3)] + tmp27 * attachments_m[(1, 3)];
+    let tmp187: f64 = tmp60 * tmp98;
+    let tmp188: f64 = tmp101 * tmp168
+        + tmp112 * tmp170
+        + tmp121 * tmp134
+        + tmp125 * tmp150
+        + tmp129 * tmp155
+        + tmp130 * reference_tension_n[1]
+        + tmp133 * tmp79
+        + tmp165 * tmp28
+        + tmp169 * tmp99
+        + tmp176 * tmp177
+        + tmp178 * tmp179
+        + tmp180 * tmp181
+        + tmp182 * tmp183
+        + tmp184 * tmp185
+        + tmp186 * tmp187
         - platform_weight_n * (tmp4 * com_offset_m[1] - tmp7 * com_offset_m[2]);
-    let tmp184: f64 = tmp107 * tmp50;
-    let tmp185: f64 = tmp61 * tmp95;
-    let tmp186: f64 = tmp61 * tmp96;
-    let tmp187: f64 = tmp70 * tmp80;
-    let tmp188: f64 = tmp70 * tmp98;
-    let tmp189: f64 = tmp106 * tmp50;
-    let tmp190: f64 = -tmp107 * tmp167
-        - tmp114 * tmp130
-        - tmp119 * tmp142
-        - tmp124 * tmp151
-        - tmp126 * reference_tension_n[1]
-        - tmp128 * tmp77
-        - tmp135 * tmp28
-        - tmp168 * tmp98
-        - tmp169 * tmp96
-        - tmp171 * tmp188
-        - tmp173 * tmp189
-        - tmp175 * tmp186
-        - tmp177 * tmp184
-        - tmp179 * tmp187
-        - tmp181 * tmp185
+    let tmp189: f64 = tmp112 * tmp50;
+    let tmp190: f64 = tmp61 * tmp98;
+    let tmp191: f64 = tmp61 * tmp99;
+    let tmp192: f64 = tmp70 * tmp80;
+    let tmp193: f64 = tmp101 * tmp70;
+    let tmp194: f64 = tmp111 * tmp50;
+    let tmp195: f64 = -tmp101 * tmp173
+        - tmp112 * tmp172
+        - tmp121 * tmp135
+        - tmp125 * tmp147
+        - tmp129 * tmp156
+        - tmp131 * reference_tension_n[1]
+        - tmp133 * tmp91
+        - tmp140 * tmp28
+        - tmp174 * tmp99
+        - tmp176 * tmp193
+        - tmp178 * tmp194
+        - tmp180 * tmp191
+        - tmp182 * tmp189
+        - tmp184 * tmp192
+        - tmp186 * tmp190
         + platform_weight_n * (tmp16 * com_offset_m[1] - tmp19 * com_offset_m[2]);
-    let tmp191: f64 = tmp10 * attachments_m[(2, 0)] - tmp4 * attachments_m[(0, 0)];
-    let tmp192: f64 = -tmp16 * attachments_m[(0, 0)] + tmp17 * attachments_m[(2, 0)];
-    let tmp193: f64 = tmp191 * tmp39 + tmp192 * tmp38;
-    let tmp194: f64 = tmp26 * attachments_m[(2, 0)] - tmp27 * attachments_m[(0, 0)];
-    let tmp195: f64 = tmp10 * attachments_m[(2, 1)] - tmp4 * attachments_m[(0, 1)];
-    let tmp196: f64 = -tmp16 * attachments_m[(0, 1)] + tmp17 * attachments_m[(2, 1)];
-    let tmp197: f64 = tmp195 * tmp68 + tmp196 * tmp70;
-    let tmp198: f64 = tmp196 * tmp67;
-    let tmp199: f64 = -tmp140 * tmp197 + tmp198;
-    let tmp200: f64 = tmp199 * tmp80;
-    let tmp201: f64 = tmp10 * attachments_m[(2, 3)] - tmp4 * attachments_m[(0, 3)];
-    let tmp202: f64 = -tmp16 * attachments_m[(0, 3)] + tmp17 * attachments_m[(2, 3)];
-    let tmp203: f64 = tmp201 * tmp60 + tmp202 * tmp61;
-    let tmp204: f64 = tmp202 * tmp59;
-    let tmp205: f64 = -tmp154 * tmp203 + tmp204;
-    let tmp206: f64 = tmp205 * tmp95;
-    let tmp207: f64 = tmp10 * attachments_m[(2, 2)] - tmp4 * attachments_m[(0, 2)];
-    let tmp208: f64 = -tmp16 * attachments_m[(0, 2)] + tmp17 * attachments_m[(2, 2)];
-    let tmp209: f64 = tmp207 * tmp62 + tmp208 * tmp50;
-    let tmp210: f64 = tmp144 * tmp209;
-    let tmp211: f64 = tmp208 * tmp49;
-    let tmp212: f64 = -tmp210 * tmp42 + tmp211;
-    let tmp213: f64 = tmp106 * tmp212;
-    let tmp214: f64 = tmp132 * tmp193;
-    let tmp215: f64 = tmp192 * tmp37;
-    let tmp216: f64 = reference_tension_n[0] * (-tmp21 * tmp214 + tmp215);
-    let tmp217: f64 = tmp200 + tmp206 + tmp213 + tmp216;
-    let tmp218: f64 = -tmp157 * tmp203 + tmp201 * tmp59;
-    let tmp219: f64 = tmp218 * tmp95;
-    let tmp220: f64 = -tmp138 * tmp197 + tmp195 * tmp67;
-    let tmp221: f64 = tmp220 * tmp80;
-    let tmp222: f64 = tmp207 * tmp49 - tmp210 * tmp44;
-    let tmp223: f64 = tmp106 * tmp222;
-    let tmp224: f64 = reference_tension_n[0] * (-tmp12 * tmp214 + tmp191 * tmp37);
-    let tmp225: f64 = tmp219 + tmp221 + tmp223 + tmp224;
-    let tmp226: f64 = -tmp106 * (-tmp207 * tmp50 + tmp211 * tmp44 - tmp212 * tmp43 + tmp222 * tmp41) + tmp11 * tmp216
-        - tmp161 * tmp215
-        + tmp191 * tmp77
-        - tmp20 * tmp224
-        - tmp80 * (-tmp195 * tmp70 + tmp198 * tmp30 - tmp199 * tmp29 + tmp220 * tmp32)
-        - tmp95 * (-tmp201 * tmp61 + tmp204 * tmp52 - tmp205 * tmp51 + tmp218 * tmp54);
-    let tmp227: f64 = tmp217 * tmp76 + tmp225 * tmp78 + tmp226 * tmp74;
-    let tmp228: f64 = tmp26 * attachments_m[(2, 3)] - tmp27 * attachments_m[(0, 3)];
-    let tmp229: f64 = tmp26 * attachments_m[(2, 2)] - tmp27 * attachments_m[(0, 2)];
-    let tmp230: f64 = tmp217 * tmp90 + tmp225 * tmp91 + tmp226 * tmp93;
-    let tmp231: f64 = tmp100 * tmp226 + tmp103 * tmp217 + tmp104 * tmp225;
-    let tmp232: f64 = tmp26 * attachments_m[(2, 1)] - tmp27 * attachments_m[(0, 1)];
-    let tmp233: f64 = tmp232 * tmp80;
-    let tmp234: f64 = tmp107 * tmp223
-        + tmp114 * tmp195
-        + tmp119 * tmp207
-        + tmp124 * tmp201
-        + tmp172 * tmp227
-        + tmp174 * tmp229
-        + tmp176 * tmp230
-        + tmp178 * tmp231
-        + tmp182 * tmp228
-        + tmp191 * reference_tension_n[1]
-        + tmp194 * tmp79
-        + tmp219 * tmp96
-        + tmp221 * tmp98
-        + tmp224 * tmp28
-        + tmp233 * tmp68
+    let tmp196: f64 = tmp10 * attachments_m[(2, 0)] - tmp4 * attachments_m[(0, 0)];
+    let tmp197: f64 = -tmp16 * attachments_m[(0, 0)] + tmp17 * attachments_m[(2, 0)];
+    let tmp198: f64 = tmp196 * tmp39 + tmp197 * tmp38;
+    let tmp199: f64 = tmp26 * attachments_m[(2, 0)] - tmp27 * attachments_m[(0, 0)];
+    let tmp200: f64 = tmp10 * attachments_m[(2, 1)] - tmp4 * attachments_m[(0, 1)];
+    let tmp201: f64 = -tmp16 * attachments_m[(0, 1)] + tmp17 * attachments_m[(2, 1)];
+    let tmp202: f64 = tmp200 * tmp68 + tmp201 * tmp70;
+    let tmp203: f64 = tmp201 * tmp67;
+    let tmp204: f64 = -tmp145 * tmp202 + tmp203;
+    let tmp205: f64 = tmp204 * tmp80;
+    let tmp206: f64 = tmp10 * attachments_m[(2, 3)] - tmp4 * attachments_m[(0, 3)];
+    let tmp207: f64 = -tmp16 * attachments_m[(0, 3)] + tmp17 * attachments_m[(2, 3)];
+    let tmp208: f64 = tmp206 * tmp60 + tmp207 * tmp61;
+    let tmp209: f64 = tmp207 * tmp59;
+    let tmp210: f64 = -tmp159 * tmp208 + tmp209;
+    let tmp211: f64 = tmp210 * tmp98;
+    let tmp212: f64 = tmp10 * attachments_m[(2, 2)] - tmp4 * attachments_m[(0, 2)];
+    let tmp213: f64 = -tmp16 * attachments_m[(0, 2)] + tmp17 * attachments_m[(2, 2)];
+    let tmp214: f64 = tmp212 * tmp62 + tmp213 * tmp50;
+    let tmp215: f64 = tmp149 * tmp214;
+    let tmp216: f64 = tmp213 * tmp49 - tmp215 * tmp42;
+    let tmp217: f64 = tmp111 * tmp216;
+    let tmp218: f64 = tmp137 * tmp198;
+    let tmp219: f64 = tmp197 * tmp37;
+    let tmp220: f64 = reference_tension_n[0] * (-tmp21 * tmp218 + tmp219);
+    let tmp221: f64 = tmp205 + tmp211 + tmp217 + tmp220;
+    let tmp222: f64 = -tmp162 * tmp208 + tmp206 * tmp59;
+    let tmp223: f64 = tmp222 * tmp98;
+    let tmp224: f64 = -tmp143 * tmp202 + tmp200 * tmp67;
+    let tmp225: f64 = tmp224 * tmp80;
+    let tmp226: f64 = tmp212 * tmp49 - tmp215 * tmp44;
+    let tmp227: f64 = tmp111 * tmp226;
+    let tmp228: f64 = reference_tension_n[0] * (-tmp12 * tmp218 + tmp196 * tmp37);
+    let tmp229: f64 = tmp223 + tmp225 + tmp227 + tmp228;
+    let tmp230: f64 = tmp11 * tmp220
+        - tmp111 * (-tmp212 * tmp50 + tmp213 * tmp62 - tmp216 * tmp43 + tmp226 * tmp41)
+        - tmp166 * tmp219
+        + tmp196 * tmp91
+        - tmp20 * tmp228
+        - tmp80 * (-tmp200 * tmp70 + tmp203 * tmp30 - tmp204 * tmp29 + tmp224 * tmp32)
+        - tmp98 * (-tmp206 * tmp61 + tmp209 * tmp52 - tmp210 * tmp51 + tmp222 * tmp54);
+    let tmp231: f64 = tmp221 * tmp76 + tmp229 * tmp78 + tmp230 * tmp74;
+    let tmp232: f64 = tmp26 * attachments_m[(2, 3)] - tmp27 * attachments_m[(0, 3)];
+    let tmp233: f64 = tmp26 * attachments_m[(2, 2)] - tmp27 * attachments_m[(0, 2)];
+    let tmp234: f64 = tmp221 * tmp90 + tmp229 * tmp93 + tmp230 * tmp96;
+    let tmp235: f64 = tmp104 * tmp230 + tmp107 * tmp221 + tmp109 * tmp229;
+    let tmp236: f64 = tmp26 * attachments_m[(2, 1)] - tmp27 * attachments_m[(0, 1)];
+    let tmp237: f64 = tmp236 * tmp80;
+    let tmp238: f64 = tmp101 * tmp225
+        + tmp112 * tmp227
+        + tmp121 * tmp200
+        + tmp125 * tmp212
+        + tmp129 * tmp206
+        + tmp177 * tmp231
+        + tmp179 * tmp233
+        + tmp181 * tmp234
+        + tmp183 * tmp235
+        + tmp187 * tmp232
+        + tmp196 * reference_tension_n[1]
+        + tmp199 * tmp79
+        + tmp223 * tmp99
+        + tmp228 * tmp28
+        + tmp237 * tmp68
         - platform_weight_n * (tmp10 * com_offset_m[2] - tmp4 * com_offset_m[0]);
-    let tmp235: f64 = -tmp107 * tmp213
-        - tmp114 * tmp196
-        - tmp119 * tmp208
-        - tmp124 * tmp202
-        - tmp184 * tmp231
-        - tmp185 * tmp228
-        - tmp186 * tmp230
-        - tmp188 * tmp227
-        - tmp189 * tmp229
-        - tmp192 * reference_tension_n[1]
-        - tmp194 * tmp77
-        - tmp200 * tmp98
-        - tmp206 * tmp96
-        - tmp216 * tmp28
-        - tmp233 * tmp70
+    let tmp239: f64 = -tmp101 * tmp205
+        - tmp112 * tmp217
+        - tmp121 * tmp201
+        - tmp125 * tmp213
+        - tmp129 * tmp207
+        - tmp189 * tmp235
+        - tmp190 * tmp232
+        - tmp191 * tmp234
+        - tmp193 * tmp231
+        - tmp194 * tmp233
+        - tmp197 * reference_tension_n[1]
+        - tmp199 * tmp91
+        - tmp211 * tmp99
+        - tmp220 * tmp28
+        - tmp237 * tmp70
         + platform_weight_n * (-tmp16 * com_offset_m[0] + tmp17 * com_offset_m[2]);
-    let tmp236: f64 = -tmp10 * attachments_m[(1, 0)] + tmp7 * attachments_m[(0, 0)];
-    let tmp237: f64 = tmp236 * tmp37;
-    let tmp238: f64 = -tmp17 * attachments_m[(1, 0)] + tmp19 * attachments_m[(0, 0)];
-    let tmp239: f64 = tmp12 * tmp237 + tmp238 * tmp38;
-    let tmp240: f64 = tmp25 * attachments_m[(0, 0)] - tmp26 * attachments_m[(1, 0)];
-    let tmp241: f64 = -tmp17 * attachments_m[(1, 1)] + tmp19 * attachments_m[(0, 1)];
-    let tmp242: f64 = -tmp10 * attachments_m[(1, 1)] + tmp7 * attachments_m[(0, 1)];
-    let tmp243: f64 = tmp242 * tmp67;
-    let tmp244: f64 = tmp241 * tmp70 + tmp243 * tmp30;
-    let tmp245: f64 = reference_tension_n[0] * (-tmp133 * tmp239 + tmp238 * tmp37);
-    let tmp246: f64 = -tmp138 * tmp244 + tmp243;
-    let tmp247: f64 = -tmp140 * tmp244 + tmp241 * tmp67;
-    let tmp248: f64 = -tmp17 * attachments_m[(1, 2)] + tmp19 * attachments_m[(0, 2)];
-    let tmp249: f64 = -tmp10 * attachments_m[(1, 2)] + tmp7 * attachments_m[(0, 2)];
-    let tmp250: f64 = tmp249 * tmp49;
-    let tmp251: f64 = tmp248 * tmp50 + tmp250 * tmp44;
-    let tmp252: f64 = tmp144 * tmp251;
-    let tmp253: f64 = tmp248 * tmp49 - tmp252 * tmp42;
-    let tmp254: f64 = tmp250 - tmp252 * tmp44;
-    let tmp255: f64 = -tmp17 * attachments_m[(1, 3)] + tmp19 * attachments_m[(0, 3)];
-    let tmp256: f64 = -tmp10 * attachments_m[(1, 3)] + tmp7 * attachments_m[(0, 3)];
-    let tmp257: f64 = tmp256 * tmp59;
-    let tmp258: f64 = tmp255 * tmp61 + tmp257 * tmp52;
-    let tmp259: f64 = -tmp154 * tmp258 + tmp255 * tmp59;
-    let tmp260: f64 = -tmp157 * tmp258 + tmp257;
-    let tmp261: f64 = reference_tension_n[0] * (-tmp159 * tmp239 + tmp237);
-    let tmp262: f64 = -tmp106 * (tmp248 * tmp62 - tmp249 * tmp50 - tmp253 * tmp43 + tmp254 * tmp41) + tmp11 * tmp245
-        - tmp20 * tmp261
-        + tmp236 * tmp77
-        - tmp238 * tmp79
-        - tmp80 * (tmp241 * tmp68 - tmp242 * tmp70 + tmp246 * tmp32 - tmp247 * tmp29)
-        - tmp95 * (tmp255 * tmp60 - tmp256 * tmp61 - tmp259 * tmp51 + tmp260 * tmp54);
-    let tmp263: f64 = tmp106 * tmp254;
-    let tmp264: f64 = tmp246 * tmp80;
-    let tmp265: f64 = tmp260 * tmp95;
-    let tmp266: f64 = tmp261 + tmp263 + tmp264 + tmp265;
-    let tmp267: f64 = tmp247 * tmp80;
-    let tmp268: f64 = tmp106 * tmp253;
-    let tmp269: f64 = tmp259 * tmp95;
-    let tmp270: f64 = tmp73 * (tmp245 + tmp267 + tmp268 + tmp269);
-    let tmp271: f64 = tmp262 * tmp74 + tmp266 * tmp78 + tmp270 * tmp69;
-    let tmp272: f64 = tmp25 * attachments_m[(0, 1)] - tmp26 * attachments_m[(1, 1)];
-    let tmp273: f64 = tmp262 * tmp93 + tmp266 * tmp91 + tmp270 * tmp89;
-    let tmp274: f64 = tmp25 * attachments_m[(0, 3)] - tmp26 * attachments_m[(1, 3)];
-    let tmp275: f64 = tmp274 * tmp95;
-    let tmp276: f64 = tmp25 * attachments_m[(0, 2)] - tmp26 * attachments_m[(1, 2)];
-    let tmp277: f64 = tmp100 * tmp262 + tmp102 * tmp270 + tmp104 * tmp266;
-    let tmp278: f64 = -tmp107 * tmp268
-        - tmp114 * tmp241
-        - tmp119 * tmp248
-        - tmp124 * tmp255
-        - tmp184 * tmp277
-        - tmp186 * tmp273
-        - tmp187 * tmp272
-        - tmp188 * tmp271
-        - tmp189 * tmp276
-        - tmp238 * reference_tension_n[1]
-        - tmp240 * tmp77
-        - tmp245 * tmp28
-        - tmp267 * tmp98
-        - tmp269 * tmp96
-        - tmp275 * tmp61
+    let tmp240: f64 = -tmp10 * attachments_m[(1, 0)] + tmp7 * attachments_m[(0, 0)];
+    let tmp241: f64 = tmp240 * tmp37;
+    let tmp242: f64 = -tmp17 * attachments_m[(1, 0)] + tmp19 * attachments_m[(0, 0)];
+    let tmp243: f64 = tmp12 * tmp241 + tmp242 * tmp38;
+    let tmp244: f64 = tmp25 * attachments_m[(0, 0)] - tmp26 * attachments_m[(1, 0)];
+    let tmp245: f64 = -tmp17 * attachments_m[(1, 1)] + tmp19 * attachments_m[(0, 1)];
+    let tmp246: f64 = -tmp10 * attachments_m[(1, 1)] + tmp7 * attachments_m[(0, 1)];
+    let tmp247: f64 = tmp246 * tmp67;
+    let tmp248: f64 = tmp245 * tmp70 + tmp247 * tmp30;
+    let tmp249: f64 = reference_tension_n[0] * (-tmp138 * tmp243 + tmp242 * tmp37);
+    let tmp250: f64 = -tmp143 * tmp248 + tmp247;
+    let tmp251: f64 = -tmp145 * tmp248 + tmp245 * tmp67;
+    let tmp252: f64 = -tmp17 * attachments_m[(1, 2)] + tmp19 * attachments_m[(0, 2)];
+    let tmp253: f64 = -tmp10 * attachments_m[(1, 2)] + tmp7 * attachments_m[(0, 2)];
+    let tmp254: f64 = tmp253 * tmp49;
+    let tmp255: f64 = tmp252 * tmp50 + tmp254 * tmp44;
+    let tmp256: f64 = tmp149 * tmp255;
+    let tmp257: f64 = tmp252 * tmp49 - tmp256 * tmp42;
+    let tmp258: f64 = tmp254 - tmp256 * tmp44;
+    let tmp259: f64 = -tmp17 * attachments_m[(1, 3)] + tmp19 * attachments_m[(0, 3)];
+    let tmp260: f64 = -tmp10 * attachments_m[(1, 3)] + tmp7 * attachments_m[(0, 3)];
+    let tmp261: f64 = tmp260 * tmp59;
+    let tmp262: f64 = tmp259 * tmp61 + tmp261 * tmp52;
+    let tmp263: f64 = -tmp159 * tmp262 + tmp259 * tmp59;
+    let tmp264: f64 = -tmp162 * tmp262 + tmp261;
+    let tmp265: f64 = reference_tension_n[0] * (-tmp164 * tmp243 + tmp241);
+    let tmp266: f64 =
+        tmp11 * tmp249 - tmp111 * (tmp252 * tmp62 - tmp253 * tmp50 - tmp257 * tmp43 + tmp258 * tmp41) - tmp20 * tmp265
+            + tmp240 * tmp91
+            - tmp242 * tmp79
+            - tmp80 * (tmp245 * tmp68 - tmp246 * tmp70 + tmp250 * tmp32 - tmp251 * tmp29)
+            - tmp98 * (tmp259 * tmp60 - tmp260 * tmp61 - tmp263 * tmp51 + tmp264 * tmp54);
+    let tmp267: f64 = tmp111 * tmp258;
+    let tmp268: f64 = tmp250 * tmp80;
+    let tmp269: f64 = tmp264 * tmp98;
+    let tmp270: f64 = tmp265 + tmp267 + tmp268 + tmp269;
+    let tmp271: f64 = tmp251 * tmp80;
+    let tmp272: f64 = tmp111 * tmp257;
+    let tmp273: f64 = tmp263 * tmp98;
+    let tmp274: f64 = tmp73 * (tmp249 + tmp271 + tmp272 + tmp273);
+    let tmp275: f64 = tmp266 * tmp74 + tmp270 * tmp78 + tmp274 * tmp69;
+    let tmp276: f64 = tmp25 * attachments_m[(0, 1)] - tmp26 * attachments_m[(1, 1)];
+    let tmp277: f64 = tmp266 * tmp96 + tmp270 * tmp93 + tmp274 * tmp89;
+    let tmp278: f64 = tmp25 * attachments_m[(0, 3)] - tmp26 * attachments_m[(1, 3)];
+    let tmp279: f64 = tmp278 * tmp98;
+    let tmp280: f64 = tmp25 * attachments_m[(0, 2)] - tmp26 * attachments_m[(1, 2)];
+    let tmp281: f64 = tmp104 * tmp266 + tmp106 * tmp274 + tmp109 * tmp270;
+    let tmp282: f64 = -tmp101 * tmp271
+        - tmp112 * tmp272
+        - tmp121 * tmp245
+        - tmp125 * tmp252
+        - tmp129 * tmp259
+        - tmp189 * tmp281
+        - tmp191 * tmp277
+        - tmp192 * tmp276
+        - tmp193 * tmp275
+        - tmp194 * tmp280
+        - tmp242 * reference_tension_n[1]
+        - tmp244 * tmp91
+        - tmp249 * tmp28
+        - tmp273 * tmp99
+        - tmp279 * tmp61
         + platform_weight_n * (-tmp17 * com_offset_m[1] + tmp19 * com_offset_m[0]);
-    let tmp279: f64 = tmp107 * tmp263
-        + tmp114 * tmp242
-        + tmp119 * tmp249
-        + tmp124 * tmp256
-        + tmp172 * tmp271
-        + tmp174 * tmp276
-        + tmp176 * tmp273
-        + tmp178 * tmp277
-        + tmp180 * tmp272
-        + tmp236 * reference_tension_n[1]
-        + tmp240 * tmp79
-        + tmp261 * tmp28
-        + tmp264 * tmp98
-        + tmp265 * tmp96
-        + tmp275 * tmp60
+    let tmp283: f64 = tmp101 * tmp268
+        + tmp112 * tmp267
+        + tmp121 * tmp246
+        + tmp125 * tmp253
+        + tmp129 * tmp260
+        + tmp177 * tmp275
+        + tmp179 * tmp280
+        + tmp181 * tmp277
+        + tmp183 * tmp281
+        + tmp185 * tmp276
+        + tmp240 * reference_tension_n[1]
+        + tmp244 * tmp79
+        + tmp265 * tmp28
+        + tmp269 * tmp99
+        + tmp279 * tmp60
         - platform_weight_n * (-tmp10 * com_offset_m[1] + tmp7 * com_offset_m[0]);
-    let tmp280: f64 = 1.0_f64 / (tmp57 * tmp57.sqrt());
-    let tmp281: f64 = tmp280 * tmp53;
-    let tmp282: f64 = -tmp281 + tmp59;
-    let tmp283: f64 = tmp280 * tmp52 * tmp55;
-    let tmp284: f64 = tmp283 * tmp51;
-    let tmp285: f64 = 1.0_f64 / (tmp35 * tmp35.sqrt());
-    let tmp286: f64 = tmp285 * tmp31;
-    let tmp287: f64 = -tmp286 + tmp67;
-    let tmp288: f64 = tmp285 * tmp30 * tmp33;
-    let tmp289: f64 = tmp288 * tmp29;
-    let tmp290: f64 = 1.0_f64 / (tmp47 * tmp47.sqrt());
-    let tmp291: f64 = tmp290 * tmp42 * tmp44;
-    let tmp292: f64 = tmp291 * tmp43;
-    let tmp293: f64 = tmp290 * tmp45;
-    let tmp294: f64 = -tmp293 + tmp49;
-    let tmp295: f64 = 1.0_f64 / (tmp23 * tmp23.sqrt());
-    let tmp296: f64 = tmp161 * tmp21 * tmp295;
-    let tmp297: f64 = tmp11 * tmp296;
-    let tmp298: f64 = tmp13 * tmp295;
-    let tmp299: f64 = reference_tension_n[0] * (-tmp298 + tmp37);
-    let tmp300: f64 = -tmp106 * (tmp292 + tmp294 * tmp41)
-        - tmp20 * tmp299
-        - tmp297
-        - tmp80 * (tmp287 * tmp32 + tmp289)
-        - tmp95 * (tmp282 * tmp54 + tmp284);
-    let tmp301: f64 = tmp282 * tmp95;
-    let tmp302: f64 = tmp106 * tmp294;
-    let tmp303: f64 = tmp287 * tmp80;
-    let tmp304: f64 = tmp299 + tmp301 + tmp302 + tmp303;
-    let tmp305: f64 = tmp106 * tmp291;
-    let tmp306: f64 = tmp288 * tmp80;
-    let tmp307: f64 = tmp283 * tmp95;
-    let tmp308: f64 = -tmp296 - tmp305 - tmp306 - tmp307;
-    let tmp309: f64 = tmp300 * tmp74 + tmp304 * tmp78 + tmp308 * tmp76;
-    let tmp310: f64 = tmp100 * tmp300 + tmp103 * tmp308 + tmp104 * tmp304;
-    let tmp311: f64 = tmp300 * tmp93 + tmp304 * tmp91 + tmp308 * tmp90;
-    let tmp312: f64 = tmp107 * tmp302
-        + tmp172 * tmp309
-        + tmp176 * tmp311
-        + tmp178 * tmp310
-        + tmp28 * tmp299
-        + tmp301 * tmp96
-        + tmp303 * tmp98;
-    let tmp313: f64 = tmp108 * tmp291;
-    let tmp314: f64 = tmp28 * tmp296;
-    let tmp315: f64 = tmp283 * tmp97;
-    let tmp316: f64 = tmp288 * tmp99;
-    let tmp317: f64 = -tmp184 * tmp310 - tmp186 * tmp311 - tmp188 * tmp309 + tmp313 + tmp314 + tmp315 + tmp316;
-    let tmp318: f64 = tmp22 * tmp295;
-    let tmp319: f64 = reference_tension_n[0] * (-tmp318 + tmp37);
-    let tmp320: f64 = tmp290 * tmp46;
-    let tmp321: f64 = -tmp320 + tmp49;
-    let tmp322: f64 = tmp106 * tmp321;
-    let tmp323: f64 = tmp280 * tmp56;
-    let tmp324: f64 = -tmp323 + tmp59;
-    let tmp325: f64 = tmp324 * tmp95;
-    let tmp326: f64 = tmp285 * tmp34;
-    let tmp327: f64 = -tmp326 + tmp67;
-    let tmp328: f64 = tmp327 * tmp80;
-    let tmp329: f64 = tmp319 + tmp322 + tmp325 + tmp328;
-    let tmp330: f64 = tmp283 * tmp54;
-    let tmp331: f64 = tmp288 * tmp32;
-    let tmp332: f64 = tmp291 * tmp41;
-    let tmp333: f64 = tmp20 * tmp296;
-    let tmp334: f64 = -tmp106 * (-tmp321 * tmp43 - tmp332) + tmp11 * tmp319 + tmp333
-        - tmp80 * (-tmp29 * tmp327 - tmp331)
-        - tmp95 * (-tmp324 * tmp51 - tmp330);
-    let tmp335: f64 = tmp308 * tmp78 + tmp329 * tmp76 + tmp334 * tmp74;
-    let tmp336: f64 = -tmp313;
-    let tmp337: f64 = -tmp314;
-    let tmp338: f64 = -tmp315;
-    let tmp339: f64 = tmp100 * tmp334 + tmp103 * tmp329 + tmp104 * tmp308;
-    let tmp340: f64 = tmp308 * tmp91 + tmp329 * tmp90 + tmp334 * tmp93;
-    let tmp341: f64 = -tmp316;
-    let tmp342: f64 = tmp172 * tmp335 + tmp176 * tmp340 + tmp178 * tmp339 + tmp336 + tmp337 + tmp338 + tmp341;
-    let tmp343: f64 = -tmp107 * tmp322
-        - tmp184 * tmp339
-        - tmp186 * tmp340
-        - tmp188 * tmp335
-        - tmp28 * tmp319
-        - tmp325 * tmp96
-        - tmp328 * tmp98;
-    let tmp344: f64 = tmp38 * tmp76 + tmp39 * tmp78 + tmp75;
-    let tmp345: f64 = tmp38 * tmp90 + tmp92 + tmp94;
-    let tmp346: f64 = tmp101 + tmp103 * tmp38 + tmp105;
-    let tmp347: f64 = tmp172 * tmp344 + tmp176 * tmp345 + tmp178 * tmp346 + tmp88;
-    let tmp348: f64 = -tmp111 - tmp184 * tmp346 - tmp186 * tmp345 - tmp188 * tmp344;
-    let tmp349: f64 = -tmp37;
-    let tmp350: f64 = reference_tension_n[0] * (tmp298 + tmp349);
-    let tmp351: f64 = -tmp20 * tmp350 + tmp297;
-    let tmp352: f64 = tmp296 * tmp76 + tmp350 * tmp78 + tmp351 * tmp74;
-    let tmp353: f64 = tmp296 * tmp90 + tmp350 * tmp91 + tmp351 * tmp93;
-    let tmp354: f64 = tmp100 * tmp351 + tmp103 * tmp296 + tmp104 * tmp350;
-    let tmp355: f64 = -tmp184 * tmp354 - tmp186 * tmp353 - tmp188 * tmp352 + tmp337;
-    let tmp356: f64 = tmp172 * tmp352 + tmp176 * tmp353 + tmp178 * tmp354 + tmp28 * tmp350;
-    let tmp357: f64 = reference_tension_n[0] * (tmp318 + tmp349);
-    let tmp358: f64 = tmp11 * tmp357 - tmp333;
-    let tmp359: f64 = tmp296 * tmp78 + tmp357 * tmp76 + tmp358 * tmp74;
-    let tmp360: f64 = tmp296 * tmp91 + tmp357 * tmp90 + tmp358 * tmp93;
-    let tmp361: f64 = tmp100 * tmp358 + tmp103 * tmp357 + tmp104 * tmp296;
-    let tmp362: f64 = -tmp184 * tmp361 - tmp186 * tmp360 - tmp188 * tmp359 - tmp28 * tmp357;
-    let tmp363: f64 = tmp172 * tmp359 + tmp176 * tmp360 + tmp178 * tmp361 + tmp314;
-    let tmp364: f64 = -tmp67;
-    let tmp365: f64 = tmp286 + tmp364;
-    let tmp366: f64 = -tmp289 + tmp32 * tmp365;
-    let tmp367: f64 = tmp74 * tmp80;
-    let tmp368: f64 = tmp365 * tmp80;
-    let tmp369: f64 = tmp306 * tmp76 - tmp366 * tmp367 + tmp368 * tmp78;
-    let tmp370: f64 = tmp366 * tmp80;
-    let tmp371: f64 = tmp306 * tmp90 + tmp368 * tmp91 - tmp370 * tmp93;
-    let tmp372: f64 = -tmp100 * tmp370 + tmp103 * tmp306 + tmp104 * tmp368;
-    let tmp373: f64 = -tmp184 * tmp372 - tmp186 * tmp371 - tmp188 * tmp369 + tmp341;
-    let tmp374: f64 = tmp86 * (tmp172 * tmp369 + tmp176 * tmp371 + tmp178 * tmp372 + tmp365 * tmp99);
-    let tmp375: f64 = tmp326 + tmp364;
-    let tmp376: f64 = tmp375 * tmp80;
-    let tmp377: f64 = -tmp29 * tmp375 + tmp331;
-    let tmp378: f64 = tmp306 * tmp78 - tmp367 * tmp377 + tmp376 * tmp76;
-    let tmp379: f64 = tmp377 * tmp80;
-    let tmp380: f64 = -tmp100 * tmp379 + tmp103 * tmp376 + tmp104 * tmp306;
-    let tmp381: f64 = tmp306 * tmp91 + tmp376 * tmp90 - tmp379 * tmp93;
-    let tmp382: f64 = tmp172 * tmp378 + tmp176 * tmp381 + tmp178 * tmp380 + tmp316;
-    let tmp383: f64 = -tmp184 * tmp380 - tmp186 * tmp381 - tmp188 * tmp378 - tmp375 * tmp99;
-    let tmp384: f64 = -tmp49;
-    let tmp385: f64 = tmp293 + tmp384;
-    let tmp386: f64 = -tmp292 + tmp385 * tmp41;
-    let tmp387: f64 = tmp106 * tmp74;
-    let tmp388: f64 = tmp106 * tmp385;
-    let tmp389: f64 = tmp305 * tmp76 - tmp386 * tmp387 + tmp388 * tmp78;
-    let tmp390: f64 = tmp100 * tmp106;
-    let tmp391: f64 = tmp103 * tmp305 + tmp104 * tmp388 - tmp386 * tmp390;
-    let tmp392: f64 = tmp106 * tmp93;
-    let tmp393: f64 = tmp305 * tmp90 - tmp386 * tmp392 + tmp388 * tmp91;
-    let tmp394: f64 = tmp108 * tmp385 + tmp172 * tmp389 + tmp176 * tmp393 + tmp178 * tmp391;
-    let tmp395: f64 = -tmp184 * tmp391 - tmp186 * tmp393 - tmp188 * tmp389 + tmp336;
-    let tmp396: f64 = tmp320 + tmp384;
-    let tmp397: f64 = tmp332 - tmp396 * tmp43;
-    let tmp398: f64 = tmp106 * tmp396;
-    let tmp399: f64 = tmp305 * tmp78 - tmp387 * tmp397 + tmp398 * tmp76;
-    let tmp400: f64 = tmp103 * tmp398 + tmp104 * tmp305 - tmp390 * tmp397;
-    let tmp401: f64 = tmp305 * tmp91 - tmp392 * tmp397 + tmp398 * tmp90;
-    let tmp402: f64 = -tmp108 * tmp396 - tmp184 * tmp400 - tmp186 * tmp401 - tmp188 * tmp399;
-    let tmp403: f64 = tmp172 * tmp399 + tmp176 * tmp401 + tmp178 * tmp400 + tmp313;
-    let tmp404: f64 = -tmp59;
-    let tmp405: f64 = tmp281 + tmp404;
-    let tmp406: f64 = tmp405 * tmp95;
-    let tmp407: f64 = -tmp284 + tmp405 * tmp54;
-    let tmp408: f64 = tmp407 * tmp95;
-    let tmp409: f64 = tmp307 * tmp76 + tmp406 * tmp78 - tmp408 * tmp74;
-    let tmp410: f64 = tmp93 * tmp95;
-    let tmp411: f64 = tmp307 * tmp90 + tmp406 * tmp91 - tmp407 * tmp410;
-    let tmp412: f64 = -tmp100 * tmp408 + tmp103 * tmp307 + tmp104 * tmp406;
-    let tmp413: f64 = tmp172 * tmp409 + tmp176 * tmp411 + tmp178 * tmp412 + tmp405 * tmp97;
-    let tmp414: f64 = -tmp184 * tmp412 - tmp186 * tmp411 - tmp188 * tmp409 + tmp338;
-    let tmp415: f64 = tmp323 + tmp404;
-    let tmp416: f64 = tmp415 * tmp95;
-    let tmp417: f64 = tmp330 - tmp415 * tmp51;
-    let tmp418: f64 = tmp417 * tmp95;
-    let tmp419: f64 = tmp307 * tmp78 + tmp416 * tmp76 - tmp418 * tmp74;
-    let tmp420: f64 = tmp307 * tmp91 - tmp410 * tmp417 + tmp416 * tmp90;
-    let tmp421: f64 = -tmp100 * tmp418 + tmp103 * tmp416 + tmp104 * tmp307;
-    let tmp422: f64 = -tmp184 * tmp421 - tmp186 * tmp420 - tmp188 * tmp419 - tmp415 * tmp97;
-    let tmp423: f64 = tmp172 * tmp419 + tmp176 * tmp420 + tmp178 * tmp421 + tmp315;
-    let tmp424: f64 = tmp113 * platform_weight_n;
-    let tmp425: f64 = tmp10 * platform_weight_n;
-    let tmp426: f64 = tmp118 * platform_weight_n;
-    let tmp427: f64 = tmp123 * platform_weight_n;
-    let tmp428: f64 = tmp7 * platform_weight_n;
-    let tmp429: f64 = tmp16 * platform_weight_n;
-    let tmp430: f64 = tmp4 * platform_weight_n;
+    let tmp284: f64 = 1.0_f64 / (tmp57 * tmp57.sqrt());
+    let tmp285: f64 = tmp284 * tmp53;
+    let tmp286: f64 = -tmp285 + tmp59;
+    let tmp287: f64 = tmp284 * tmp52 * tmp55;
+    let tmp288: f64 = tmp287 * tmp51;
+    let tmp289: f64 = 1.0_f64 / (tmp35 * tmp35.sqrt());
+    let tmp290: f64 = tmp289 * tmp31;
+    let tmp291: f64 = -tmp290 + tmp67;
+    let tmp292: f64 = tmp289 * tmp30 * tmp33;
+    let tmp293: f64 = tmp29 * tmp292;
+    let tmp294: f64 = 1.0_f64 / (tmp47 * tmp47.sqrt());
+    let tmp295: f64 = tmp294 * tmp42 * tmp44;
+    let tmp296: f64 = tmp295 * tmp43;
+    let tmp297: f64 = tmp294 * tmp45;
+    let tmp298: f64 = -tmp297 + tmp49;
+    let tmp299: f64 = 1.0_f64 / (tmp23 * tmp23.sqrt());
+    let tmp300: f64 = tmp166 * tmp21 * tmp299;
+    let tmp301: f64 = tmp11 * tmp300;
+    let tmp302: f64 = tmp13 * tmp299;
+    let tmp303: f64 = reference_tension_n[0] * (-tmp302 + tmp37);
+    let tmp304: f64 = -tmp111 * (tmp296 + tmp298 * tmp41)
+        - tmp20 * tmp303
+        - tmp301
+        - tmp80 * (tmp291 * tmp32 + tmp293)
+        - tmp98 * (tmp286 * tmp54 + tmp288);
+    let tmp305: f64 = tmp286 * tmp98;
+    let tmp306: f64 = tmp111 * tmp298;
+    let tmp307: f64 = tmp291 * tmp80;
+    let tmp308: f64 = tmp303 + tmp305 + tmp306 + tmp307;
+    let tmp309: f64 = tmp111 * tmp295;
+    let tmp310: f64 = tmp292 * tmp80;
+    let tmp311: f64 = tmp287 * tmp98;
+    let tmp312: f64 = -tmp300 - tmp309 - tmp310 - tmp311;
+    let tmp313: f64 = tmp304 * tmp74 + tmp308 * tmp78 + tmp312 * tmp76;
+    let tmp314: f64 = tmp312 * tmp73;
+    let tmp315: f64 = tmp304 * tmp73;
+    let tmp316: f64 = tmp103 * tmp315 + tmp106 * tmp314 + tmp109 * tmp308;
+    let tmp317: f64 = tmp308 * tmp93 + tmp312 * tmp90 + tmp315 * tmp95;
+    let tmp318: f64 = tmp101 * tmp307
+        + tmp112 * tmp306
+        + tmp177 * tmp313
+        + tmp181 * tmp317
+        + tmp183 * tmp316
+        + tmp28 * tmp303
+        + tmp305 * tmp99;
+    let tmp319: f64 = tmp113 * tmp295;
+    let tmp320: f64 = tmp28 * tmp300;
+    let tmp321: f64 = tmp100 * tmp287;
+    let tmp322: f64 = tmp102 * tmp292;
+    let tmp323: f64 = -tmp189 * tmp316 - tmp191 * tmp317 - tmp193 * tmp313 + tmp319 + tmp320 + tmp321 + tmp322;
+    let tmp324: f64 = tmp22 * tmp299;
+    let tmp325: f64 = reference_tension_n[0] * (-tmp324 + tmp37);
+    let tmp326: f64 = tmp294 * tmp46;
+    let tmp327: f64 = -tmp326 + tmp49;
+    let tmp328: f64 = tmp111 * tmp327;
+    let tmp329: f64 = tmp284 * tmp56;
+    let tmp330: f64 = -tmp329 + tmp59;
+    let tmp331: f64 = tmp330 * tmp98;
+    let tmp332: f64 = tmp289 * tmp34;
+    let tmp333: f64 = -tmp332 + tmp67;
+    let tmp334: f64 = tmp333 * tmp80;
+    let tmp335: f64 = tmp325 + tmp328 + tmp331 + tmp334;
+    let tmp336: f64 = tmp287 * tmp54;
+    let tmp337: f64 = tmp292 * tmp32;
+    let tmp338: f64 = tmp295 * tmp41;
+    let tmp339: f64 = tmp20 * tmp300;
+    let tmp340: f64 = tmp11 * tmp325 - tmp111 * (-tmp327 * tmp43 - tmp338) + tmp339
+        - tmp80 * (-tmp29 * tmp333 - tmp337)
+        - tmp98 * (-tmp330 * tmp51 - tmp336);
+    let tmp341: f64 = tmp314 * tmp66 + tmp335 * tmp76 + tmp340 * tmp74;
+    let tmp342: f64 = -tmp319;
+    let tmp343: f64 = -tmp320;
+    let tmp344: f64 = -tmp321;
+    let tmp345: f64 = tmp104 * tmp340 + tmp107 * tmp335 + tmp109 * tmp312;
+    let tmp346: f64 = tmp314 * tmp92 + tmp335 * tmp90 + tmp340 * tmp96;
+    let tmp347: f64 = -tmp322;
+    let tmp348: f64 = tmp177 * tmp341 + tmp181 * tmp346 + tmp183 * tmp345 + tmp342 + tmp343 + tmp344 + tmp347;
+    let tmp349: f64 = -tmp101 * tmp334
+        - tmp112 * tmp328
+        - tmp189 * tmp345
+        - tmp191 * tmp346
+        - tmp193 * tmp341
+        - tmp28 * tmp325
+        - tmp331 * tmp99;
+    let tmp350: f64 = tmp39 * tmp78 + tmp75 + tmp77;
+    let tmp351: f64 = tmp38 * tmp90 + tmp94 + tmp97;
+    let tmp352: f64 = tmp105 + tmp107 * tmp38 + tmp110;
+    let tmp353: f64 = tmp177 * tmp350 + tmp181 * tmp351 + tmp183 * tmp352 + tmp88;
+    let tmp354: f64 = -tmp118 - tmp189 * tmp352 - tmp191 * tmp351 - tmp193 * tmp350;
+    let tmp355: f64 = -tmp37;
+    let tmp356: f64 = reference_tension_n[0] * (tmp302 + tmp355);
+    let tmp357: f64 = -tmp20 * tmp356 + tmp301;
+    let tmp358: f64 = tmp300 * tmp76 + tmp356 * tmp78 + tmp357 * tmp74;
+    let tmp359: f64 = tmp300 * tmp90 + tmp356 * tmp93 + tmp357 * tmp96;
+    let tmp360: f64 = tmp104 * tmp357 + tmp107 * tmp300 + tmp109 * tmp356;
+    let tmp361: f64 = -tmp189 * tmp360 - tmp191 * tmp359 - tmp193 * tmp358 + tmp343;
+    let tmp362: f64 = tmp177 * tmp358 + tmp181 * tmp359 + tmp183 * tmp360 + tmp28 * tmp356;
+    let tmp363: f64 = reference_tension_n[0] * (tmp324 + tmp355);
+    let tmp364: f64 = tmp11 * tmp363 - tmp339;
+    let tmp365: f64 = tmp300 * tmp78 + tmp363 * tmp76 + tmp364 * tmp74;
+    let tmp366: f64 = tmp300 * tmp93 + tmp363 * tmp90 + tmp364 * tmp96;
+    let tmp367: f64 = tmp104 * tmp364 + tmp107 * tmp363 + tmp109 * tmp300;
+    let tmp368: f64 = -tmp189 * tmp367 - tmp191 * tmp366 - tmp193 * tmp365 - tmp28 * tmp363;
+    let tmp369: f64 = tmp177 * tmp365 + tmp181 * tmp366 + tmp183 * tmp367 + tmp320;
+    let tmp370: f64 = -tmp67;
+    let tmp371: f64 = tmp290 + tmp370;
+    let tmp372: f64 = -tmp293 + tmp32 * tmp371;
+    let tmp373: f64 = tmp74 * tmp80;
+    let tmp374: f64 = tmp371 * tmp80;
+    let tmp375: f64 = tmp310 * tmp76 - tmp372 * tmp373 + tmp374 * tmp78;
+    let tmp376: f64 = tmp372 * tmp80;
+    let tmp377: f64 = tmp310 * tmp90 + tmp374 * tmp93 - tmp376 * tmp96;
+    let tmp378: f64 = -tmp104 * tmp376 + tmp107 * tmp310 + tmp109 * tmp374;
+    let tmp379: f64 = -tmp189 * tmp378 - tmp191 * tmp377 - tmp193 * tmp375 + tmp347;
+    let tmp380: f64 = tmp102 * tmp371 + tmp177 * tmp375 + tmp181 * tmp377 + tmp183 * tmp378;
+    let tmp381: f64 = tmp332 + tmp370;
+    let tmp382: f64 = tmp381 * tmp80;
+    let tmp383: f64 = -tmp29 * tmp381 + tmp337;
+    let tmp384: f64 = tmp310 * tmp78 - tmp373 * tmp383 + tmp382 * tmp76;
+    let tmp385: f64 = tmp383 * tmp80;
+    let tmp386: f64 = -tmp104 * tmp385 + tmp107 * tmp382 + tmp109 * tmp310;
+    let tmp387: f64 = tmp310 * tmp93 + tmp382 * tmp90 - tmp385 * tmp96;
+    let tmp388: f64 = tmp177 * tmp384 + tmp181 * tmp387 + tmp183 * tmp386 + tmp322;
+    let tmp389: f64 = -tmp102 * tmp381 - tmp189 * tmp386 - tmp191 * tmp387 - tmp193 * tmp384;
+    let tmp390: f64 = -tmp49;
+    let tmp391: f64 = tmp297 + tmp390;
+    let tmp392: f64 = -tmp296 + tmp391 * tmp41;
+    let tmp393: f64 = tmp111 * tmp74;
+    let tmp394: f64 = tmp111 * tmp391;
+    let tmp395: f64 = tmp309 * tmp76 - tmp392 * tmp393 + tmp394 * tmp78;
+    let tmp396: f64 = tmp104 * tmp111;
+    let tmp397: f64 = tmp107 * tmp309 + tmp109 * tmp394 - tmp392 * tmp396;
+    let tmp398: f64 = tmp111 * tmp96;
+    let tmp399: f64 = tmp309 * tmp90 - tmp392 * tmp398 + tmp394 * tmp93;
+    let tmp400: f64 = tmp113 * tmp391 + tmp177 * tmp395 + tmp181 * tmp399 + tmp183 * tmp397;
+    let tmp401: f64 = -tmp189 * tmp397 - tmp191 * tmp399 - tmp193 * tmp395 + tmp342;
+    let tmp402: f64 = tmp326 + tmp390;
+    let tmp403: f64 = tmp338 - tmp402 * tmp43;
+    let tmp404: f64 = tmp111 * tmp402;
+    let tmp405: f64 = tmp309 * tmp78 - tmp393 * tmp403 + tmp404 * tmp76;
+    let tmp406: f64 = tmp107 * tmp404 + tmp109 * tmp309 - tmp396 * tmp403;
+    let tmp407: f64 = tmp309 * tmp93 - tmp398 * tmp403 + tmp404 * tmp90;
+    let tmp408: f64 = -tmp113 * tmp402 - tmp189 * tmp406 - tmp191 * tmp407 - tmp193 * tmp405;
+    let tmp409: f64 = tmp177 * tmp405 + tmp181 * tmp407 + tmp183 * tmp406 + tmp319;
+    let tmp410: f64 = -tmp59;
+    let tmp411: f64 = tmp285 + tmp410;
+    let tmp412: f64 = tmp411 * tmp98;
+    let tmp413: f64 = -tmp288 + tmp411 * tmp54;
+    let tmp414: f64 = tmp413 * tmp98;
+    let tmp415: f64 = tmp311 * tmp76 + tmp412 * tmp78 - tmp414 * tmp74;
+    let tmp416: f64 = tmp96 * tmp98;
+    let tmp417: f64 = tmp311 * tmp90 + tmp412 * tmp93 - tmp413 * tmp416;
+    let tmp418: f64 = -tmp104 * tmp414 + tmp107 * tmp311 + tmp109 * tmp412;
+    let tmp419: f64 = tmp100 * tmp411 + tmp177 * tmp415 + tmp181 * tmp417 + tmp183 * tmp418;
+    let tmp420: f64 = -tmp189 * tmp418 - tmp191 * tmp417 - tmp193 * tmp415 + tmp344;
+    let tmp421: f64 = tmp329 + tmp410;
+    let tmp422: f64 = tmp421 * tmp98;
+    let tmp423: f64 = tmp336 - tmp421 * tmp51;
+    let tmp424: f64 = tmp423 * tmp98;
+    let tmp425: f64 = tmp311 * tmp78 + tmp422 * tmp76 - tmp424 * tmp74;
+    let tmp426: f64 = tmp311 * tmp93 - tmp416 * tmp423 + tmp422 * tmp90;
+    let tmp427: f64 = -tmp104 * tmp424 + tmp107 * tmp422 + tmp109 * tmp311;
+    let tmp428: f64 = -tmp100 * tmp421 - tmp189 * tmp427 - tmp191 * tmp426 - tmp193 * tmp425;
+    let tmp429: f64 = tmp177 * tmp425 + tmp181 * tmp426 + tmp183 * tmp427 + tmp321;
+    let tmp430: f64 = tmp120 * platform_weight_n;
+    let tmp431: f64 = tmp10 * platform_weight_n;
+    let tmp432: f64 = tmp124 * platform_weight_n;
+    let tmp433: f64 = tmp128 * platform_weight_n;
+    let tmp434: f64 = tmp7 * platform_weight_n;
+    let tmp435: f64 = tmp16 * platform_weight_n;
+    let tmp436: f64 = tmp4 * platform_weight_n;
 
-    // Output terms (5)
+    // Output terms (6)
     if let Some(jacobian_pose) = jacobian_pose {
-        jacobian_pose[(0, 0)] = tmp127;
+        jacobian_pose[(0, 0)] = tmp132;
         jacobian_pose[(1, 0)] = 0.0;
         jacobian_pose[(2, 0)] = 0.0;
-        jacobian_pose[(3, 0)] = -tmp128;
-        jacobian_pose[(4, 0)] = tmp131;
-        jacobian_pose[(5, 0)] = tmp171;
-        jacobian_pose[(6, 0)] = tmp110 * tmp183 + tmp113 * tmp190;
-        jacobian_pose[(7, 0)] = -tmp179;
-        jacobian_pose[(8, 0)] = tmp146;
-        jacobian_pose[(9, 0)] = tmp177;
-        jacobian_pose[(10, 0)] = tmp117 * tmp183 + tmp118 * tmp190;
-        jacobian_pose[(11, 0)] = -tmp173;
-        jacobian_pose[(12, 0)] = tmp152;
-        jacobian_pose[(13, 0)] = tmp175;
-        jacobian_pose[(14, 0)] = tmp121 * tmp183 + tmp123 * tmp190;
-        jacobian_pose[(15, 0)] = -tmp181;
-        jacobian_pose[(0, 1)] = tmp193;
+        jacobian_pose[(3, 0)] = -tmp133;
+        jacobian_pose[(4, 0)] = tmp136;
+        jacobian_pose[(5, 0)] = tmp176;
+        jacobian_pose[(6, 0)] = tmp116 * tmp188 + tmp120 * tmp195;
+        jacobian_pose[(7, 0)] = -tmp184;
+        jacobian_pose[(8, 0)] = tmp151;
+        jacobian_pose[(9, 0)] = tmp182;
+        jacobian_pose[(10, 0)] = tmp123 * tmp188 + tmp124 * tmp195;
+        jacobian_pose[(11, 0)] = -tmp178;
+        jacobian_pose[(12, 0)] = tmp157;
+        jacobian_pose[(13, 0)] = tmp180;
+        jacobian_pose[(14, 0)] = tmp126 * tmp188 + tmp128 * tmp195;
+        jacobian_pose[(15, 0)] = -tmp186;
+        jacobian_pose[(0, 1)] = tmp198;
         jacobian_pose[(1, 1)] = 0.0;
         jacobian_pose[(2, 1)] = 0.0;
-        jacobian_pose[(3, 1)] = -tmp194;
-        jacobian_pose[(4, 1)] = tmp197;
-        jacobian_pose[(5, 1)] = tmp227;
-        jacobian_pose[(6, 1)] = tmp110 * tmp234 + tmp113 * tmp235;
-        jacobian_pose[(7, 1)] = -tmp232;
-        jacobian_pose[(8, 1)] = tmp209;
-        jacobian_pose[(9, 1)] = tmp231;
-        jacobian_pose[(10, 1)] = tmp117 * tmp234 + tmp118 * tmp235;
-        jacobian_pose[(11, 1)] = -tmp229;
-        jacobian_pose[(12, 1)] = tmp203;
-        jacobian_pose[(13, 1)] = tmp230;
-        jacobian_pose[(14, 1)] = tmp121 * tmp234 + tmp123 * tmp235;
-        jacobian_pose[(15, 1)] = -tmp228;
-        jacobian_pose[(0, 2)] = tmp239;
+        jacobian_pose[(3, 1)] = -tmp199;
+        jacobian_pose[(4, 1)] = tmp202;
+        jacobian_pose[(5, 1)] = tmp231;
+        jacobian_pose[(6, 1)] = tmp116 * tmp238 + tmp120 * tmp239;
+        jacobian_pose[(7, 1)] = -tmp236;
+        jacobian_pose[(8, 1)] = tmp214;
+        jacobian_pose[(9, 1)] = tmp235;
+        jacobian_pose[(10, 1)] = tmp123 * tmp238 + tmp124 * tmp239;
+        jacobian_pose[(11, 1)] = -tmp233;
+        jacobian_pose[(12, 1)] = tmp208;
+        jacobian_pose[(13, 1)] = tmp234;
+        jacobian_pose[(14, 1)] = tmp126 * tmp238 + tmp128 * tmp239;
+        jacobian_pose[(15, 1)] = -tmp232;
+        jacobian_pose[(0, 2)] = tmp243;
         jacobian_pose[(1, 2)] = 0.0;
         jacobian_pose[(2, 2)] = 0.0;
-        jacobian_pose[(3, 2)] = -tmp240;
-        jacobian_pose[(4, 2)] = tmp244;
-        jacobian_pose[(5, 2)] = tmp271;
-        jacobian_pose[(6, 2)] = tmp110 * tmp279 + tmp113 * tmp278;
-        jacobian_pose[(7, 2)] = -tmp272;
-        jacobian_pose[(8, 2)] = tmp251;
-        jacobian_pose[(9, 2)] = tmp277;
-        jacobian_pose[(10, 2)] = tmp117 * tmp279 + tmp118 * tmp278;
-        jacobian_pose[(11, 2)] = -tmp276;
-        jacobian_pose[(12, 2)] = tmp258;
-        jacobian_pose[(13, 2)] = tmp273;
-        jacobian_pose[(14, 2)] = tmp121 * tmp279 + tmp123 * tmp278;
-        jacobian_pose[(15, 2)] = -tmp274;
+        jacobian_pose[(3, 2)] = -tmp244;
+        jacobian_pose[(4, 2)] = tmp248;
+        jacobian_pose[(5, 2)] = tmp275;
+        jacobian_pose[(6, 2)] = tmp116 * tmp283 + tmp120 * tmp282;
+        jacobian_pose[(7, 2)] = -tmp276;
+        jacobian_pose[(8, 2)] = tmp255;
+        jacobian_pose[(9, 2)] = tmp281;
+        jacobian_pose[(10, 2)] = tmp123 * tmp283 + tmp124 * tmp282;
+        jacobian_pose[(11, 2)] = -tmp280;
+        jacobian_pose[(12, 2)] = tmp262;
+        jacobian_pose[(13, 2)] = tmp277;
+        jacobian_pose[(14, 2)] = tmp126 * tmp283 + tmp128 * tmp282;
+        jacobian_pose[(15, 2)] = -tmp278;
         jacobian_pose[(0, 3)] = tmp39;
         jacobian_pose[(1, 3)] = 0.0;
         jacobian_pose[(2, 3)] = 0.0;
         jacobian_pose[(3, 3)] = 0.0;
         jacobian_pose[(4, 3)] = tmp68;
-        jacobian_pose[(5, 3)] = tmp309;
-        jacobian_pose[(6, 3)] = tmp110 * tmp312 + tmp113 * tmp317;
+        jacobian_pose[(5, 3)] = tmp313;
+        jacobian_pose[(6, 3)] = tmp116 * tmp318 + tmp120 * tmp323;
         jacobian_pose[(7, 3)] = 0.0;
         jacobian_pose[(8, 3)] = tmp62;
-        jacobian_pose[(9, 3)] = tmp310;
-        jacobian_pose[(10, 3)] = tmp117 * tmp312 + tmp118 * tmp317;
+        jacobian_pose[(9, 3)] = tmp316;
+        jacobian_pose[(10, 3)] = tmp123 * tmp318 + tmp124 * tmp323;
         jacobian_pose[(11, 3)] = 0.0;
         jacobian_pose[(12, 3)] = tmp60;
-        jacobian_pose[(13, 3)] = tmp311;
-        jacobian_pose[(14, 3)] = tmp121 * tmp312 + tmp123 * tmp317;
+        jacobian_pose[(13, 3)] = tmp317;
+        jacobian_pose[(14, 3)] = tmp126 * tmp318 + tmp128 * tmp323;
         jacobian_pose[(15, 3)] = 0.0;
         jacobian_pose[(0, 4)] = tmp38;
         jacobian_pose[(1, 4)] = 0.0;
         jacobian_pose[(2, 4)] = 0.0;
         jacobian_pose[(3, 4)] = 0.0;
         jacobian_pose[(4, 4)] = tmp70;
-        jacobian_pose[(5, 4)] = tmp335;
-        jacobian_pose[(6, 4)] = tmp110 * tmp342 + tmp113 * tmp343;
+        jacobian_pose[(5, 4)] = tmp341;
+        jacobian_pose[(6, 4)] = tmp116 * tmp348 + tmp120 * tmp349;
         jacobian_pose[(7, 4)] = 0.0;
         jacobian_pose[(8, 4)] = tmp50;
-        jacobian_pose[(9, 4)] = tmp339;
-        jacobian_pose[(10, 4)] = tmp117 * tmp342 + tmp118 * tmp343;
+        jacobian_pose[(9, 4)] = tmp345;
+        jacobian_pose[(10, 4)] = tmp123 * tmp348 + tmp124 * tmp349;
         jacobian_pose[(11, 4)] = 0.0;
         jacobian_pose[(12, 4)] = tmp61;
-        jacobian_pose[(13, 4)] = tmp340;
-        jacobian_pose[(14, 4)] = tmp121 * tmp342 + tmp123 * tmp343;
+        jacobian_pose[(13, 4)] = tmp346;
+        jacobian_pose[(14, 4)] = tmp126 * tmp348 + tmp128 * tmp349;
         jacobian_pose[(15, 4)] = 0.0;
         jacobian_pose[(0, 5)] = 0.0;
         jacobian_pose[(1, 5)] = 0.0;
@@ -711,16 +714,16 @@ pub fn cable_geometry(
         jacobian_reference_tension[(2, 0)] = 0.0;
         jacobian_reference_tension[(3, 0)] = 0.0;
         jacobian_reference_tension[(4, 0)] = 0.0;
-        jacobian_reference_tension[(5, 0)] = tmp344;
-        jacobian_reference_tension[(6, 0)] = tmp110 * tmp347 + tmp113 * tmp348;
+        jacobian_reference_tension[(5, 0)] = tmp350;
+        jacobian_reference_tension[(6, 0)] = tmp116 * tmp353 + tmp120 * tmp354;
         jacobian_reference_tension[(7, 0)] = 0.0;
         jacobian_reference_tension[(8, 0)] = 0.0;
-        jacobian_reference_tension[(9, 0)] = tmp346;
-        jacobian_reference_tension[(10, 0)] = tmp117 * tmp347 + tmp118 * tmp348;
+        jacobian_reference_tension[(9, 0)] = tmp352;
+        jacobian_reference_tension[(10, 0)] = tmp123 * tmp353 + tmp124 * tmp354;
         jacobian_reference_tension[(11, 0)] = 0.0;
         jacobian_reference_tension[(12, 0)] = 0.0;
-        jacobian_reference_tension[(13, 0)] = tmp345;
-        jacobian_reference_tension[(14, 0)] = tmp121 * tmp347 + tmp123 * tmp348;
+        jacobian_reference_tension[(13, 0)] = tmp351;
+        jacobian_reference_tension[(14, 0)] = tmp126 * tmp353 + tmp128 * tmp354;
         jacobian_reference_tension[(15, 0)] = 0.0;
         jacobian_reference_tension[(0, 1)] = 0.0;
         jacobian_reference_tension[(1, 1)] = 0.0;
@@ -728,15 +731,15 @@ pub fn cable_geometry(
         jacobian_reference_tension[(3, 1)] = 0.0;
         jacobian_reference_tension[(4, 1)] = 0.0;
         jacobian_reference_tension[(5, 1)] = 0.0;
-        jacobian_reference_tension[(6, 1)] = tmp11 * tmp110 - tmp113 * tmp20 - tmp87;
+        jacobian_reference_tension[(6, 1)] = tmp11 * tmp116 - tmp120 * tmp20 - tmp87;
         jacobian_reference_tension[(7, 1)] = 0.0;
         jacobian_reference_tension[(8, 1)] = 0.0;
         jacobian_reference_tension[(9, 1)] = 0.0;
-        jacobian_reference_tension[(10, 1)] = tmp11 * tmp117 - tmp115 - tmp118 * tmp20;
+        jacobian_reference_tension[(10, 1)] = tmp11 * tmp123 - tmp122 - tmp124 * tmp20;
         jacobian_reference_tension[(11, 1)] = 0.0;
         jacobian_reference_tension[(12, 1)] = 0.0;
         jacobian_reference_tension[(13, 1)] = 0.0;
-        jacobian_reference_tension[(14, 1)] = tmp11 * tmp121 - tmp122 - tmp123 * tmp20;
+        jacobian_reference_tension[(14, 1)] = tmp11 * tmp126 - tmp127 - tmp128 * tmp20;
         jacobian_reference_tension[(15, 1)] = 0.0;
     }
     if let Some(jacobian_anchors) = jacobian_anchors {
@@ -745,32 +748,32 @@ pub fn cable_geometry(
         jacobian_anchors[(2, 0)] = 0.0;
         jacobian_anchors[(3, 0)] = 0.0;
         jacobian_anchors[(4, 0)] = 0.0;
-        jacobian_anchors[(5, 0)] = tmp352;
-        jacobian_anchors[(6, 0)] = tmp110 * tmp356 + tmp113 * tmp355;
+        jacobian_anchors[(5, 0)] = tmp358;
+        jacobian_anchors[(6, 0)] = tmp116 * tmp362 + tmp120 * tmp361;
         jacobian_anchors[(7, 0)] = 0.0;
         jacobian_anchors[(8, 0)] = 0.0;
-        jacobian_anchors[(9, 0)] = tmp354;
-        jacobian_anchors[(10, 0)] = tmp117 * tmp356 + tmp118 * tmp355;
+        jacobian_anchors[(9, 0)] = tmp360;
+        jacobian_anchors[(10, 0)] = tmp123 * tmp362 + tmp124 * tmp361;
         jacobian_anchors[(11, 0)] = 0.0;
         jacobian_anchors[(12, 0)] = 0.0;
-        jacobian_anchors[(13, 0)] = tmp353;
-        jacobian_anchors[(14, 0)] = tmp121 * tmp356 + tmp123 * tmp355;
+        jacobian_anchors[(13, 0)] = tmp359;
+        jacobian_anchors[(14, 0)] = tmp126 * tmp362 + tmp128 * tmp361;
         jacobian_anchors[(15, 0)] = 0.0;
         jacobian_anchors[(0, 1)] = -tmp38;
         jacobian_anchors[(1, 1)] = 0.0;
         jacobian_anchors[(2, 1)] = 0.0;
         jacobian_anchors[(3, 1)] = 0.0;
         jacobian_anchors[(4, 1)] = 0.0;
-        jacobian_anchors[(5, 1)] = tmp359;
-        jacobian_anchors[(6, 1)] = tmp110 * tmp363 + tmp113 * tmp362;
+        jacobian_anchors[(5, 1)] = tmp365;
+        jacobian_anchors[(6, 1)] = tmp116 * tmp369 + tmp120 * tmp368;
         jacobian_anchors[(7, 1)] = 0.0;
         jacobian_anchors[(8, 1)] = 0.0;
-        jacobian_anchors[(9, 1)] = tmp361;
-        jacobian_anchors[(10, 1)] = tmp117 * tmp363 + tmp118 * tmp362;
+        jacobian_anchors[(9, 1)] = tmp367;
+        jacobian_anchors[(10, 1)] = tmp123 * tmp369 + tmp124 * tmp368;
         jacobian_anchors[(11, 1)] = 0.0;
         jacobian_anchors[(12, 1)] = 0.0;
-        jacobian_anchors[(13, 1)] = tmp360;
-        jacobian_anchors[(14, 1)] = tmp121 * tmp363 + tmp123 * tmp362;
+        jacobian_anchors[(13, 1)] = tmp366;
+        jacobian_anchors[(14, 1)] = tmp126 * tmp369 + tmp128 * tmp368;
         jacobian_anchors[(15, 1)] = 0.0;
         jacobian_anchors[(0, 2)] = 0.0;
         jacobian_anchors[(1, 2)] = 0.0;
@@ -793,32 +796,32 @@ pub fn cable_geometry(
         jacobian_anchors[(2, 3)] = 0.0;
         jacobian_anchors[(3, 3)] = 0.0;
         jacobian_anchors[(4, 3)] = -tmp68;
-        jacobian_anchors[(5, 3)] = tmp369;
-        jacobian_anchors[(6, 3)] = tmp113 * tmp373 + tmp374 * tmp83;
+        jacobian_anchors[(5, 3)] = tmp375;
+        jacobian_anchors[(6, 3)] = tmp116 * tmp380 + tmp120 * tmp379;
         jacobian_anchors[(7, 3)] = 0.0;
         jacobian_anchors[(8, 3)] = 0.0;
-        jacobian_anchors[(9, 3)] = tmp372;
-        jacobian_anchors[(10, 3)] = tmp116 * tmp374 + tmp118 * tmp373;
+        jacobian_anchors[(9, 3)] = tmp378;
+        jacobian_anchors[(10, 3)] = tmp123 * tmp380 + tmp124 * tmp379;
         jacobian_anchors[(11, 3)] = 0.0;
         jacobian_anchors[(12, 3)] = 0.0;
-        jacobian_anchors[(13, 3)] = tmp371;
-        jacobian_anchors[(14, 3)] = tmp120 * tmp374 + tmp123 * tmp373;
+        jacobian_anchors[(13, 3)] = tmp377;
+        jacobian_anchors[(14, 3)] = tmp126 * tmp380 + tmp128 * tmp379;
         jacobian_anchors[(15, 3)] = 0.0;
         jacobian_anchors[(0, 4)] = 0.0;
         jacobian_anchors[(1, 4)] = 0.0;
         jacobian_anchors[(2, 4)] = 0.0;
         jacobian_anchors[(3, 4)] = 0.0;
         jacobian_anchors[(4, 4)] = -tmp70;
-        jacobian_anchors[(5, 4)] = tmp378;
-        jacobian_anchors[(6, 4)] = tmp110 * tmp382 + tmp113 * tmp383;
+        jacobian_anchors[(5, 4)] = tmp384;
+        jacobian_anchors[(6, 4)] = tmp116 * tmp388 + tmp120 * tmp389;
         jacobian_anchors[(7, 4)] = 0.0;
         jacobian_anchors[(8, 4)] = 0.0;
-        jacobian_anchors[(9, 4)] = tmp380;
-        jacobian_anchors[(10, 4)] = tmp117 * tmp382 + tmp118 * tmp383;
+        jacobian_anchors[(9, 4)] = tmp386;
+        jacobian_anchors[(10, 4)] = tmp123 * tmp388 + tmp124 * tmp389;
         jacobian_anchors[(11, 4)] = 0.0;
         jacobian_anchors[(12, 4)] = 0.0;
-        jacobian_anchors[(13, 4)] = tmp381;
-        jacobian_anchors[(14, 4)] = tmp121 * tmp382 + tmp123 * tmp383;
+        jacobian_anchors[(13, 4)] = tmp387;
+        jacobian_anchors[(14, 4)] = tmp126 * tmp388 + tmp128 * tmp389;
         jacobian_anchors[(15, 4)] = 0.0;
         jacobian_anchors[(0, 5)] = 0.0;
         jacobian_anchors[(1, 5)] = 0.0;
@@ -841,32 +844,32 @@ pub fn cable_geometry(
         jacobian_anchors[(2, 6)] = 0.0;
         jacobian_anchors[(3, 6)] = 0.0;
         jacobian_anchors[(4, 6)] = 0.0;
-        jacobian_anchors[(5, 6)] = tmp389;
-        jacobian_anchors[(6, 6)] = tmp110 * tmp394 + tmp113 * tmp395;
+        jacobian_anchors[(5, 6)] = tmp395;
+        jacobian_anchors[(6, 6)] = tmp116 * tmp400 + tmp120 * tmp401;
         jacobian_anchors[(7, 6)] = 0.0;
         jacobian_anchors[(8, 6)] = -tmp62;
-        jacobian_anchors[(9, 6)] = tmp391;
-        jacobian_anchors[(10, 6)] = tmp117 * tmp394 + tmp118 * tmp395;
+        jacobian_anchors[(9, 6)] = tmp397;
+        jacobian_anchors[(10, 6)] = tmp123 * tmp400 + tmp124 * tmp401;
         jacobian_anchors[(11, 6)] = 0.0;
         jacobian_anchors[(12, 6)] = 0.0;
-        jacobian_anchors[(13, 6)] = tmp393;
-        jacobian_anchors[(14, 6)] = tmp121 * tmp394 + tmp123 * tmp395;
+        jacobian_anchors[(13, 6)] = tmp399;
+        jacobian_anchors[(14, 6)] = tmp126 * tmp400 + tmp128 * tmp401;
         jacobian_anchors[(15, 6)] = 0.0;
         jacobian_anchors[(0, 7)] = 0.0;
         jacobian_anchors[(1, 7)] = 0.0;
         jacobian_anchors[(2, 7)] = 0.0;
         jacobian_anchors[(3, 7)] = 0.0;
         jacobian_anchors[(4, 7)] = 0.0;
-        jacobian_anchors[(5, 7)] = tmp399;
-        jacobian_anchors[(6, 7)] = tmp110 * tmp403 + tmp113 * tmp402;
+        jacobian_anchors[(5, 7)] = tmp405;
+        jacobian_anchors[(6, 7)] = tmp116 * tmp409 + tmp120 * tmp408;
         jacobian_anchors[(7, 7)] = 0.0;
         jacobian_anchors[(8, 7)] = -tmp50;
-        jacobian_anchors[(9, 7)] = tmp400;
-        jacobian_anchors[(10, 7)] = tmp117 * tmp403 + tmp118 * tmp402;
+        jacobian_anchors[(9, 7)] = tmp406;
+        jacobian_anchors[(10, 7)] = tmp123 * tmp409 + tmp124 * tmp408;
         jacobian_anchors[(11, 7)] = 0.0;
         jacobian_anchors[(12, 7)] = 0.0;
-        jacobian_anchors[(13, 7)] = tmp401;
-        jacobian_anchors[(14, 7)] = tmp121 * tmp403 + tmp123 * tmp402;
+        jacobian_anchors[(13, 7)] = tmp407;
+        jacobian_anchors[(14, 7)] = tmp126 * tmp409 + tmp128 * tmp408;
         jacobian_anchors[(15, 7)] = 0.0;
         jacobian_anchors[(0, 8)] = 0.0;
         jacobian_anchors[(1, 8)] = 0.0;
@@ -889,32 +892,32 @@ pub fn cable_geometry(
         jacobian_anchors[(2, 9)] = 0.0;
         jacobian_anchors[(3, 9)] = 0.0;
         jacobian_anchors[(4, 9)] = 0.0;
-        jacobian_anchors[(5, 9)] = tmp409;
-        jacobian_anchors[(6, 9)] = tmp110 * tmp413 + tmp113 * tmp414;
+        jacobian_anchors[(5, 9)] = tmp415;
+        jacobian_anchors[(6, 9)] = tmp116 * tmp419 + tmp120 * tmp420;
         jacobian_anchors[(7, 9)] = 0.0;
         jacobian_anchors[(8, 9)] = 0.0;
-        jacobian_anchors[(9, 9)] = tmp412;
-        jacobian_anchors[(10, 9)] = tmp117 * tmp413 + tmp118 * tmp414;
+        jacobian_anchors[(9, 9)] = tmp418;
+        jacobian_anchors[(10, 9)] = tmp123 * tmp419 + tmp124 * tmp420;
         jacobian_anchors[(11, 9)] = 0.0;
         jacobian_anchors[(12, 9)] = -tmp60;
-        jacobian_anchors[(13, 9)] = tmp411;
-        jacobian_anchors[(14, 9)] = tmp121 * tmp413 + tmp123 * tmp414;
+        jacobian_anchors[(13, 9)] = tmp417;
+        jacobian_anchors[(14, 9)] = tmp126 * tmp419 + tmp128 * tmp420;
         jacobian_anchors[(15, 9)] = 0.0;
         jacobian_anchors[(0, 10)] = 0.0;
         jacobian_anchors[(1, 10)] = 0.0;
         jacobian_anchors[(2, 10)] = 0.0;
         jacobian_anchors[(3, 10)] = 0.0;
         jacobian_anchors[(4, 10)] = 0.0;
-        jacobian_anchors[(5, 10)] = tmp419;
-        jacobian_anchors[(6, 10)] = tmp110 * tmp423 + tmp113 * tmp422;
+        jacobian_anchors[(5, 10)] = tmp425;
+        jacobian_anchors[(6, 10)] = tmp116 * tmp429 + tmp120 * tmp428;
         jacobian_anchors[(7, 10)] = 0.0;
         jacobian_anchors[(8, 10)] = 0.0;
-        jacobian_anchors[(9, 10)] = tmp421;
-        jacobian_anchors[(10, 10)] = tmp117 * tmp423 + tmp118 * tmp422;
+        jacobian_anchors[(9, 10)] = tmp427;
+        jacobian_anchors[(10, 10)] = tmp123 * tmp429 + tmp124 * tmp428;
         jacobian_anchors[(11, 10)] = 0.0;
         jacobian_anchors[(12, 10)] = -tmp61;
-        jacobian_anchors[(13, 10)] = tmp420;
-        jacobian_anchors[(14, 10)] = tmp121 * tmp423 + tmp123 * tmp422;
+        jacobian_anchors[(13, 10)] = tmp426;
+        jacobian_anchors[(14, 10)] = tmp126 * tmp429 + tmp128 * tmp428;
         jacobian_anchors[(15, 10)] = 0.0;
         jacobian_anchors[(0, 11)] = 0.0;
         jacobian_anchors[(1, 11)] = 0.0;
@@ -940,15 +943,15 @@ pub fn cable_geometry(
         jacobian_com_offset[(3, 0)] = 0.0;
         jacobian_com_offset[(4, 0)] = 0.0;
         jacobian_com_offset[(5, 0)] = 0.0;
-        jacobian_com_offset[(6, 0)] = -tmp110 * tmp425 + tmp17 * tmp424;
+        jacobian_com_offset[(6, 0)] = -tmp116 * tmp431 + tmp17 * tmp430;
         jacobian_com_offset[(7, 0)] = 0.0;
         jacobian_com_offset[(8, 0)] = 0.0;
         jacobian_com_offset[(9, 0)] = 0.0;
-        jacobian_com_offset[(10, 0)] = -tmp117 * tmp425 + tmp17 * tmp426;
+        jacobian_com_offset[(10, 0)] = -tmp123 * tmp431 + tmp17 * tmp432;
         jacobian_com_offset[(11, 0)] = 0.0;
         jacobian_com_offset[(12, 0)] = 0.0;
         jacobian_com_offset[(13, 0)] = 0.0;
-        jacobian_com_offset[(14, 0)] = -tmp121 * tmp425 + tmp17 * tmp427;
+        jacobian_com_offset[(14, 0)] = -tmp126 * tmp431 + tmp17 * tmp433;
         jacobian_com_offset[(15, 0)] = 0.0;
         jacobian_com_offset[(0, 1)] = 0.0;
         jacobian_com_offset[(1, 1)] = 0.0;
@@ -956,15 +959,15 @@ pub fn cable_geometry(
         jacobian_com_offset[(3, 1)] = 0.0;
         jacobian_com_offset[(4, 1)] = 0.0;
         jacobian_com_offset[(5, 1)] = 0.0;
-        jacobian_com_offset[(6, 1)] = -tmp110 * tmp428 + tmp19 * tmp424;
+        jacobian_com_offset[(6, 1)] = -tmp116 * tmp434 + tmp19 * tmp430;
         jacobian_com_offset[(7, 1)] = 0.0;
         jacobian_com_offset[(8, 1)] = 0.0;
         jacobian_com_offset[(9, 1)] = 0.0;
-        jacobian_com_offset[(10, 1)] = -tmp117 * tmp428 + tmp19 * tmp426;
+        jacobian_com_offset[(10, 1)] = -tmp123 * tmp434 + tmp19 * tmp432;
         jacobian_com_offset[(11, 1)] = 0.0;
         jacobian_com_offset[(12, 1)] = 0.0;
         jacobian_com_offset[(13, 1)] = 0.0;
-        jacobian_com_offset[(14, 1)] = -tmp121 * tmp428 + tmp19 * tmp427;
+        jacobian_com_offset[(14, 1)] = -tmp126 * tmp434 + tmp19 * tmp433;
         jacobian_com_offset[(15, 1)] = 0.0;
         jacobian_com_offset[(0, 2)] = 0.0;
         jacobian_com_offset[(1, 2)] = 0.0;
@@ -972,16 +975,34 @@ pub fn cable_geometry(
         jacobian_com_offset[(3, 2)] = 0.0;
         jacobian_com_offset[(4, 2)] = 0.0;
         jacobian_com_offset[(5, 2)] = 0.0;
-        jacobian_com_offset[(6, 2)] = -tmp110 * tmp430 + tmp113 * tmp429;
+        jacobian_com_offset[(6, 2)] = -tmp116 * tmp436 + tmp120 * tmp435;
         jacobian_com_offset[(7, 2)] = 0.0;
         jacobian_com_offset[(8, 2)] = 0.0;
         jacobian_com_offset[(9, 2)] = 0.0;
-        jacobian_com_offset[(10, 2)] = -tmp117 * tmp430 + tmp16 * tmp426;
+        jacobian_com_offset[(10, 2)] = -tmp123 * tmp436 + tmp16 * tmp432;
         jacobian_com_offset[(11, 2)] = 0.0;
         jacobian_com_offset[(12, 2)] = 0.0;
         jacobian_com_offset[(13, 2)] = 0.0;
-        jacobian_com_offset[(14, 2)] = -tmp121 * tmp430 + tmp123 * tmp429;
+        jacobian_com_offset[(14, 2)] = -tmp126 * tmp436 + tmp128 * tmp435;
         jacobian_com_offset[(15, 2)] = 0.0;
+    }
+    if let Some(jacobian_platform_weight) = jacobian_platform_weight {
+        jacobian_platform_weight[0] = 0.0;
+        jacobian_platform_weight[1] = 0.0;
+        jacobian_platform_weight[2] = 0.0;
+        jacobian_platform_weight[3] = 0.0;
+        jacobian_platform_weight[4] = 0.0;
+        jacobian_platform_weight[5] = 0.0;
+        jacobian_platform_weight[6] = -tmp114 * tmp116 + tmp117 * tmp120 + tmp87;
+        jacobian_platform_weight[7] = 0.0;
+        jacobian_platform_weight[8] = 0.0;
+        jacobian_platform_weight[9] = 0.0;
+        jacobian_platform_weight[10] = -tmp114 * tmp123 + tmp117 * tmp124 + tmp122;
+        jacobian_platform_weight[11] = 0.0;
+        jacobian_platform_weight[12] = 0.0;
+        jacobian_platform_weight[13] = 0.0;
+        jacobian_platform_weight[14] = -tmp114 * tmp126 + tmp117 * tmp128 + tmp127;
+        jacobian_platform_weight[15] = 0.0;
     }
     nalgebra::SVector::<f64, 16>::from([
         tmp24,
@@ -990,15 +1011,15 @@ pub fn cable_geometry(
         -tmp28 + anchors_m[(2, 0)] - position_m[2],
         tmp36,
         tmp80,
-        tmp114,
-        -tmp98 + anchors_m[(2, 1)] - position_m[2],
+        tmp121,
+        -tmp101 + anchors_m[(2, 1)] - position_m[2],
         tmp48,
-        tmp106,
-        tmp119,
-        -tmp107 + anchors_m[(2, 2)] - position_m[2],
+        tmp111,
+        tmp125,
+        -tmp112 + anchors_m[(2, 2)] - position_m[2],
         tmp58,
-        tmp95,
-        tmp124,
-        -tmp96 + anchors_m[(2, 3)] - position_m[2],
+        tmp98,
+        tmp129,
+        -tmp99 + anchors_m[(2, 3)] - position_m[2],
     ])
 }

@@ -30,6 +30,7 @@
 /// * `jacobian_axial_compliance` (2x1): derivative of `cable` with respect to `axial_compliance_per_mn`.
 /// * `jacobian_pulley_radius` (2x1): derivative of `cable` with respect to `pulley_radius_m`.
 /// * `jacobian_inverse_segments_squared` (2x1): derivative of `cable` with respect to `inverse_segments_squared`.
+/// * `jacobian_cable_weight` (2x1): derivative of `cable` with respect to `cable_weight_n_per_m`.
 #[allow(clippy::too_many_arguments)]
 pub fn extended_cable(
     span_m: f64,
@@ -46,417 +47,479 @@ pub fn extended_cable(
     jacobian_axial_compliance: Option<&mut nalgebra::SVector<f64, 2>>,
     jacobian_pulley_radius: Option<&mut nalgebra::SVector<f64, 2>>,
     jacobian_inverse_segments_squared: Option<&mut nalgebra::SVector<f64, 2>>,
+    jacobian_cable_weight: Option<&mut nalgebra::SVector<f64, 2>>,
 ) -> nalgebra::SVector<f64, 2> {
-    // Total ops: 737
+    // Total ops: 864
 
-    // Intermediate terms (272)
+    // Intermediate terms (305)
     let tmp0: f64 = horizontal_tension_n * horizontal_tension_n;
     let tmp1: f64 = 1.0_f64 / horizontal_tension_n;
-    let tmp2: f64 = 0.5_f64 * cable_weight_n_per_m;
-    let tmp3: f64 = tmp1 * tmp2;
+    let tmp2: f64 = 0.5_f64 * tmp1;
+    let tmp3: f64 = tmp2 * cable_weight_n_per_m;
     let tmp4: f64 = tmp3 * span_m;
     let tmp5: f64 = tmp4 + epsilon * tmp4.signum();
-    let tmp6: f64 = 1.0_f64 / tmp5;
-    let tmp7: f64 = (tmp1 * vertical_tension_n).asinh();
-    let tmp8: f64 = tmp4 + tmp7;
-    let tmp9: f64 = tmp8.cosh();
-    let tmp10: f64 = tmp6 * tmp9;
-    let tmp11: f64 = tmp5.sinh();
-    let tmp12: f64 = tmp11 * cable_weight_n_per_m;
-    let tmp13: f64 = tmp10 * tmp12;
-    let tmp14: f64 = tmp13 * span_m + vertical_tension_n;
+    let tmp6: f64 = tmp5.sinh();
+    let tmp7: f64 = 1.0_f64 / tmp5;
+    let tmp8: f64 = (tmp1 * vertical_tension_n).asinh();
+    let tmp9: f64 = tmp4 + tmp8;
+    let tmp10: f64 = tmp9.cosh();
+    let tmp11: f64 = tmp10 * tmp7;
+    let tmp12: f64 = tmp11 * tmp6;
+    let tmp13: f64 = tmp12 * span_m;
+    let tmp14: f64 = tmp13 * cable_weight_n_per_m + vertical_tension_n;
     let tmp15: f64 = tmp14 * tmp14;
     let tmp16: f64 = tmp0 + tmp15;
     let tmp17: f64 = 1.0_f64 / tmp16.sqrt();
     let tmp18: f64 = tmp14 * tmp17;
     let tmp19: f64 = -pulley_radius_m * (tmp18 + 1.0_f64) + span_m;
-    let tmp20: f64 = tmp19 * tmp3;
-    let tmp21: f64 = tmp20 + epsilon * tmp20.signum();
-    let tmp22: f64 = 1.0_f64 / tmp21;
-    let tmp23: f64 = tmp20 + tmp7;
-    let tmp24: f64 = tmp23.cosh();
-    let tmp25: f64 = tmp22 * tmp24;
-    let tmp26: f64 = tmp21.sinh();
-    let tmp27: f64 = tmp26 * cable_weight_n_per_m;
-    let tmp28: f64 = tmp25 * tmp27;
-    let tmp29: f64 = tmp19 * tmp28 + vertical_tension_n;
-    let tmp30: f64 = tmp29 * tmp29;
-    let tmp31: f64 = tmp0 + tmp30;
-    let tmp32: f64 = 1.0_f64 / tmp31.sqrt();
-    let tmp33: f64 = tmp29 * tmp32;
-    let tmp34: f64 = -pulley_radius_m * (tmp33 + 1.0_f64) + span_m;
-    let tmp35: f64 = tmp3 * tmp34;
-    let tmp36: f64 = tmp35 + tmp7;
-    let tmp37: f64 = tmp36.cosh();
-    let tmp38: f64 = tmp35 + epsilon * tmp35.signum();
+    let tmp20: f64 = tmp19 * tmp2;
+    let tmp21: f64 = tmp20 * cable_weight_n_per_m;
+    let tmp22: f64 = tmp21 + epsilon * tmp21.signum();
+    let tmp23: f64 = 1.0_f64 / tmp22;
+    let tmp24: f64 = tmp22.sinh();
+    let tmp25: f64 = tmp21 + tmp8;
+    let tmp26: f64 = tmp25.cosh();
+    let tmp27: f64 = tmp24 * tmp26;
+    let tmp28: f64 = tmp23 * tmp27;
+    let tmp29: f64 = tmp19 * tmp28;
+    let tmp30: f64 = tmp29 * cable_weight_n_per_m + vertical_tension_n;
+    let tmp31: f64 = tmp30 * tmp30;
+    let tmp32: f64 = tmp0 + tmp31;
+    let tmp33: f64 = 1.0_f64 / tmp32.sqrt();
+    let tmp34: f64 = tmp30 * tmp33;
+    let tmp35: f64 = -pulley_radius_m * (tmp34 + 1.0_f64) + span_m;
+    let tmp36: f64 = tmp2 * tmp35;
+    let tmp37: f64 = tmp36 * cable_weight_n_per_m;
+    let tmp38: f64 = tmp37 + epsilon * tmp37.signum();
     let tmp39: f64 = 1.0_f64 / tmp38;
     let tmp40: f64 = tmp38.sinh();
     let tmp41: f64 = tmp39 * tmp40;
-    let tmp42: f64 = tmp37 * tmp41;
-    let tmp43: f64 = tmp34 * tmp42;
-    let tmp44: f64 = tmp43 * cable_weight_n_per_m + vertical_tension_n;
-    let tmp45: f64 = tmp44 * tmp44;
-    let tmp46: f64 = tmp0 + tmp45;
-    let tmp47: f64 = tmp46.sqrt();
-    let tmp48: f64 = (1.0_f64 / 1000000.0_f64) * tmp47;
-    let tmp49: f64 = tmp48 * axial_compliance_per_mn;
-    let tmp50: f64 = 1.0_f64 - tmp49;
-    let tmp51: f64 = tmp42 * tmp50;
-    let tmp52: f64 = vertical_tension_n * vertical_tension_n;
-    let tmp53: f64 = tmp0 + tmp52;
-    let tmp54: f64 = 1.0_f64 / (tmp53 * tmp53.sqrt());
-    let tmp55: f64 = 1.0_f64 / (tmp46 * tmp46.sqrt());
-    let tmp56: f64 = tmp44 * tmp55 - tmp54 * vertical_tension_n;
-    let tmp57: f64 = tmp34 * tmp34;
-    let tmp58: f64 = tmp37 * tmp37;
+    let tmp42: f64 = tmp37 + tmp8;
+    let tmp43: f64 = tmp42.cosh();
+    let tmp44: f64 = tmp35 * cable_weight_n_per_m;
+    let tmp45: f64 = tmp43 * tmp44;
+    let tmp46: f64 = tmp41 * tmp45 + vertical_tension_n;
+    let tmp47: f64 = tmp46 * tmp46;
+    let tmp48: f64 = tmp0 + tmp47;
+    let tmp49: f64 = tmp48.sqrt();
+    let tmp50: f64 = (1.0_f64 / 1000000.0_f64) * tmp49;
+    let tmp51: f64 = tmp50 * axial_compliance_per_mn;
+    let tmp52: f64 = 1.0_f64 - tmp51;
+    let tmp53: f64 = tmp35 * tmp41;
+    let tmp54: f64 = tmp43 * tmp53;
+    let tmp55: f64 = 1.0_f64 / (tmp38 * tmp38);
+    let tmp56: f64 = tmp40 * tmp40;
+    let tmp57: f64 = tmp35 * tmp35;
+    let tmp58: f64 = tmp43 * tmp43;
     let tmp59: f64 = tmp57 * tmp58;
-    let tmp60: f64 = tmp59 * cable_weight_n_per_m;
-    let tmp61: f64 = 1.0_f64 / (tmp38 * tmp38);
-    let tmp62: f64 = tmp40 * tmp40;
-    let tmp63: f64 = tmp61 * tmp62;
-    let tmp64: f64 = tmp60 * tmp63;
-    let tmp65: f64 = (1.0_f64 / 24.0_f64) * tmp64;
-    let tmp66: f64 = tmp56 * tmp65;
-    let tmp67: f64 = tmp47 * tmp66;
-    let tmp68: f64 = (tmp1 * tmp29).atan() + 0.5_f64 * core::f64::consts::PI;
-    let tmp69: f64 = tmp49 + 1.0_f64;
-    let tmp70: f64 = 1.0_f64 / tmp69;
-    let tmp71: f64 = tmp68 * tmp70;
-    let tmp72: f64 = tmp44 * tmp56;
-    let tmp73: f64 = tmp65 * tmp72;
-    let tmp74: f64 = tmp73 * inverse_segments_squared;
-    let tmp75: f64 = (1.0_f64 / 2000000.0_f64) * tmp63;
-    let tmp76: f64 = tmp60 * tmp75;
-    let tmp77: f64 = -tmp54;
-    let tmp78: f64 = tmp55 + tmp77;
-    let tmp79: f64 = tmp0 * tmp65;
-    let tmp80: f64 = tmp78 * tmp79;
-    let tmp81: f64 = tmp32 * horizontal_tension_n;
-    let tmp82: f64 = tmp36.sinh();
-    let tmp83: f64 = tmp41 * tmp82;
-    let tmp84: f64 = tmp34 * tmp83;
-    let tmp85: f64 = tmp6 * span_m * tmp8.sinh();
-    let tmp86: f64 = cable_weight_n_per_m * cable_weight_n_per_m;
-    let tmp87: f64 = 0.5_f64 * tmp86;
-    let tmp88: f64 = tmp1 * tmp87;
-    let tmp89: f64 = tmp11 * tmp9 / (tmp5 * tmp5);
-    let tmp90: f64 = tmp88 * span_m;
-    let tmp91: f64 = tmp10 * tmp5.cosh();
-    let tmp92: f64 = tmp11 * tmp85 * tmp88 + tmp13 - tmp89 * tmp90 + tmp90 * tmp91;
-    let tmp93: f64 = 1.0_f64 / (tmp16 * tmp16.sqrt());
-    let tmp94: f64 = tmp15 * tmp93;
-    let tmp95: f64 = -pulley_radius_m * (tmp17 * tmp92 - tmp92 * tmp94) + 1.0_f64;
-    let tmp96: f64 = tmp25 * tmp95;
-    let tmp97: f64 = tmp88 * tmp95;
-    let tmp98: f64 = tmp24 / (tmp21 * tmp21);
-    let tmp99: f64 = tmp19 * tmp26;
-    let tmp100: f64 = tmp98 * tmp99;
-    let tmp101: f64 = tmp19 * tmp21.cosh();
-    let tmp102: f64 = tmp22 * tmp23.sinh();
-    let tmp103: f64 = tmp102 * tmp99;
-    let tmp104: f64 = -tmp100 * tmp97 + tmp101 * tmp88 * tmp96 + tmp103 * tmp97 + tmp27 * tmp96;
-    let tmp105: f64 = 1.0_f64 / (tmp31 * tmp31.sqrt());
-    let tmp106: f64 = tmp105 * tmp30;
-    let tmp107: f64 = -pulley_radius_m * (-tmp104 * tmp106 + tmp104 * tmp32) + 1.0_f64;
-    let tmp108: f64 = tmp107 * tmp35;
-    let tmp109: f64 = tmp40 * tmp61;
-    let tmp110: f64 = tmp37 * tmp50;
-    let tmp111: f64 = tmp109 * tmp110;
-    let tmp112: f64 = tmp42 * cable_weight_n_per_m;
-    let tmp113: f64 = tmp107 * tmp34;
-    let tmp114: f64 = tmp38.cosh();
-    let tmp115: f64 = tmp114 * tmp39;
-    let tmp116: f64 = tmp37 * tmp88;
-    let tmp117: f64 = tmp115 * tmp116;
-    let tmp118: f64 = tmp109 * tmp116;
-    let tmp119: f64 = tmp84 * tmp88;
-    let tmp120: f64 = tmp107 * tmp112 + tmp107 * tmp119 + tmp113 * tmp117 - tmp113 * tmp118;
-    let tmp121: f64 = 1.0_f64 / tmp47;
-    let tmp122: f64 = tmp121 * tmp74;
-    let tmp123: f64 = tmp110 * tmp115;
-    let tmp124: f64 = tmp1 * tmp86;
-    let tmp125: f64 = tmp107 * tmp124;
-    let tmp126: f64 = tmp47 * tmp56;
-    let tmp127: f64 = tmp109 * tmp114;
-    let tmp128: f64 = tmp127 * tmp59;
-    let tmp129: f64 = (1.0_f64 / 24.0_f64) * inverse_segments_squared;
-    let tmp130: f64 = tmp128 * tmp129;
-    let tmp131: f64 = tmp126 * tmp130;
+    let tmp60: f64 = tmp56 * tmp59;
+    let tmp61: f64 = tmp55 * tmp60;
+    let tmp62: f64 = tmp61 * cable_weight_n_per_m;
+    let tmp63: f64 = vertical_tension_n * vertical_tension_n;
+    let tmp64: f64 = tmp0 + tmp63;
+    let tmp65: f64 = 1.0_f64 / (tmp64 * tmp64.sqrt());
+    let tmp66: f64 = 1.0_f64 / (tmp48 * tmp48.sqrt());
+    let tmp67: f64 = tmp46 * tmp66 - tmp65 * vertical_tension_n;
+    let tmp68: f64 = (1.0_f64 / 24.0_f64) * tmp67;
+    let tmp69: f64 = tmp49 * tmp68;
+    let tmp70: f64 = tmp62 * tmp69;
+    let tmp71: f64 = (tmp1 * tmp30).atan() + 0.5_f64 * core::f64::consts::PI;
+    let tmp72: f64 = tmp51 + 1.0_f64;
+    let tmp73: f64 = 1.0_f64 / tmp72;
+    let tmp74: f64 = tmp71 * tmp73;
+    let tmp75: f64 = tmp46 * tmp68;
+    let tmp76: f64 = tmp62 * tmp75;
+    let tmp77: f64 = tmp76 * inverse_segments_squared;
+    let tmp78: f64 = (1.0_f64 / 2000000.0_f64) * axial_compliance_per_mn;
+    let tmp79: f64 = tmp61 * tmp78;
+    let tmp80: f64 = (1.0_f64 / 24.0_f64) * tmp62;
+    let tmp81: f64 = -tmp65;
+    let tmp82: f64 = tmp66 + tmp81;
+    let tmp83: f64 = tmp0 * tmp82;
+    let tmp84: f64 = tmp80 * tmp83;
+    let tmp85: f64 = tmp33 * horizontal_tension_n;
+    let tmp86: f64 = tmp42.sinh();
+    let tmp87: f64 = tmp53 * tmp86;
+    let tmp88: f64 = tmp43 * tmp52;
+    let tmp89: f64 = tmp37 * tmp88;
+    let tmp90: f64 = tmp6 * span_m;
+    let tmp91: f64 = tmp7 * tmp9.sinh();
+    let tmp92: f64 = tmp90 * tmp91;
+    let tmp93: f64 = cable_weight_n_per_m * cable_weight_n_per_m;
+    let tmp94: f64 = tmp2 * tmp93;
+    let tmp95: f64 = tmp10 / (tmp5 * tmp5);
+    let tmp96: f64 = tmp11 * tmp5.cosh();
+    let tmp97: f64 = tmp12 * cable_weight_n_per_m - tmp90 * tmp94 * tmp95 + tmp92 * tmp94 + tmp94 * tmp96 * span_m;
+    let tmp98: f64 = 1.0_f64 / (tmp16 * tmp16.sqrt());
+    let tmp99: f64 = tmp15 * tmp98;
+    let tmp100: f64 = -pulley_radius_m * (tmp17 * tmp97 - tmp97 * tmp99) + 1.0_f64;
+    let tmp101: f64 = tmp28 * cable_weight_n_per_m;
+    let tmp102: f64 = tmp27 / (tmp22 * tmp22);
+    let tmp103: f64 = tmp20 * tmp93;
+    let tmp104: f64 = tmp102 * tmp103;
+    let tmp105: f64 = tmp26 * tmp22.cosh();
+    let tmp106: f64 = tmp103 * tmp23;
+    let tmp107: f64 = tmp100 * tmp106;
+    let tmp108: f64 = tmp24 * tmp25.sinh();
+    let tmp109: f64 = tmp100 * tmp101 - tmp100 * tmp104 + tmp105 * tmp107 + tmp107 * tmp108;
+    let tmp110: f64 = 1.0_f64 / (tmp32 * tmp32.sqrt());
+    let tmp111: f64 = tmp110 * tmp31;
+    let tmp112: f64 = -pulley_radius_m * (-tmp109 * tmp111 + tmp109 * tmp33) + 1.0_f64;
+    let tmp113: f64 = tmp40 * tmp55;
+    let tmp114: f64 = tmp112 * tmp113;
+    let tmp115: f64 = tmp43 * cable_weight_n_per_m;
+    let tmp116: f64 = tmp112 * tmp41;
+    let tmp117: f64 = tmp38.cosh();
+    let tmp118: f64 = tmp117 * tmp39;
+    let tmp119: f64 = tmp36 * tmp93;
+    let tmp120: f64 = tmp119 * tmp43;
+    let tmp121: f64 = tmp112 * tmp120;
+    let tmp122: f64 = tmp112 * tmp86;
+    let tmp123: f64 = tmp122 * tmp41;
+    let tmp124: f64 = -tmp113 * tmp121 + tmp115 * tmp116 + tmp118 * tmp121 + tmp119 * tmp123;
+    let tmp125: f64 = 1.0_f64 / tmp49;
+    let tmp126: f64 = tmp125 * tmp77;
+    let tmp127: f64 = tmp1 * inverse_segments_squared;
+    let tmp128: f64 = tmp127 * tmp69;
+    let tmp129: f64 = tmp128 * tmp93;
+    let tmp130: f64 = tmp117 * tmp59;
+    let tmp131: f64 = tmp114 * tmp130;
     let tmp132: f64 = 1.0_f64 / tmp0;
-    let tmp133: f64 = tmp70 * pulley_radius_m / (tmp132 * tmp30 + 1.0_f64);
+    let tmp133: f64 = tmp73 * pulley_radius_m / (tmp132 * tmp31 + 1.0_f64);
     let tmp134: f64 = tmp1 * tmp133;
-    let tmp135: f64 = tmp63 * cable_weight_n_per_m;
-    let tmp136: f64 = tmp113 * tmp58;
+    let tmp135: f64 = tmp55 * tmp56;
+    let tmp136: f64 = tmp44 * tmp58;
     let tmp137: f64 = tmp135 * tmp136;
-    let tmp138: f64 = (1.0_f64 / 12.0_f64) * inverse_segments_squared;
-    let tmp139: f64 = tmp126 * tmp138;
-    let tmp140: f64 = tmp37 * tmp57 * tmp82;
-    let tmp141: f64 = tmp125 * tmp140;
-    let tmp142: f64 = tmp129 * tmp63;
-    let tmp143: f64 = tmp141 * tmp142;
-    let tmp144: f64 = tmp107 * tmp83;
-    let tmp145: f64 = tmp35 * tmp50;
-    let tmp146: f64 = 1.0_f64 / (tmp46 * tmp46 * tmp46.sqrt());
+    let tmp138: f64 = tmp112 * tmp137;
+    let tmp139: f64 = (1.0_f64 / 12.0_f64) * inverse_segments_squared;
+    let tmp140: f64 = tmp139 * tmp67;
+    let tmp141: f64 = tmp138 * tmp140;
+    let tmp142: f64 = tmp122 * tmp57;
+    let tmp143: f64 = tmp135 * tmp43;
+    let tmp144: f64 = tmp129 * tmp143;
+    let tmp145: f64 = tmp37 * tmp52;
+    let tmp146: f64 = 1.0_f64 / (tmp48 * tmp48 * tmp48.sqrt());
     let tmp147: f64 = 3.0_f64 * tmp146;
-    let tmp148: f64 = tmp147 * tmp45;
-    let tmp149: f64 = tmp65 * inverse_segments_squared;
-    let tmp150: f64 = tmp149 * (-tmp120 * tmp148 + tmp120 * tmp55);
-    let tmp151: f64 = tmp68 * pulley_radius_m / (tmp69 * tmp69);
-    let tmp152: f64 = (1.0_f64 / 1000000.0_f64) * axial_compliance_per_mn;
-    let tmp153: f64 = tmp121 * tmp152;
-    let tmp154: f64 = tmp151 * tmp153;
-    let tmp155: f64 = tmp154 * tmp44;
-    let tmp156: f64 = tmp62 / (tmp38 * tmp38 * tmp38);
-    let tmp157: f64 = tmp156 * tmp59;
-    let tmp158: f64 = tmp129 * tmp157;
-    let tmp159: f64 = tmp125 * tmp158;
-    let tmp160: f64 = tmp153 * tmp43;
-    let tmp161: f64 = tmp160 * tmp44;
-    let tmp162: f64 = tmp108 * tmp82;
-    let tmp163: f64 = tmp78 * tmp86;
-    let tmp164: f64 = tmp163 * horizontal_tension_n;
-    let tmp165: f64 = tmp129 * tmp164;
-    let tmp166: f64 = tmp128 * tmp165;
-    let tmp167: f64 = tmp138 * tmp78;
-    let tmp168: f64 = tmp0 * tmp167;
-    let tmp169: f64 = tmp135 * tmp152;
-    let tmp170: f64 = tmp105 * tmp29;
-    let tmp171: f64 = horizontal_tension_n * pulley_radius_m;
-    let tmp172: f64 = tmp170 * tmp171;
-    let tmp173: f64 = tmp64 * inverse_segments_squared;
-    let tmp174: f64 = 0.125_f64 * tmp0 * tmp146 * tmp173 * tmp44;
-    let tmp175: f64 = tmp140 * tmp165 * tmp63;
-    let tmp176: f64 = tmp75 * axial_compliance_per_mn;
-    let tmp177: f64 = tmp138 * tmp72;
-    let tmp178: f64 = tmp66 * inverse_segments_squared;
-    let tmp179: f64 = (1.0_f64 / 2000000.0_f64) * axial_compliance_per_mn;
-    let tmp180: f64 = tmp157 * tmp179;
-    let tmp181: f64 = tmp130 * tmp72;
-    let tmp182: f64 = tmp128 * tmp179;
-    let tmp183: f64 = tmp158 * tmp164;
-    let tmp184: f64 = tmp132 * tmp2;
-    let tmp185: f64 = 1.0_f64 / (tmp132 * tmp52 + 1.0_f64).sqrt();
-    let tmp186: f64 = -tmp132 * tmp185 * vertical_tension_n;
-    let tmp187: f64 = tmp12 * tmp85;
-    let tmp188: f64 = tmp132 * tmp87 * (span_m * span_m);
-    let tmp189: f64 = tmp187 * (-tmp184 * span_m + tmp186) + tmp188 * tmp89 - tmp188 * tmp91;
-    let tmp190: f64 = 2.0_f64 * horizontal_tension_n;
-    let tmp191: f64 = -0.5_f64 * tmp14 * tmp93 * (2.0_f64 * tmp14 * tmp189 + tmp190) + tmp17 * tmp189;
-    let tmp192: f64 = tmp28 * pulley_radius_m;
-    let tmp193: f64 = tmp3 * pulley_radius_m;
-    let tmp194: f64 = -tmp184 * tmp19 - tmp191 * tmp193;
-    let tmp195: f64 = tmp19 * tmp27;
-    let tmp196: f64 = tmp102 * tmp195;
-    let tmp197: f64 = tmp101 * tmp25;
-    let tmp198: f64 = -tmp191 * tmp192 - tmp194 * tmp195 * tmp98
-        + tmp194 * tmp197 * cable_weight_n_per_m
-        + tmp196 * (tmp186 + tmp194);
-    let tmp199: f64 = 0.5_f64 * tmp190 + tmp198 * tmp29;
-    let tmp200: f64 = -tmp170 * tmp199 + tmp198 * tmp32;
-    let tmp201: f64 = -tmp184 * tmp34 - tmp193 * tmp200;
-    let tmp202: f64 = tmp201 * tmp60;
-    let tmp203: f64 = tmp127 * tmp202;
-    let tmp204: f64 = tmp156 * tmp202;
-    let tmp205: f64 = tmp201 * tmp34;
-    let tmp206: f64 = tmp205 * tmp37;
-    let tmp207: f64 = tmp109 * tmp206;
-    let tmp208: f64 = tmp186 + tmp201;
-    let tmp209: f64 = tmp208 * tmp84;
-    let tmp210: f64 = tmp115 * tmp206;
-    let tmp211: f64 = tmp51 * pulley_radius_m;
-    let tmp212: f64 = tmp112 * pulley_radius_m;
-    let tmp213: f64 = -tmp200 * tmp212 - tmp207 * cable_weight_n_per_m
-        + tmp209 * cable_weight_n_per_m
-        + tmp210 * cable_weight_n_per_m;
-    let tmp214: f64 = 3.0_f64 / (tmp53 * tmp53 * tmp53.sqrt());
-    let tmp215: f64 = tmp214 * vertical_tension_n;
-    let tmp216: f64 = tmp190 + 2.0_f64 * tmp213 * tmp44;
-    let tmp217: f64 = 1.5_f64 * tmp146 * tmp216;
-    let tmp218: f64 = tmp213 * tmp55 + tmp215 * horizontal_tension_n - tmp217 * tmp44;
-    let tmp219: f64 = tmp149 * tmp47;
-    let tmp220: f64 = tmp135 * tmp140;
-    let tmp221: f64 = tmp208 * tmp220;
-    let tmp222: f64 = tmp121 * tmp216;
-    let tmp223: f64 = tmp179 * tmp222;
-    let tmp224: f64 = tmp200 * tmp34 * pulley_radius_m;
-    let tmp225: f64 = tmp135 * tmp58;
-    let tmp226: f64 = tmp139 * tmp225;
-    let tmp227: f64 = tmp149 * tmp44;
-    let tmp228: f64 = tmp152 * tmp202;
-    let tmp229: f64 = tmp140 * tmp169;
-    let tmp230: f64 = tmp177 * tmp225;
-    let tmp231: f64 = tmp168 * tmp225;
-    let tmp232: f64 = tmp205 * tmp82;
-    let tmp233: f64 = tmp79 * inverse_segments_squared;
-    let tmp234: f64 = tmp83 * pulley_radius_m;
-    let tmp235: f64 = tmp169 * tmp58;
-    let tmp236: f64 = tmp1 * tmp185;
-    let tmp237: f64 = tmp187 * tmp236 + 1.0_f64;
-    let tmp238: f64 = tmp17 * tmp237 - tmp237 * tmp94;
-    let tmp239: f64 = tmp238 * tmp88 * pulley_radius_m;
-    let tmp240: f64 =
-        tmp100 * tmp239 - tmp192 * tmp238 + tmp196 * (-tmp193 * tmp238 + tmp236) - tmp197 * tmp239 + 1.0_f64;
-    let tmp241: f64 = -tmp106 * tmp240 + tmp240 * tmp32;
-    let tmp242: f64 = tmp241 * pulley_radius_m;
-    let tmp243: f64 = tmp242 * tmp34;
-    let tmp244: f64 = -tmp193 * tmp241 + tmp236;
-    let tmp245: f64 = tmp244 * tmp84;
-    let tmp246: f64 = -tmp117 * tmp243 + tmp118 * tmp243 - tmp212 * tmp241 + tmp245 * cable_weight_n_per_m + 1.0_f64;
-    let tmp247: f64 = tmp149 * (-tmp148 * tmp246 + tmp214 * tmp52 + tmp246 * tmp55 + tmp77);
-    let tmp248: f64 = tmp246 * tmp44;
-    let tmp249: f64 = tmp109 * tmp242;
-    let tmp250: f64 = tmp145 * tmp37;
-    let tmp251: f64 = tmp124 * tmp242;
-    let tmp252: f64 = tmp158 * tmp251;
-    let tmp253: f64 = tmp220 * tmp244;
-    let tmp254: f64 = tmp115 * tmp242;
-    let tmp255: f64 = tmp163 * tmp171 * tmp241;
-    let tmp256: f64 = tmp35 * tmp82;
-    let tmp257: f64 = -tmp18 - 1.0_f64;
-    let tmp258: f64 = tmp257 * tmp88;
-    let tmp259: f64 = -tmp100 * tmp258 + tmp103 * tmp258 + tmp197 * tmp258 + tmp257 * tmp28;
-    let tmp260: f64 = -tmp33 - pulley_radius_m * (-tmp106 * tmp259 + tmp259 * tmp32) - 1.0_f64;
-    let tmp261: f64 = tmp124 * tmp260;
-    let tmp262: f64 = tmp140 * tmp261;
-    let tmp263: f64 = tmp142 * tmp262;
-    let tmp264: f64 = tmp260 * tmp35;
-    let tmp265: f64 = tmp260 * tmp34;
-    let tmp266: f64 = tmp112 * tmp260 + tmp117 * tmp265 - tmp118 * tmp265 + tmp119 * tmp260;
-    let tmp267: f64 = tmp260 * tmp83;
-    let tmp268: f64 = tmp225 * tmp265;
-    let tmp269: f64 = tmp158 * tmp261;
-    let tmp270: f64 = -tmp148 * tmp266 + tmp266 * tmp55;
-    let tmp271: f64 = tmp264 * tmp82;
+    let tmp148: f64 = tmp147 * tmp47;
+    let tmp149: f64 = -tmp124 * tmp148 + tmp124 * tmp66;
+    let tmp150: f64 = tmp80 * inverse_segments_squared;
+    let tmp151: f64 = tmp150 * tmp49;
+    let tmp152: f64 = tmp71 * pulley_radius_m / (tmp72 * tmp72);
+    let tmp153: f64 = tmp125 * tmp152;
+    let tmp154: f64 = (1.0_f64 / 1000000.0_f64) * axial_compliance_per_mn;
+    let tmp155: f64 = tmp153 * tmp154;
+    let tmp156: f64 = tmp155 * tmp46;
+    let tmp157: f64 = tmp60 / (tmp38 * tmp38 * tmp38);
+    let tmp158: f64 = tmp157 * tmp93;
+    let tmp159: f64 = tmp112 * tmp158;
+    let tmp160: f64 = tmp125 * tmp54;
+    let tmp161: f64 = tmp154 * tmp160;
+    let tmp162: f64 = tmp124 * tmp46;
+    let tmp163: f64 = tmp122 * tmp37;
+    let tmp164: f64 = tmp37 * tmp43;
+    let tmp165: f64 = tmp82 * horizontal_tension_n;
+    let tmp166: f64 = (1.0_f64 / 24.0_f64) * inverse_segments_squared;
+    let tmp167: f64 = tmp165 * tmp166;
+    let tmp168: f64 = tmp167 * tmp93;
+    let tmp169: f64 = tmp130 * tmp168;
+    let tmp170: f64 = tmp139 * tmp83;
+    let tmp171: f64 = tmp135 * tmp154;
+    let tmp172: f64 = tmp136 * tmp171;
+    let tmp173: f64 = tmp127 * tmp75;
+    let tmp174: f64 = tmp173 * tmp93;
+    let tmp175: f64 = tmp143 * tmp174;
+    let tmp176: f64 = tmp110 * tmp30;
+    let tmp177: f64 = horizontal_tension_n * pulley_radius_m;
+    let tmp178: f64 = tmp176 * tmp177;
+    let tmp179: f64 = tmp62 * inverse_segments_squared;
+    let tmp180: f64 = 0.125_f64 * tmp0 * tmp146 * tmp179;
+    let tmp181: f64 = tmp143 * tmp168;
+    let tmp182: f64 = tmp1 * tmp78;
+    let tmp183: f64 = tmp182 * tmp93;
+    let tmp184: f64 = tmp143 * tmp183;
+    let tmp185: f64 = tmp179 * tmp68;
+    let tmp186: f64 = tmp130 * tmp183;
+    let tmp187: f64 = tmp150 * tmp46;
+    let tmp188: f64 = tmp140 * tmp49;
+    let tmp189: f64 = 0.5_f64 * tmp132;
+    let tmp190: f64 = 1.0_f64 / (tmp132 * tmp63 + 1.0_f64).sqrt();
+    let tmp191: f64 = -tmp132 * tmp190 * vertical_tension_n;
+    let tmp192: f64 = tmp189 * cable_weight_n_per_m;
+    let tmp193: f64 = tmp92 * cable_weight_n_per_m;
+    let tmp194: f64 = span_m * span_m;
+    let tmp195: f64 = tmp189 * tmp194 * tmp93;
+    let tmp196: f64 = tmp193 * (tmp191 - tmp192 * span_m) + tmp195 * tmp6 * tmp95 - tmp195 * tmp96;
+    let tmp197: f64 = 2.0_f64 * horizontal_tension_n;
+    let tmp198: f64 = -0.5_f64 * tmp14 * tmp98 * (2.0_f64 * tmp14 * tmp196 + tmp197) + tmp17 * tmp196;
+    let tmp199: f64 = tmp101 * pulley_radius_m;
+    let tmp200: f64 = tmp3 * pulley_radius_m;
+    let tmp201: f64 = -tmp19 * tmp192 - tmp198 * tmp200;
+    let tmp202: f64 = tmp19 * cable_weight_n_per_m;
+    let tmp203: f64 = tmp202 * tmp23;
+    let tmp204: f64 = tmp108 * tmp203;
+    let tmp205: f64 = tmp102 * tmp202;
+    let tmp206: f64 = tmp105 * tmp203;
+    let tmp207: f64 = -tmp198 * tmp199 - tmp201 * tmp205 + tmp201 * tmp206 + tmp204 * (tmp191 + tmp201);
+    let tmp208: f64 = 0.5_f64 * tmp197 + tmp207 * tmp30;
+    let tmp209: f64 = -tmp176 * tmp208 + tmp207 * tmp33;
+    let tmp210: f64 = -tmp189 * tmp44 - tmp200 * tmp209;
+    let tmp211: f64 = tmp210 * cable_weight_n_per_m;
+    let tmp212: f64 = tmp113 * tmp130;
+    let tmp213: f64 = tmp211 * tmp212;
+    let tmp214: f64 = tmp157 * tmp211;
+    let tmp215: f64 = tmp35 * tmp88;
+    let tmp216: f64 = tmp210 * tmp215;
+    let tmp217: f64 = tmp191 + tmp210;
+    let tmp218: f64 = tmp52 * tmp87;
+    let tmp219: f64 = tmp41 * pulley_radius_m;
+    let tmp220: f64 = tmp219 * tmp88;
+    let tmp221: f64 = tmp210 * tmp45;
+    let tmp222: f64 = tmp41 * tmp86;
+    let tmp223: f64 = tmp222 * tmp44;
+    let tmp224: f64 = tmp115 * tmp219;
+    let tmp225: f64 = -tmp113 * tmp221 + tmp118 * tmp221 - tmp209 * tmp224 + tmp217 * tmp223;
+    let tmp226: f64 = 3.0_f64 / (tmp64 * tmp64 * tmp64.sqrt());
+    let tmp227: f64 = tmp226 * vertical_tension_n;
+    let tmp228: f64 = tmp197 + 2.0_f64 * tmp225 * tmp46;
+    let tmp229: f64 = 1.5_f64 * tmp146 * tmp228;
+    let tmp230: f64 = tmp225 * tmp66 + tmp227 * horizontal_tension_n - tmp229 * tmp46;
+    let tmp231: f64 = tmp57 * tmp86;
+    let tmp232: f64 = tmp115 * tmp231;
+    let tmp233: f64 = tmp135 * tmp232;
+    let tmp234: f64 = tmp188 * tmp233;
+    let tmp235: f64 = tmp228 * tmp78;
+    let tmp236: f64 = tmp209 * pulley_radius_m;
+    let tmp237: f64 = tmp137 * tmp188;
+    let tmp238: f64 = tmp154 * tmp211;
+    let tmp239: f64 = tmp140 * tmp46;
+    let tmp240: f64 = tmp170 * tmp233;
+    let tmp241: f64 = tmp171 * tmp232;
+    let tmp242: f64 = tmp137 * tmp239;
+    let tmp243: f64 = tmp137 * tmp170;
+    let tmp244: f64 = tmp35 * tmp86;
+    let tmp245: f64 = tmp210 * tmp244;
+    let tmp246: f64 = tmp0 * tmp150;
+    let tmp247: f64 = tmp222 * pulley_radius_m;
+    let tmp248: f64 = tmp233 * tmp239;
+    let tmp249: f64 = tmp1 * tmp190;
+    let tmp250: f64 = tmp193 * tmp249 + 1.0_f64;
+    let tmp251: f64 = tmp17 * tmp250 - tmp250 * tmp99;
+    let tmp252: f64 = tmp251 * pulley_radius_m;
+    let tmp253: f64 =
+        tmp104 * tmp252 - tmp105 * tmp106 * tmp252 - tmp199 * tmp251 + tmp204 * (-tmp200 * tmp251 + tmp249) + 1.0_f64;
+    let tmp254: f64 = -tmp111 * tmp253 + tmp253 * tmp33;
+    let tmp255: f64 = tmp254 * pulley_radius_m;
+    let tmp256: f64 = tmp118 * tmp255;
+    let tmp257: f64 = -tmp200 * tmp254 + tmp249;
+    let tmp258: f64 = tmp113 * tmp255;
+    let tmp259: f64 = -tmp120 * tmp256 + tmp120 * tmp258 + tmp223 * tmp257 - tmp224 * tmp254 + 1.0_f64;
+    let tmp260: f64 = -tmp148 * tmp259 + tmp226 * tmp63 + tmp259 * tmp66 + tmp81;
+    let tmp261: f64 = tmp259 * tmp46;
+    let tmp262: f64 = tmp158 * tmp255;
+    let tmp263: f64 = tmp212 * tmp93;
+    let tmp264: f64 = tmp255 * tmp263;
+    let tmp265: f64 = tmp166 * tmp177 * tmp254 * tmp82;
+    let tmp266: f64 = tmp37 * tmp86;
+    let tmp267: f64 = tmp182 * tmp255;
+    let tmp268: f64 = -tmp18 - 1.0_f64;
+    let tmp269: f64 = tmp106 * tmp268;
+    let tmp270: f64 = tmp101 * tmp268 - tmp104 * tmp268 + tmp105 * tmp269 + tmp108 * tmp269;
+    let tmp271: f64 = -tmp34 - pulley_radius_m * (-tmp111 * tmp270 + tmp270 * tmp33) - 1.0_f64;
+    let tmp272: f64 = tmp231 * tmp271;
+    let tmp273: f64 = tmp118 * tmp271;
+    let tmp274: f64 = tmp271 * tmp41;
+    let tmp275: f64 = tmp274 * tmp86;
+    let tmp276: f64 = tmp113 * tmp271;
+    let tmp277: f64 = tmp115 * tmp274 + tmp119 * tmp275 + tmp120 * tmp273 - tmp120 * tmp276;
+    let tmp278: f64 = tmp161 * tmp46;
+    let tmp279: f64 = tmp137 * tmp271;
+    let tmp280: f64 = tmp158 * tmp271;
+    let tmp281: f64 = -tmp148 * tmp277 + tmp277 * tmp66;
+    let tmp282: f64 = tmp130 * tmp276;
+    let tmp283: f64 = tmp180 * tmp46;
+    let tmp284: f64 = tmp61 * inverse_segments_squared;
+    let tmp285: f64 = tmp194 * tmp3;
+    let tmp286: f64 = tmp285 * tmp6;
+    let tmp287: f64 = tmp13 + tmp285 * tmp96 + tmp286 * tmp91 - tmp286 * tmp95;
+    let tmp288: f64 = tmp17 * tmp287 - tmp287 * tmp99;
+    let tmp289: f64 = tmp20 - tmp200 * tmp288;
+    let tmp290: f64 = -tmp199 * tmp288 + tmp204 * tmp289 - tmp205 * tmp289 + tmp206 * tmp289 + tmp29;
+    let tmp291: f64 = -tmp111 * tmp290 + tmp290 * tmp33;
+    let tmp292: f64 = -tmp200 * tmp291 + tmp36;
+    let tmp293: f64 = tmp291 * pulley_radius_m;
+    let tmp294: f64 = tmp293 * tmp41;
+    let tmp295: f64 = tmp113 * tmp292;
+    let tmp296: f64 = tmp118 * tmp292;
+    let tmp297: f64 = -tmp115 * tmp294 + tmp223 * tmp292 - tmp295 * tmp45 + tmp296 * tmp45 + tmp54;
+    let tmp298: f64 = tmp157 * tmp292;
+    let tmp299: f64 = tmp298 * cable_weight_n_per_m;
+    let tmp300: f64 = -tmp148 * tmp297 + tmp297 * tmp66;
+    let tmp301: f64 = tmp130 * tmp295;
+    let tmp302: f64 = tmp301 * cable_weight_n_per_m;
+    let tmp303: f64 = tmp154 * cable_weight_n_per_m;
+    let tmp304: f64 = tmp244 * tmp292;
 
-    // Output terms (7)
+    // Output terms (8)
     if let Some(jacobian_span) = jacobian_span {
-        jacobian_span[0] = tmp104 * tmp134 + tmp107 * tmp51 - tmp108 * tmp111 + tmp108 * tmp123
-            - tmp120 * tmp122
-            - tmp120 * tmp155
-            - tmp120 * tmp161
-            - tmp125 * tmp131
-            - tmp126 * tmp143
-            + tmp126 * tmp159
-            - tmp137 * tmp139
-            + tmp144 * tmp145
-            - tmp150 * tmp47;
-        jacobian_span[1] = tmp104 * tmp172 - tmp107 * tmp166 - tmp107 * tmp175 + tmp107 * tmp183 + tmp108 * tmp42
-            - tmp109 * tmp162
-            + tmp115 * tmp162
-            + tmp120 * tmp174
-            - tmp120 * tmp178
-            + tmp125 * tmp180
-            - tmp125 * tmp181
-            - tmp125 * tmp182
-            - tmp136 * tmp169
-            - tmp137 * tmp168
-            - tmp137 * tmp177
-            - tmp141 * tmp176
-            - tmp143 * tmp72
-            + tmp144
-            - tmp150 * tmp44
-            + tmp159 * tmp72;
+        jacobian_span[0] =
+            tmp109 * tmp134 + tmp112 * tmp118 * tmp89 - tmp114 * tmp89 + tmp116 * tmp88 + tmp123 * tmp145
+                - tmp124 * tmp126
+                - tmp124 * tmp156
+                + tmp128 * tmp159
+                - tmp129 * tmp131
+                - tmp141 * tmp49
+                - tmp142 * tmp144
+                - tmp149 * tmp151
+                - tmp161 * tmp162;
+        jacobian_span[1] = tmp109 * tmp178 - tmp112 * tmp172 - tmp113 * tmp163 - tmp114 * tmp169 - tmp114 * tmp186
+            + tmp116 * tmp164
+            + tmp118 * tmp163
+            + tmp123
+            - tmp124 * tmp185
+            - tmp131 * tmp174
+            - tmp138 * tmp170
+            - tmp141 * tmp46
+            - tmp142 * tmp175
+            - tmp142 * tmp181
+            - tmp142 * tmp184
+            - tmp149 * tmp187
+            + tmp159 * tmp167
+            + tmp159 * tmp173
+            + tmp159 * tmp182
+            + tmp162 * tmp180;
     }
     if let Some(jacobian_horizontal_tension) = jacobian_horizontal_tension {
-        jacobian_horizontal_tension[0] = tmp133 * (tmp1 * tmp198 - tmp132 * tmp29) - tmp139 * tmp203 + tmp139 * tmp204
-            - tmp139 * tmp221
-            - tmp151 * tmp223
-            - (1.0_f64 / 48.0_f64) * tmp173 * tmp222 * tmp56
-            - tmp200 * tmp211
-            - tmp207 * tmp50
-            + tmp209 * tmp50
-            + tmp210 * tmp50
-            - tmp218 * tmp219
-            - tmp223 * tmp43
-            + tmp224 * tmp226;
-        jacobian_horizontal_tension[1] = tmp105 * tmp171 * tmp199 - tmp109 * tmp232 + tmp115 * tmp232 - tmp127 * tmp228
-            + tmp156 * tmp228
-            - tmp167 * tmp64 * horizontal_tension_n
-            - tmp168 * tmp203
-            + tmp168 * tmp204
-            - tmp168 * tmp221
-            - tmp177 * tmp203
-            + tmp177 * tmp204
-            - tmp177 * tmp221
-            - tmp178 * tmp213
-            - tmp200 * tmp234
-            - tmp208 * tmp229
-            + tmp208 * tmp43
-            - tmp218 * tmp227
-            + tmp224 * tmp230
-            + tmp224 * tmp231
-            + tmp224 * tmp235
-            - tmp233 * (tmp214 * horizontal_tension_n - tmp217)
-            - tmp32 * pulley_radius_m;
+        jacobian_horizontal_tension[0] = -tmp113 * tmp216 + tmp118 * tmp216
+            - (1.0_f64 / 48.0_f64) * tmp125 * tmp179 * tmp228 * tmp67
+            + tmp133 * (tmp1 * tmp207 - tmp132 * tmp30)
+            - tmp151 * tmp230
+            - tmp153 * tmp235
+            - tmp160 * tmp235
+            - tmp188 * tmp213
+            + tmp188 * tmp214
+            - tmp209 * tmp220
+            + tmp217 * tmp218
+            - tmp217 * tmp234
+            + tmp236 * tmp237;
+        jacobian_horizontal_tension[1] = tmp110 * tmp177 * tmp208 - tmp113 * tmp245 + tmp118 * tmp245 + tmp157 * tmp238
+            - (1.0_f64 / 12.0_f64) * tmp165 * tmp179
+            - tmp170 * tmp213
+            + tmp170 * tmp214
+            + tmp172 * tmp236
+            - tmp185 * tmp225
+            - tmp187 * tmp230
+            - tmp209 * tmp247
+            - tmp212 * tmp238
+            - tmp213 * tmp239
+            + tmp214 * tmp239
+            - tmp217 * tmp240
+            - tmp217 * tmp241
+            - tmp217 * tmp248
+            + tmp217 * tmp54
+            + tmp236 * tmp242
+            + tmp236 * tmp243
+            - tmp246 * (tmp226 * horizontal_tension_n - tmp229)
+            - tmp33 * pulley_radius_m;
     }
     if let Some(jacobian_vertical_tension) = jacobian_vertical_tension {
-        jacobian_vertical_tension[0] = -tmp121 * tmp178 * tmp248 - tmp126 * tmp252 + tmp131 * tmp251 + tmp134 * tmp240
-            - tmp139 * tmp253
-            - tmp154 * tmp248
-            - tmp160 * tmp248
-            - tmp211 * tmp241
-            + tmp226 * tmp243
-            + tmp245 * tmp50
-            - tmp247 * tmp47
-            + tmp249 * tmp250
-            - tmp250 * tmp254;
-        jacobian_vertical_tension[1] = tmp130 * tmp255 - tmp158 * tmp255 - tmp168 * tmp253 + tmp172 * tmp240
-            - tmp177 * tmp253
-            - tmp178 * tmp246
-            - tmp180 * tmp251
-            + tmp181 * tmp251
-            + tmp182 * tmp251
-            - tmp229 * tmp244
-            + tmp230 * tmp243
-            + tmp231 * tmp243
-            - tmp233 * (-tmp147 * tmp248 + tmp215)
-            - tmp234 * tmp241
-            + tmp235 * tmp243
-            + tmp244 * tmp43
-            - tmp247 * tmp44
-            + tmp249 * tmp256
-            - tmp252 * tmp72
-            - tmp254 * tmp256;
+        jacobian_vertical_tension[0] = -tmp125 * tmp185 * tmp261 - tmp128 * tmp262 + tmp128 * tmp264 + tmp134 * tmp253
+            - tmp151 * tmp260
+            - tmp155 * tmp261
+            - tmp161 * tmp261
+            + tmp218 * tmp257
+            - tmp220 * tmp254
+            - tmp234 * tmp257
+            + tmp237 * tmp255
+            - tmp256 * tmp89
+            + tmp258 * tmp89;
+        jacobian_vertical_tension[1] =
+            -tmp158 * tmp265 - tmp158 * tmp267 + tmp172 * tmp255 - tmp173 * tmp262 + tmp173 * tmp264 + tmp178 * tmp253
+                - tmp185 * tmp259
+                - tmp187 * tmp260
+                - tmp240 * tmp257
+                - tmp241 * tmp257
+                + tmp242 * tmp255
+                + tmp243 * tmp255
+                - tmp246 * (-tmp147 * tmp261 + tmp227)
+                - tmp247 * tmp254
+                - tmp248 * tmp257
+                - tmp256 * tmp266
+                + tmp257 * tmp54
+                + tmp258 * tmp266
+                + tmp263 * tmp265
+                + tmp263 * tmp267;
     }
     if let Some(jacobian_axial_compliance) = jacobian_axial_compliance {
-        jacobian_axial_compliance[0] = -tmp151 * tmp48 - tmp43 * tmp48;
-        jacobian_axial_compliance[1] = -tmp76;
+        jacobian_axial_compliance[0] = -tmp152 * tmp50 - tmp50 * tmp54;
+        jacobian_axial_compliance[1] = -(1.0_f64 / 2000000.0_f64) * tmp62;
     }
     if let Some(jacobian_pulley_radius) = jacobian_pulley_radius {
         jacobian_pulley_radius[0] =
-            -tmp111 * tmp264 - tmp122 * tmp266 + tmp123 * tmp264 - tmp126 * tmp263 + tmp126 * tmp269 - tmp131 * tmp261
-                + tmp134 * tmp259
-                - tmp139 * tmp268
-                + tmp145 * tmp267
-                - tmp155 * tmp266
-                - tmp161 * tmp266
-                - tmp219 * tmp270
-                + tmp260 * tmp51
-                + tmp71;
+            -tmp126 * tmp277 + tmp128 * tmp280 - tmp129 * tmp282 + tmp134 * tmp270 - tmp144 * tmp272 + tmp145 * tmp275
+                - tmp151 * tmp281
+                - tmp156 * tmp277
+                - tmp188 * tmp279
+                + tmp273 * tmp89
+                + tmp274 * tmp88
+                - tmp276 * tmp89
+                - tmp277 * tmp278
+                + tmp74;
         jacobian_pulley_radius[1] =
-            -tmp109 * tmp271 + tmp115 * tmp271 - tmp166 * tmp260 - tmp168 * tmp268 + tmp172 * tmp259 + tmp174 * tmp266
-                - tmp175 * tmp260
-                - tmp176 * tmp262
-                - tmp177 * tmp268
-                - tmp178 * tmp266
-                + tmp180 * tmp261
-                - tmp181 * tmp261
-                - tmp182 * tmp261
-                + tmp183 * tmp260
-                - tmp227 * tmp270
-                - tmp235 * tmp265
-                - tmp263 * tmp72
-                + tmp264 * tmp42
-                + tmp267
-                + tmp269 * tmp72
-                - tmp81;
+            tmp164 * tmp274 + tmp167 * tmp280 - tmp169 * tmp276 - tmp170 * tmp279 - tmp172 * tmp271 + tmp173 * tmp280
+                - tmp174 * tmp282
+                - tmp175 * tmp272
+                + tmp178 * tmp270
+                - tmp181 * tmp272
+                + tmp182 * tmp280
+                - tmp184 * tmp272
+                - tmp185 * tmp277
+                - tmp186 * tmp276
+                - tmp187 * tmp281
+                - tmp239 * tmp279
+                + tmp266 * tmp273
+                - tmp266 * tmp276
+                + tmp275
+                + tmp277 * tmp283
+                - tmp85;
     }
     if let Some(jacobian_inverse_segments_squared) = jacobian_inverse_segments_squared {
-        jacobian_inverse_segments_squared[0] = -tmp67;
-        jacobian_inverse_segments_squared[1] = -tmp73 - tmp80;
+        jacobian_inverse_segments_squared[0] = -tmp70;
+        jacobian_inverse_segments_squared[1] = -tmp76 - tmp84;
+    }
+    if let Some(jacobian_cable_weight) = jacobian_cable_weight {
+        jacobian_cable_weight[0] = -tmp126 * tmp297 + tmp134 * tmp290 - tmp151 * tmp300 - tmp156 * tmp297
+            + tmp188 * tmp299
+            - tmp188 * tmp302
+            - tmp215 * tmp295
+            + tmp215 * tmp296
+            + tmp218 * tmp292
+            - tmp234 * tmp292
+            + tmp237 * tmp293
+            - tmp278 * tmp297
+            - tmp284 * tmp69
+            - tmp294 * tmp88;
+        jacobian_cable_weight[1] =
+            -tmp113 * tmp304 + tmp118 * tmp304 + tmp170 * tmp299 - tmp170 * tmp302 + tmp172 * tmp293 + tmp178 * tmp290
+                - tmp185 * tmp297
+                - tmp187 * tmp300
+                - tmp222 * tmp293
+                + tmp239 * tmp299
+                - tmp239 * tmp302
+                - tmp240 * tmp292
+                - tmp241 * tmp292
+                + tmp242 * tmp293
+                + tmp243 * tmp293
+                - tmp248 * tmp292
+                + tmp283 * tmp297
+                - tmp284 * tmp75
+                - (1.0_f64 / 24.0_f64) * tmp284 * tmp83
+                + tmp292 * tmp54
+                + tmp298 * tmp303
+                - tmp301 * tmp303
+                - tmp79;
     }
     nalgebra::SVector::<f64, 2>::from([
-        tmp34 * tmp51 - tmp67 * inverse_segments_squared + tmp71 * pulley_radius_m,
-        -tmp74 - tmp76 * axial_compliance_per_mn - tmp80 * inverse_segments_squared - tmp81 * pulley_radius_m + tmp84,
+        tmp52 * tmp54 - tmp70 * inverse_segments_squared + tmp74 * pulley_radius_m,
+        -tmp77 - tmp79 * cable_weight_n_per_m - tmp84 * inverse_segments_squared - tmp85 * pulley_radius_m + tmp87,
     ])
 }

@@ -16,7 +16,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sagcal::calib::{CableModel, OrientationPrior};
 use sagcal::experiments::table2::{pose_pool, run_trial, PoolPose, Protocol, Source};
-use sagcal::model::effects::EffectSet;
+use sagcal::model::effect_kind::EffectSet;
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};

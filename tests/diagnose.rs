@@ -10,7 +10,8 @@ use std::process::{Command, Output};
 use sagcal::experiments::hidden_effects::{
     case_seed, identifiability, refused_readings, run_case, simulate_case, HiddenEffectOptions,
 };
-use sagcal::model::effects::{EffectKind, Effects};
+use sagcal::model::effect_kind::EffectKind;
+use sagcal::model::effects::Effects;
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 
@@ -196,8 +197,12 @@ fn diagnose_cli_json_plots_and_errors() {
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["verdict"], "elastic");
     let candidates = json["candidates"].as_array().unwrap();
-    // Step 1 tests the eight effects (the localiser mount among them) and the orientation against the baseline.
-    assert_eq!(candidates.iter().filter(|c| c["step"] == 1).count(), 9);
+    // Step 1 tests every effect of the catalogue (the localiser mount among them) and the
+    // orientation against the baseline.
+    assert_eq!(
+        candidates.iter().filter(|c| c["step"] == 1).count(),
+        EffectKind::ALL.len() + 1
+    );
     for c in candidates {
         for key in [
             "effect",

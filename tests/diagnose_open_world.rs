@@ -13,7 +13,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sagcal::calib::CalibrationOptions;
 use sagcal::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
-use sagcal::model::effects::{EffectKind, Effects};
+use sagcal::model::effect_kind::EffectKind;
+use sagcal::model::effects::Effects;
 use sagcal::model::measurement::PoseMeasurement;
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::{Robot, CABLE_COUNT};
@@ -68,13 +69,24 @@ fn run(
 }
 
 /// A platform 11 % heavier than the robot file says (an unmodelled payload)
-/// was named `segments+loadcell`: a chain of 2.9 elements. The chain is now a
-/// stand-in, never a cause, and the verdict says that something is left.
+/// was named `segments+loadcell`: a chain of 2.9 elements. The platform's
+/// weight is now a hypothesis and is named, at its value; with it left out
+/// of the catalogue the chain is a stand-in, never a cause, and the verdict
+/// says that something is left.
 #[test]
 fn an_unmodelled_payload_is_not_named_as_a_chain_of_three_elements() {
     let seed = 31;
     let data = case(seed, |t| t.platform_weight_n *= 1.11, &[]);
-    let d = run("payload +11 %", seed, &data, &[]);
+    let named = run("payload +11 %", seed, &data, &[]);
+    assert_eq!(named.verdict, "platform-weight");
+    let scale = &named.effects[0].params[0];
+    assert!((scale.value - 1.11).abs() < 4.0 * scale.sigma, "{scale:?}");
+    let d = run(
+        "payload +11 %, platform-weight left out",
+        seed,
+        &data,
+        &[EffectKind::PlatformWeight],
+    );
     assert!(d.verdict.ends_with("unexplained"), "{}", d.verdict);
     assert!(!d.explanation.explained);
     assert!(

@@ -27,7 +27,7 @@ fn model_data_converge_at_the_cramer_rao_bound_and_reproduce_from_the_seed() {
         offset_perturbation_m: 80.0,
         basin_radius_m: 3.0,
         orientation_prior: sagcal::calib::OrientationPrior::Auto,
-        estimate: sagcal::model::effects::EffectSet::NONE,
+        estimate: sagcal::model::effect_kind::EffectSet::NONE,
         apply_gross_errors: false,
     };
     let run = || run_protocol(&truth, &pool, &[25], 12, 5, &protocol, &|| {}).unwrap();

@@ -10,7 +10,7 @@ use rand_chacha::ChaCha8Rng;
 use sagcal::calib::{build_graph, CableModel, CalibrationOptions};
 use sagcal::graph::{FactorGraph, VariableValue};
 use sagcal::io::measurements::PoseMeasurement;
-use sagcal::model::effects::{EffectKind, EffectSet};
+use sagcal::model::effect_kind::{EffectKind, EffectSet};
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::statics::{CableTension, Equilibrium};
 use sagcal::model::{Effects, PlatformPose, Robot};
@@ -148,6 +148,8 @@ fn extended_jacobians_match_central_differences() {
         "encoder-scale:gain1=1.002,gain3=0.998",
         "loadcell:bias_n=5,gain=1.01",
         "com:dx_m=0.02,dy_m=-0.01,dz_m=0.05",
+        "platform-weight:scale=1.05",
+        "cable-weight:scale=0.93",
     ];
     robot.effects = effects(&all);
     let eqs = equilibria(&robot, 3);
@@ -231,6 +233,14 @@ fn extended_model_matches_the_discretised_simulator() {
         ("large", &["pulley:radius_m=0.2"][..], 0.05, 2e-4),
         ("large", &["elastic:ea_n=3e6", "pulley:radius_m=0.2"][..], 0.05, 3e-4),
         ("small", &["elastic:ea_n=2e5", "pulley:radius_m=0.05"][..], 0.005, 1e-4),
+        ("large", &["platform-weight:scale=1.1"][..], 0.1, 2e-4),
+        ("large", &["cable-weight:scale=0.85"][..], 0.1, 2e-4),
+        (
+            "small",
+            &["platform-weight:scale=0.9", "cable-weight:scale=1.15"][..],
+            0.1,
+            1e-4,
+        ),
     ] {
         let robot = Robot::builtin(name).unwrap();
         let e = effects(specs);
@@ -303,4 +313,68 @@ fn segmented_chain_matches_the_discretised_simulator() {
             previous = Some((b, x));
         }
     }
+}
+
+/// The weights' scaling (`WEIGHT_SCALING` of src/diagnose/candidates.rs): a platform
+/// `p` times and cables `c` times as heavy, read through a load cell of gain
+/// `g`, predict the same readings as `(s p, s c, g / s)` with every tension
+/// scaled by `s` (the catenary depends on `f_h / w`, the platform's balance
+/// is linear in its weight). Every residual of the extended model agrees, so
+/// the data cannot tell them apart and the diagnosis never fits all three.
+#[test]
+fn scaling_both_weights_is_seen_only_as_a_load_cell_gain() {
+    let robot = Robot::builtin("large").unwrap();
+    let eqs = equilibria(&robot, 4);
+    let (measurements, poses, tensions) = {
+        let solved = solve_with_effects(&robot, &effects(&["platform-weight:scale=1.1"]), &eqs, 50).unwrap();
+        from_discretised(&robot, &solved)
+    };
+    let fitted = |specs: &[&str], s: f64| {
+        let mut model = robot.clone();
+        model.effects = effects(specs);
+        let scaled: Vec<CableTension> = tensions
+            .iter()
+            .map(|t| CableTension {
+                horizontal_n: s * t.horizontal_n,
+                vertical_n: s * t.vertical_n,
+            })
+            .collect();
+        let opts = CalibrationOptions {
+            free_effects: EffectSet::of(EffectKind::LoadCell),
+            ..options()
+        };
+        let built = build_graph(&model, &measurements, &poses, &scaled, CableModel::Catenary, &opts);
+        let residuals: Vec<f64> = built
+            .graph
+            .factors
+            .iter()
+            .flat_map(|f| {
+                f.evaluate(&built.graph.values, None)
+                    .unwrap()
+                    .iter()
+                    .copied()
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        residuals
+    };
+    let s = 1.0 / 1.1;
+    let heavier_platform = fitted(&["platform-weight:scale=1.1", "loadcell:gain=1.0"], 1.0);
+    let lighter_cables = fitted(&["cable-weight:scale=0.9090909090909091", "loadcell:gain=1.1"], s);
+    let other_model = fitted(&["cable-weight:scale=0.9090909090909091"], s);
+    let worst = heavier_platform
+        .iter()
+        .zip(&lighter_cables)
+        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    let different = heavier_platform
+        .iter()
+        .zip(&other_model)
+        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    println!(
+        "{} residuals: worst difference {worst:.2e}; without the load-cell gain {different:.2e}",
+        heavier_platform.len()
+    );
+    assert!(worst < 1e-6, "{worst}");
+    // The load cell does see the scale: the same cables without its gain differ by newtons.
+    assert!(different > 1.0, "{different}");
 }

@@ -326,8 +326,13 @@ fn rigid_length_residual_outputs() {
 #[test]
 fn cable_geometry_outputs() {
     let x = inputs();
-    let (mut pose, mut reference, mut anchors, mut com) =
-        (nan::<16, 6>(), nan::<16, 2>(), nan::<16, 12>(), nan::<16, 3>());
+    let (mut pose, mut reference, mut anchors, mut com, mut weight) = (
+        nan::<16, 6>(),
+        nan::<16, 2>(),
+        nan::<16, 12>(),
+        nan::<16, 3>(),
+        nan::<16, 1>(),
+    );
     let value = generated::cable_geometry(
         &x.pose.position_m,
         &x.pose.rotation_xyzw(),
@@ -341,6 +346,7 @@ fn cable_geometry_outputs() {
         Some(&mut reference),
         Some(&mut anchors),
         Some(&mut com),
+        Some(&mut weight),
     );
     let mut out = String::new();
     format_block(&mut out, "geometry", &value);
@@ -348,6 +354,7 @@ fn cable_geometry_outputs() {
     format_block(&mut out, "jacobian_reference_tension", &reference);
     format_block(&mut out, "jacobian_anchors", &anchors);
     format_block(&mut out, "jacobian_com_offset", &com);
+    format_block(&mut out, "jacobian_platform_weight", &weight);
     insta::assert_snapshot!(out);
 }
 
@@ -369,10 +376,12 @@ fn extended_cable_outputs() {
         None,
         None,
         None,
+        None,
     );
     let mut out = String::new();
     for slot in 0..4 {
-        let (mut span, mut horizontal, mut vertical, mut compliance, mut radius, mut segments) = (
+        let (mut span, mut horizontal, mut vertical, mut compliance, mut radius, mut segments, mut weight) = (
+            nan::<2, 1>(),
             nan::<2, 1>(),
             nan::<2, 1>(),
             nan::<2, 1>(),
@@ -395,6 +404,7 @@ fn extended_cable_outputs() {
             Some(&mut compliance),
             Some(&mut radius),
             Some(&mut segments),
+            Some(&mut weight),
         );
         writeln!(out, "slot {slot}:").unwrap();
         format_block(&mut out, "cable", &value);
@@ -404,6 +414,7 @@ fn extended_cable_outputs() {
         format_block(&mut out, "jacobian_axial_compliance", &compliance);
         format_block(&mut out, "jacobian_pulley_radius", &radius);
         format_block(&mut out, "jacobian_inverse_segments_squared", &segments);
+        format_block(&mut out, "jacobian_cable_weight", &weight);
     }
     insta::assert_snapshot!(out);
 }

@@ -150,7 +150,7 @@ fn held_out_errors_match_the_predicted_sigmas_on_model_data() {
     use sagcal::experiments::localize_after_calibration::{run, summarise};
     use sagcal::experiments::table2::{pose_pool, Protocol, Source};
     use sagcal::io::measurements::{read_measurements, ReadOptions};
-    use sagcal::model::effects::EffectSet;
+    use sagcal::model::effect_kind::EffectSet;
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let log = root.join("../shared/data/recurdyn-large/recurdyn_large.csv");
     if !log.exists() {

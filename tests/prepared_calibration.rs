@@ -7,7 +7,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sagcal::calib::{calibrate, CalibrationOptions, CalibrationResult, OrientationPrior, PreparedCalibration};
 use sagcal::graph::RobustKernel;
-use sagcal::model::effects::{EffectKind, EffectSet};
+use sagcal::model::effect_kind::{EffectKind, EffectSet};
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};

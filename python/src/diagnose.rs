@@ -5,7 +5,7 @@ use std::sync::Mutex;
 
 use pyo3::prelude::*;
 use sagcal::diagnose::DiagnoseOptions;
-use sagcal::model::effects::EffectKind;
+use sagcal::model::effect_kind::EffectKind;
 
 use crate::arrays::out2;
 use crate::json::to_python;

@@ -41,7 +41,7 @@ use super::factors::{
 };
 use crate::generated;
 use crate::graph::{evaluate_through_into, Factor, RobustKernel, SharedEvaluation, Values, VariableId};
-use crate::model::effects::EffectKind;
+use crate::model::effect_kind::EffectKind;
 use crate::model::robot::CABLE_COUNT;
 
 /// The effect parameters of the extended model, one variable per effect.
@@ -67,6 +67,12 @@ pub struct EffectVariables {
     pub common_gain_error: VariableId,
     /// `[rx, ry, rz]`, the localiser's mounting rotation vector, platform frame, degrees.
     pub localiser_mount: VariableId,
+    /// `[s - 1]`, the platform's weight error as a share of the robot file's
+    /// (true weight = `s` x `platform_weight_n`).
+    pub platform_weight_error: VariableId,
+    /// `[s - 1]`, the cables' weight-per-metre error as a share of the robot
+    /// file's (true weight per metre = `s` x `cable_weight_n_per_m`).
+    pub cable_weight_error: VariableId,
 }
 
 impl EffectVariables {
@@ -81,6 +87,8 @@ impl EffectVariables {
             EffectKind::CommonGain => self.common_gain_error,
             EffectKind::Segments => self.inverse_segments_squared,
             EffectKind::LocaliserMount => self.localiser_mount,
+            EffectKind::PlatformWeight => self.platform_weight_error,
+            EffectKind::CableWeight => self.cable_weight_error,
         }
     }
 }
@@ -94,6 +102,12 @@ struct EffectArguments {
     /// Nominal centre of mass plus the shift, platform frame.
     com_offset_m: Vector3<f64>,
     inverse_segments_squared: f64,
+    /// The platform's weight, newtons, and its derivative by the weight error (the file's weight).
+    platform_weight_n: f64,
+    nominal_platform_weight_n: f64,
+    /// The cables' weight per metre, N/m, and its derivative by the weight error (the file's).
+    cable_weight_n_per_m: f64,
+    nominal_cable_weight_n_per_m: f64,
 }
 
 fn effect_arguments(values: &Values, slots: &SlotOrder, effects: &EffectVariables) -> EffectArguments {
@@ -106,13 +120,18 @@ fn effect_arguments(values: &Values, slots: &SlotOrder, effects: &EffectVariable
         gain_errors: Vector4::from_fn(|slot, _| gains[slots.cables[slot]] + common),
         com_offset_m: slots.com_offset_m + Vector3::new(shift[0], shift[1], 0.0),
         inverse_segments_squared: values.vector(effects.inverse_segments_squared)[0],
+        platform_weight_n: slots.platform_weight_n * (1.0 + values.vector(effects.platform_weight_error)[0]),
+        nominal_platform_weight_n: slots.platform_weight_n,
+        cable_weight_n_per_m: slots.cable_weight_n_per_m * (1.0 + values.vector(effects.cable_weight_error)[0]),
+        nominal_cable_weight_n_per_m: slots.cable_weight_n_per_m,
     }
 }
 
 /// Number of geometry columns chained through `generated::extended_cable`:
 /// pose (6), reference tension (2), anchors (12, slot order), centre of mass (3),
-/// then compliance (1), pulley radius (1) and `1/n^2` (1).
-const CHAIN_COLUMNS: usize = 26;
+/// then compliance (1), pulley radius (1), `1/n^2` (1), the platform's weight
+/// error (1) and the cables' weight error (1).
+const CHAIN_COLUMNS: usize = 28;
 
 /// The extended cable model of one pose: per slot the paid-out length and
 /// `drop - h` (the attachment residual), with Jacobians by the chain rule
@@ -125,15 +144,17 @@ pub struct ExtendedCables {
     paid_out_m: Vector4<f64>,
     /// Attachment residual `drop - h` per slot, metres.
     height_residual_m: Vector4<f64>,
-    /// `d paid_out / d [pose, tension, anchors, com, compliance, radius, 1/n^2]`.
+    /// `d paid_out / d [pose, tension, anchors, com, compliance, radius, 1/n^2,
+    /// platform weight error, cable weight error]`.
     d_paid_out: SMatrix<f64, 4, CHAIN_COLUMNS>,
     /// `d height_residual / d [...]`, same columns.
     d_height: SMatrix<f64, 4, CHAIN_COLUMNS>,
 }
 
 /// Inputs of [`extended_cables`] that change with the variables: pose 7,
-/// reference tension 2, anchors 12, compliance, pulley radius, centre of mass 3, `1/n^2`.
-const EXTENDED_INPUTS: usize = 27;
+/// reference tension 2, anchors 12, compliance, pulley radius, centre of mass 3, `1/n^2`,
+/// the platform's and the cables' weights.
+const EXTENDED_INPUTS: usize = 29;
 
 /// The last [`ExtendedCables`] of a graph, read by the length and height
 /// factors of the pose it was computed for (one call per pose and point
@@ -164,6 +185,8 @@ fn shared_extended_cables<R>(
     inputs[22] = effects.pulley_radius_m;
     inputs[23..26].copy_from_slice(effects.com_offset_m.as_slice());
     inputs[26] = effects.inverse_segments_squared;
+    inputs[27] = effects.platform_weight_n;
+    inputs[28] = effects.cable_weight_n_per_m;
     let evaluate = |out: &mut ExtendedCables, want: bool| {
         *out = extended_cables(values, slots, globals, pose, effects, want);
     };
@@ -185,6 +208,7 @@ fn extended_cables(
     let mut j_tension = SMatrix::<f64, 16, 2>::zeros();
     let mut j_anchors = SMatrix::<f64, 16, 12>::zeros();
     let mut j_com = SMatrix::<f64, 16, 3>::zeros();
+    let mut j_weight = nalgebra::SVector::<f64, 16>::zeros();
     let w = want_jacobians;
     let geometry = generated::cable_geometry(
         &position,
@@ -193,12 +217,13 @@ fn extended_cables(
         &anchors,
         &slots.attachments_m,
         &effects.com_offset_m,
-        slots.platform_weight_n,
+        effects.platform_weight_n,
         EPSILON,
         w.then_some(&mut j_pose),
         w.then_some(&mut j_tension),
         w.then_some(&mut j_anchors),
         w.then_some(&mut j_com),
+        w.then_some(&mut j_weight),
     );
     let mut out = ExtendedCables {
         paid_out_m: Vector4::zeros(),
@@ -210,11 +235,12 @@ fn extended_cables(
         let row = 4 * slot;
         let (mut d_span, mut d_fh, mut d_fv) = (Vector2::zeros(), Vector2::zeros(), Vector2::zeros());
         let (mut d_compliance, mut d_radius, mut d_segments) = (Vector2::zeros(), Vector2::zeros(), Vector2::zeros());
+        let mut d_cable_weight = Vector2::zeros();
         let cable = generated::extended_cable(
             geometry[row],
             geometry[row + 1],
             geometry[row + 2],
-            slots.cable_weight_n_per_m,
+            effects.cable_weight_n_per_m,
             effects.compliance_per_mn,
             effects.pulley_radius_m,
             effects.inverse_segments_squared,
@@ -225,26 +251,37 @@ fn extended_cables(
             w.then_some(&mut d_compliance),
             w.then_some(&mut d_radius),
             w.then_some(&mut d_segments),
+            w.then_some(&mut d_cable_weight),
         );
         out.paid_out_m[slot] = cable[0];
         out.height_residual_m[slot] = cable[1] - geometry[row + 3];
         if !w {
             continue;
         }
-        // Columns of the geometry rows [L, f_h, f_v, h] of this slot.
-        let geometry_row = |k: usize| -> SMatrix<f64, 1, 23> {
-            let mut r = SMatrix::<f64, 1, 23>::zeros();
+        // Columns of the geometry rows [L, f_h, f_v, h] of this slot; the
+        // platform's weight error (column 23 here) scales the file's weight.
+        let geometry_row = |k: usize| -> SMatrix<f64, 1, 24> {
+            let mut r = SMatrix::<f64, 1, 24>::zeros();
             r.fixed_columns_mut::<6>(0).copy_from(&j_pose.row(row + k));
             r.fixed_columns_mut::<2>(6).copy_from(&j_tension.row(row + k));
             r.fixed_columns_mut::<12>(8).copy_from(&j_anchors.row(row + k));
             r.fixed_columns_mut::<3>(20).copy_from(&j_com.row(row + k));
+            r[23] = j_weight[row + k] * effects.nominal_platform_weight_n;
             r
         };
         let (g_span, g_fh, g_fv, g_h) = (geometry_row(0), geometry_row(1), geometry_row(2), geometry_row(3));
         let paid = g_span * d_span[0] + g_fh * d_fh[0] + g_fv * d_fv[0];
         let height = g_span * d_span[1] + g_fh * d_fh[1] + g_fv * d_fv[1] - g_h;
-        out.d_paid_out.fixed_view_mut::<1, 23>(slot, 0).copy_from(&paid);
-        out.d_height.fixed_view_mut::<1, 23>(slot, 0).copy_from(&height);
+        out.d_paid_out
+            .fixed_view_mut::<1, 23>(slot, 0)
+            .copy_from(&paid.fixed_columns::<23>(0));
+        out.d_height
+            .fixed_view_mut::<1, 23>(slot, 0)
+            .copy_from(&height.fixed_columns::<23>(0));
+        out.d_paid_out[(slot, 26)] = paid[23];
+        out.d_height[(slot, 26)] = height[23];
+        out.d_paid_out[(slot, 27)] = d_cable_weight[0] * effects.nominal_cable_weight_n_per_m;
+        out.d_height[(slot, 27)] = d_cable_weight[1] * effects.nominal_cable_weight_n_per_m;
         out.d_paid_out[(slot, 23)] = d_compliance[0];
         out.d_paid_out[(slot, 24)] = d_radius[0];
         out.d_height[(slot, 23)] = d_compliance[1];
@@ -261,9 +298,12 @@ struct EffectBlocks {
     radius: usize,
     com: usize,
     segments: usize,
+    platform_weight: usize,
+    cable_weight: usize,
 }
 
-/// Copy chained columns `[pose, tension, anchors, com, compliance, radius, 1/n^2]`
+/// Copy chained columns `[pose, tension, anchors, com, compliance, radius,
+/// 1/n^2, platform weight error, cable weight error]`
 /// into the blocks `[pose, tension, anchor x4 (robot order), ...]` and the
 /// effect blocks at `at`.
 fn split_chain(
@@ -280,6 +320,8 @@ fn split_chain(
     blocks[at.compliance].copy_from(&jacobian.fixed_columns::<1>(23));
     blocks[at.radius].copy_from(&jacobian.fixed_columns::<1>(24));
     blocks[at.segments].copy_from(&jacobian.fixed_columns::<1>(25));
+    blocks[at.platform_weight].copy_from(&jacobian.fixed_columns::<1>(26));
+    blocks[at.cable_weight].copy_from(&jacobian.fixed_columns::<1>(27));
 }
 
 /// Extended length factor: `(1 + g_i) paid_out_i + l_i^0 - z_i^enc` with the
@@ -318,6 +360,8 @@ impl ExtendedLengthFactor {
             effects.com_shift,
             effects.inverse_segments_squared,
             effects.common_gain_error,
+            effects.platform_weight_error,
+            effects.cable_weight_error,
         ]);
         Self {
             variables,
@@ -381,6 +425,8 @@ impl ExtendedLengthFactor {
                 radius: 11,
                 com: 13,
                 segments: 14,
+                platform_weight: 16,
+                cable_weight: 17,
             };
             split_chain(&chained, s, blocks, at);
             blocks[6..10].iter_mut().for_each(|b| b.fill(0.0));
@@ -425,6 +471,8 @@ impl ExtendedHeightFactor {
             effects.pulley_radius,
             effects.com_shift,
             effects.inverse_segments_squared,
+            effects.platform_weight_error,
+            effects.cable_weight_error,
         ]);
         Self {
             variables,
@@ -456,6 +504,8 @@ impl Factor for ExtendedHeightFactor {
                     radius: 7,
                     com: 8,
                     segments: 9,
+                    platform_weight: 10,
+                    cable_weight: 11,
                 };
                 split_chain(&cables.d_height, s, blocks, at);
                 rows_to_cables(s, blocks);

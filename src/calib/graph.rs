@@ -15,7 +15,8 @@ use super::factors::{
 use super::options::{CableModel, CalibrationOptions, OrientationPrior};
 use crate::error::{Error, Result};
 use crate::graph::{Factor, FactorGraph, MaskedFactor, Values, VariableValue};
-use crate::model::effects::{EffectKind, EffectSet, Effects};
+use crate::model::effect_kind::{EffectKind, EffectSet};
+use crate::model::effects::Effects;
 use crate::model::measurement::{PoseMeasurement, Sensor};
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
@@ -384,6 +385,8 @@ fn insert_effect_variables(values: &mut Values, robot: &Robot, free: EffectSet) 
         inverse_segments_squared: vector("inverse segments squared", &[e.inverse_segments_squared()]),
         common_gain_error: vector("common encoder gain error", &[0.0]),
         localiser_mount: vector("localiser mount (deg)", &e.localiser_mount_deg),
+        platform_weight_error: vector("platform weight error", &[e.platform_weight_scale - 1.0]),
+        cable_weight_error: vector("cable weight error", &[e.cable_weight_scale - 1.0]),
     };
     for kind in EffectKind::ALL {
         values.set_fixed(variables.of(kind), !free.contains(kind));
@@ -411,6 +414,8 @@ pub fn effects_from_graph(template: &Robot, built: &CalibrationGraph) -> Option<
         com_shift_m: [com[0], com[1], template.effects.com_shift_m[2]],
         cable_segments: (inverse_segments_squared > 0.0).then(|| 1.0 / inverse_segments_squared.sqrt()),
         localiser_mount_deg: std::array::from_fn(|i| values.vector(vars.localiser_mount)[i]),
+        platform_weight_scale: 1.0 + values.vector(vars.platform_weight_error)[0],
+        cable_weight_scale: 1.0 + values.vector(vars.cable_weight_error)[0],
     })
 }
 

@@ -112,7 +112,8 @@ mod system_scope;
 mod uncertainty;
 
 use crate::error::{Error, Result};
-use crate::model::effects::{EffectKind, Effects};
+use crate::model::effect_kind::EffectKind;
+use crate::model::effects::Effects;
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::solver::{optimize_cached, LmParams};
@@ -538,6 +539,8 @@ pub fn without_estimated(effects: &Effects, estimates: &[EffectEstimate]) -> Eff
             }
             EffectKind::Segments => out.cable_segments = neutral.cable_segments,
             EffectKind::LocaliserMount => out.localiser_mount_deg = neutral.localiser_mount_deg,
+            EffectKind::PlatformWeight => out.platform_weight_scale = neutral.platform_weight_scale,
+            EffectKind::CableWeight => out.cable_weight_scale = neutral.cable_weight_scale,
         }
     }
     out

@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use crate::graph::RobustKernel;
-use crate::model::effects::EffectSet;
+use crate::model::effect_kind::EffectSet;
 use crate::model::sensors::SensorNoise;
 use crate::solver::LmParams;
 

@@ -5,7 +5,7 @@ use serde::Serialize;
 
 use super::orientation::OrientationCheck;
 use crate::graph::{whitened_squared_norm, FactorGraph};
-use crate::model::effects::EffectKind;
+use crate::model::effect_kind::EffectKind;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{ParameterCovariance, Robot};
 use crate::model::statics::CableTension;
@@ -99,21 +99,15 @@ pub struct CalibrationResult {
 impl EffectEstimate {
     /// Report values (gains as `1 + error`) from the effect variable's contents.
     pub fn values_from_variable(kind: EffectKind, raw: &[f64]) -> Vec<f64> {
-        match kind {
-            EffectKind::EncoderScale | EffectKind::CommonGain => raw.iter().map(|g| 1.0 + g).collect(),
-            EffectKind::LoadCell => vec![raw[0], 1.0 + raw[1]],
-            _ => raw.to_vec(),
-        }
+        let scale = |(i, v): (usize, &f64)| if kind.is_scale(i) { 1.0 + v } else { *v };
+        raw.iter().enumerate().map(scale).collect()
     }
 
     /// The effect variable's contents (gain errors) for these estimates: the
     /// inverse of [`EffectEstimate::values_from_variable`].
     pub fn variable_values(&self) -> Vec<f64> {
-        match self.effect {
-            EffectKind::EncoderScale | EffectKind::CommonGain => self.values.iter().map(|g| g - 1.0).collect(),
-            EffectKind::LoadCell => vec![self.values[0], self.values[1] - 1.0],
-            _ => self.values.clone(),
-        }
+        let error = |(i, v): (usize, &f64)| if self.effect.is_scale(i) { v - 1.0 } else { *v };
+        self.values.iter().enumerate().map(error).collect()
     }
 }
 

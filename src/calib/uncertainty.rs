@@ -10,7 +10,7 @@ use super::options::{CalibrationOptions, RobustKernels};
 use super::result::{EffectEstimate, ParameterUncertainty};
 use crate::error::{Error, Result};
 use crate::graph::VariableId;
-use crate::model::effects::EffectKind;
+use crate::model::effect_kind::EffectKind;
 use crate::model::measurement::PoseMeasurement;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};

@@ -5,7 +5,7 @@ use std::path::Path;
 use sagcal::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
 use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
 use sagcal::io::OutputSet;
-use sagcal::model::effects::EffectKind;
+use sagcal::model::effect_kind::EffectKind;
 use sagcal::model::Robot;
 use sagcal::plot::residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
 
@@ -323,6 +323,9 @@ fn render_verdict(d: &Diagnosis) -> String {
             ": NOT explained by the catalogue"
         }
     );
+    for fit in &d.equivalent_fits {
+        out += &format!("   {fit}\n");
+    }
     if !d.undetectable.is_empty() {
         out += &format!(
             "   not detectable at this noise with these poses (power < 0.9 at the smallest plausible magnitude): {}\n",

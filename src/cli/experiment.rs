@@ -10,7 +10,7 @@ use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 use serde::Serialize;
 
-use sagcal::model::effects::{EffectKind, EffectSet};
+use sagcal::model::effect_kind::{EffectKind, EffectSet};
 
 use super::output::{print_json, progress_bar, Table};
 use super::Table2Args;

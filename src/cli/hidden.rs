@@ -8,7 +8,7 @@ use sagcal::experiments::hidden_effects::{
     effect_ranges, identifiability, mean_reference_tension_n, run_sweep, smallest_effects, EffectRange, HiddenCase,
     HiddenEffectOptions, Identifiability, SweepCases, UnmeasurableCase, PAIRS,
 };
-use sagcal::model::effects::EffectKind;
+use sagcal::model::effect_kind::EffectKind;
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 use sagcal::sim::closed_form::Closure;

@@ -7,7 +7,7 @@ use sagcal::calib::{CableModel, OrientationPrior};
 use sagcal::experiments::localize_after_calibration::{run, summarise, LocalizeSummary};
 use sagcal::experiments::table2::{pose_pool, Protocol, Source};
 use sagcal::io::measurements::{read_measurements, ReadOptions};
-use sagcal::model::effects::EffectSet;
+use sagcal::model::effect_kind::EffectSet;
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 

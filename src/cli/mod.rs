@@ -139,6 +139,15 @@ struct HiddenEffectsArgs {
 }
 
 /// `paper`, `authors` or `both`.
+/// `simulate --effect`'s long help: every effect with its parameters.
+fn effect_help() -> String {
+    format!(
+        "A physical effect the closed-form model lacks, `NAME:PARAM=VALUE[,PARAM=VALUE...]` \
+         (repeatable): {}. The data then come from the discretised simulator.",
+        sagcal::model::effects::EFFECT_NAMES
+    )
+}
+
 fn parse_noises(text: &str) -> Result<Vec<sagcal::model::sensors::NoisePreset>, String> {
     use sagcal::model::sensors::NoisePreset;
     match text {
@@ -394,9 +403,8 @@ struct SimulateArgs {
     #[arg(long)]
     truth: Option<PathBuf>,
     /// A physical effect the closed-form model lacks, `NAME:PARAM=VALUE[,PARAM=VALUE...]`
-    /// (repeatable): elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4,
-    /// loadcell:bias_n,gain, com:dx_m,dy_m,dz_m. The data then come from the discretised simulator.
-    #[arg(long = "effect", value_name = "SPEC")]
+    /// (repeatable). The data then come from the discretised simulator.
+    #[arg(long = "effect", value_name = "SPEC", long_help = effect_help())]
     effects: Vec<String>,
     /// Segments per cable of the discretised simulator (only used with effects).
     #[arg(long, default_value_t = 100)]

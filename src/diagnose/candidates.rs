@@ -13,13 +13,30 @@ use crate::calib::{
     EffectEstimate, OrientationPrior,
 };
 use crate::error::Result;
+use crate::model::effect_kind::{EffectKind, EffectSet};
 use crate::model::effect_ranges::smallest_plausible;
-use crate::model::effects::{EffectKind, EffectSet};
 use crate::model::measurement::PoseMeasurement;
 use crate::stats::{chi_square_critical, chi_square_survival, noncentral_chi_square_survival, noncentrality_for_power};
 
 /// The power a test must have before its silence counts as evidence of absence.
 pub const DETECTION_POWER: f64 = 0.9;
+
+/// Three effects of which any two explain all three: the catenary's shape
+/// depends on the tensions only through `f_h / w` (paper eq. 2-3), and the
+/// platform's balance (eq. 9) is linear in its weight, so scaling the
+/// platform's weight and the cables' weight per metre by one factor `s`
+/// scales every tension by `s` and leaves every length and orientation as
+/// it was: only the load cell, reading `s |T_ref|`, sees it, exactly as a
+/// load-cell gain of `s`. The data cannot tell `(W, w, g)` from
+/// `(s W, s w, g / s)`; fitting all three is singular, so at most two enter
+/// a model, and a heavier platform is indistinguishable from lighter cables
+/// read through a load cell of higher gain (the report says so where it
+/// names one of them).
+pub const WEIGHT_SCALING: [EffectKind; 3] = [
+    EffectKind::PlatformWeight,
+    EffectKind::CableWeight,
+    EffectKind::LoadCell,
+];
 
 /// One hypothesis of the search.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,14 +105,19 @@ impl Model {
             .collect()
     }
 
-    /// Whether `hypothesis` may be added: not already in, and not nested in an
-    /// effect that is (the common gain in the per-drum gains).
+    /// Whether `hypothesis` may be added: not already in, not nested in an
+    /// effect that is (the common gain in the per-drum gains), and not the
+    /// third of [`WEIGHT_SCALING`].
     pub fn can_add(&self, hypothesis: Hypothesis) -> bool {
         if self.hypotheses.contains(&hypothesis) {
             return false;
         }
         match hypothesis {
             Hypothesis::Effect(EffectKind::LocaliserMount) => !self.hypotheses.contains(&Hypothesis::OrientationFree),
+            Hypothesis::Effect(kind) if WEIGHT_SCALING.contains(&kind) => {
+                let effects = self.effects();
+                WEIGHT_SCALING.iter().filter(|k| effects.contains(**k)).count() < 2
+            }
             Hypothesis::Effect(kind) => kind.nested_in().is_none_or(|outer| !self.effects().contains(outer)),
             Hypothesis::OrientationFree => true,
         }

@@ -12,7 +12,7 @@ use serde::Serialize;
 use super::candidates::rebuild;
 use crate::calib::{CalibrationOptions, CalibrationResult};
 use crate::error::Result;
-use crate::model::effects::EffectKind;
+use crate::model::effect_kind::EffectKind;
 use crate::model::measurement::{PoseMeasurement, ReadingSet, Sensor};
 use crate::model::robot::CABLE_COUNT;
 use crate::model::statics;
@@ -104,6 +104,8 @@ pub(super) fn winning_driver(effect: EffectKind) -> (&'static str, &'static str)
         // A mount turns the orientation readings only; its trace in the other
         // residuals is the statics' answer to the tilt, strongest in the tension.
         EffectKind::LocaliserMount => ("encoder", DRIVERS[0]),
+        // Both change the sag, which grows with the cable's length.
+        EffectKind::PlatformWeight | EffectKind::CableWeight => ("encoder", DRIVERS[3]),
     }
 }
 

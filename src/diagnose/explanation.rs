@@ -37,7 +37,7 @@ use super::residual_tests::{factor_tests_at, measurement_components, FactorTest}
 use super::selection::SelectionStep;
 use super::stand_ins::{orientation_stand_in, own_sensor, partial_stand_in, stand_in, StandIn};
 use super::Baseline;
-use crate::model::effects::EffectKind;
+use crate::model::effect_kind::EffectKind;
 use crate::model::robot::CABLE_COUNT;
 use crate::stats::chi_square_critical;
 

@@ -49,7 +49,7 @@
 //! use rand::SeedableRng;
 //! use sagcal::calib::CalibrationOptions;
 //! use sagcal::diagnose::{diagnose, DiagnoseOptions};
-//! use sagcal::model::effects::EffectKind;
+//! use sagcal::model::effect_kind::EffectKind;
 //! use sagcal::model::sensors::NoisePreset;
 //! use sagcal::model::Robot;
 //! use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
@@ -88,7 +88,7 @@ use crate::calib::{
     calibrate, CalibrationGraph, CalibrationOptions, CalibrationResult, OrientationPrior, PreparedCalibration,
 };
 use crate::error::{Error, Result};
-use crate::model::effects::{EffectKind, EffectSet};
+use crate::model::effect_kind::{EffectKind, EffectSet};
 use crate::model::measurement::{PoseMeasurement, ReadingSet};
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::stats::{self, chi_square_quantile_999};
@@ -352,6 +352,7 @@ pub fn diagnose(
     );
     let reason = report::reason(&selection, &base, options, &not_predictive, &explanation);
     let undetectable = report::undetectable(&selection);
+    let equivalent_fits = report::equivalent_fits(&model.result.effect_estimates);
     Ok(Diagnosis {
         robot: robot.name.clone(),
         poses_used: base.used.len(),
@@ -375,6 +376,7 @@ pub fn diagnose(
         effects: report::effect_fits(&model.result.effect_estimates),
         steps: selection.steps,
         undetectable,
+        equivalent_fits,
         candidates: selection.candidates,
         reason,
         gain,

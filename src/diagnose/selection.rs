@@ -31,7 +31,7 @@ use crate::calib::{
 };
 use crate::error::{Error, Result};
 use crate::graph::whitened_squared_norm;
-use crate::model::effects::EffectKind;
+use crate::model::effect_kind::EffectKind;
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::Robot;
 use crate::model::statics::CableTension;

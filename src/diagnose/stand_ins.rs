@@ -23,8 +23,8 @@ use serde::Serialize;
 
 use super::residual_tests::FactorTest;
 use crate::calib::EffectEstimate;
+use crate::model::effect_kind::EffectKind;
 use crate::model::effect_limits::{plausible_limits, PlausibleLimit};
-use crate::model::effects::EffectKind;
 use crate::model::robot::Robot;
 
 /// How many standard deviations beyond its limit an estimate must be to be a stand-in.
@@ -97,6 +97,9 @@ pub(super) fn own_sensor(kind: EffectKind) -> &'static str {
         | EffectKind::Segments => "catenary_length",
         EffectKind::LoadCell => "reference_tension",
         EffectKind::Com | EffectKind::LocaliserMount => "pose_prior",
+        // A heavier platform pulls every cable harder: the sag, and so the
+        // lengths, change with it; heavier cables sag more.
+        EffectKind::PlatformWeight | EffectKind::CableWeight => "catenary_length",
     }
 }
 
@@ -126,9 +129,7 @@ pub(super) fn partial_stand_in(estimate: &EffectEstimate, sensor_test: &FactorTe
 
 /// A parameter in the effect variable's units (gains as errors).
 fn variable_value(kind: EffectKind, index: usize, value: f64) -> f64 {
-    let gain = matches!(kind, EffectKind::EncoderScale | EffectKind::CommonGain)
-        || (kind == EffectKind::LoadCell && index == 1);
-    if gain {
+    if kind.is_scale(index) {
         value - 1.0
     } else {
         value
@@ -192,6 +193,12 @@ fn describe(estimate: &EffectEstimate, limit: &PlausibleLimit) -> String {
             1.0 / value.sqrt()
         ),
         EffectKind::LocaliserMount => format!("a localiser turned by {norm:.2} +- {sigma:.2} deg"),
+        EffectKind::PlatformWeight => {
+            format!("a platform {value:.3} +- {value_sigma:.3} times as heavy as its file says")
+        }
+        EffectKind::CableWeight => {
+            format!("cables {value:.3} +- {value_sigma:.3} times as heavy per metre as the file says")
+        }
     }
 }
 
@@ -209,6 +216,10 @@ fn stands_for(kind: EffectKind) -> &'static str {
         EffectKind::Com => "something that tilts the platform or moves its load between the cables",
         EffectKind::Segments => "something that changes the cables' sag or length",
         EffectKind::LocaliserMount => "something that turns the localiser's orientations",
+        EffectKind::PlatformWeight => {
+            "something that changes every tension in proportion (a load cell's gain, the cables' weight)"
+        }
+        EffectKind::CableWeight => "something that changes the cables' sag",
     }
 }
 

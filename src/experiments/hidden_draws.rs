@@ -4,11 +4,13 @@
 
 use rand::Rng;
 
+use crate::model::effect_kind::EffectKind;
 use crate::model::effect_ranges::{
-    axial_stiffness_range_n, com_shift_range_m, pulley_radius_range_m, COMMON_GAIN_HIGH, COMMON_GAIN_LOW,
-    LOCALISER_MOUNT_HIGH_DEG, LOCALISER_MOUNT_LOW_DEG, SEGMENTS_HIGH, SEGMENTS_LOW,
+    axial_stiffness_range_n, com_shift_range_m, pulley_radius_range_m, CABLE_WEIGHT_HIGH, CABLE_WEIGHT_LOW,
+    COMMON_GAIN_HIGH, COMMON_GAIN_LOW, LOCALISER_MOUNT_HIGH_DEG, LOCALISER_MOUNT_LOW_DEG, PLATFORM_WEIGHT_HIGH,
+    PLATFORM_WEIGHT_LOW, SEGMENTS_HIGH, SEGMENTS_LOW,
 };
-use crate::model::effects::{EffectKind, Effects};
+use crate::model::effects::Effects;
 use crate::model::robot::{Robot, CABLE_COUNT};
 
 /// The smallest magnitude of every scored effect's range (encoder gains with
@@ -132,6 +134,12 @@ fn draw_effect(robot: &Robot, effect: EffectKind, mean_reference_tension_n: f64,
             let azimuth = rng.random_range(0.0..std::f64::consts::TAU);
             let r = (1.0 - z * z).sqrt();
             e.localiser_mount_deg = [angle * r * azimuth.cos(), angle * r * azimuth.sin(), angle * z];
+        }
+        EffectKind::PlatformWeight => {
+            e.platform_weight_scale = 1.0 + signed(rng, PLATFORM_WEIGHT_LOW, PLATFORM_WEIGHT_HIGH);
+        }
+        EffectKind::CableWeight => {
+            e.cable_weight_scale = 1.0 + signed(rng, CABLE_WEIGHT_LOW, CABLE_WEIGHT_HIGH);
         }
     }
 }

@@ -54,7 +54,7 @@
 //! use sagcal::experiments::hidden_effects::{
 //!     case_seed, draw_effects, simulate_case, HiddenEffectOptions, TRUTH_ANCHOR_SPREAD_M, TRUTH_OFFSET_SPREAD_M,
 //! };
-//! use sagcal::model::effects::EffectKind;
+//! use sagcal::model::effect_kind::EffectKind;
 //! use sagcal::model::Robot;
 //! let nominal = Robot::builtin("large")?;
 //! let hidden = [EffectKind::EncoderScale, EffectKind::LoadCell];
@@ -88,8 +88,9 @@ use serde::Serialize;
 use crate::calib::{calibrate, validate_measurements, CalibrationError, CalibrationOptions};
 use crate::diagnose::{diagnose, power_against, CandidateFit, DiagnoseOptions};
 use crate::error::{Error, Result};
+use crate::model::effect_kind::EffectKind;
 pub use crate::model::effect_ranges::{effect_ranges, EffectRange, CABLE_DENSITY_KG_M3};
-use crate::model::effects::{EffectKind, Effects};
+use crate::model::effects::Effects;
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::NoisePreset;

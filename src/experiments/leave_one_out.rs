@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::model::effects::EffectKind;
+use crate::model::effect_kind::EffectKind;
 
 /// The catalogue the diagnosis of each case has.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]

@@ -25,7 +25,7 @@
 //! use sagcal::calib::{CableModel, OrientationPrior};
 //! use sagcal::experiments::localize_after_calibration::{run_trial, summarise, LocalizeTrial};
 //! use sagcal::experiments::table2::{pose_pool, Protocol, Source};
-//! use sagcal::model::effects::EffectSet;
+//! use sagcal::model::effect_kind::EffectSet;
 //! use sagcal::model::sensors::NoisePreset;
 //! use sagcal::model::Robot;
 //! use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};

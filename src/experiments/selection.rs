@@ -16,7 +16,7 @@
 //! use sagcal::calib::{CableModel, OrientationPrior};
 //! use sagcal::experiments::selection::{PlanSettings, Selection};
 //! use sagcal::experiments::table2::{pose_pool, run_selected_trial, Protocol, Source};
-//! use sagcal::model::effects::EffectSet;
+//! use sagcal::model::effect_kind::EffectSet;
 //! use sagcal::model::sensors::NoisePreset;
 //! use sagcal::model::Robot;
 //! use sagcal::plan::Criterion;

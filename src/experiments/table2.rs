@@ -20,7 +20,7 @@
 //! use rand::SeedableRng;
 //! use sagcal::calib::{CableModel, OrientationPrior};
 //! use sagcal::experiments::table2::{pose_pool, run_trial, trial_inputs, Protocol, Source};
-//! use sagcal::model::effects::EffectSet;
+//! use sagcal::model::effect_kind::EffectSet;
 //! use sagcal::model::sensors::NoisePreset;
 //! use sagcal::model::Robot;
 //! use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
@@ -70,7 +70,7 @@ use crate::calib::{
     CalibrationResult, OrientationPrior, ParameterUncertainty,
 };
 use crate::error::{Error, Result};
-use crate::model::effects::EffectSet;
+use crate::model::effect_kind::EffectSet;
 use crate::model::measurement::PoseMeasurement;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};

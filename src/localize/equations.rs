@@ -82,8 +82,8 @@ impl SlotRobot {
             anchors_m: Matrix3x4::from_fn(|r, s| robot.anchors_m[cables[s]][r]),
             attachments_m: Matrix3x4::from_fn(|r, s| robot.attachments_m[cables[s]][r]),
             com_offset_m: robot.com_offset_m + Vector3::from(effects.com_shift_m),
-            platform_weight_n: robot.platform_weight_n,
-            cable_weight_n_per_m: robot.cable_weight_n_per_m,
+            platform_weight_n: robot.platform_weight_n * effects.platform_weight_scale,
+            cable_weight_n_per_m: robot.cable_weight_n_per_m * effects.cable_weight_scale,
             length_offsets_m: Vector4::from_fn(|s, _| robot.length_offsets_m[cables[s]]),
             encoder_gains: Vector4::from_fn(|s, _| effects.encoder_gain[cables[s]]),
             compliance_per_mn: effects.axial_compliance_per_mn(),
@@ -159,6 +159,7 @@ fn extended_cable(
         None,
         None,
         None,
+        None,
     );
     (cable, d_span, d_fh, d_fv)
 }
@@ -186,6 +187,7 @@ pub fn model_at_pose(robot: &SlotRobot, pose: &PlatformPose, reference_n: &Vecto
         EPSILON,
         Some(&mut j_pose),
         Some(&mut j_tension),
+        None,
         None,
         None,
     );
@@ -302,6 +304,7 @@ pub fn parameter_partials(
         None,
         None,
         Some(&mut j_anchors),
+        None,
         None,
     );
     let mut out = ParameterPartials {

@@ -17,10 +17,12 @@
 //! | `com` | a horizontal shift up to the platform's attachment radius | a centre of mass outside the platform's footprint would tip a real payload off it |
 //! | `segments` | `1/n^2 = 0.01` (10 elements) | a real cable is continuous (`1/n^2 = 0`); finite-element cable models use at least 10 elements |
 //! | `localiser-mount` | 10 degrees | a localiser bolted on with its axes further off would be seen by eye |
+//! | `platform-weight` | weight 1 +- 0.5 x the file's | a platform half again as heavy, or half as heavy, as its file says would be noticed when it is lifted or its motors sized |
+//! | `cable-weight` | weight per metre 1 +- 0.5 x the file's | a rope off by half its weight per metre is off by a fifth or more of its diameter, two or three size steps: another rope, not a datasheet error |
 //!
 //! ```
 //! use sagcal::model::effect_limits::plausible_limits;
-//! use sagcal::model::effects::EffectKind;
+//! use sagcal::model::effect_kind::EffectKind;
 //! use sagcal::model::Robot;
 //! let robot = Robot::builtin("large")?;
 //! // A chain of 3 elements is no real cable: 1/9 is beyond the limit 1/100.
@@ -34,8 +36,8 @@
 //! # Ok::<(), sagcal::Error>(())
 //! ```
 
+use crate::model::effect_kind::EffectKind;
 use crate::model::effect_ranges::{axial_stiffness_range_n, pulley_radius_range_m, SEGMENTS_LOW};
-use crate::model::effects::EffectKind;
 use crate::model::robot::Robot;
 
 /// The largest plausible encoder gain error (dimensionless, module docs).
@@ -44,6 +46,10 @@ pub const ENCODER_GAIN_LIMIT: f64 = 0.05;
 pub const LOAD_CELL_BIAS_LIMIT: f64 = 0.15;
 /// The largest plausible load-cell gain error (dimensionless).
 pub const LOAD_CELL_GAIN_LIMIT: f64 = 0.10;
+/// The largest plausible platform-weight error, as a share of the file's weight.
+pub const PLATFORM_WEIGHT_LIMIT: f64 = 0.5;
+/// The largest plausible cable-weight error, as a share of the file's weight per metre.
+pub const CABLE_WEIGHT_LIMIT: f64 = 0.5;
 /// The largest plausible localiser mounting rotation, degrees.
 pub const LOCALISER_MOUNT_LIMIT_DEG: f64 = 10.0;
 
@@ -142,6 +148,18 @@ pub fn plausible_limits(kind: EffectKind, robot: &Robot, mean_reference_tension_
             limit: format!("a rotation of at most {LOCALISER_MOUNT_LIMIT_DEG} deg"),
             why: "a localiser bolted on with its axes further off would be seen by eye".into(),
         }],
+        EffectKind::PlatformWeight => vec![one(
+            0,
+            PLATFORM_WEIGHT_LIMIT,
+            format!("a weight within 1 +- {PLATFORM_WEIGHT_LIMIT} x the robot file's"),
+            "a platform that much heavier or lighter than its file says would be noticed when it is lifted",
+        )],
+        EffectKind::CableWeight => vec![one(
+            0,
+            CABLE_WEIGHT_LIMIT,
+            format!("a weight per metre within 1 +- {CABLE_WEIGHT_LIMIT} x the robot file's"),
+            "a rope off by half its weight per metre is another rope, two or three diameter steps away",
+        )],
     }
 }
 

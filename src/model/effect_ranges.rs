@@ -19,7 +19,7 @@
 
 use serde::Serialize;
 
-use crate::model::effects::EffectKind;
+use crate::model::effect_kind::EffectKind;
 use crate::model::robot::Robot;
 
 /// Density of the synthetic-fibre (aramid) cables, kg/m^3.
@@ -94,6 +94,22 @@ pub fn effect_ranges(robot: &Robot) -> Vec<EffectRange> {
             range: format!("{SEGMENTS_LOW} .. {SEGMENTS_HIGH} straight elements per cable"),
             justification: "finite-element cable models (lumped-mass chains) of tens of elements".into(),
         },
+        EffectRange {
+            effect: "platform-weight".into(),
+            range: format!(
+                "weight 1 +- ({PLATFORM_WEIGHT_LOW} .. {PLATFORM_WEIGHT_HIGH}) x the robot file's {:.1} N",
+                robot.platform_weight_n
+            ),
+            justification: "a payload, tool or cabling left out of the platform's weight (or one taken off)".into(),
+        },
+        EffectRange {
+            effect: "cable-weight".into(),
+            range: format!(
+                "weight per metre 1 +- ({CABLE_WEIGHT_LOW} .. {CABLE_WEIGHT_HIGH}) x the robot file's {:.3} N/m",
+                robot.cable_weight_n_per_m
+            ),
+            justification: "a rope of the next diameter (weight ~ d^2: 10-20 % per size step) or with a coating the datasheet leaves out".into(),
+        },
     ]
 }
 
@@ -105,6 +121,14 @@ pub const LOCALISER_MOUNT_HIGH_DEG: f64 = 3.0;
 pub const COMMON_GAIN_LOW: f64 = 0.001;
 /// See [`COMMON_GAIN_LOW`].
 pub const COMMON_GAIN_HIGH: f64 = 0.003;
+/// The platform's weight error: smallest plausible share of its weight.
+pub const PLATFORM_WEIGHT_LOW: f64 = 0.03;
+/// The platform's weight error: largest typical share of its weight.
+pub const PLATFORM_WEIGHT_HIGH: f64 = 0.15;
+/// The cables' weight-per-metre error: smallest plausible share.
+pub const CABLE_WEIGHT_LOW: f64 = 0.05;
+/// The cables' weight-per-metre error: largest typical share.
+pub const CABLE_WEIGHT_HIGH: f64 = 0.20;
 /// The number of elements of a finite-element cable: fewest plausible.
 pub const SEGMENTS_LOW: f64 = 10.0;
 /// The number of elements of a finite-element cable: most plausible.
@@ -116,7 +140,8 @@ pub const SEGMENTS_HIGH: f64 = 100.0;
 /// smallest pulley, gains off by 0.1 % with alternating signs, a load cell
 /// off by 5 % of `mean_reference_tension_n` and 2 % in gain, a 5 cm
 /// centre-of-mass shift along the diagonal, the finest plausible chain, a
-/// localiser turned by 0.5 degrees about the diagonal of its axes.
+/// localiser turned by 0.5 degrees about the diagonal of its axes, a platform
+/// 3 % and cables 5 % heavier than the robot file says.
 pub fn smallest_plausible(kind: EffectKind, robot: &Robot, mean_reference_tension_n: f64) -> Vec<f64> {
     match kind {
         EffectKind::Elastic => vec![1e6 / axial_stiffness_range_n(robot).1],
@@ -130,6 +155,8 @@ pub fn smallest_plausible(kind: EffectKind, robot: &Robot, mean_reference_tensio
         EffectKind::CommonGain => vec![COMMON_GAIN_LOW],
         EffectKind::Segments => vec![1.0 / (SEGMENTS_HIGH * SEGMENTS_HIGH)],
         EffectKind::LocaliserMount => vec![LOCALISER_MOUNT_LOW_DEG / 3f64.sqrt(); 3],
+        EffectKind::PlatformWeight => vec![PLATFORM_WEIGHT_LOW],
+        EffectKind::CableWeight => vec![CABLE_WEIGHT_LOW],
     }
 }
 

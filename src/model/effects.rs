@@ -20,9 +20,12 @@
 //! | `com` | `dx_m`, `dy_m`, `dz_m` (platform frame, m) |
 //! | `segments` | `n` (number of straight elements of a finite-element cable, >= 1) |
 //! | `localiser-mount` | `rx_deg`, `ry_deg`, `rz_deg` (the localiser's mounting rotation, a rotation vector in the platform frame, degrees) |
+//! | `platform-weight` | `scale` (the platform's true weight over the robot file's `platform_weight_n`, > 0) |
+//! | `cable-weight` | `scale` (the cables' true weight per metre over the robot file's `cable_weight_n_per_m`, > 0) |
 //!
 //! ```
-//! use sagcal::model::effects::{EffectKind, Effects};
+//! use sagcal::model::effect_kind::EffectKind;
+//! use sagcal::model::effects::Effects;
 //! let mut effects = Effects::default();
 //! effects.apply_spec("elastic:ea_n=2e6").map_err(sagcal::Error::InvalidInput)?;
 //! effects.apply_spec("encoder-scale:gain1=1.002,gain3=0.999").map_err(sagcal::Error::InvalidInput)?;
@@ -101,6 +104,24 @@ pub struct Effects {
     /// of the orientation readings (`codegen/factors.py::mounted_pose_prior_residual`).
     #[serde(skip_serializing_if = "is_zero3")]
     pub localiser_mount_deg: [f64; 3],
+    /// The platform's true weight over the robot file's `platform_weight_n`
+    /// (`platform-weight:scale`); 1: as the file says.
+    ///
+    /// An unmodelled payload (or a tool taken off): the gravity wrench of
+    /// paper eq. (9) scales, and with it every tension.
+    #[serde(skip_serializing_if = "is_one")]
+    pub platform_weight_scale: f64,
+    /// The cables' true weight per metre over the robot file's
+    /// `cable_weight_n_per_m` (`cable-weight:scale`); 1: as the file says.
+    ///
+    /// A wrong cable specification (another diameter, a coating): the sag
+    /// parameter `lambda = w L / f_h` of the catenary (eq. 2-3) scales.
+    #[serde(skip_serializing_if = "is_one")]
+    pub cable_weight_scale: f64,
+}
+
+fn is_one(x: &f64) -> bool {
+    *x == 1.0
 }
 
 fn is_zero3(v: &[f64; 3]) -> bool {
@@ -119,13 +140,30 @@ impl Default for Effects {
             com_shift_m: [0.0; 3],
             cable_segments: None,
             localiser_mount_deg: [0.0; 3],
+            platform_weight_scale: 1.0,
+            cable_weight_scale: 1.0,
         }
     }
 }
 
 /// The effect names accepted by [`Effects::apply_spec`], with their parameters.
 pub const EFFECT_NAMES: &str =
-    "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m, segments:n, localiser-mount:rx_deg,ry_deg,rz_deg";
+    "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m, segments:n, localiser-mount:rx_deg,ry_deg,rz_deg, platform-weight:scale, cable-weight:scale";
+
+/// The parameters [`Effects::apply_spec`] accepts for the effect `name`; `None` for no effect.
+fn spec_parameters(name: &str) -> Option<&'static [&'static str]> {
+    Some(match name {
+        "elastic" => &["ea_n"],
+        "pulley" => &["radius_m"],
+        "encoder-scale" => &["gain", "gain1", "gain2", "gain3", "gain4"],
+        "loadcell" => &["bias_n", "gain"],
+        "com" => &["dx_m", "dy_m", "dz_m"],
+        "segments" => &["n"],
+        "localiser-mount" => &["rx_deg", "ry_deg", "rz_deg"],
+        "platform-weight" | "cable-weight" => &["scale"],
+        _ => return None,
+    })
+}
 
 impl Effects {
     /// The cables' axial compliance `1e6 / EA` in 1/MN (0: inextensible), the
@@ -155,16 +193,8 @@ impl Effects {
             format!("effect `{spec}`: expected NAME:PARAM=VALUE[,PARAM=VALUE...] (effects: {EFFECT_NAMES})")
         })?;
         let name = name.trim();
-        let known: &[&str] = match name {
-            "elastic" => &["ea_n"],
-            "pulley" => &["radius_m"],
-            "encoder-scale" => &["gain", "gain1", "gain2", "gain3", "gain4"],
-            "loadcell" => &["bias_n", "gain"],
-            "com" => &["dx_m", "dy_m", "dz_m"],
-            "segments" => &["n"],
-            "localiser-mount" => &["rx_deg", "ry_deg", "rz_deg"],
-            other => return Err(format!("unknown effect `{other}` (effects: {EFFECT_NAMES})")),
-        };
+        let known =
+            spec_parameters(name).ok_or_else(|| format!("unknown effect `{name}` (effects: {EFFECT_NAMES})"))?;
         if params.trim().is_empty() {
             return Err(format!(
                 "effect `{name}`: no parameters given (parameters: {})",
@@ -241,6 +271,8 @@ impl Effects {
                         .expect("known axis");
                     next.localiser_mount_deg[axis] = value;
                 }
+                ("platform-weight", _) => next.platform_weight_scale = positive("weight scale")?,
+                ("cable-weight", _) => next.cable_weight_scale = positive("weight scale")?,
                 _ => unreachable!("parameter names are checked above"),
             }
         }
@@ -290,6 +322,14 @@ impl Effects {
                 self.localiser_mount_deg
             ));
         }
+        for (name, scale) in [
+            ("platform_weight_scale", self.platform_weight_scale),
+            ("cable_weight_scale", self.cable_weight_scale),
+        ] {
+            if !(scale.is_finite() && scale > 0.0) {
+                return Err(format!("`{name}` must be finite and > 0, got {scale}"));
+            }
+        }
         Ok(())
     }
 
@@ -333,202 +373,13 @@ impl Effects {
             let [x, y, z] = self.localiser_mount_deg;
             specs.push(format!("localiser-mount:rx_deg={x},ry_deg={y},rz_deg={z}"));
         }
+        if self.platform_weight_scale != 1.0 {
+            specs.push(format!("platform-weight:scale={}", self.platform_weight_scale));
+        }
+        if self.cable_weight_scale != 1.0 {
+            specs.push(format!("cable-weight:scale={}", self.cable_weight_scale));
+        }
         specs
-    }
-}
-
-/// One effect of the catalogue, as a model extension `sagcal diagnose` can fit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum EffectKind {
-    /// Finite axial stiffness (Irvine's elastic catenary); parameter the compliance `1e6 / EA` (1/MN).
-    Elastic,
-    /// Pulley radius (exit-point motion and wrapped arc); parameter `r`.
-    Pulley,
-    /// Per-cable encoder gain (drum radius error); four parameters.
-    EncoderScale,
-    /// Bias and gain of the reference cable's load cell; two parameters.
-    LoadCell,
-    /// Horizontal centre-of-mass shift from the nominal one; two parameters
-    /// (a vertical shift is not identifiable from nearly level poses).
-    Com,
-    /// One encoder gain shared by the four drums (a common drum-radius or
-    /// counts-per-metre error); one parameter. Nested in [`EffectKind::EncoderScale`].
-    CommonGain,
-    /// The cable as a chain of `n` straight finite elements; one parameter, `1/n^2`.
-    Segments,
-    /// The localiser's mounting rotation (a rotation vector, degrees); three
-    /// parameters shared by every pose. Nested in freeing every pose's
-    /// orientation (`sagcal diagnose`'s `orientation` hypothesis).
-    LocaliserMount,
-}
-
-impl EffectKind {
-    /// Every effect of the catalogue, in report order.
-    pub const ALL: [EffectKind; 8] = [
-        EffectKind::Elastic,
-        EffectKind::Pulley,
-        EffectKind::EncoderScale,
-        EffectKind::LoadCell,
-        EffectKind::Com,
-        EffectKind::CommonGain,
-        EffectKind::Segments,
-        EffectKind::LocaliserMount,
-    ];
-
-    /// The name used on the command line and in reports (`elastic`, `encoder-scale`, ...).
-    pub fn name(self) -> &'static str {
-        match self {
-            EffectKind::Elastic => "elastic",
-            EffectKind::Pulley => "pulley",
-            EffectKind::EncoderScale => "encoder-scale",
-            EffectKind::LoadCell => "loadcell",
-            EffectKind::Com => "com",
-            EffectKind::CommonGain => "encoder-gain",
-            EffectKind::Segments => "segments",
-            EffectKind::LocaliserMount => "localiser-mount",
-        }
-    }
-
-    /// Parse [`EffectKind::name`].
-    pub fn parse(text: &str) -> Result<Self, String> {
-        Self::ALL.into_iter().find(|k| k.name() == text.trim()).ok_or_else(|| {
-            let names: Vec<&str> = Self::ALL.iter().map(|k| k.name()).collect();
-            format!("unknown effect `{text}` (effects: {})", names.join(", "))
-        })
-    }
-
-    /// Names of the fitted parameters, in the order of [`EffectKind::parameters`].
-    pub fn parameter_names(self) -> &'static [&'static str] {
-        match self {
-            EffectKind::Elastic => &["compliance_per_mn"],
-            EffectKind::Pulley => &["radius_m"],
-            EffectKind::EncoderScale => &["gain1", "gain2", "gain3", "gain4"],
-            EffectKind::LoadCell => &["bias_n", "gain"],
-            EffectKind::Com => &["dx_m", "dy_m"],
-            EffectKind::CommonGain => &["gain"],
-            EffectKind::Segments => &["inverse_segments_squared"],
-            EffectKind::LocaliserMount => &["rx_deg", "ry_deg", "rz_deg"],
-        }
-    }
-
-    /// Number of fitted parameters.
-    pub fn parameter_count(self) -> usize {
-        self.parameter_names().len()
-    }
-
-    /// This effect's parameters in `effects`, in the units of
-    /// [`EffectKind::parameter_names`] (compliance 0 for an inextensible cable).
-    pub fn parameters(self, effects: &Effects) -> Vec<f64> {
-        match self {
-            EffectKind::Elastic => vec![effects.axial_compliance_per_mn()],
-            EffectKind::Pulley => vec![effects.pulley_radius_m],
-            EffectKind::EncoderScale => effects.encoder_gain.to_vec(),
-            EffectKind::LoadCell => vec![effects.load_cell_bias_n, effects.load_cell_gain],
-            EffectKind::Com => effects.com_shift_m[..2].to_vec(),
-            EffectKind::CommonGain => vec![effects.encoder_gain.iter().sum::<f64>() / CABLE_COUNT as f64],
-            EffectKind::Segments => vec![effects.inverse_segments_squared()],
-            EffectKind::LocaliserMount => effects.localiser_mount_deg.to_vec(),
-        }
-    }
-
-    /// This effect's parameters in `effects` in the units of the extended
-    /// model's variables: gains as errors (`gain - 1`), the elastic cable as
-    /// its compliance in 1/MN, the segmented cable as `1/n^2`.
-    pub fn variable_values(self, effects: &Effects) -> Vec<f64> {
-        match self {
-            EffectKind::EncoderScale | EffectKind::CommonGain => {
-                self.parameters(effects).iter().map(|g| g - 1.0).collect()
-            }
-            EffectKind::LoadCell => vec![effects.load_cell_bias_n, effects.load_cell_gain - 1.0],
-            _ => self.parameters(effects),
-        }
-    }
-
-    /// Whether `effects` contains this effect (a parameter away from its
-    /// neutral value). Encoder gains count as the common gain when the four
-    /// are equal and as per-drum gains otherwise.
-    pub fn present_in(self, effects: &Effects) -> bool {
-        let gains = effects.encoder_gain;
-        let common = gains.iter().all(|g| *g == gains[0]);
-        match self {
-            EffectKind::EncoderScale => !common,
-            EffectKind::CommonGain => common && gains[0] != 1.0,
-            _ => self.parameters(effects) != self.parameters(&Effects::default()),
-        }
-    }
-
-    /// The effect that contains this one as a special case, if any: the
-    /// common encoder gain is the per-drum gains with four equal values.
-    pub fn nested_in(self) -> Option<EffectKind> {
-        (self == EffectKind::CommonGain).then_some(EffectKind::EncoderScale)
-    }
-}
-
-/// A set of effects of the catalogue (for an extended model with several at once).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
-pub struct EffectSet(u16);
-
-impl EffectSet {
-    /// No effect.
-    pub const NONE: EffectSet = EffectSet(0);
-
-    /// The set holding `kind` alone.
-    pub fn of(kind: EffectKind) -> Self {
-        Self::NONE.with(kind)
-    }
-
-    /// This set and `kind`.
-    pub fn with(self, kind: EffectKind) -> Self {
-        Self(self.0 | 1 << kind as u16)
-    }
-
-    /// This set without `kind`.
-    pub fn without(self, kind: EffectKind) -> Self {
-        Self(self.0 & !(1 << kind as u16))
-    }
-
-    /// Whether `kind` is in the set.
-    pub fn contains(self, kind: EffectKind) -> bool {
-        self.0 & (1 << kind as u16) != 0
-    }
-
-    /// Whether the set is empty.
-    pub fn is_empty(self) -> bool {
-        self.0 == 0
-    }
-
-    /// The effects in catalogue order.
-    pub fn iter(self) -> impl Iterator<Item = EffectKind> {
-        EffectKind::ALL.into_iter().filter(move |k| self.contains(*k))
-    }
-
-    /// Number of fitted parameters of all the set's effects.
-    pub fn parameter_count(self) -> usize {
-        self.iter().map(EffectKind::parameter_count).sum()
-    }
-}
-
-impl std::fmt::Display for EffectSet {
-    /// The names joined by `+` in catalogue order, or `none`.
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        if self.is_empty() {
-            return f.write_str("none");
-        }
-        let names: Vec<&str> = self.iter().map(EffectKind::name).collect();
-        f.write_str(&names.join("+"))
-    }
-}
-
-impl FromIterator<EffectKind> for EffectSet {
-    fn from_iter<I: IntoIterator<Item = EffectKind>>(kinds: I) -> Self {
-        kinds.into_iter().fold(Self::NONE, Self::with)
-    }
-}
-
-impl std::fmt::Display for EffectKind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
     }
 }
 
@@ -574,6 +425,8 @@ mod tests {
             "com:dx_m=0.02,dz_m=-0.05",
             "segments:n=12",
             "localiser-mount:rx_deg=0.5,rz_deg=-1.5",
+            "platform-weight:scale=1.11",
+            "cable-weight:scale=0.9",
         ])
         .unwrap();
         assert_eq!(e.axial_stiffness_n, Some(3e6));
@@ -585,6 +438,7 @@ mod tests {
         assert_eq!(e.cable_segments, Some(12.0));
         assert_eq!(e.inverse_segments_squared(), 1.0 / 144.0);
         assert_eq!(e.localiser_mount_deg, [0.5, 0.0, -1.5]);
+        assert_eq!((e.platform_weight_scale, e.cable_weight_scale), (1.11, 0.9));
         // The specifications parse back to the same effects.
         let specs = e.specs();
         let again = parsed(&specs.iter().map(String::as_str).collect::<Vec<_>>()).unwrap();
@@ -617,6 +471,11 @@ mod tests {
             ),
             ("com:dx=0.1", &["effect `com`", "unknown parameter `dx`"]),
             ("segments:n=0.5", &["effect `segments`", "`n`", ">= 1"]),
+            (
+                "platform-weight:scale=0",
+                &["effect `platform-weight`", "`scale`", "> 0"],
+            ),
+            ("cable-weight:scale=-1", &["effect `cable-weight`", "`scale`", "> 0"]),
         ];
         for (spec, needles) in cases {
             let mut effects = Effects::default();

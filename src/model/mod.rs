@@ -28,6 +28,7 @@
 //! ```
 
 pub mod catenary;
+pub mod effect_kind;
 pub mod effect_limits;
 pub mod effect_ranges;
 pub mod effects;

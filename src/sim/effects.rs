@@ -67,6 +67,17 @@ pub fn discretised_options(robot: &Robot, effects: &Effects, segments: usize) ->
     }
 }
 
+/// The robot as it truly is under `effects`' weight errors: the platform's
+/// weight and the cables' weight per metre scaled (`platform-weight`,
+/// `cable-weight`); the commanded cable lengths still come from the robot
+/// file's (wrong) weights, as a controller's would.
+pub fn weighed(robot: &Robot, effects: &Effects) -> Robot {
+    let mut true_robot = robot.clone();
+    true_robot.platform_weight_n *= effects.platform_weight_scale;
+    true_robot.cable_weight_n_per_m *= effects.cable_weight_scale;
+    true_robot
+}
+
 /// The discretised robot's equilibrium under each closed-form equilibrium's
 /// cable lengths as paid-out lengths. A pose whose solve fails is an error
 /// naming the pose (1-based) and its commanded position.
@@ -82,15 +93,16 @@ pub fn solve_with_effects(
     crate::model::plausibility::check_effects(robot, effects)
         .map_err(|e| Error::InvalidInput(format!("effects on robot `{}`: {e}", robot.name)))?;
     let options = discretised_options(robot, effects, segments);
+    let true_robot = weighed(robot, effects);
     equilibria
         .iter()
         .enumerate()
         .map(|(k, eq)| {
             solve_forward(
-                robot,
+                &true_robot,
                 &options,
                 &eq.cable_lengths_m,
-                &InitialGuess::from_closed_form(robot, eq),
+                &InitialGuess::from_closed_form(&true_robot, eq),
             )
             .map_err(|e| {
                 let p = eq.pose.position_m;

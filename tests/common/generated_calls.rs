@@ -192,10 +192,13 @@ pub fn rigid_length(p: &Point, j: Option<&mut (M<4, 6>, M<4, 12>, M<4, 4>)>) -> 
     )
 }
 
-pub fn geometry(p: &Point, j: Option<&mut (M<16, 6>, M<16, 2>, M<16, 12>, M<16, 3>)>) -> SVector<f64, 16> {
-    let (pose, reference, anchors, com) = match j {
-        Some((a, b, c, d)) => (Some(a), Some(b), Some(c), Some(d)),
-        None => (None, None, None, None),
+/// The Jacobians of `cable_geometry`: pose, reference tension, anchors, centre of mass, platform weight.
+pub type GeometryJacobians = (M<16, 6>, M<16, 2>, M<16, 12>, M<16, 3>, M<16, 1>);
+
+pub fn geometry(p: &Point, j: Option<&mut GeometryJacobians>) -> SVector<f64, 16> {
+    let (pose, reference, anchors, com, weight) = match j {
+        Some((a, b, c, d, e)) => (Some(a), Some(b), Some(c), Some(d), Some(e)),
+        None => (None, None, None, None, None),
     };
     generated::cable_geometry(
         &p.pose.position_m,
@@ -210,22 +213,35 @@ pub fn geometry(p: &Point, j: Option<&mut (M<16, 6>, M<16, 2>, M<16, 12>, M<16, 
         reference,
         anchors,
         com,
+        weight,
     )
 }
 
-/// Per slot the 2x1 Jacobians of `extended_cable`: span, `f_h`, `f_v`, compliance, radius, `1/n^2`.
-pub type ExtendedJacobians = [(M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>); 4];
+/// The Jacobians of [`geometry`] as dynamic blocks, in argument order.
+pub fn geometry_blocks(j: &GeometryJacobians) -> Vec<DMatrix<f64>> {
+    vec![
+        dynamic(&j.0),
+        dynamic(&j.1),
+        dynamic(&j.2),
+        dynamic(&j.3),
+        dynamic(&j.4),
+    ]
+}
+
+/// Per slot the 2x1 Jacobians of `extended_cable`: span, `f_h`, `f_v`, compliance, radius,
+/// `1/n^2`, cable weight.
+pub type ExtendedJacobians = [(M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>, M<2, 1>); 4];
 
 /// `extended_cable` of the four slots stacked: `[paid_out_0, drop_0, paid_out_1, ...]`.
 pub fn extended(p: &Point, mut j: Option<&mut ExtendedJacobians>) -> SVector<f64, 8> {
     let mut value = SVector::<f64, 8>::zeros();
     for s in 0..4 {
-        let (span, horizontal, vertical, compliance, radius, segments) = match j.as_deref_mut() {
+        let (span, horizontal, vertical, compliance, radius, segments, weight) = match j.as_deref_mut() {
             Some(j) => {
-                let (a, b, c, d, e, f) = &mut j[s];
-                (Some(a), Some(b), Some(c), Some(d), Some(e), Some(f))
+                let (a, b, c, d, e, f, g) = &mut j[s];
+                (Some(a), Some(b), Some(c), Some(d), Some(e), Some(f), Some(g))
             }
-            None => (None, None, None, None, None, None),
+            None => (None, None, None, None, None, None, None),
         };
         let cable = generated::extended_cable(
             p.cable_spans_m[s],
@@ -242,6 +258,7 @@ pub fn extended(p: &Point, mut j: Option<&mut ExtendedJacobians>) -> SVector<f64
             compliance,
             radius,
             segments,
+            weight,
         );
         value.fixed_rows_mut::<2>(2 * s).copy_from(&cable);
     }
@@ -252,14 +269,20 @@ pub fn extended(p: &Point, mut j: Option<&mut ExtendedJacobians>) -> SVector<f64
 /// (8x4, block diagonal), compliance, radius and `1/n^2` (8x1).
 pub fn extended_blocks(j: &ExtendedJacobians) -> Vec<DMatrix<f64>> {
     let mut blocks = vec![DMatrix::zeros(8, 4), DMatrix::zeros(8, 4), DMatrix::zeros(8, 4)];
-    blocks.extend([DMatrix::zeros(8, 1), DMatrix::zeros(8, 1), DMatrix::zeros(8, 1)]);
-    for (s, (span, horizontal, vertical, compliance, radius, segments)) in j.iter().enumerate() {
+    blocks.extend([
+        DMatrix::zeros(8, 1),
+        DMatrix::zeros(8, 1),
+        DMatrix::zeros(8, 1),
+        DMatrix::zeros(8, 1),
+    ]);
+    for (s, (span, horizontal, vertical, compliance, radius, segments, weight)) in j.iter().enumerate() {
         for (b, d) in [span, horizontal, vertical].into_iter().enumerate() {
             blocks[b].view_mut((2 * s, s), (2, 1)).copy_from(d);
         }
         blocks[3].view_mut((2 * s, 0), (2, 1)).copy_from(compliance);
         blocks[4].view_mut((2 * s, 0), (2, 1)).copy_from(radius);
         blocks[5].view_mut((2 * s, 0), (2, 1)).copy_from(segments);
+        blocks[6].view_mut((2 * s, 0), (2, 1)).copy_from(weight);
     }
     blocks
 }
