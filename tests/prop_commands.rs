@@ -560,10 +560,14 @@ fn sampler_draws(poses: usize) -> u64 {
     100 * poses as u64 + 1000
 }
 
-/// Draws a plan makes at most for `candidates` candidates
-/// (`experiments::plan_candidates::ATTEMPTS_PER_CANDIDATE` = 50 each).
+/// Draws a plan makes at most for `candidates` candidates: each candidate
+/// draws positions until one is kept, at most
+/// `sim::closed_form::FIRST_DRAWS` = 1000 in all
+/// (`experiments::plan_candidates::draw_candidates`). (A budget of 50 draws
+/// per candidate, the attempts' count, was exceeded by a box where
+/// equilibria are rare: a candidate's first attempt drew 1000 positions.)
 fn plan_draws(candidates: usize) -> u64 {
-    50 * candidates as u64
+    1000 * candidates as u64
 }
 
 /// Command-line words from one line (no argument here holds a space).

@@ -42,7 +42,7 @@ use crate::model::geometry::check_workspace;
 use crate::model::robot::{Robot, Workspace};
 use crate::model::statics::Equilibrium;
 use crate::plan::Margins;
-use crate::sim::closed_form::sample_equilibria;
+use crate::sim::closed_form::{sample_equilibria_counted, Closure, FIRST_DRAWS};
 
 /// Draws per candidate before giving up on it (most of a frame is reachable).
 pub const ATTEMPTS_PER_CANDIDATE: usize = 50;
@@ -145,11 +145,24 @@ fn draw_one(robot: &Robot, slots: &SlotRobot, workspace: &Workspace, margins: &M
         unstable: 0,
         no_equilibrium: None,
     };
-    for _ in 0..ATTEMPTS_PER_CANDIDATE {
-        let mut one = match sample_equilibria(robot, workspace, 1, &mut rng) {
-            Ok(one) => one,
+    // The candidate's positions in all, over its attempts: a box where
+    // equilibria are rare costs at most FIRST_DRAWS draws, not that per attempt.
+    let mut left = FIRST_DRAWS;
+    for attempt in 0..ATTEMPTS_PER_CANDIDATE {
+        if left == 0 {
+            drawn.no_equilibrium = Some(format!(
+                "{FIRST_DRAWS} positions drawn gave only {attempt} equilibria, none of them kept: \
+                 equilibria are rare in this box"
+            ));
+            return drawn;
+        }
+        let mut one = match sample_equilibria_counted(robot, workspace, 1, Closure::Level, left, &mut rng) {
+            Ok((one, draws)) => {
+                left = left.saturating_sub(draws);
+                one
+            }
             Err(e) => {
-                // FIRST_DRAWS positions in a row without an equilibrium: more would not find one.
+                // No equilibrium in the draws left: more would not find one.
                 drawn.no_equilibrium = Some(e.to_string());
                 return drawn;
             }
@@ -169,7 +182,7 @@ fn draw_one(robot: &Robot, slots: &SlotRobot, workspace: &Workspace, margins: &M
 }
 
 /// Draw `count` candidates in `workspace`: candidate `k` draws level
-/// equilibria ([`sample_equilibria`]) from its own stream `(seed, k)` until
+/// equilibria ([`crate::sim::closed_form::sample_equilibria`]) from its own stream `(seed, k)` until
 /// one keeps the margins and is stable, so the set does not depend on the
 /// number of threads. Level equilibria: a robot commanded to a position
 /// with a level platform hangs near the most level member of the family (the
@@ -179,8 +192,10 @@ fn draw_one(robot: &Robot, slots: &SlotRobot, workspace: &Workspace, margins: &M
 /// The box is checked against the robot first
 /// ([`crate::model::geometry::check_workspace`]), and the work is bounded:
 /// a candidate gives up after [`ATTEMPTS_PER_CANDIDATE`] poses that break a
-/// margin or are unstable, or at once when the box gave no equilibrium in
-/// [`crate::sim::closed_form::FIRST_DRAWS`] draws; candidates are drawn in
+/// margin or are unstable, or when its positions drawn in all reach
+/// [`crate::sim::closed_form::FIRST_DRAWS`] (a box where equilibria are rare:
+/// a draw whose statics fail costs up to the whole reference-tension scan,
+/// 0.1 s); candidates are drawn in
 /// batches of 1, 4, 16, ... in candidate order, and the first batch with a
 /// candidate that gave up ends the drawing with an error saying why (a
 /// hopeless box fails on its first candidate, within [`ATTEMPTS_PER_CANDIDATE`]

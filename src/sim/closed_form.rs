@@ -207,6 +207,19 @@ pub fn sample_equilibria_with(
     closure: Closure,
     rng: &mut impl Rng,
 ) -> Result<Vec<Equilibrium>> {
+    sample_equilibria_counted(robot, workspace, count, closure, FIRST_DRAWS, rng).map(|(poses, _)| poses)
+}
+
+/// [`sample_equilibria_with`] giving up after `first_draws` draws without
+/// any equilibrium (instead of [`FIRST_DRAWS`]), with the number of draws it made.
+pub fn sample_equilibria_counted(
+    robot: &Robot,
+    workspace: &Workspace,
+    count: usize,
+    closure: Closure,
+    first_draws: usize,
+    rng: &mut impl Rng,
+) -> Result<(Vec<Equilibrium>, usize)> {
     closure.validate()?;
     geometry::check_workspace(robot, workspace)
         .map_err(|e| Error::InvalidInput(format!("robot `{}`: no pose can be drawn: {e}", robot.name)))?;
@@ -219,7 +232,7 @@ pub fn sample_equilibria_with(
         loop {
             crate::cancel::check()?;
             attempts += 1;
-            if attempts > limit || (poses.is_empty() && attempts > FIRST_DRAWS) {
+            if attempts > limit || (poses.is_empty() && attempts > first_draws) {
                 let drawn = attempts - 1;
                 return Err(Error::InvalidInput(format!(
                     "robot `{}`: only {} of {count} reachable static poses ({closure} closure) found in the box {:?} .. {:?} m \
@@ -245,7 +258,7 @@ pub fn sample_equilibria_with(
             }
         }
     }
-    Ok(poses)
+    Ok((poses, attempts))
 }
 
 /// The most level equilibrium at `position`, its reference tension scaled by
