@@ -93,7 +93,7 @@ use crate::model::measurement::{PoseMeasurement, ReadingSet};
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::stats::{self, chi_square_quantile_999};
 
-pub use candidates::{power_against, CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER};
+pub use candidates::{power_against, CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER, WEIGHT_SCALING};
 pub use drivers::{DriverSeries, DriverTest, DRIVERS, DRIVER_T_LIMIT};
 pub use explanation::{Ambiguity, Explanation, AMBIGUOUS_BIC};
 pub use prediction::NotPredictive;

@@ -4,9 +4,14 @@
 //! says that something is left unexplained, and every cause it names is a
 //! hidden effect still in the catalogue (a stand-in is named as one, never as
 //! a cause). `none` on data with a detectable hidden effect is not honest.
+//! One exception is exact: a wrong platform or cable weight left out is
+//! still in the catalogue as the other weight with a load-cell gain, which
+//! predicts every reading alike ([`crate::diagnose::WEIGHT_SCALING`]); the
+//! diagnosis naming that pair (its report gives the equivalent fit) is honest.
 
 use serde::{Deserialize, Serialize};
 
+use crate::diagnose::WEIGHT_SCALING;
 use crate::model::effect_kind::EffectKind;
 
 /// The catalogue the diagnosis of each case has.
@@ -55,8 +60,22 @@ pub fn left_out_with(hidden: EffectKind) -> Vec<EffectKind> {
 /// Whether `verdict` is honest about data holding `hidden` when the
 /// diagnosis' catalogue lacked `left_out` (module docs): it says
 /// `unexplained`, and each cause it names (or one of each ambiguous pair)
-/// is a hidden effect still in the catalogue.
+/// is a hidden effect still in the catalogue; or it names exactly the two
+/// other members of [`WEIGHT_SCALING`] for a hidden weight left out (module docs).
 pub fn honest(verdict: &str, hidden: &[EffectKind], left_out: &[EffectKind]) -> bool {
+    if let [weight @ (EffectKind::PlatformWeight | EffectKind::CableWeight)] = hidden {
+        let mut equivalent: Vec<&str> = WEIGHT_SCALING
+            .iter()
+            .filter(|k| *k != weight)
+            .map(|k| k.name())
+            .collect();
+        let mut named: Vec<&str> = verdict.split('+').collect();
+        equivalent.sort_unstable();
+        named.sort_unstable();
+        if left_out.contains(weight) && named == equivalent {
+            return true;
+        }
+    }
     let still_in: Vec<&str> = hidden
         .iter()
         .filter(|k| !left_out.contains(k))
@@ -85,6 +104,12 @@ mod tests {
         assert!(honest("com+unexplained", &[com, elastic], &[elastic]));
         assert!(honest("com|localiser-mount+unexplained", &[com, elastic], &[elastic]));
         assert!(!honest("elastic+unexplained", &[com, elastic], &[elastic]));
+        // A weight left out: its exact equivalent, the other weight with a load-cell gain.
+        let (platform, cable) = (EffectKind::PlatformWeight, EffectKind::CableWeight);
+        assert!(honest("loadcell+cable-weight", &[platform], &[platform]));
+        assert!(honest("platform-weight+loadcell", &[cable], &[cable]));
+        assert!(!honest("loadcell", &[platform], &[platform]));
+        assert!(!honest("loadcell+cable-weight", &[platform, com], &[platform]));
         assert_eq!(
             left_out_with(EffectKind::CommonGain),
             vec![EffectKind::EncoderScale, EffectKind::CommonGain]
