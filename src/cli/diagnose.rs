@@ -222,6 +222,16 @@ fn render_residual_tests(d: &Diagnosis) -> String {
         ]);
     }
     out += &tests.to_string();
+    if let Some(n) = &d.noise_shown {
+        out += &format!(
+            "   the sensors are more precise than stated, each by its own factor: the table and every test use the noise \
+             their data show (encoder {:.3} mm, load cell {:.3} N, localiser {:.3} mm and {:.5} rad)\n",
+            n.encoder_sigma_m * 1e3,
+            n.load_cell_sigma_n,
+            n.position_sigma_m * 1e3,
+            n.orientation_sigma_rad
+        );
+    }
     if d.variance_factor != 1.0 {
         out += &format!(
             "   the data are more precise than the stated noise: the tests use the a posteriori variance factor {:.4} (residual scale x{:.3})\n",

@@ -80,6 +80,7 @@ mod report;
 mod residual_tests;
 mod selection;
 mod stand_ins;
+mod variance_components;
 pub mod verify;
 
 use crate::calib::gross_errors::{calibrate_checked, ExcludedReading, GrossErrorOptions, Verdict};
@@ -91,6 +92,7 @@ use crate::error::{Error, Result};
 use crate::model::effect_kind::{EffectKind, EffectSet};
 use crate::model::measurement::{PoseMeasurement, ReadingSet};
 use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::sensors::SensorNoise;
 use crate::stats::{self, chi_square_quantile_999};
 
 pub use candidates::{power_against, CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER, WEIGHT_SCALING};
@@ -101,6 +103,7 @@ pub use report::{error_over_sigma, Diagnosis, EffectFit, Gain};
 pub use residual_tests::{FactorTest, MEASUREMENT_KINDS};
 pub use selection::SelectionStep;
 pub use stand_ins::{StandIn, STAND_IN_SIGMAS};
+pub use variance_components::{noise_the_data_show, SMALLEST_NOISE_SCALE};
 
 use candidates::rebuild;
 use drivers::{driver_series, driver_tests, samples};
@@ -307,8 +310,8 @@ pub fn diagnose(
     let (cleaned, excluded_readings, mistakes) = screen_gross_errors(robot, measurements, options, &mut progress)?;
     let measurements = cleaned.as_slice();
     // 1. The baseline calibration, its residuals tested against the stated noise.
-    let base = Baseline::fit(robot, measurements, options, &mut progress)?;
-    let factor_tests = factor_tests(&base.graph.graph, base.components, base.dof);
+    let (base, factor_tests, noise_shown, used_options) = fit_baseline(robot, measurements, options, &mut progress)?;
+    let options = &used_options;
     // 2. The residuals against the physical drivers.
     let base_samples = samples(&base.result, &base.used, &base.options)?;
     let drivers = driver_tests(&base_samples, options.rows_in_time_order);
@@ -361,6 +364,7 @@ pub fn diagnose(
         baseline_dof: base.dof,
         baseline_consistent: base.chi_square <= chi_square_quantile_999(base.dof),
         variance_factor: base.variance_factor,
+        noise_shown,
         orientation_prior: base.options.orientation_prior,
         false_alarm: options.false_alarm,
         factor_tests,
@@ -386,6 +390,37 @@ pub fn diagnose(
         excluded_readings,
         mistakes,
     })
+}
+
+/// The baseline fit and its chi-square test per sensor. Where the data are
+/// more precise than stated, each sensor by its own factor, the baseline is
+/// fitted again with the noise the data show ([`noise_the_data_show`]),
+/// which the options returned carry into every later test.
+fn fit_baseline(
+    robot: &Robot,
+    measurements: &[PoseMeasurement],
+    options: &DiagnoseOptions,
+    progress: &mut Progress<'_>,
+) -> Result<(Baseline, Vec<FactorTest>, Option<SensorNoise>, DiagnoseOptions)> {
+    let base = Baseline::fit(robot, measurements, options, progress)?;
+    let tests = factor_tests(&base.graph.graph, base.components, base.dof);
+    let shown = (base.variance_factor < 1.0)
+        .then(|| noise_the_data_show(&options.calibration.noise, &tests))
+        .flatten();
+    let Some(noise) = shown else {
+        return Ok((base, tests, None, options.clone()));
+    };
+    let rescaled = DiagnoseOptions {
+        calibration: CalibrationOptions {
+            noise,
+            ..options.calibration
+        },
+        ..options.clone()
+    };
+    progress.grow(1);
+    let base = Baseline::fit(robot, measurements, &rescaled, progress)?;
+    let tests = factor_tests(&base.graph.graph, base.components, base.dof);
+    Ok((base, tests, Some(noise), rescaled))
 }
 
 /// The options' own checks: at least 2 folds, a false-alarm rate in (0, 1).

@@ -14,6 +14,7 @@ use crate::calib::mistakes::Mistake;
 use crate::calib::{CalibrationError, EffectEstimate, OrientationPrior, ParameterUncertainty};
 use crate::model::effect_kind::EffectKind;
 use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::sensors::SensorNoise;
 
 /// What the chosen extension gains.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -54,6 +55,10 @@ pub struct Diagnosis {
     /// The a posteriori variance factor dividing every chi-square of the
     /// tests (1 unless the data are more precise than the stated noise).
     pub variance_factor: f64,
+    /// Where the sensors are more precise than stated by different factors,
+    /// the noise each sensor's data show, which every test uses
+    /// ([`super::noise_the_data_show`]); `None` (JSON `null`): the stated noise.
+    pub noise_shown: Option<SensorNoise>,
     /// The localiser's orientation in the baseline (`on` unless turned off).
     pub orientation_prior: OrientationPrior,
     /// The false-alarm rate of the search.
