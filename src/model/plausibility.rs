@@ -125,7 +125,15 @@ pub fn check_effects(robot: &Robot, effects: &Effects) -> Result<(), String> {
             j + 1
         ));
     }
-    Ok(())
+    let mut weighed = robot.clone();
+    weighed.platform_weight_n *= effects.platform_weight_scale;
+    weighed.cable_weight_n_per_m *= effects.cable_weight_scale;
+    check_masses(&weighed).map_err(|e| {
+        format!(
+            "with `platform_weight_scale` {} and `cable_weight_scale` {} the robot's true weights: {e}",
+            effects.platform_weight_scale, effects.cable_weight_scale
+        )
+    })
 }
 
 #[cfg(test)]
@@ -154,6 +162,14 @@ mod tests {
             let mut effects = robot.effects;
             effects.pulley_radius_m = largest;
             check_effects(&robot, &effects).unwrap();
+            // A true weight beyond the plausible range is refused, naming the scale.
+            effects.cable_weight_scale = 1e6;
+            let message = check_effects(&robot, &effects).unwrap_err();
+            assert!(
+                message.contains("cable_weight_scale") && message.contains("cable_weight_n_per_m"),
+                "{message}"
+            );
+            effects.cable_weight_scale = 1.0;
             assert!(
                 largest < 0.2 * MAX_PULLEY_FRACTION * closest,
                 "{name}: {largest} m against {closest} m"
