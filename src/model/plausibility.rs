@@ -169,7 +169,6 @@ mod tests {
                 message.contains("cable_weight_scale") && message.contains("cable_weight_n_per_m"),
                 "{message}"
             );
-            effects.cable_weight_scale = 1.0;
             assert!(
                 largest < 0.2 * MAX_PULLEY_FRACTION * closest,
                 "{name}: {largest} m against {closest} m"
