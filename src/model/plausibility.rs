@@ -125,10 +125,7 @@ pub fn check_effects(robot: &Robot, effects: &Effects) -> Result<(), String> {
             j + 1
         ));
     }
-    let mut weighed = robot.clone();
-    weighed.platform_weight_n *= effects.platform_weight_scale;
-    weighed.cable_weight_n_per_m *= effects.cable_weight_scale;
-    check_masses(&weighed).map_err(|e| {
+    check_masses(&crate::model::robot::with_true_weights(robot, effects)).map_err(|e| {
         format!(
             "with `platform_weight_scale` {} and `cable_weight_scale` {} the robot's true weights: {e}",
             effects.platform_weight_scale, effects.cable_weight_scale

@@ -96,3 +96,13 @@ pub struct Workspace {
     /// Upper corner.
     pub max_m: [f64; 3],
 }
+
+/// `robot` as it truly is under `effects`' weight errors: the platform's
+/// weight and the cables' weight per metre times their scales
+/// (`platform-weight`, `cable-weight`).
+pub fn with_true_weights(robot: &Robot, effects: &Effects) -> Robot {
+    let mut true_robot = robot.clone();
+    true_robot.platform_weight_n *= effects.platform_weight_scale;
+    true_robot.cable_weight_n_per_m *= effects.cable_weight_scale;
+    true_robot
+}

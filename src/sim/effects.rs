@@ -72,10 +72,7 @@ pub fn discretised_options(robot: &Robot, effects: &Effects, segments: usize) ->
 /// `cable-weight`); the commanded cable lengths still come from the robot
 /// file's (wrong) weights, as a controller's would.
 pub fn weighed(robot: &Robot, effects: &Effects) -> Robot {
-    let mut true_robot = robot.clone();
-    true_robot.platform_weight_n *= effects.platform_weight_scale;
-    true_robot.cable_weight_n_per_m *= effects.cable_weight_scale;
-    true_robot
+    crate::model::robot::with_true_weights(robot, effects)
 }
 
 /// The discretised robot's equilibrium under each closed-form equilibrium's
