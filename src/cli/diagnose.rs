@@ -299,10 +299,15 @@ fn render_verdict(d: &Diagnosis) -> String {
             .map(|p| format!("{} {:.5e} +- {:.1e}", p.name, p.value, p.sigma))
             .collect();
         let stand_in = d.explanation.stand_ins.iter().any(|s| s.hypothesis == e.effect);
+        let proxy = d.explanation.explained_away.contains(&e.effect);
         out += &format!(
             "   {}{}: {}\n",
             e.effect,
-            if stand_in { " (stand-in)" } else { "" },
+            match (stand_in, proxy) {
+                (true, _) => " (stand-in)",
+                (false, true) => " (proxy: not needed beyond the proposed terms)",
+                _ => "",
+            },
             params.join(", ")
         );
     }
@@ -336,6 +341,7 @@ fn render_verdict(d: &Diagnosis) -> String {
     for fit in &d.equivalent_fits {
         out += &format!("   {fit}\n");
     }
+    out += &render_missing_terms(d);
     if !d.undetectable.is_empty() {
         out += &format!(
             "   not detectable at this noise with these poses (power < 0.9 at the smallest plausible magnitude): {}\n",
@@ -365,6 +371,32 @@ fn render_verdict(d: &Diagnosis) -> String {
             d.explanation.final_model
         );
         out += &driver_table(&d.drivers_after, 5);
+    }
+    out
+}
+
+/// The terms the final model (or, past a stand-in, the baseline) misses by
+/// the score test, and the terms proposed to explain them.
+fn render_missing_terms(d: &Diagnosis) -> String {
+    let e = &d.explanation;
+    if e.missing_terms.is_empty() {
+        return format!(
+            "   no term missing: no reading's residual follows a driver (score test, |z| below {:.2})\n",
+            e.structure_limit_t
+        );
+    }
+    let mut out = format!(
+        "   terms missing from {} (score test, |z| above {:.2}): {} of them; the strongest: {}\n",
+        e.terms_missing_from,
+        e.structure_limit_t,
+        e.missing_terms.len(),
+        e.missing_terms[0].formula()
+    );
+    for term in &e.proposed_terms {
+        out += &format!(
+            "   proposed term (fitted with the others proposed): {}\n",
+            term.formula()
+        );
     }
     out
 }

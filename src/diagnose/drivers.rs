@@ -86,6 +86,8 @@ pub const DRIVERS: [&str; CABLE_DRIVER_COUNT] = [
     "platform height (m)",
 ];
 
+/// The pose driver of the load cell's own reading.
+pub const MEASURED_TENSION: &str = "measured tension (N)";
 /// The driver of time: the row in the order taken.
 pub const ROW_DRIVER: &str = "row (order taken)";
 /// The driver of motion, per cable.
@@ -97,7 +99,7 @@ pub(super) fn winning_driver(effect: EffectKind) -> (&'static str, &'static str)
         EffectKind::Elastic => ("encoder", DRIVERS[1]),
         EffectKind::Pulley => ("encoder", DRIVERS[5]),
         EffectKind::EncoderScale => ("encoder", DRIVERS[2]),
-        EffectKind::LoadCell => ("load_cell", "measured tension (N)"),
+        EffectKind::LoadCell => ("load_cell", MEASURED_TENSION),
         EffectKind::Com => ("encoder", DRIVERS[0]),
         EffectKind::CommonGain => ("encoder", DRIVERS[2]),
         EffectKind::Segments => ("encoder", DRIVERS[3]),
@@ -188,49 +190,74 @@ pub(super) fn samples(
         .collect()
 }
 
+/// The value of `driver` at one pose: for `cable` (a per-cable driver), or
+/// for the pose (a pose driver, or the mean of a per-cable driver over the
+/// cables when `cable` is `None`).
+pub(super) fn driver_value(s: &PoseSample, driver: &str, cable: Option<usize>) -> Option<f64> {
+    let pose_driver = match driver {
+        MEASURED_TENSION => Some(s.measured_tension_n),
+        "platform x (m)" => Some(s.position_m.x),
+        "platform y (m)" => Some(s.position_m.y),
+        ROW_DRIVER => Some(s.row),
+        _ => None,
+    };
+    let cable_driver = |i: usize| -> Option<f64> {
+        if driver == DIRECTION_DRIVER {
+            return Some(s.direction[i]);
+        }
+        DRIVERS.iter().position(|d| *d == driver).map(|d| s.cable_drivers[i][d])
+    };
+    pose_driver.or_else(|| match cable {
+        Some(i) => cable_driver(i),
+        None => {
+            let values: Option<Vec<f64>> = (0..CABLE_COUNT).map(cable_driver).collect();
+            values.map(|v| v.iter().sum::<f64>() / CABLE_COUNT as f64)
+        }
+    })
+}
+
+/// The normalised residual of one reading at one pose: `encoder` of
+/// `cable`, or `load_cell`, `position_x|y|z` (NaN when left out).
+pub(super) fn residual_value(s: &PoseSample, residual: &str, cable: usize) -> f64 {
+    match residual {
+        "encoder" => s.encoder[cable],
+        "load_cell" => s.load_cell,
+        "position_x" => s.position[0],
+        "position_y" => s.position[1],
+        _ => s.position[2],
+    }
+}
+
+/// The residuals of [`driver_tests`].
+pub(super) const RESIDUALS: [&str; 5] = ["encoder", "load_cell", "position_x", "position_y", "position_z"];
+
+/// The drivers of [`driver_tests`]: the row and the direction of motion only
+/// where `time_order`.
+pub(super) fn drivers_tested(time_order: bool) -> Vec<&'static str> {
+    let mut drivers: Vec<&str> = DRIVERS.to_vec();
+    drivers.extend([MEASURED_TENSION, "platform x (m)", "platform y (m)"]);
+    if time_order {
+        drivers.extend([ROW_DRIVER, DIRECTION_DRIVER]);
+    }
+    drivers
+}
+
 /// `(driver, residual)` points of one residual against one driver.
 pub(super) fn series_of(samples: &[PoseSample], residual: &str, driver: &str) -> Vec<(f64, f64)> {
     let mut points = Vec::new();
     for s in samples {
-        let pose_driver = match driver {
-            "measured tension (N)" => Some(s.measured_tension_n),
-            "platform x (m)" => Some(s.position_m.x),
-            "platform y (m)" => Some(s.position_m.y),
-            ROW_DRIVER => Some(s.row),
-            _ => None,
-        };
-        let cable_driver = |i: usize| -> Option<f64> {
-            if driver == DIRECTION_DRIVER {
-                return Some(s.direction[i]);
-            }
-            DRIVERS.iter().position(|d| *d == driver).map(|d| s.cable_drivers[i][d])
-        };
-        match residual {
-            "encoder" => {
-                for i in 0..CABLE_COUNT {
-                    let x = pose_driver.or_else(|| cable_driver(i));
-                    if let Some(x) = x {
-                        if x.is_finite() && s.encoder[i].is_finite() {
-                            points.push((x, s.encoder[i]));
-                        }
+        if residual == "encoder" {
+            for i in 0..CABLE_COUNT {
+                if let Some(x) = driver_value(s, driver, Some(i)) {
+                    if x.is_finite() && s.encoder[i].is_finite() {
+                        points.push((x, s.encoder[i]));
                     }
                 }
             }
-            other => {
-                let y = match other {
-                    "load_cell" => s.load_cell,
-                    "position_x" => s.position[0],
-                    "position_y" => s.position[1],
-                    _ => s.position[2],
-                };
-                let x = pose_driver.or_else(|| {
-                    let values: Option<Vec<f64>> = (0..CABLE_COUNT).map(cable_driver).collect();
-                    values.map(|v| v.iter().sum::<f64>() / CABLE_COUNT as f64)
-                });
-                if let (Some(x), true) = (x, y.is_finite()) {
-                    if !x.is_finite() {
-                        continue;
-                    }
+        } else {
+            let y = residual_value(s, residual, 0);
+            if let Some(x) = driver_value(s, driver, None) {
+                if x.is_finite() && y.is_finite() {
                     points.push((x, y));
                 }
             }
@@ -243,14 +270,9 @@ pub(super) fn series_of(samples: &[PoseSample], residual: &str, driver: &str) ->
 /// row and the direction of motion only where `time_order` (the rows are in
 /// the order the poses were taken).
 pub(super) fn driver_tests(samples: &[PoseSample], time_order: bool) -> Vec<DriverTest> {
-    let residuals = ["encoder", "load_cell", "position_x", "position_y", "position_z"];
-    let mut drivers: Vec<&str> = DRIVERS.to_vec();
-    drivers.extend(["measured tension (N)", "platform x (m)", "platform y (m)"]);
-    if time_order {
-        drivers.extend([ROW_DRIVER, DIRECTION_DRIVER]);
-    }
+    let drivers = drivers_tested(time_order);
     let mut tests = Vec::new();
-    for residual in residuals {
+    for residual in RESIDUALS {
         for driver in &drivers {
             let points = series_of(samples, residual, driver);
             let (r, t) = correlation(&points);

@@ -75,6 +75,7 @@
 mod candidates;
 mod drivers;
 mod explanation;
+mod missing_terms;
 mod prediction;
 mod report;
 mod residual_tests;
@@ -98,6 +99,7 @@ use crate::stats::{self, chi_square_quantile_999};
 pub use candidates::{power_against, CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER, WEIGHT_SCALING};
 pub use drivers::{DriverSeries, DriverTest, DRIVERS, DRIVER_T_LIMIT};
 pub use explanation::{Ambiguity, Explanation, AMBIGUOUS_BIC};
+pub use missing_terms::{CausesGivenTerms, MissingTerm, ALIKE_SHARE};
 pub use prediction::NotPredictive;
 pub use report::{error_over_sigma, Diagnosis, EffectFit, Gain};
 pub use residual_tests::{FactorTest, MEASUREMENT_KINDS};
@@ -333,26 +335,27 @@ pub fn diagnose(
     // 5-6. The report: what the final model gains, whether it explains the
     // data, and the structure left.
     let gain = report::gain(truth, &base.result.robot, &model.result.robot, baseline_cv, cv_after);
-    let (drivers_after, series) = if model.hypotheses.is_empty() {
-        (Vec::new(), driver_series(&drivers, &base_samples, None))
+    let (drivers_after, series, after_samples) = if model.hypotheses.is_empty() {
+        (Vec::new(), driver_series(&drivers, &base_samples, None), None)
     } else {
         let after_samples = samples(&model.result, &base.used, &model.options)?;
         let shown = first_effect(model).map(|kind| (kind, after_samples.as_slice()));
         let series = driver_series(&drivers, &base_samples, shown);
-        (driver_tests(&after_samples, options.rows_in_time_order), series)
+        let tests = driver_tests(&after_samples, options.rows_in_time_order);
+        (tests, series, Some(after_samples))
     };
-    let left = if model.hypotheses.is_empty() {
-        &drivers
-    } else {
-        &drivers_after
+    let left = match &after_samples {
+        None => (drivers.as_slice(), base_samples.as_slice(), base_samples.as_slice()),
+        Some(after) => (drivers_after.as_slice(), after.as_slice(), base_samples.as_slice()),
     };
     let explanation = explain(
         &base,
         model,
         left,
         (&selection.steps, &selection.candidates),
-        options.false_alarm,
-    );
+        (options.false_alarm, options.rows_in_time_order),
+        measurements,
+    )?;
     let reason = report::reason(&selection, &base, options, &not_predictive, &explanation);
     let undetectable = report::undetectable(&selection);
     let equivalent_fits = report::equivalent_fits(&model.result.effect_estimates);

@@ -342,7 +342,11 @@ fn diagnose_case(
     )?;
     let left_out = match options.catalogue {
         Catalogue::Full => Vec::new(),
-        Catalogue::LeaveOneOut => leave_each_out(&guess, &measurements, &truth, hidden, &diagnose_options)?,
+        Catalogue::LeaveOneOut => leave_each_out(
+            (&guess, &measurements, &truth),
+            (hidden, &diagnosis.verdict),
+            &diagnose_options,
+        )?,
     };
     let hidden_name = set_name(hidden.iter().map(|k| k.name().to_string()));
 
@@ -413,12 +417,11 @@ fn diagnose_case(
 }
 
 /// Per hidden effect, the diagnosis of the case with it (and its nested
-/// relatives) left out of the catalogue, and whether its verdict is honest.
+/// relatives) left out of the catalogue, and whether its verdict is honest
+/// (`full_verdict`: the verdict with the whole catalogue).
 fn leave_each_out(
-    guess: &Robot,
-    measurements: &[PoseMeasurement],
-    truth: &Robot,
-    hidden: &[EffectKind],
+    (guess, measurements, truth): (&Robot, &[PoseMeasurement], &Robot),
+    (hidden, full_verdict): (&[EffectKind], &str),
     options: &DiagnoseOptions,
 ) -> Result<Vec<LeftOut>> {
     hidden
@@ -430,7 +433,7 @@ fn leave_each_out(
             let diagnosis = diagnose(guess, measurements, Some(truth), &blind, &mut |_, _, _| {})?;
             Ok(LeftOut {
                 left_out: set_name(out.iter().map(|k| k.name().to_string())),
-                honest: honest(&diagnosis.verdict, hidden, &out),
+                honest: honest(&diagnosis.verdict, hidden, &out, full_verdict),
                 verdict: diagnosis.verdict,
             })
         })

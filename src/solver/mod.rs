@@ -42,6 +42,7 @@ mod local;
 mod redundancy;
 mod schur;
 mod schur_avx2;
+mod score;
 mod sparse_cholesky;
 mod system_cache;
 
@@ -51,6 +52,7 @@ pub use covariance::{marginal_covariance, marginal_covariance_cached, Covariance
 use linear_system::fill_zeros;
 pub use linear_system::LinearSystem;
 pub use redundancy::redundancy_numbers;
+pub use score::{score_system, score_tests, Direction, ScoreSystem, ScoreTest};
 pub use system_cache::SystemCache;
 
 use serde::Serialize;

@@ -13,64 +13,88 @@
 use nalgebra::DMatrix;
 
 use super::{linearize, LinearSystem};
-use crate::graph::FactorGraph;
+use crate::graph::{Factor, FactorGraph};
 
 /// Per factor (graph order) whose kind is in `kinds`, the redundancy number
 /// of each residual row (`None` for the other factors), at the graph's values.
 /// Each row costs one solve with the factored information matrix, over the
 /// blocks the row touches.
 pub fn redundancy_numbers(graph: &FactorGraph, kinds: &[&str]) -> Result<Vec<Option<Vec<f64>>>, String> {
-    let mut system = LinearSystem::new(&graph.values, &graph.factors, &graph.local_groups)?;
-    let hessian = linearize(graph, &graph.values, &system)
-        .map_err(|e| format!("redundancy numbers at the solution: {e}"))?
-        .hessian;
-    // A rank-deficient fit (a direction the data do not fix) has no inverse:
-    // the smallest damping that factors stands in for it, which leaves the
-    // leverage of every row that the data do control unchanged to that order.
-    let diagonal = system.diagonal(&hessian);
-    let factored = [0.0, 1e-12, 1e-9, 1e-6].into_iter().any(|relative| {
-        let damping: Vec<f64> = diagonal.iter().map(|d| relative * d.abs().max(1e-300)).collect();
-        system.factorize(&hessian, &damping)
-    });
-    if !factored {
-        return Err("redundancy numbers: the information matrix is singular".into());
-    }
+    let mut system = factored_information(graph, "redundancy numbers")?;
     let mut all = Vec::with_capacity(graph.factors.len());
     for factor in &graph.factors {
         if !kinds.contains(&factor.kind()) {
             all.push(None);
             continue;
         }
-        let rows = factor.residual_dim();
-        let mut blocks: Vec<DMatrix<f64>> = factor
-            .variables()
-            .iter()
-            .map(|&id| DMatrix::zeros(rows, graph.values.tangent_dim(id)))
-            .collect();
-        factor.evaluate(&graph.values, Some(&mut blocks)).ok_or_else(|| {
-            format!(
-                "redundancy numbers: a `{}` factor is undefined at the solution",
-                factor.kind()
-            )
-        })?;
-        let mut numbers = Vec::with_capacity(rows);
-        for row in 0..rows {
-            let mut a = vec![0.0; system.dim];
-            for (block, &id) in blocks.iter().zip(factor.variables()) {
-                if let Some(offset) = system.offsets[id.0] {
-                    for c in 0..block.ncols() {
-                        a[offset + c] = block[(row, c)] / factor.sigmas()[row];
-                    }
-                }
-            }
+        let (_, rows) = whitened_rows(graph, factor.as_ref(), &system, "redundancy numbers")?;
+        let mut numbers = Vec::with_capacity(rows.len());
+        for a in &rows {
             let leverage = system
-                .inverse_quadratic_form(&a)
+                .inverse_quadratic_form(a)
                 .ok_or("redundancy numbers: the solve with the information matrix failed")?;
             numbers.push((1.0 - leverage).clamp(0.0, 1.0));
         }
         all.push(Some(numbers));
     }
     Ok(all)
+}
+
+/// The undamped information matrix `H = A^T A` at the graph's values,
+/// factored (`what` names the caller in errors). A rank-deficient fit (a
+/// direction the data do not fix) has no inverse: the smallest damping that
+/// factors stands in for it, which leaves every quadratic form of a row the
+/// data do control unchanged to that order.
+pub(super) fn factored_information(graph: &FactorGraph, what: &str) -> Result<LinearSystem, String> {
+    let mut system = LinearSystem::new(&graph.values, &graph.factors, &graph.local_groups)?;
+    let hessian = linearize(graph, &graph.values, &system)
+        .map_err(|e| format!("{what} at the solution: {e}"))?
+        .hessian;
+    let diagonal = system.diagonal(&hessian);
+    let factored = [0.0, 1e-12, 1e-9, 1e-6].into_iter().any(|relative| {
+        let damping: Vec<f64> = diagonal.iter().map(|d| relative * d.abs().max(1e-300)).collect();
+        system.factorize(&hessian, &damping)
+    });
+    if !factored {
+        return Err(format!("{what}: the information matrix is singular"));
+    }
+    Ok(system)
+}
+
+/// One factor at the graph's values: its whitened residual `r_i / sigma_i`
+/// and each row's whitened Jacobian `a_i = J_i / sigma_i`, dense over the
+/// system's unknowns (`what` names the caller in errors).
+pub(super) fn whitened_rows(
+    graph: &FactorGraph,
+    factor: &dyn Factor,
+    system: &LinearSystem,
+    what: &str,
+) -> Result<(Vec<f64>, Vec<Vec<f64>>), String> {
+    let rows = factor.residual_dim();
+    let mut blocks: Vec<DMatrix<f64>> = factor
+        .variables()
+        .iter()
+        .map(|&id| DMatrix::zeros(rows, graph.values.tangent_dim(id)))
+        .collect();
+    let residual = factor
+        .evaluate(&graph.values, Some(&mut blocks))
+        .ok_or_else(|| format!("{what}: a `{}` factor is undefined at the solution", factor.kind()))?;
+    let sigmas = factor.sigmas();
+    let whitened = (0..rows).map(|row| residual[row] / sigmas[row]).collect();
+    let jacobian = (0..rows)
+        .map(|row| {
+            let mut a = vec![0.0; system.dim];
+            for (block, &id) in blocks.iter().zip(factor.variables()) {
+                if let Some(offset) = system.offsets[id.0] {
+                    for c in 0..block.ncols() {
+                        a[offset + c] = block[(row, c)] / sigmas[row];
+                    }
+                }
+            }
+            a
+        })
+        .collect();
+    Ok((whitened, jacobian))
 }
 
 #[cfg(test)]
