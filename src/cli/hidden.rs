@@ -62,6 +62,16 @@ struct Summary {
     /// Honest verdicts among the diagnoses of detectable cases with a hidden
     /// effect left out of the catalogue (NaN without `--catalogue leave-one-out`).
     left_out_honest_rate: f64,
+    /// Mean chi-square per degree of freedom of the unseen poses, localised
+    /// with the baseline's robot, over every case.
+    held_out_before: f64,
+    /// The same with the final model's robot.
+    held_out_after: f64,
+    /// Cases whose verdict names a cause.
+    declared: usize,
+    /// Those whose final model does not lower the unseen poses' mean
+    /// chi-square per degree of freedom: a declared cause that does not predict.
+    declared_not_predicting: usize,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -141,7 +151,7 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         poses: args.poses,
         noises: args.noise.clone(),
         ranges: robots.iter().map(|r| (r.name.clone(), effect_ranges(r))).collect(),
-        summaries: summaries(&robots, &args.noise, &scores),
+        summaries: summaries(&robots, &args.noise, &scores, &cases),
         scores,
         smallest,
         cases,
@@ -241,7 +251,7 @@ fn score(robot: &str, noise: NoisePreset, hidden: &str, group: &[&HiddenCase]) -
 }
 
 /// Per robot and noise reading: the rates the issue asks for.
-fn summaries(robots: &[Robot], noises: &[NoisePreset], scores: &[EffectScore]) -> Vec<Summary> {
+fn summaries(robots: &[Robot], noises: &[NoisePreset], scores: &[EffectScore], cases: &[HiddenCase]) -> Vec<Summary> {
     let rate = |num: usize, den: usize| if den == 0 { f64::NAN } else { num as f64 / den as f64 };
     let mut out = Vec::new();
     for robot in robots {
@@ -257,6 +267,18 @@ fn summaries(robots: &[Robot], noises: &[NoisePreset], scores: &[EffectScore]) -
             let pair = |s: &EffectScore| s.hidden.contains('+');
             let none = |s: &EffectScore| s.hidden == "none";
             let effect = |s: &EffectScore| s.hidden != "none";
+            let own: Vec<&HiddenCase> = cases
+                .iter()
+                .filter(|c| c.robot == robot.name && c.noise == *noise)
+                .collect();
+            let mean = |value: &dyn Fn(&HiddenCase) -> f64| {
+                let values: Vec<f64> = own.iter().map(|c| value(c)).filter(|v| v.is_finite()).collect();
+                values.iter().sum::<f64>() / values.len().max(1) as f64
+            };
+            let declared: Vec<&&HiddenCase> = own
+                .iter()
+                .filter(|c| c.verdict.split('+').any(|t| t != "none" && t != "unexplained"))
+                .collect();
             out.push(Summary {
                 robot: robot.name.clone(),
                 noise: *noise,
@@ -268,6 +290,18 @@ fn summaries(robots: &[Robot], noises: &[NoisePreset], scores: &[EffectScore]) -
                     sum(&effect, &|s| s.left_out_honest),
                     sum(&effect, &|s| s.left_out_detectable),
                 ),
+                held_out_before: mean(&|c| c.held_out.chi_square_per_dof_before),
+                held_out_after: mean(&|c| c.held_out.chi_square_per_dof_after),
+                declared: declared.len(),
+                declared_not_predicting: declared
+                    .iter()
+                    .filter(|c| {
+                        c.held_out
+                            .chi_square_per_dof_after
+                            .total_cmp(&c.held_out.chi_square_per_dof_before)
+                            .is_gt()
+                    })
+                    .count(),
             });
         }
     }
@@ -294,8 +328,42 @@ fn print_report(args: &HiddenEffectsArgs, report: &Report) {
     }
     print_scores(&report.scores);
     print_summaries(&report.summaries);
+    print_dishonest(&report.cases);
     print_unmeasurable(&report.unmeasurable);
     print_smallest(&report.smallest);
+}
+
+/// With the hidden effect left out of the catalogue: the detectable cases
+/// whose verdict was not honest, each with the full catalogue's verdict.
+fn print_dishonest(cases: &[HiddenCase]) {
+    let mut t = Table::new([
+        "robot",
+        "noise",
+        "hidden",
+        "seed",
+        "left out",
+        "verdict",
+        "full catalogue's verdict",
+    ]);
+    let mut count = 0;
+    for c in cases.iter().filter(|c| c.power.is_some_and(|p| p >= DETECTABLE_POWER)) {
+        for x in c.left_out.iter().filter(|x| !x.honest) {
+            count += 1;
+            t.row([
+                c.robot.clone(),
+                format!("{:?}", c.noise).to_lowercase(),
+                c.hidden.clone(),
+                c.seed.to_string(),
+                x.left_out.clone(),
+                x.verdict.clone(),
+                c.verdict.clone(),
+            ]);
+        }
+    }
+    if count > 0 {
+        println!("{count} verdict(s) not honest with the hidden effect left out (detectable cases):");
+        println!("{t}");
+    }
 }
 
 /// The cases left out because sagcal refuses their simulated readings.
@@ -366,6 +434,8 @@ fn print_summaries(summaries: &[Summary]) {
         "`none` wrongly rejected",
         "anchor error at least halved",
         "honest with the hidden effect left out",
+        "unseen poses: chi2/dof baseline -> final",
+        "causes declared / not predicting unseen poses",
     ]);
     let pct = |x: f64| {
         if x.is_finite() {
@@ -383,6 +453,8 @@ fn print_summaries(summaries: &[Summary]) {
             pct(s.none_false_rejection_rate),
             pct(s.halved_rate),
             pct(s.left_out_honest_rate),
+            format!("{:.2} -> {:.2}", s.held_out_before, s.held_out_after),
+            format!("{} / {}", s.declared, s.declared_not_predicting),
         ]);
     }
     println!("{t}");

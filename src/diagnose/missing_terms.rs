@@ -7,7 +7,10 @@
 //! wrap angle, platform height) and each pose driver (platform x and y, and, where the rows are in the order taken, the row: a
 //! drift, and each cable's direction of last motion: friction, backlash,
 //! hysteresis); the load cell and the localiser's position against the same
-//! drivers (a per-cable driver taken as its mean over the cables). The
+//! drivers (a per-cable driver taken as its mean over the cables), and so
+//! is the localiser's orientation (its rotation error, where the model has
+//! the orientation as a prior); each reading also against a constant (a
+//! bias: an encoder's is its offset, so only the others' are testable). The
 //! measured tension, a driver of step 2, is not one here: it holds the load
 //! cell's own noise, so it correlates with the residuals under any model.
 //!
@@ -35,9 +38,7 @@
 
 use serde::Serialize;
 
-use super::drivers::{
-    driver_value, drivers_tested, residual_value, PoseSample, DIRECTION_DRIVER, MEASURED_TENSION, RESIDUALS, ROW_DRIVER,
-};
+use super::drivers::{driver_value, drivers_tested, PoseSample, DIRECTION_DRIVER, MEASURED_TENSION, ROW_DRIVER};
 use crate::calib::CalibrationGraph;
 use crate::error::{Error, Result};
 use crate::model::measurement::{PoseMeasurement, Sensor};
@@ -84,7 +85,11 @@ impl MissingTerm {
     /// The term as a formula with its coefficient and 1-sigma, and what
     /// such a term is in the robot, where a driver of time or motion says it.
     pub fn formula(&self) -> String {
-        let unit = if self.residual == "load_cell" { "N" } else { "m" };
+        let unit = match self.residual.as_str() {
+            "load_cell" => "N",
+            r if r.starts_with("orientation") => "rad",
+            _ => "m",
+        };
         let per = match self.driver.as_str() {
             ROW_DRIVER => "row".to_string(),
             DIRECTION_DRIVER => "unit of the direction of last motion (+1 out, -1 in)".to_string(),
@@ -98,7 +103,10 @@ impl MissingTerm {
             "load_cell" => "load-cell reading",
             "position_x" => "localiser x",
             "position_y" => "localiser y",
-            _ => "localiser z",
+            "position_z" => "localiser z",
+            "orientation_x" => "localiser orientation about x",
+            "orientation_y" => "localiser orientation about y",
+            _ => "localiser orientation about z",
         };
         let what = match (self.residual.as_str(), self.driver.as_str()) {
             ("encoder", ROW_DRIVER) => ": the encoders drift over time",
@@ -112,12 +120,34 @@ impl MissingTerm {
             true => String::new(),
             false => format!(" (or, alike in these data: {})", self.alike.join(", ")),
         };
+        if self.driver == CONSTANT_DRIVER {
+            return format!(
+                "{reading} - model = ({:+.3e} +- {:.1e}) {unit}, a constant bias (z = {:+.1}){alike}",
+                self.coefficient, self.sigma, self.z
+            );
+        }
         format!(
             "{reading} - model = ({:+.3e} +- {:.1e}) {unit} per {per} (about its mean; z = {:+.1}){what}{alike}",
             self.coefficient, self.sigma, self.z
         )
     }
 }
+
+/// The readings whose residuals the terms describe: step 2's, and the
+/// localiser's orientation (its rotation error about world x, y, z, rad).
+const TERM_RESIDUALS: [&str; 8] = [
+    "encoder",
+    "load_cell",
+    "position_x",
+    "position_y",
+    "position_z",
+    "orientation_x",
+    "orientation_y",
+    "orientation_z",
+];
+
+/// The driver of a constant bias: `reading - model = c` (not centred).
+pub const CONSTANT_DRIVER: &str = "constant (a bias)";
 
 /// What [`missing_terms`] finds.
 #[derive(Debug, Clone, PartialEq)]
@@ -210,11 +240,12 @@ pub(super) fn missing_terms(
     let mut directions = Vec::new();
     // The measured tension holds the load cell's own noise: as a driver it
     // would correlate with the residuals under any model.
-    let drivers: Vec<&str> = drivers_tested(time_order)
+    let mut drivers: Vec<&str> = drivers_tested(time_order)
         .into_iter()
         .filter(|d| *d != MEASURED_TENSION)
         .collect();
-    for residual in RESIDUALS {
+    drivers.push(CONSTANT_DRIVER);
+    for residual in TERM_RESIDUALS {
         for &driver in &drivers {
             let (direction, points) = direction_of(graph, used, samples, residual, driver);
             if points > 2 {
@@ -296,25 +327,40 @@ fn direction_of(
         ),
     };
     let whole = |k: usize| !sensors.iter().any(|s| used[k].excluded.contains(*s));
+    let constant = (driver == CONSTANT_DRIVER).then_some(1.0);
     // Per pose: (row in the factor, driver value) of each reading in the test.
     let readings = |k: usize, rows: usize| -> Vec<(usize, f64)> {
         let s = &samples[k];
         let all: Vec<(usize, f64)> = match residual {
             "encoder" => (0..CABLE_COUNT)
-                .filter_map(|i| Some((i, driver_value(s, driver, Some(i))?)))
+                .filter_map(|i| Some((i, constant.or_else(|| driver_value(s, driver, Some(i)))?)))
                 .collect(),
-            "load_cell" => driver_value(s, driver, None).map(|x| (0, x)).into_iter().collect(),
+            "load_cell" => constant
+                .or_else(|| driver_value(s, driver, None))
+                .map(|x| (0, x))
+                .into_iter()
+                .collect(),
             _ => {
-                let axis = RESIDUALS.iter().position(|r| *r == residual).unwrap_or(2) - 2;
-                driver_value(s, driver, None)
-                    .map(|x| (rows - 3 + axis, x))
+                // Position rows are the factor's last three; orientation rows
+                // its first three, where it has them.
+                let (axis, first) = match residual.strip_prefix("orientation_") {
+                    Some(axis) => (axis, if rows == 6 { Some(0) } else { None }),
+                    None => (residual.strip_prefix("position_").unwrap_or("z"), Some(rows - 3)),
+                };
+                let axis = ["x", "y", "z"].iter().position(|a| *a == axis).unwrap_or(2);
+                let value = if driver == CONSTANT_DRIVER {
+                    Some(1.0)
+                } else {
+                    driver_value(s, driver, None)
+                };
+                first
+                    .zip(value)
+                    .map(|(first, x)| (first + axis, x))
                     .into_iter()
                     .collect()
             }
         };
-        all.into_iter()
-            .filter(|(row, x)| x.is_finite() && residual_value(s, residual, *row % CABLE_COUNT).is_finite())
-            .collect()
+        all.into_iter().filter(|(_, x)| x.is_finite()).collect()
     };
     let mut per_factor: Vec<Option<Vec<(usize, f64)>>> = Vec::with_capacity(graph.graph.factors.len());
     let mut pose = 0;
@@ -331,7 +377,11 @@ fn direction_of(
     }
     let values: Vec<f64> = per_factor.iter().flatten().flatten().map(|(_, x)| *x).collect();
     let points = values.len();
-    let mean = values.iter().sum::<f64>() / points.max(1) as f64;
+    // A bias is the constant itself; every other driver is centred.
+    let mean = match constant {
+        Some(_) => 0.0,
+        None => values.iter().sum::<f64>() / points.max(1) as f64,
+    };
     let direction = per_factor
         .iter()
         .zip(&graph.graph.factors)

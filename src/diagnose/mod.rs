@@ -28,8 +28,13 @@
 //!    sensor's expectation its redundancy) and hold no stand-in
 //!    (`stand_ins`: an estimate beyond what any real robot could have,
 //!    [`crate::model::effect_limits`]; an effect whose own sensor stays
-//!    inconsistent; freed orientations). Hypotheses whose BIC is within 2 of
-//!    each other are named together (`X|Y`);
+//!    inconsistent; freed orientations) and leave no structure: no term
+//!    (a reading's residual linear in a driver, the row or the direction of
+//!    motion) beyond Rao's score test at the stated rate (`missing_terms`).
+//!    The terms missing are proposed by a sparse regression; the causes of
+//!    a model that does not explain the data are named only where they are
+//!    needed beyond those terms. Hypotheses whose BIC is within 2 of each
+//!    other are named together (`X|Y`);
 //! 6. reports the verdict (the causes in the order added, joined by `+`;
 //!    `none` when nothing is wrong; `unexplained`, or the causes and
 //!    `+unexplained`, when the catalogue does not hold what is wrong), the
@@ -389,6 +394,7 @@ pub fn diagnose(
         gain,
         baseline_error_over_sigma: truth.map(|t| error_over_sigma(&base.result.robot, t, &base.result.uncertainty)),
         robot_after: model.result.robot.clone(),
+        robot_before: base.result.robot.clone(),
         series,
         excluded_readings,
         mistakes,

@@ -110,6 +110,9 @@ pub struct Diagnosis {
     /// The final model's calibrated robot (anchors, offsets, effects); the baseline's without hypotheses.
     #[serde(skip)]
     pub robot_after: Robot,
+    /// The baseline's calibrated robot.
+    #[serde(skip)]
+    pub robot_before: Robot,
     /// Residual against the winning driver (or the strongest, for `none`).
     #[serde(skip)]
     pub series: DriverSeries,

@@ -85,6 +85,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::held_out::{held_out_prediction, HeldOutPrediction};
 use crate::calib::{calibrate, validate_measurements, CalibrationError, CalibrationOptions};
 use crate::diagnose::{diagnose, power_against, CandidateFit, DiagnoseOptions};
 use crate::error::{Error, Result};
@@ -183,6 +184,9 @@ pub struct HiddenCase {
     pub baseline_error_over_sigma: f64,
     /// Pulley cases: anchor error of a calibration given the true radius.
     pub anchor_mae_known_geometry_m: Option<f64>,
+    /// [`HELD_OUT_POSES`] unseen poses of the same truth localised with the
+    /// baseline's robot and the final model's.
+    pub held_out: HeldOutPrediction,
 }
 
 /// The mean reference-cable tension over `poses` sampled equilibria, newtons.
@@ -220,6 +224,8 @@ pub struct SimulatedTruth {
     equilibria: Vec<Equilibrium>,
     rng: ChaCha8Rng,
     nominal: Robot,
+    closure: Closure,
+    seed: u64,
 }
 
 /// Draw the truth of the case `seed` hiding `hidden` (the poses closed by
@@ -251,6 +257,8 @@ pub fn simulate_truth(
         equilibria,
         rng,
         nominal: nominal.clone(),
+        closure: options.closure,
+        seed,
     })
 }
 
@@ -273,7 +281,25 @@ impl SimulatedTruth {
         truth.effects = self.effects;
         Ok((measurements, truth, self.nominal.clone()))
     }
+
+    /// [`HELD_OUT_POSES`] more poses of the same truth under `noise`, drawn
+    /// from a random stream of their own (seeded from the case's seed), so
+    /// that the case's own data are the same with or without them.
+    pub fn held_out(&self, noise: NoisePreset, segments: usize) -> Result<Vec<PoseMeasurement>> {
+        let mut rng = ChaCha8Rng::seed_from_u64(self.seed ^ HELD_OUT_STREAM);
+        let workspace = Workspace::default_for(&self.truth);
+        let equilibria = sample_equilibria_with(&self.truth, &workspace, HELD_OUT_POSES, self.closure, &mut rng)?;
+        let sigmas = noise.sigmas(self.truth.platform_weight_n);
+        measure_with_effects(&self.truth, &self.effects, &equilibria, &sigmas, segments, &mut rng)
+    }
 }
+
+/// Poses of each case's truth held out of its diagnosis, to measure what
+/// the final model predicts ([`crate::experiments::HeldOutPrediction`]).
+pub const HELD_OUT_POSES: usize = 15;
+
+/// Mixed into a case's seed for its held-out poses' random stream.
+const HELD_OUT_STREAM: u64 = 0x6865_6c64_6f75_7421;
 
 /// One case's data: the measurements, the true robot (off the nominal one,
 /// its effects set) and the initial guess (the nominal robot). The poses are
@@ -313,22 +339,19 @@ pub fn run_case(
     seed: u64,
     options: &HiddenEffectOptions,
 ) -> Result<HiddenCase> {
-    diagnose_case(
-        nominal,
-        hidden,
-        seed,
-        options,
-        simulate_case(nominal, hidden, seed, options)?,
-    )
+    let simulated = simulate_truth(nominal, hidden, seed, options)?;
+    let held_out = simulated.held_out(options.noise, options.segments)?;
+    let data = simulated.measure(options.noise, options.segments)?;
+    diagnose_case(nominal, (hidden, seed), options, data, &held_out)
 }
 
 /// [`run_case`] on the case's simulated data (`measurements, truth, guess`).
 fn diagnose_case(
     nominal: &Robot,
-    hidden: &[EffectKind],
-    seed: u64,
+    (hidden, seed): (&[EffectKind], u64),
     options: &HiddenEffectOptions,
     (measurements, truth, guess): (Vec<PoseMeasurement>, Robot, Robot),
+    held_out: &[PoseMeasurement],
 ) -> Result<HiddenCase> {
     let mut diagnose_options =
         DiagnoseOptions::new(CalibrationOptions::new(options.noise.sigmas(truth.platform_weight_n)));
@@ -413,6 +436,12 @@ fn diagnose_case(
         anchor_mae_extended_m,
         baseline_error_over_sigma: diagnosis.baseline_error_over_sigma.unwrap_or(f64::NAN),
         anchor_mae_known_geometry_m,
+        held_out: held_out_prediction(
+            &diagnosis.robot_before,
+            &diagnosis.robot_after,
+            &diagnose_options.calibration.noise,
+            held_out,
+        ),
     })
 }
 
@@ -525,7 +554,7 @@ pub struct SweepCases {
 
 /// One case of a sweep: diagnosed, or its readings refused.
 enum SweepCase {
-    Diagnosed(HiddenCase),
+    Diagnosed(Box<HiddenCase>),
     Unmeasurable(UnmeasurableCase),
 }
 
@@ -605,8 +634,11 @@ pub fn run_sweep(
                     let case = simulated
                         .as_ref()
                         .map_err(|e| Error::InvalidInput(e.to_string()))
-                        .and_then(|truth| truth.measure(*noise, options.segments))
-                        .and_then(|data| match refused_readings(&data.0) {
+                        .and_then(|truth| {
+                            let held_out = truth.held_out(*noise, options.segments)?;
+                            Ok((truth.measure(*noise, options.segments)?, held_out))
+                        })
+                        .and_then(|(data, held_out)| match refused_readings(&data.0) {
                             Some(reason) => Ok(SweepCase::Unmeasurable(UnmeasurableCase {
                                 robot: robots[*r].name.clone(),
                                 seed,
@@ -614,9 +646,8 @@ pub fn run_sweep(
                                 hidden: set_name(set.iter().map(|k| k.name().to_string())),
                                 reason,
                             })),
-                            None => {
-                                diagnose_case(&robots[*r], set, seed, &case_options, data).map(SweepCase::Diagnosed)
-                            }
+                            None => diagnose_case(&robots[*r], (set, seed), &case_options, data, &held_out)
+                                .map(|case| SweepCase::Diagnosed(Box::new(case))),
                         })
                         .map_err(|e| {
                             Error::InvalidInput(format!("{}: {e}", name(*r, set, format!("{noise:?}"), seed)))
@@ -635,7 +666,7 @@ pub fn run_sweep(
             for (j, job) in jobs.iter().enumerate() {
                 if job.0 == r {
                     match by_job[j].next().transpose()? {
-                        Some(SweepCase::Diagnosed(case)) => cases.diagnosed.push(case),
+                        Some(SweepCase::Diagnosed(case)) => cases.diagnosed.push(*case),
                         Some(SweepCase::Unmeasurable(case)) => cases.unmeasurable.push(case),
                         None => {}
                     }

@@ -22,6 +22,7 @@
 //! ```
 
 pub mod benchmark;
+mod held_out;
 mod hidden_draws;
 pub mod hidden_effects;
 mod hidden_options;
@@ -32,3 +33,5 @@ pub mod plan_candidates;
 pub mod pose_plan;
 pub mod selection;
 pub mod table2;
+
+pub use held_out::{held_out_prediction, HeldOutPrediction};
