@@ -240,7 +240,10 @@ pub(super) fn explain(
     let base_terms = || missing_terms(&base.graph, &base.used, base_samples, time_order, false_alarm);
     let (of, terms) = match stand_ins.is_empty() {
         true => (
-            model.name(),
+            match model.hypotheses.is_empty() {
+                true => "the baseline".to_string(),
+                false => model.name(),
+            },
             missing_terms(&graph, &base.used, samples, time_order, false_alarm)?,
         ),
         false => ("the baseline".to_string(), base_terms()?),
