@@ -211,6 +211,18 @@ fn a_hidden_effect_left_out_of_the_catalogue_is_unexplained_not_a_wrong_cause() 
             blind.verdict,
             blind.reason
         );
+        // The load cell's gain error shows as a term: its reading grows by
+        // 0.04 N per newton of the tension it reads.
+        if kind == EffectKind::LoadCell {
+            let gain = blind
+                .explanation
+                .missing_terms
+                .iter()
+                .find(|t| t.residual == "load_cell" && t.driver == "tension at the pulley (N)")
+                .expect("the gain is a missing term");
+            println!("{}", gain.formula());
+            assert!((gain.coefficient - 0.04).abs() < 5.0 * gain.sigma, "{gain:?}");
+        }
     }
 }
 

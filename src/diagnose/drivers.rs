@@ -68,6 +68,8 @@ pub(super) struct PoseSample {
     position: [f64; 3],
     /// The row, counted from 1 in the order the poses were taken.
     row: f64,
+    /// The cable the load cell reads (robot cable order).
+    pub reference_cable: usize,
     /// Per cable: +1 when its encoder reading grew since the previous row
     /// (paid out), -1 when it shrank (reeled in), NaN for the first row.
     direction: [f64; CABLE_COUNT],
@@ -177,6 +179,7 @@ pub(super) fn samples(
                 _ => (used[k].encoder_lengths_m[i] - used[k - 1].encoder_lengths_m[i]).signum(),
             });
             Ok(PoseSample {
+                reference_cable: robot.reference_cable,
                 row: (k + 1) as f64,
                 direction,
                 cable_drivers,

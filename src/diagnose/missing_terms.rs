@@ -6,8 +6,10 @@
 //! each per-cable driver (tension, tension x length, length, sag, elevation,
 //! wrap angle, platform height) and each pose driver (platform x and y, and, where the rows are in the order taken, the row: a
 //! drift, and each cable's direction of last motion: friction, backlash,
-//! hysteresis); the load cell and the localiser's position against the same
-//! drivers (a per-cable driver taken as its mean over the cables), and so
+//! hysteresis); the load cell against the same drivers (a per-cable driver
+//! at the cable it reads: a gain error is then `c` newtons per newton of
+//! its tension); the localiser's position against them too (a per-cable
+//! driver taken as its mean over the cables), and so
 //! is the localiser's orientation (its rotation error, where the model has
 //! the orientation as a prior); each reading also against a constant (a
 //! bias: an encoder's is its offset, so only the others' are testable). The
@@ -336,7 +338,7 @@ fn direction_of(
                 .filter_map(|i| Some((i, constant.or_else(|| driver_value(s, driver, Some(i)))?)))
                 .collect(),
             "load_cell" => constant
-                .or_else(|| driver_value(s, driver, None))
+                .or_else(|| driver_value(s, driver, Some(s.reference_cable)))
                 .map(|x| (0, x))
                 .into_iter()
                 .collect(),
