@@ -31,7 +31,7 @@
 //!
 //! A model that does not explain the data names its causes only where they
 //! are needed beyond the terms proposed for the baseline
-//! ([`super::missing_terms::CausesGivenTerms`]: their likelihood ratio given
+//! ([`CausesGivenTerms`]: their likelihood ratio given
 //! those terms, at `false_alarm`); otherwise they fitted part of what is
 //! wrong as proxies, and the verdict is `unexplained`.
 //!
@@ -95,7 +95,7 @@ pub struct Explanation {
     pub structure_left: Vec<String>,
     /// The `|z|` above which a term the final model lacks is structure it
     /// does not explain: two-sided `p < false_alarm / m` over its `m`
-    /// testable terms (Bonferroni, [`super::missing_terms`]).
+    /// testable terms (Bonferroni, `missing_terms`).
     pub structure_limit_t: f64,
     /// The terms beyond it, in words: structure the final model misses (part
     /// of `explained`, module docs).
@@ -103,7 +103,7 @@ pub struct Explanation {
     /// The same terms, strongest first.
     pub missing_terms: Vec<MissingTerm>,
     /// The missing terms proposed (a sparse regression of the residuals,
-    /// [`super::missing_terms`]), with coefficients fitted together.
+    /// `missing_terms`), with coefficients fitted together.
     pub proposed_terms: Vec<MissingTerm>,
     /// The model the terms are missing from: the final model, or the
     /// baseline where the final model holds a stand-in.

@@ -2,19 +2,27 @@
 //! term that would explain it (discovery).
 //!
 //! Each candidate term is one reading's residual linear in one physical
-//! driver (`reading - model = c (driver - its mean)`): the encoders against
-//! each per-cable driver (tension, tension x length, length, sag, elevation,
-//! wrap angle, platform height) and each pose driver (platform x and y, and, where the rows are in the order taken, the row: a
-//! drift, and each cable's direction of last motion: friction, backlash,
-//! hysteresis); the load cell against the same drivers (a per-cable driver
-//! at the cable it reads: a gain error is then `c` newtons per newton of
-//! its tension); the localiser's position against them too (a per-cable
-//! driver taken as its mean over the cables), and so
-//! is the localiser's orientation (its rotation error, where the model has
-//! the orientation as a prior); each reading also against a constant (a
-//! bias: an encoder's is its offset, so only the others' are testable). The
-//! measured tension, a driver of step 2, is not one here: it holds the load
-//! cell's own noise, so it correlates with the residuals under any model.
+//! driver (`reading - model = c (driver - its mean)`):
+//!
+//! - the encoders against each per-cable driver (tension, tension x length,
+//!   length, sag, elevation, wrap angle, platform height) and each pose
+//!   driver (platform x and y and, where the rows are in the order taken,
+//!   the row: a drift, and each cable's direction of last motion: friction,
+//!   backlash, hysteresis);
+//! - the load cell against the same drivers, a per-cable driver taken at the
+//!   cable it reads (a gain error is then `c` newtons per newton of its
+//!   tension);
+//! - the localiser's position and, where the model has the orientation as a
+//!   prior, its orientation (the rotation error about world x, y, z, rad)
+//!   against them, a per-cable driver taken as its mean over the cables;
+//! - each reading against a constant, `reading - model = c`: a bias (an
+//!   encoder's is its offset, so it is testable only where a pose is left
+//!   out of the encoder terms, and is then an offset step of the others).
+//!
+//! A pose with a reading of the term's sensor left out as a gross error
+//! takes no part in the term. The measured tension, a driver of step 2, is
+//! not one here: it holds the load cell's own noise, so it correlates with
+//! the residuals under any model.
 //!
 //! Each term gets Rao's score test at the fitted model
 //! ([`crate::solver::score_tests`]): its coefficient with 1-sigma as if it
@@ -33,9 +41,8 @@
 //! `|z|` given those chosen (its information and score with their
 //! coefficients re-fitted, [`crate::solver::ScoreSystem::test`]) while it
 //! exceeds the Bonferroni limit over the terms left, at most
-//! [`MOST_PROPOSED`] of them; the terms chosen are
-//! reported in words and as formulas with their coefficients fitted
-//! together. They are what the data ask for, not physical causes: the
+//! [`MOST_PROPOSED`] of them; the terms chosen are reported in words and as
+//! formulas with their coefficients fitted together. They are what the data ask for, not physical causes: the
 //! report names them as terms, never as effects.
 
 use serde::Serialize;
@@ -51,7 +58,7 @@ use crate::stats::{chi_square_critical, chi_square_survival};
 /// A term the fitted model lacks: one reading's residual linear in one driver.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct MissingTerm {
-    /// The reading (`encoder`, `load_cell`, `position_x|y|z`).
+    /// The reading (`encoder`, `load_cell`, `position_x|y|z`, `orientation_x|y|z`).
     pub residual: String,
     /// The driver, with its unit.
     pub driver: String,

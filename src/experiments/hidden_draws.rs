@@ -83,7 +83,7 @@ fn signed(rng: &mut impl Rng, low: f64, high: f64) -> f64 {
 }
 
 /// Draw the magnitudes of `hidden` for `robot` (empty: no effect), each
-/// from its range ([`effect_ranges`]).
+/// from its range ([`crate::model::effect_ranges`]).
 pub fn draw_effects(
     robot: &Robot,
     hidden: &[EffectKind],

@@ -46,7 +46,7 @@ pub struct LeftOut {
     pub left_out: String,
     /// The verdict.
     pub verdict: String,
-    /// Whether the verdict is honest ([`honest`]).
+    /// Whether the verdict is honest (`honest`).
     pub honest: bool,
 }
 
