@@ -67,7 +67,7 @@ pub fn validate_measurements(measurements: &[PoseMeasurement]) -> Result<()> {
 
 /// The localiser's pose of a measurement.
 pub(super) fn measured_pose(m: &PoseMeasurement) -> PlatformPose {
-    PlatformPose::from_roll_pitch_yaw_deg(Vector3::from(m.position_m), m.roll_deg, m.pitch_deg, m.yaw_deg)
+    m.localiser_pose()
 }
 
 /// The graph and its variable ids.

@@ -10,7 +10,6 @@ use serde::Serialize;
 
 use crate::localize::{LocalizeOptions, Localizer, Readings};
 use crate::model::measurement::PoseMeasurement;
-use crate::model::pose::PlatformPose;
 use crate::model::robot::Robot;
 use crate::model::sensors::SensorNoise;
 
@@ -49,12 +48,7 @@ pub fn held_out_prediction(
                 let readings = Readings {
                     encoder_lengths_m: m.encoder_lengths_m,
                     load_cell_n: Some(m.reference_tension_n),
-                    localiser_pose: Some(PlatformPose::from_roll_pitch_yaw_deg(
-                        m.position_m.into(),
-                        m.roll_deg,
-                        m.pitch_deg,
-                        m.yaw_deg,
-                    )),
+                    localiser_pose: Some(m.localiser_pose()),
                 };
                 let found = localizer.localize(&readings, None).ok()?;
                 (found.degrees_of_freedom > 0).then(|| found.chi_square / found.degrees_of_freedom as f64)

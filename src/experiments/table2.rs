@@ -110,8 +110,7 @@ pub fn pose_pool(robot: &Robot, measurements: &[PoseMeasurement], source: Source
     let options = StaticsOptions::default();
     let mut pool = Vec::with_capacity(measurements.len());
     for m in measurements {
-        let logged =
-            PlatformPose::from_roll_pitch_yaw_deg(Vector3::from(m.position_m), m.roll_deg, m.pitch_deg, m.yaw_deg);
+        let logged = m.localiser_pose();
         let equilibrium = statics::solve_with_reference_tension(
             robot,
             logged.position_m,

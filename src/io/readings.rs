@@ -201,12 +201,7 @@ fn read_measurement_rows(path: &Path, reference_cable: usize) -> Result<Readings
             line: m.line,
             encoder_lengths_m: m.encoder_lengths_m,
             load_cell_n: Some(m.reference_tension_n),
-            localiser_pose: Some(PlatformPose::from_roll_pitch_yaw_deg(
-                m.position_m.into(),
-                m.roll_deg,
-                m.pitch_deg,
-                m.yaw_deg,
-            )),
+            localiser_pose: Some(m.localiser_pose()),
         })
         .collect();
     Ok(ReadingsFile {

@@ -13,6 +13,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::model::pose::PlatformPose;
+
 /// One static pose: localiser pose, encoder readings and load-cell tension.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PoseMeasurement {
@@ -36,6 +38,13 @@ pub struct PoseMeasurement {
     /// snooping, `crate::calib::gross_errors`); empty as read from a file.
     #[serde(default, skip_serializing_if = "ReadingSet::is_empty")]
     pub excluded: ReadingSet,
+}
+
+impl PoseMeasurement {
+    /// The localiser's reading as a pose (its position and roll, pitch, yaw).
+    pub fn localiser_pose(&self) -> PlatformPose {
+        PlatformPose::from_roll_pitch_yaw_deg(self.position_m.into(), self.roll_deg, self.pitch_deg, self.yaw_deg)
+    }
 }
 
 /// One reading of a pose: a sensor, and for encoders and localiser axes which one.
