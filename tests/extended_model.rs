@@ -11,12 +11,13 @@ use sagcal::calib::{build_graph, CableModel, CalibrationOptions};
 use sagcal::graph::{FactorGraph, VariableValue};
 use sagcal::io::measurements::PoseMeasurement;
 use sagcal::model::effect_kind::{EffectKind, EffectSet};
+use sagcal::model::measurement::mark_time_order;
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::statics::{CableTension, Equilibrium};
 use sagcal::model::{Effects, PlatformPose, Robot};
 use sagcal::sim::closed_form::{sample_equilibria, Workspace};
 use sagcal::sim::discretised::DiscretisedEquilibrium;
-use sagcal::sim::effects::solve_with_effects;
+use sagcal::sim::effects::{measure_with_effects, solve_with_effects};
 
 fn effects(specs: &[&str]) -> Effects {
     let mut e = Effects::default();
@@ -51,6 +52,7 @@ fn from_discretised(
             encoder_lengths_m: std::array::from_fn(|i| eq.paid_out_lengths_m[i] + robot.length_offsets_m[i]),
             reference_tension_n: force.norm(),
             excluded: Default::default(),
+            order: None,
         });
         poses.push(eq.pose);
         tensions.push(CableTension {
@@ -98,6 +100,7 @@ fn neutral_effects_reproduce_the_baseline_factors() {
                 encoder_lengths_m: std::array::from_fn(|i| eq.cable_lengths_m[i] + 0.01 * i as f64),
                 reference_tension_n: eq.tensions[robot.reference_cable].magnitude_n() + 3.0,
                 excluded: Default::default(),
+                order: None,
             }
         })
         .collect();
@@ -150,10 +153,15 @@ fn extended_jacobians_match_central_differences() {
         "com:dx_m=0.02,dy_m=-0.01,dz_m=0.05",
         "platform-weight:scale=1.05",
         "cable-weight:scale=0.93",
+        "encoder-drift:rate1_m=1e-4,rate2_m=-2e-4,rate3_m=3e-4,rate4_m=5e-5",
+        "encoder-backlash:b1_m=0.002,b2_m=-0.001,b3_m=0.003,b4_m=0.0015",
+        "loadcell-drift:rate_n=0.5",
+        "loadcell-friction:k=0.02",
     ];
     robot.effects = effects(&all);
     let eqs = equilibria(&robot, 3);
-    let measurements: Vec<PoseMeasurement> = eqs
+    // Rows in time order: the drift and the direction of motion act.
+    let mut measurements: Vec<PoseMeasurement> = eqs
         .iter()
         .map(|eq| {
             let (roll_deg, pitch_deg, yaw_deg) = eq.pose.roll_pitch_yaw_deg();
@@ -166,9 +174,14 @@ fn extended_jacobians_match_central_differences() {
                 encoder_lengths_m: eq.cable_lengths_m,
                 reference_tension_n: eq.tensions[robot.reference_cable].magnitude_n(),
                 excluded: Default::default(),
+                order: None,
             }
         })
         .collect();
+    mark_time_order(&mut measurements);
+    assert!(measurements[1..]
+        .iter()
+        .all(|m| m.order.unwrap().direction.iter().all(|d| *d != 0)));
     let poses: Vec<PlatformPose> = eqs.iter().map(|e| e.pose).collect();
     let tensions: Vec<CableTension> = eqs.iter().map(|e| e.tensions[robot.reference_cable]).collect();
     let mut worst = 0.0_f64;
@@ -195,6 +208,16 @@ fn extended_jacobians_match_central_differences() {
                         // 1/n^2 moves the lengths (~100 m) by ~0.2 m per unit: a step of 1e-8
                         // would leave central differences at the rounding level.
                         VariableValue::Vector(_) if var == built.effects.unwrap().inverse_segments_squared => 1e-4,
+                        // Millimetres on lengths of ~100 m: the residual is linear in them.
+                        VariableValue::Vector(_)
+                            if [
+                                built.effects.unwrap().encoder_drift,
+                                built.effects.unwrap().encoder_backlash,
+                            ]
+                            .contains(&var) =>
+                        {
+                            1e-2
+                        }
                         VariableValue::Vector(v) => 1e-6 * v[c].abs().max(1e-2),
                     };
                     let eval = |sign: f64| -> DVector<f64> {
@@ -278,6 +301,70 @@ fn extended_model_matches_the_discretised_simulator() {
         );
         assert!(e_len < extended_max_m && e_height < extended_max_m);
     }
+}
+
+/// The effects of time and motion: the simulator's noise-free readings (rows
+/// in order, each cable's true direction of last motion) against the
+/// extended model with the true effects, which takes the directions from the
+/// readings. From the second row on it leaves the discretisation error;
+/// the baseline misses by the drift and backlash (millimetres) and the
+/// friction (tens of newtons). The first row's direction is unknown to the
+/// model (0): it misses there by the backlash and the friction.
+#[test]
+fn time_and_motion_match_the_simulator_after_the_first_row() {
+    let robot = Robot::builtin("large").unwrap();
+    let e = effects(&[
+        "encoder-drift:rate1_m=5e-4,rate2_m=-3e-4,rate3_m=2e-4,rate4_m=-6e-4",
+        "encoder-backlash:b1_m=0.003,b2_m=-0.002,b3_m=0.004,b4_m=0.001",
+        "loadcell-drift:rate_n=1.5",
+        "loadcell-friction:k=0.03",
+    ]);
+    let eqs = equilibria(&robot, 6);
+    let solved = solve_with_effects(&robot, &e, &eqs, 200).unwrap();
+    let (_, poses, tensions) = from_discretised(&robot, &solved);
+    let none = NoisePreset::None.sigmas(robot.platform_weight_n);
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let measurements = measure_with_effects(&robot, &e, &eqs, &none, 200, &mut rng).unwrap();
+    assert_eq!(measurements[5].order.unwrap().row, 6);
+    let mut known = robot.clone();
+    known.effects = e;
+    let build = |r: &Robot| build_graph(r, &measurements, &poses, &tensions, CableModel::Catenary, &options());
+    let (baseline, extended) = (build(&robot), build(&known));
+    // Per pose (factor order is pose order), the largest residual of `kind`.
+    let per_pose = |g: &FactorGraph, kind: &str| -> Vec<f64> {
+        g.factors
+            .iter()
+            .filter(|f| f.kind() == kind)
+            .map(|f| f.evaluate(&g.values, None).unwrap().amax())
+            .collect()
+    };
+    let (b_len, x_len) = (
+        per_pose(&baseline.graph, "catenary_length"),
+        per_pose(&extended.graph, "catenary_length"),
+    );
+    let (b_cell, x_cell) = (
+        per_pose(&baseline.graph, "reference_tension"),
+        per_pose(&extended.graph, "reference_tension"),
+    );
+    println!("lengths: baseline {b_len:?}, extended {x_len:?}; load cell: baseline {b_cell:?}, extended {x_cell:?}");
+    for k in 1..6 {
+        assert!(x_len[k] < 2e-4, "row {}: {}", k + 1, x_len[k]);
+        assert!(x_cell[k] < 0.05, "row {}: {}", k + 1, x_cell[k]);
+        assert!(
+            b_len[k] > 1e-3,
+            "row {}: the baseline sees the drift and backlash",
+            k + 1
+        );
+    }
+    // (Drift and friction may cancel on one row; not on all.)
+    assert!(b_cell.iter().fold(0.0_f64, |m, r| m.max(*r)) > 20.0);
+    // Row 1: the reference cable's unknown direction leaves k |T| on the load cell.
+    let reference = tensions[0].magnitude_n();
+    assert!(
+        (x_cell[0] - 0.03 * reference).abs() < 0.01 * reference,
+        "{} vs {reference}",
+        x_cell[0]
+    );
 }
 
 /// The segmented cable against the discretised simulator run with that many

@@ -7,6 +7,7 @@ use sagcal::io::measurements::{
     read_measurements, write_measurements, MeasurementFormat, MeasurementSet, PoseMeasurement, ReadOptions,
     MEASUREMENT_HEADER,
 };
+use sagcal::model::measurement::ReadingOrder;
 use sagcal::Error;
 
 const SHARED: &str = concat!(
@@ -126,6 +127,7 @@ fn tricky_poses() -> Vec<PoseMeasurement> {
             encoder_lengths_m: [183.324069126233, -12.5, 0.0, 1e300],
             reference_tension_n: 698.722056942942,
             excluded: Default::default(),
+            order: None,
         },
         PoseMeasurement {
             line: 17,
@@ -136,6 +138,7 @@ fn tricky_poses() -> Vec<PoseMeasurement> {
             encoder_lengths_m: [1e-7, -1e-7, 171.686733095484, 9007199254740991.0],
             reference_tension_n: f64::MIN_POSITIVE,
             excluded: Default::default(),
+            order: None,
         },
         PoseMeasurement {
             line: 0,
@@ -146,6 +149,7 @@ fn tricky_poses() -> Vec<PoseMeasurement> {
             encoder_lengths_m: [156.778902665505, 171.962857387867, 184.290054861894, 170.209354387472],
             reference_tension_n: 722.490692830791,
             excluded: Default::default(),
+            order: None,
         },
     ]
 }
@@ -233,6 +237,12 @@ fn reads_comments_blank_lines_crlf_bom_and_spaces() {
             encoder_lengths_m: [180.125, -0.5, 0.0, 171.75],
             reference_tension_n: 600.5,
             excluded: Default::default(),
+            // A sagcal file's rows are in the order taken: the first has no
+            // direction of last motion.
+            order: Some(ReadingOrder {
+                row: 1,
+                direction: [0; 4]
+            }),
         }
     );
     assert_eq!(
@@ -246,6 +256,11 @@ fn reads_comments_blank_lines_crlf_bom_and_spaces() {
             encoder_lengths_m: [-100.0, 10.0, 3.0, 0.5],
             reference_tension_n: 1e-3,
             excluded: Default::default(),
+            // Each cable's direction: the sign of its reading's change since row 1.
+            order: Some(ReadingOrder {
+                row: 2,
+                direction: [-1, 1, 1, -1]
+            }),
         }
     );
 }
@@ -255,6 +270,8 @@ fn shared_recurdyn_log() {
     let Some(path) = shared() else { return };
     let set = read_measurements(path, &ReadOptions::default()).expect("shared log loads");
     assert_eq!(set.path, PathBuf::from(path));
+    // A RecurDyn log's rows are not the order a robot took its poses in.
+    assert!(set.poses.iter().all(|p| p.order.is_none()));
     assert_eq!(set.format, MeasurementFormat::RecurDyn);
     assert_eq!(set.poses.len(), 57);
     assert_eq!(set.rejected.len(), 35);
@@ -277,6 +294,7 @@ fn shared_recurdyn_log() {
             encoder_lengths_m: [183.324069126233, 169.162981532604, 155.642263929178, 170.927219368362],
             reference_tension_n: 698.722056942942,
             excluded: Default::default(),
+            order: None,
         }
     );
     let line5 = set.poses.iter().find(|p| p.line == 5).expect("line 5 kept");

@@ -56,8 +56,11 @@ pub fn measurements(value: &Bound<'_, PyAny>, reference_cable: usize) -> PyResul
             label: path,
         });
     }
+    // An array's rows are the order the poses were taken in.
+    let mut poses = from_rows(&rows::<11>(value, ARRAY_LABEL)?)?;
+    sagcal::model::measurement::mark_time_order(&mut poses);
     Ok(Data {
-        poses: from_rows(&rows::<11>(value, ARRAY_LABEL)?)?,
+        poses,
         label: PathBuf::from(ARRAY_LABEL),
         rows_in_time_order: true,
     })

@@ -114,8 +114,10 @@ impl Diagnosis {
 /// ``measurements`` an (N, 11) array or a path, as for :func:`calibrate`;
 /// ``truth`` an optional true robot (simulations) for anchor and offset
 /// errors before and after; ``candidates`` a list of effect names (default:
-/// the whole catalogue: ``elastic``, ``pulley``, ``encoder-scale``,
-/// ``loadcell``, ``com``, ``encoder-gain``, ``segments``); ``progress`` an
+/// the whole catalogue, as ``sagcal diagnose --candidates`` lists it; the
+/// effects of time and motion, ``encoder-drift``, ``encoder-backlash``,
+/// ``loadcell-drift`` and ``loadcell-friction``, only for rows in the order
+/// taken: an array or a sagcal file); ``progress`` an
 /// optional ``callable(done, total, what)`` called before each fit. The
 /// solver keywords are those of :func:`calibrate`.
 ///

@@ -40,9 +40,12 @@ use super::factors::{
     tension_argument, variable_list, CalibrationVariables, PoseVariables, SlotOrder, EPSILON,
 };
 use crate::generated;
-use crate::graph::{evaluate_through_into, Factor, RobustKernel, SharedEvaluation, Values, VariableId};
+use crate::graph::{Factor, RobustKernel, SharedEvaluation, Values, VariableId};
 use crate::model::effect_kind::EffectKind;
+use crate::model::measurement::ReadingOrder;
 use crate::model::robot::CABLE_COUNT;
+
+pub use super::load_cell_factor::LoadCellFactor;
 
 /// The effect parameters of the extended model, one variable per effect.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -73,6 +76,16 @@ pub struct EffectVariables {
     /// `[s - 1]`, the cables' weight-per-metre error as a share of the robot
     /// file's (true weight per metre = `s` x `cable_weight_n_per_m`).
     pub cable_weight_error: VariableId,
+    /// `[d_1 .. d_4]`, each drum's encoder creep, millimetres per row
+    /// (reading + `d_i row`), robot cable order.
+    pub encoder_drift: VariableId,
+    /// `[b_1 .. b_4]`, each drum's backlash, millimetres (reading + `b_i s_i`,
+    /// `s_i` the direction of last motion), robot cable order.
+    pub encoder_backlash: VariableId,
+    /// `[e]`, the load cell's creep, newtons per row.
+    pub load_cell_drift: VariableId,
+    /// `[k]`, friction `mu theta` of a pulley before a drum-side load cell (reading `T (1 - k s)`).
+    pub load_cell_friction: VariableId,
 }
 
 impl EffectVariables {
@@ -89,6 +102,10 @@ impl EffectVariables {
             EffectKind::LocaliserMount => self.localiser_mount,
             EffectKind::PlatformWeight => self.platform_weight_error,
             EffectKind::CableWeight => self.cable_weight_error,
+            EffectKind::EncoderDrift => self.encoder_drift,
+            EffectKind::EncoderBacklash => self.encoder_backlash,
+            EffectKind::LoadCellDrift => self.load_cell_drift,
+            EffectKind::LoadCellFriction => self.load_cell_friction,
         }
     }
 }
@@ -108,6 +125,9 @@ struct EffectArguments {
     /// The cables' weight per metre, N/m, and its derivative by the weight error (the file's).
     cable_weight_n_per_m: f64,
     nominal_cable_weight_n_per_m: f64,
+    /// Encoder drift (mm per row) and backlash (mm), slot order.
+    drift_mm_per_row: Vector4<f64>,
+    backlash_mm: Vector4<f64>,
 }
 
 fn effect_arguments(values: &Values, slots: &SlotOrder, effects: &EffectVariables) -> EffectArguments {
@@ -124,6 +144,8 @@ fn effect_arguments(values: &Values, slots: &SlotOrder, effects: &EffectVariable
         nominal_platform_weight_n: slots.platform_weight_n,
         cable_weight_n_per_m: slots.cable_weight_n_per_m * (1.0 + values.vector(effects.cable_weight_error)[0]),
         nominal_cable_weight_n_per_m: slots.cable_weight_n_per_m,
+        drift_mm_per_row: Vector4::from_fn(|slot, _| values.vector(effects.encoder_drift)[slots.cables[slot]]),
+        backlash_mm: Vector4::from_fn(|slot, _| values.vector(effects.encoder_backlash)[slots.cables[slot]]),
     }
 }
 
@@ -334,12 +356,26 @@ pub struct ExtendedLengthFactor {
     pose: PoseVariables,
     effects: EffectVariables,
     encoder_lengths_m: Vector4<f64>,
+    /// The pose's row (0: order unknown), and each cable's direction of last motion, slot order.
+    row: f64,
+    direction: Vector4<f64>,
     sigmas: DVector<f64>,
     kernel: RobustKernel,
     memo: Arc<ExtendedMemo>,
 }
 
 impl ExtendedLengthFactor {
+    /// The factor of a pose at `order` (its row and directions of last
+    /// motion): the encoder drift and backlash act on it. Without an order
+    /// (the default) they do not.
+    pub fn at(mut self, order: Option<ReadingOrder>) -> Self {
+        if let Some(order) = order {
+            self.row = order.row as f64;
+            self.direction = Vector4::from_fn(|slot, _| f64::from(order.direction[self.slots.cables[slot]]));
+        }
+        self
+    }
+
     /// `encoder_lengths_m` in the robot's cable order; `memo` shared with the pose's height factor.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
@@ -362,10 +398,14 @@ impl ExtendedLengthFactor {
             effects.common_gain_error,
             effects.platform_weight_error,
             effects.cable_weight_error,
+            effects.encoder_drift,
+            effects.encoder_backlash,
         ]);
         Self {
             variables,
             encoder_lengths_m: slots.to_slots(encoder_lengths_m),
+            row: 0.0,
+            direction: Vector4::zeros(),
             slots,
             globals,
             pose,
@@ -414,7 +454,11 @@ impl ExtendedLengthFactor {
     ) -> Option<DVector<f64>> {
         let s = &self.slots;
         let scale = Vector4::from_fn(|slot, _| 1.0 + e.gain_errors[slot]);
-        let residual = cables.paid_out_m.component_mul(&scale) + offsets - self.encoder_lengths_m;
+        // Drift and backlash (`Effects::time_and_motion`), millimetres to metres.
+        let time_and_motion = Vector4::from_fn(|slot, _| {
+            1e-3 * (e.drift_mm_per_row[slot] * self.row + e.backlash_mm[slot] * self.direction[slot])
+        });
+        let residual = cables.paid_out_m.component_mul(&scale) + offsets + time_and_motion - self.encoder_lengths_m;
         if let Some(blocks) = jacobians {
             let mut chained = cables.d_paid_out;
             for slot in 0..CABLE_COUNT {
@@ -431,10 +475,14 @@ impl ExtendedLengthFactor {
             split_chain(&chained, s, blocks, at);
             blocks[6..10].iter_mut().for_each(|b| b.fill(0.0));
             blocks[12].fill(0.0);
+            blocks[18].fill(0.0);
+            blocks[19].fill(0.0);
             for (slot, &cable) in s.cables.iter().enumerate() {
                 blocks[6 + cable][(slot, 0)] = 1.0;
                 blocks[12][(slot, cable)] = cables.paid_out_m[slot];
                 blocks[15][(slot, 0)] = cables.paid_out_m[slot];
+                blocks[18][(slot, cable)] = 1e-3 * self.row;
+                blocks[19][(slot, cable)] = 1e-3 * self.direction[slot];
             }
             rows_to_cables(s, blocks);
         }
@@ -595,78 +643,5 @@ impl Factor for MountedPosePriorFactor {
     }
     fn kind(&self) -> &'static str {
         "pose_prior"
-    }
-}
-
-/// Force factor with a load-cell model: `bias + (1 + gain_error) |(f_h, f_v)| - f_m`.
-pub struct LoadCellFactor {
-    variables: [VariableId; 2],
-    measured_tension_n: f64,
-    sigmas: DVector<f64>,
-    kernel: RobustKernel,
-}
-
-impl LoadCellFactor {
-    /// A load-cell reading `measured_tension_n` with standard deviation `sigma_n`;
-    /// `load_cell` is the `[bias_n, gain_error]` variable.
-    pub fn new(
-        tension: VariableId,
-        load_cell: VariableId,
-        measured_tension_n: f64,
-        sigma_n: f64,
-        kernel: RobustKernel,
-    ) -> Self {
-        Self {
-            variables: [tension, load_cell],
-            measured_tension_n,
-            sigmas: DVector::from_element(1, sigma_n),
-            kernel,
-        }
-    }
-}
-
-impl Factor for LoadCellFactor {
-    fn variables(&self) -> &[VariableId] {
-        &self.variables
-    }
-    fn residual_dim(&self) -> usize {
-        1
-    }
-    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
-        evaluate_through_into(self, values, jacobians)
-    }
-    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
-        let tension = tension_argument(values, self.variables[0]);
-        let cell = values.vector(self.variables[1]);
-        let mut j_tension = SMatrix::<f64, 1, 2>::zeros();
-        let mut j_bias = SMatrix::<f64, 1, 1>::zeros();
-        let mut j_gain = SMatrix::<f64, 1, 1>::zeros();
-        let want = jacobians.is_some();
-        let r = generated::load_cell_residual(
-            &tension,
-            cell[0],
-            cell[1],
-            self.measured_tension_n,
-            EPSILON,
-            want.then_some(&mut j_tension),
-            want.then_some(&mut j_bias),
-            want.then_some(&mut j_gain),
-        );
-        if let Some(blocks) = jacobians {
-            blocks[0].copy_from(&j_tension);
-            blocks[1][(0, 0)] = j_bias[(0, 0)];
-            blocks[1][(0, 1)] = j_gain[(0, 0)];
-        }
-        residual[0] = r[0];
-        true
-    }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.kernel
-    }
-    fn kind(&self) -> &'static str {
-        "reference_tension"
     }
 }

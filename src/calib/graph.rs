@@ -311,7 +311,8 @@ impl PoseFactors<'_> {
             noise.encoder_sigma_m,
             self.options.robust.encoder,
             self.extended_memo.clone(),
-        );
+        )
+        .at(m.order);
         push_masked(graph, Box::new(lengths), &encoder_rows(m));
         graph.add(ExtendedHeightFactor::new(
             self.slots.clone(),
@@ -327,6 +328,12 @@ impl PoseFactors<'_> {
             m.reference_tension_n,
             noise.load_cell_sigma_n,
             self.options.robust.load_cell,
+        )
+        .in_time(
+            effects.load_cell_drift,
+            effects.load_cell_friction,
+            m.order,
+            self.slots.cables[0],
         );
         push_masked(graph, Box::new(cell), &load_cell_rows(m));
     }
@@ -387,6 +394,13 @@ fn insert_effect_variables(values: &mut Values, robot: &Robot, free: EffectSet) 
         localiser_mount: vector("localiser mount (deg)", &e.localiser_mount_deg),
         platform_weight_error: vector("platform weight error", &[e.platform_weight_scale - 1.0]),
         cable_weight_error: vector("cable weight error", &[e.cable_weight_scale - 1.0]),
+        encoder_drift: vector(
+            "encoder drift (mm per row)",
+            &e.encoder_drift_m_per_row.map(|d| d * 1e3),
+        ),
+        encoder_backlash: vector("encoder backlash (mm)", &e.encoder_backlash_m.map(|b| b * 1e3)),
+        load_cell_drift: vector("load cell drift (N per row)", &[e.load_cell_drift_n_per_row]),
+        load_cell_friction: vector("load cell friction", &[e.load_cell_friction]),
     };
     for kind in EffectKind::ALL {
         values.set_fixed(variables.of(kind), !free.contains(kind));
@@ -416,6 +430,10 @@ pub fn effects_from_graph(template: &Robot, built: &CalibrationGraph) -> Option<
         localiser_mount_deg: std::array::from_fn(|i| values.vector(vars.localiser_mount)[i]),
         platform_weight_scale: 1.0 + values.vector(vars.platform_weight_error)[0],
         cable_weight_scale: 1.0 + values.vector(vars.cable_weight_error)[0],
+        encoder_drift_m_per_row: std::array::from_fn(|i| values.vector(vars.encoder_drift)[i] * 1e-3),
+        encoder_backlash_m: std::array::from_fn(|i| values.vector(vars.encoder_backlash)[i] * 1e-3),
+        load_cell_drift_n_per_row: values.vector(vars.load_cell_drift)[0],
+        load_cell_friction: values.vector(vars.load_cell_friction)[0],
     })
 }
 

@@ -99,6 +99,7 @@ pub mod factors;
 mod graph;
 pub mod gross_errors;
 mod init;
+mod load_cell_factor;
 pub mod mistakes;
 mod options;
 mod orientation;
@@ -541,6 +542,10 @@ pub fn without_estimated(effects: &Effects, estimates: &[EffectEstimate]) -> Eff
             EffectKind::LocaliserMount => out.localiser_mount_deg = neutral.localiser_mount_deg,
             EffectKind::PlatformWeight => out.platform_weight_scale = neutral.platform_weight_scale,
             EffectKind::CableWeight => out.cable_weight_scale = neutral.cable_weight_scale,
+            EffectKind::EncoderDrift => out.encoder_drift_m_per_row = neutral.encoder_drift_m_per_row,
+            EffectKind::EncoderBacklash => out.encoder_backlash_m = neutral.encoder_backlash_m,
+            EffectKind::LoadCellDrift => out.load_cell_drift_n_per_row = neutral.load_cell_drift_n_per_row,
+            EffectKind::LoadCellFriction => out.load_cell_friction = neutral.load_cell_friction,
         }
     }
     out

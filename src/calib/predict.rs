@@ -47,6 +47,7 @@ pub fn predict_with_effects(robot: &Robot, start: &Equilibrium, load_cell_n: f64
         encoder_lengths_m: [0.0; CABLE_COUNT],
         reference_tension_n: load_cell_n,
         excluded: Default::default(),
+        order: None,
     };
     let options = CalibrationOptions {
         orientation_prior: OrientationPrior::Off,

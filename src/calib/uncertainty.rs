@@ -99,6 +99,7 @@ pub fn cramer_rao_bound(
                 encoder_lengths_m: std::array::from_fn(|i| eq.cable_lengths_m[i] + truth.length_offsets_m[i]),
                 reference_tension_n: eq.tensions[truth.reference_cable].magnitude_n(),
                 excluded: Default::default(),
+                order: None,
             }
         })
         .collect();

@@ -159,7 +159,12 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
     out += "\n2. residual structure (baseline): correlation with physical drivers, strongest first\n";
     if !d.rows_in_time_order {
         out += "   the rows are not in the order the poses were taken (a RecurDyn log or an authors' folder): \
-                no drift over the rows or direction of motion is tested\n";
+                no drift over the rows or direction of motion is tested, and the effects of time and motion \
+                (encoder-drift, encoder-backlash, loadcell-drift, loadcell-friction) are not hypotheses\n";
+    }
+    if d.first_row_left_out {
+        out += "   the first row's encoders and load cell take no part in any fit: the direction of the motion \
+                that led there is unknown, and backlash and pulley friction depend on it\n";
     }
     out += &driver_table(&d.drivers, 8);
     out += &format!(

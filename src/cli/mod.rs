@@ -60,7 +60,7 @@ struct CompletionsArgs {
 enum ExperimentCommand {
     /// The paper's Table II calibration protocol with the Cramer-Rao bound.
     Table2(Table2Args),
-    /// Hide effects in simulated data and score `sagcal diagnose` (issue 4's sweep).
+    /// Hide effects in simulated data and score `sagcal diagnose`.
     HiddenEffects(HiddenEffectsArgs),
     /// Calibrate by the Table II protocol, then localise the held-out poses.
     Localize(LocalizeExperimentArgs),
@@ -359,7 +359,9 @@ struct DiagnoseArgs {
     /// Format of the `--plots` figures: svg or png.
     #[arg(long, value_enum, default_value = "svg")]
     plot_format: PlotFormat,
-    /// Candidate effects, comma separated (default: elastic,pulley,encoder-scale,loadcell,com,encoder-gain,segments).
+    /// Candidate effects, comma separated (default: the whole catalogue: elastic, pulley, encoder-scale, loadcell,
+    /// com, encoder-gain, segments, localiser-mount, platform-weight, cable-weight, and, for rows in the order
+    /// taken (a sagcal file), encoder-drift, encoder-backlash, loadcell-drift, loadcell-friction).
     #[arg(long)]
     candidates: Option<String>,
     /// Leave out the hypothesis "the localiser's orientations are unreliable".

@@ -110,6 +110,10 @@ pub(super) fn winning_driver(effect: EffectKind) -> (&'static str, &'static str)
         EffectKind::LocaliserMount => ("encoder", DRIVERS[0]),
         // Both change the sag, which grows with the cable's length.
         EffectKind::PlatformWeight | EffectKind::CableWeight => ("encoder", DRIVERS[3]),
+        EffectKind::EncoderDrift => ("encoder", ROW_DRIVER),
+        EffectKind::EncoderBacklash => ("encoder", DIRECTION_DRIVER),
+        EffectKind::LoadCellDrift => ("load_cell", ROW_DRIVER),
+        EffectKind::LoadCellFriction => ("load_cell", DIRECTION_DRIVER),
     }
 }
 
@@ -174,13 +178,25 @@ pub(super) fn samples(
             let position_rows = prior.len() - 3;
             let out = used[k].excluded;
             let unless = |sensor: Sensor, value: f64| if out.contains(sensor) { f64::NAN } else { value };
-            let direction = std::array::from_fn(|i| match k {
-                0 => f64::NAN,
-                _ => (used[k].encoder_lengths_m[i] - used[k - 1].encoder_lengths_m[i]).signum(),
-            });
+            // The pose's place in the order taken, where the rows carry it
+            // (a pose the baseline left out keeps the rows after it in place);
+            // else its place among the poses used.
+            let (row, direction) = match used[k].order {
+                Some(order) => (
+                    order.row as f64,
+                    order.direction.map(|d| if d == 0 { f64::NAN } else { f64::from(d) }),
+                ),
+                None => (
+                    (k + 1) as f64,
+                    std::array::from_fn(|i| match k {
+                        0 => f64::NAN,
+                        _ => (used[k].encoder_lengths_m[i] - used[k - 1].encoder_lengths_m[i]).signum(),
+                    }),
+                ),
+            };
             Ok(PoseSample {
                 reference_cable: robot.reference_cable,
-                row: (k + 1) as f64,
+                row,
                 direction,
                 cable_drivers,
                 position_m: pose.position_m,

@@ -371,15 +371,16 @@ fn direction_of(
         };
         all.into_iter().filter(|(_, x)| x.is_finite()).collect()
     };
+    // A pose whose every reading of this factor was left out has no factor
+    // (`push_masked`): the factors of this kind are the other poses', in order.
+    let mut poses_with_factor = (0..used.len()).filter(|&k| !sensors.iter().all(|s| used[k].excluded.contains(*s)));
     let mut per_factor: Vec<Option<Vec<(usize, f64)>>> = Vec::with_capacity(graph.graph.factors.len());
-    let mut pose = 0;
     for factor in &graph.graph.factors {
         if factor.kind() != kind {
             per_factor.push(None);
             continue;
         }
-        let k = pose;
-        pose += 1;
+        let k = poses_with_factor.next().unwrap_or(usize::MAX);
         let rows = factor.residual_dim();
         let usable = k < used.len() && whole(k) && (kind != "pose_prior" || rows >= 3);
         per_factor.push(usable.then(|| readings(k, rows)));

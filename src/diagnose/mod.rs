@@ -96,7 +96,7 @@ use crate::calib::{
 };
 use crate::error::{Error, Result};
 use crate::model::effect_kind::{EffectKind, EffectSet};
-use crate::model::measurement::{PoseMeasurement, ReadingSet};
+use crate::model::measurement::{PoseMeasurement, ReadingSet, Sensor};
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::SensorNoise;
 use crate::stats::{self, chi_square_quantile_999};
@@ -164,7 +164,12 @@ struct Progress<'a> {
     report: &'a mut dyn FnMut(usize, usize, &str),
 }
 
-impl Progress<'_> {
+impl<'a> Progress<'a> {
+    /// A progress of `total` steps, reported to `report`.
+    fn new(total: usize, report: &'a mut dyn FnMut(usize, usize, &str)) -> Self {
+        Self { done: 0, total, report }
+    }
+
     /// Report `what` as the next step.
     fn step(&mut self, what: &str) {
         (self.report)(self.done, self.total, what);
@@ -308,13 +313,11 @@ pub fn diagnose(
     progress: &mut dyn FnMut(usize, usize, &str),
 ) -> Result<Diagnosis> {
     check_options(options)?;
-    let mut progress = Progress {
-        done: 0,
-        total: 3 + 2 * options.folds,
-        report: progress,
-    };
+    let options = &time_order_resolved(options, measurements);
+    let mut progress = Progress::new(3 + 2 * options.folds, progress);
     // 0. Gross errors: blunders and common mistakes are not model errors.
     let (cleaned, excluded_readings, mistakes) = screen_gross_errors(robot, measurements, options, &mut progress)?;
+    let (cleaned, first_row_left_out) = first_motion_unknown(cleaned, options);
     let measurements = cleaned.as_slice();
     // 1. The baseline calibration, its residuals tested against the stated noise.
     let (base, factor_tests, noise_shown, used_options) = fit_baseline(robot, measurements, options, &mut progress)?;
@@ -377,6 +380,7 @@ pub fn diagnose(
         false_alarm: options.false_alarm,
         factor_tests,
         rows_in_time_order: options.rows_in_time_order,
+        first_row_left_out,
         drivers,
         drivers_after,
         baseline_bic: base.bic,
@@ -430,6 +434,52 @@ fn fit_baseline(
     let base = Baseline::fit(robot, measurements, &rescaled, progress)?;
     let tests = factor_tests(&base.graph.graph, base.components, base.dof);
     Ok((base, tests, Some(noise), rescaled))
+}
+
+/// `options` for `measurements`: the row and the direction of last motion
+/// are drivers, and the effects of time and motion
+/// ([`EffectKind::needs_time_order`]) candidates, only where the rows are
+/// in the order the robot took them and every pose carries that order
+/// ([`PoseMeasurement::order`]); elsewhere they are off.
+fn time_order_resolved(options: &DiagnoseOptions, measurements: &[PoseMeasurement]) -> DiagnoseOptions {
+    let ordered = options.rows_in_time_order && measurements.iter().all(|m| m.order.is_some());
+    DiagnoseOptions {
+        rows_in_time_order: ordered,
+        candidates: options
+            .candidates
+            .iter()
+            .copied()
+            .filter(|k| ordered || !k.needs_time_order())
+            .collect(),
+        ..options.clone()
+    }
+}
+
+/// The direction of the motion that led to the first row is unknown (the
+/// robot came from wherever it was homed): where a candidate depends on that
+/// direction (backlash, pulley friction), the first row's encoders and load
+/// cell take no part in any fit, so that every hypothesis sees the same
+/// readings. Returns the measurements and whether that was done.
+fn first_motion_unknown(
+    mut measurements: Vec<PoseMeasurement>,
+    options: &DiagnoseOptions,
+) -> (Vec<PoseMeasurement>, bool) {
+    let needs_direction = options
+        .candidates
+        .iter()
+        .any(|k| matches!(k, EffectKind::EncoderBacklash | EffectKind::LoadCellFriction));
+    if !(options.rows_in_time_order && needs_direction) {
+        return (measurements, false);
+    }
+    let mut left_out = false;
+    for m in measurements.iter_mut().filter(|m| m.order.is_some_and(|o| o.row == 1)) {
+        m.excluded = (0..CABLE_COUNT)
+            .map(Sensor::Encoder)
+            .chain([Sensor::LoadCell])
+            .fold(m.excluded, ReadingSet::with);
+        left_out = true;
+    }
+    (measurements, left_out)
 }
 
 /// The options' own checks: at least 2 folds, a false-alarm rate in (0, 1).

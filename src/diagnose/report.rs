@@ -68,6 +68,10 @@ pub struct Diagnosis {
     /// Whether the rows were taken in their order (the row and direction
     /// drivers are tested only then, [`super::DiagnoseOptions::rows_in_time_order`]).
     pub rows_in_time_order: bool,
+    /// Whether the first row's encoders and load cell were left out of every
+    /// fit: the direction of the motion that led there is unknown, and
+    /// backlash and pulley friction depend on it.
+    pub first_row_left_out: bool,
     /// Residual-driver correlations of the baseline, strongest first.
     pub drivers: Vec<DriverTest>,
     /// The same with the verdict's model (empty for `none`): the structure left.

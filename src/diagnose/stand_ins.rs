@@ -100,6 +100,8 @@ pub(super) fn own_sensor(kind: EffectKind) -> &'static str {
         // A heavier platform pulls every cable harder: the sag, and so the
         // lengths, change with it; heavier cables sag more.
         EffectKind::PlatformWeight | EffectKind::CableWeight => "catenary_length",
+        EffectKind::EncoderDrift | EffectKind::EncoderBacklash => "catenary_length",
+        EffectKind::LoadCellDrift | EffectKind::LoadCellFriction => "reference_tension",
     }
 }
 
@@ -199,6 +201,17 @@ fn describe(estimate: &EffectEstimate, limit: &PlausibleLimit) -> String {
         EffectKind::CableWeight => {
             format!("cables {value:.3} +- {value_sigma:.3} times as heavy per metre as the file says")
         }
+        EffectKind::EncoderDrift => {
+            format!("drum {} creeping {value:.3} +- {value_sigma:.3} mm per row", first + 1)
+        }
+        EffectKind::EncoderBacklash => {
+            format!(
+                "drum {} with a backlash of {value:.2} +- {value_sigma:.2} mm",
+                first + 1
+            )
+        }
+        EffectKind::LoadCellDrift => format!("a load cell creeping {value:.3} +- {value_sigma:.3} N per row"),
+        EffectKind::LoadCellFriction => format!("a pulley friction mu theta of {value:.4} +- {value_sigma:.1e}"),
     }
 }
 
@@ -220,6 +233,12 @@ fn stands_for(kind: EffectKind) -> &'static str {
             "something that changes every tension in proportion (a load cell's gain, the cables' weight)"
         }
         EffectKind::CableWeight => "something that changes the cables' sag",
+        EffectKind::EncoderDrift => "something that moves the encoder readings over time",
+        EffectKind::EncoderBacklash => "something that moves the encoder readings with the direction of motion",
+        EffectKind::LoadCellDrift => "something that moves the load cell's reading over time",
+        EffectKind::LoadCellFriction => {
+            "something that changes the tension the load cell sees with the direction of motion"
+        }
     }
 }
 

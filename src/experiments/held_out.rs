@@ -5,6 +5,9 @@
 //! model's (its anchors, offsets and `[effects]`). A model that holds
 //! gives each row a chi-square per degree of freedom of about 1; a declared
 //! cause that does not lower the mean over unseen poses does not predict.
+//! The effects of time and motion act on the rows through their order
+//! ([`crate::model::effects::Effects::without_time_and_motion`]): the unseen
+//! poses continue the session the diagnosis saw.
 
 use serde::Serialize;
 
@@ -44,6 +47,7 @@ pub fn held_out_prediction(
             return vec![None; rows.len()];
         };
         rows.iter()
+            .map(|m| robot.effects.without_time_and_motion(m, robot.reference_cable))
             .map(|m| {
                 let readings = Readings {
                     encoder_lengths_m: m.encoder_lengths_m,

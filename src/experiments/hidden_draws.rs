@@ -6,9 +6,11 @@ use rand::Rng;
 
 use crate::model::effect_kind::EffectKind;
 use crate::model::effect_ranges::{
-    axial_stiffness_range_n, com_shift_range_m, pulley_radius_range_m, CABLE_WEIGHT_HIGH, CABLE_WEIGHT_LOW,
-    COMMON_GAIN_HIGH, COMMON_GAIN_LOW, LOCALISER_MOUNT_HIGH_DEG, LOCALISER_MOUNT_LOW_DEG, PLATFORM_WEIGHT_HIGH,
-    PLATFORM_WEIGHT_LOW, SEGMENTS_HIGH, SEGMENTS_LOW,
+    axial_stiffness_range_n, com_shift_range_m, encoder_backlash_range_mm, encoder_drift_range_mm_per_row,
+    pulley_radius_range_m, CABLE_WEIGHT_HIGH, CABLE_WEIGHT_LOW, COMMON_GAIN_HIGH, COMMON_GAIN_LOW,
+    LOAD_CELL_DRIFT_HIGH, LOAD_CELL_DRIFT_LOW, LOAD_CELL_FRICTION_HIGH, LOAD_CELL_FRICTION_LOW,
+    LOCALISER_MOUNT_HIGH_DEG, LOCALISER_MOUNT_LOW_DEG, PLATFORM_WEIGHT_HIGH, PLATFORM_WEIGHT_LOW, SEGMENTS_HIGH,
+    SEGMENTS_LOW,
 };
 use crate::model::effects::Effects;
 use crate::model::robot::{Robot, CABLE_COUNT};
@@ -140,6 +142,21 @@ fn draw_effect(robot: &Robot, effect: EffectKind, mean_reference_tension_n: f64,
         }
         EffectKind::CableWeight => {
             e.cable_weight_scale = 1.0 + signed(rng, CABLE_WEIGHT_LOW, CABLE_WEIGHT_HIGH);
+        }
+        EffectKind::EncoderDrift => {
+            let (low, high) = encoder_drift_range_mm_per_row(robot);
+            e.encoder_drift_m_per_row = std::array::from_fn(|_| 1e-3 * signed(rng, low, high));
+        }
+        EffectKind::EncoderBacklash => {
+            let (low, high) = encoder_backlash_range_mm(robot);
+            e.encoder_backlash_m = std::array::from_fn(|_| 1e-3 * signed(rng, low, high));
+        }
+        EffectKind::LoadCellDrift => {
+            e.load_cell_drift_n_per_row =
+                signed(rng, LOAD_CELL_DRIFT_LOW, LOAD_CELL_DRIFT_HIGH) * mean_reference_tension_n;
+        }
+        EffectKind::LoadCellFriction => {
+            e.load_cell_friction = rng.random_range(LOAD_CELL_FRICTION_LOW..LOAD_CELL_FRICTION_HIGH);
         }
     }
 }

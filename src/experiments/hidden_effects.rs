@@ -4,30 +4,9 @@
 //!
 //! # Magnitudes
 //!
-//! Each case draws its effect's magnitude from a physically plausible range
-//! for the robot ([`effect_ranges`]), derived from the robot's own data:
-//!
-//! * `elastic`: the cables are synthetic-fibre ropes of density 1.44 g/cm^3
-//!   (the large robot's 72.4 g/m is an 8 mm rope), so the fibre cross section
-//!   is `A = g_c / (rho g)` and `EA = A E`, `E` drawn log-uniformly. The large
-//!   robot's long spans call for an aramid rope, `E` = 30-160 GPa (from a
-//!   loosely laid rope to the stiff fibre grades). The small robot's 3 mm rope
-//!   is taken as a nylon braid, `E` = 1-3 GPa: with its 6-22 N
-//!   tensions an aramid rope would stretch less than a millimetre, below the
-//!   encoders' noise, and could not change the anchors by their 1-sigma.
-//! * `pulley`: radius between 2.5 % and 7.5 % of the platform's weight-scaled
-//!   size: 0.1-0.3 m for the large robot, 0.02-0.05 m for the small one.
-//! * `encoder-scale`: each drum's gain `1 +- e`, `e` uniform in 0.1-0.3 %
-//!   (a rope wound on a drum has an effective radius uncertain by a fraction
-//!   of its diameter), random signs.
-//! * `loadcell`: bias of 5-12 % of the mean reference tension and gain error of
-//!   2-5 %, random signs: an uncalibrated field load cell sized for the peak
-//!   tension (full scale 2-3 x the mean) has zero and span errors of a few %
-//!   of full scale.
-//! * `com`: a horizontal shift in a random direction: a payload mounted off
-//!   the centre of the 0.42 m platform, 5-25 cm on the large robot, 5-20 cm
-//!   on the small one (the weak end moves the anchors by less than their
-//!   1-sigma: the cases a diagnosis may miss).
+//! Each case draws its effects' magnitudes from the physically plausible
+//! ranges for the robot ([`effect_ranges`]: derived from the robot's own data
+//! and justified there, e.g. the rope's stiffness from its weight per metre).
 //!
 //! The experiment reports, per effect, the smallest ratio of the baseline's
 //! anchor error to its stated 1-sigma: above 1, every magnitude drawn changes
@@ -282,15 +261,18 @@ impl SimulatedTruth {
         Ok((measurements, truth, self.nominal.clone()))
     }
 
-    /// [`HELD_OUT_POSES`] more poses of the same truth under `noise`, drawn
-    /// from a random stream of their own (seeded from the case's seed), so
-    /// that the case's own data are the same with or without them.
+    /// [`HELD_OUT_POSES`] more poses of the same truth under `noise`, from a
+    /// random stream of their own (seeded from the case's), so the case's
+    /// data are the same with or without them. The robot takes them after
+    /// the case's poses: their rows (and a drift with them) follow on.
     pub fn held_out(&self, noise: NoisePreset, segments: usize) -> Result<Vec<PoseMeasurement>> {
         let mut rng = ChaCha8Rng::seed_from_u64(self.seed ^ HELD_OUT_STREAM);
         let workspace = Workspace::default_for(&self.truth);
-        let equilibria = sample_equilibria_with(&self.truth, &workspace, HELD_OUT_POSES, self.closure, &mut rng)?;
+        let unseen = sample_equilibria_with(&self.truth, &workspace, HELD_OUT_POSES, self.closure, &mut rng)?;
+        let session: Vec<_> = self.equilibria.iter().chain(&unseen).cloned().collect();
         let sigmas = noise.sigmas(self.truth.platform_weight_n);
-        measure_with_effects(&self.truth, &self.effects, &equilibria, &sigmas, segments, &mut rng)
+        let rows = measure_with_effects(&self.truth, &self.effects, &session, &sigmas, segments, &mut rng)?;
+        Ok(rows[self.equilibria.len()..].to_vec())
     }
 }
 
@@ -301,9 +283,8 @@ pub const HELD_OUT_POSES: usize = 15;
 /// Mixed into a case's seed for its held-out poses' random stream.
 const HELD_OUT_STREAM: u64 = 0x6865_6c64_6f75_7421;
 
-/// One case's data: the measurements, the true robot (off the nominal one,
-/// its effects set) and the initial guess (the nominal robot). The poses are
-/// closed by `options.closure`.
+/// One case's data: the measurements, the true robot (off the nominal one, its
+/// effects set) and the initial guess (the nominal robot); poses closed by `options.closure`.
 pub fn simulate_case(
     nominal: &Robot,
     hidden: &[EffectKind],
@@ -314,10 +295,11 @@ pub fn simulate_case(
 }
 
 /// The pairs of effects the sweep hides together.
-pub const PAIRS: [[EffectKind; 2]; 3] = [
+pub const PAIRS: [[EffectKind; 2]; 4] = [
     [EffectKind::Com, EffectKind::Elastic],
     [EffectKind::EncoderScale, EffectKind::LoadCell],
     [EffectKind::Elastic, EffectKind::CommonGain],
+    [EffectKind::EncoderDrift, EffectKind::LoadCellFriction],
 ];
 
 /// `none`, or the names joined by `+` in sorted order.

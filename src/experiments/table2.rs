@@ -304,6 +304,7 @@ pub(crate) fn noisy_measurements(
                 encoder_lengths_m,
                 reference_tension_n: p.reference_tension_n + normal(noise.load_cell_sigma_n),
                 excluded: Default::default(),
+                order: None,
             }
         })
         .collect()

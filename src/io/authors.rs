@@ -168,6 +168,7 @@ pub fn read_authors_folder(dir: &Path) -> Result<Vec<PoseMeasurement>> {
                 encoder_lengths_m: [len[0], len[1], len[2], len[3]],
                 reference_tension_n: tension,
                 excluded: Default::default(),
+                order: None,
             })
         })
         .collect()

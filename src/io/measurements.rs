@@ -90,6 +90,7 @@ use crate::error::{Error, Result};
 use crate::io::atomic::write_atomically;
 use crate::io::authors::{is_authors_folder, read_authors_folder};
 use crate::io::recurdyn::{looks_like_recurdyn, read_recurdyn, LoadOptions, RecurDynRow, RejectedRow};
+use crate::model::measurement::mark_time_order;
 pub use crate::model::measurement::PoseMeasurement;
 
 /// The header of a sagcal measurement file, in column order.
@@ -247,6 +248,8 @@ pub fn read_measurements(path: &Path, options: &ReadOptions) -> Result<Measureme
             format!("no measurements: the file holds the header (line {header_line}) but no data rows"),
         ));
     }
+    // A sagcal file's rows are the order the robot took its poses in.
+    mark_time_order(&mut poses);
     Ok(MeasurementSet {
         path: path.to_path_buf(),
         format: MeasurementFormat::Sagcal,
@@ -438,6 +441,7 @@ fn from_recurdyn(row: &RecurDynRow, reference_cable: usize) -> Option<PoseMeasur
         encoder_lengths_m: row.cable_lengths_m,
         reference_tension_n: tension.total_n,
         excluded: Default::default(),
+        order: None,
     })
 }
 
@@ -582,6 +586,7 @@ fn pose_from_values(line: usize, values: &[f64; N_COLUMNS]) -> PoseMeasurement {
         encoder_lengths_m: [l1, l2, l3, l4],
         reference_tension_n: f_ref,
         excluded: Default::default(),
+        order: None,
     }
 }
 

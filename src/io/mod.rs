@@ -24,6 +24,7 @@
 //!     encoder_lengths_m: [183.3, 169.2, 155.6, 170.9],
 //!     reference_tension_n: 698.7,
 //!     excluded: Default::default(),
+//!     order: None,
 //! };
 //! let path = std::env::temp_dir().join(format!("sagcal-io-doc-{}.csv", std::process::id()));
 //! write_measurements(&path, &["written by the io docs".into()], &[pose])?;

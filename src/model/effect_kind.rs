@@ -54,11 +54,23 @@ pub enum EffectKind {
     /// The cables' weight per metre (a wrong cable specification); one
     /// parameter, the scale of the robot file's weight per metre.
     CableWeight,
+    /// Per-drum creep of the encoder readings with the row; four parameters,
+    /// millimetres per row. Needs rows in time order ([`EffectKind::needs_time_order`]).
+    EncoderDrift,
+    /// Per-drum backlash: the reading `+b` off after paying out, `-b` after
+    /// reeling in; four parameters, millimetres. Needs rows in time order.
+    EncoderBacklash,
+    /// Creep of the load cell's zero with the row; one parameter, newtons
+    /// per row. Needs rows in time order.
+    LoadCellDrift,
+    /// Friction of a pulley between the cable and a drum-side load cell
+    /// (reading `T (1 - k s)`); one parameter `k = mu theta`. Needs rows in time order.
+    LoadCellFriction,
 }
 
 impl EffectKind {
     /// Every effect of the catalogue, in report order.
-    pub const ALL: [EffectKind; 10] = [
+    pub const ALL: [EffectKind; 14] = [
         EffectKind::Elastic,
         EffectKind::Pulley,
         EffectKind::EncoderScale,
@@ -69,6 +81,10 @@ impl EffectKind {
         EffectKind::LocaliserMount,
         EffectKind::PlatformWeight,
         EffectKind::CableWeight,
+        EffectKind::EncoderDrift,
+        EffectKind::EncoderBacklash,
+        EffectKind::LoadCellDrift,
+        EffectKind::LoadCellFriction,
     ];
 
     /// The name used on the command line and in reports (`elastic`, `encoder-scale`, ...).
@@ -84,6 +100,10 @@ impl EffectKind {
             EffectKind::LocaliserMount => "localiser-mount",
             EffectKind::PlatformWeight => "platform-weight",
             EffectKind::CableWeight => "cable-weight",
+            EffectKind::EncoderDrift => "encoder-drift",
+            EffectKind::EncoderBacklash => "encoder-backlash",
+            EffectKind::LoadCellDrift => "loadcell-drift",
+            EffectKind::LoadCellFriction => "loadcell-friction",
         }
     }
 
@@ -107,6 +127,15 @@ impl EffectKind {
             EffectKind::Segments => &["inverse_segments_squared"],
             EffectKind::LocaliserMount => &["rx_deg", "ry_deg", "rz_deg"],
             EffectKind::PlatformWeight | EffectKind::CableWeight => &["scale"],
+            EffectKind::EncoderDrift => &[
+                "drift1_mm_per_row",
+                "drift2_mm_per_row",
+                "drift3_mm_per_row",
+                "drift4_mm_per_row",
+            ],
+            EffectKind::EncoderBacklash => &["backlash1_mm", "backlash2_mm", "backlash3_mm", "backlash4_mm"],
+            EffectKind::LoadCellDrift => &["drift_n_per_row"],
+            EffectKind::LoadCellFriction => &["friction"],
         }
     }
 
@@ -129,6 +158,10 @@ impl EffectKind {
             EffectKind::LocaliserMount => effects.localiser_mount_deg.to_vec(),
             EffectKind::PlatformWeight => vec![effects.platform_weight_scale],
             EffectKind::CableWeight => vec![effects.cable_weight_scale],
+            EffectKind::EncoderDrift => effects.encoder_drift_m_per_row.map(|d| d * 1e3).to_vec(),
+            EffectKind::EncoderBacklash => effects.encoder_backlash_m.map(|b| b * 1e3).to_vec(),
+            EffectKind::LoadCellDrift => vec![effects.load_cell_drift_n_per_row],
+            EffectKind::LoadCellFriction => vec![effects.load_cell_friction],
         }
     }
 
@@ -169,6 +202,19 @@ impl EffectKind {
             EffectKind::CommonGain => common && gains[0] != 1.0,
             _ => self.parameters(effects) != self.parameters(&Effects::default()),
         }
+    }
+
+    /// Whether the effect lives in time and motion: its readings depend on
+    /// the row or the direction of last motion, which only rows in the
+    /// order the robot took them carry ([`crate::model::measurement::ReadingOrder`]).
+    pub fn needs_time_order(self) -> bool {
+        matches!(
+            self,
+            EffectKind::EncoderDrift
+                | EffectKind::EncoderBacklash
+                | EffectKind::LoadCellDrift
+                | EffectKind::LoadCellFriction
+        )
     }
 
     /// The effect that contains this one as a special case, if any: the

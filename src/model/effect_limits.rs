@@ -19,6 +19,10 @@
 //! | `localiser-mount` | 10 degrees | a localiser bolted on with its axes further off would be seen by eye |
 //! | `platform-weight` | weight 1 +- 0.5 x the file's | a platform half again as heavy, or half as heavy, as its file says would be noticed when it is lifted or its motors sized |
 //! | `cable-weight` | weight per metre 1 +- 0.5 x the file's | a rope off by half its weight per metre is off by a fifth or more of its diameter, two or three size steps: another rope, not a datasheet error |
+//! | `encoder-drift` | 5 x the typical range's top per drum (5 mm per row large, 1 mm small) | a drum losing more per pose would be decimetres off within a session, which an operator sees |
+//! | `encoder-backlash` | 5 x the typical range's top per drum (25 mm large, 5 mm small) | a dead band that wide is a broken gearbox, felt by hand |
+//! | `loadcell-drift` | 1 % of the mean reference tension per row | a gauge whose zero moves that fast is faulty and fails its own zero check |
+//! | `loadcell-friction` | `mu theta` 0.2 | a pulley that holds a fifth of the tension is seized (a plain bush's mu 0.15 over more than a quarter turn) |
 //!
 //! ```
 //! use sagcal::model::effect_limits::plausible_limits;
@@ -37,8 +41,11 @@
 //! ```
 
 use crate::model::effect_kind::EffectKind;
-use crate::model::effect_ranges::{axial_stiffness_range_n, pulley_radius_range_m, SEGMENTS_LOW};
-use crate::model::robot::Robot;
+use crate::model::effect_ranges::{
+    axial_stiffness_range_n, encoder_backlash_range_mm, encoder_drift_range_mm_per_row, pulley_radius_range_m,
+    SEGMENTS_LOW,
+};
+use crate::model::robot::{Robot, CABLE_COUNT};
 
 /// The largest plausible encoder gain error (dimensionless, module docs).
 pub const ENCODER_GAIN_LIMIT: f64 = 0.05;
@@ -52,6 +59,12 @@ pub const PLATFORM_WEIGHT_LIMIT: f64 = 0.5;
 pub const CABLE_WEIGHT_LIMIT: f64 = 0.5;
 /// The largest plausible localiser mounting rotation, degrees.
 pub const LOCALISER_MOUNT_LIMIT_DEG: f64 = 10.0;
+/// The largest plausible encoder creep and backlash, as a multiple of the top of their typical range.
+pub const ENCODER_TIME_LIMIT_FACTOR: f64 = 5.0;
+/// The largest plausible load-cell creep per row, as a share of the mean reference tension.
+pub const LOAD_CELL_DRIFT_LIMIT: f64 = 0.01;
+/// The largest plausible pulley friction `mu theta` before a load cell.
+pub const LOAD_CELL_FRICTION_LIMIT: f64 = 0.2;
 
 /// The largest plausible magnitude of a group of an effect's parameters.
 #[derive(Debug, Clone, PartialEq)]
@@ -71,12 +84,6 @@ pub struct PlausibleLimit {
 /// The limits of `kind` for `robot` (module docs); `mean_reference_tension_n`
 /// scales the load cell's bias.
 pub fn plausible_limits(kind: EffectKind, robot: &Robot, mean_reference_tension_n: f64) -> Vec<PlausibleLimit> {
-    let one = |index: usize, largest: f64, limit: String, why: &str| PlausibleLimit {
-        parameters: vec![index],
-        largest,
-        limit,
-        why: why.to_string(),
-    };
     match kind {
         EffectKind::Elastic => {
             let softest_n = axial_stiffness_range_n(robot).0;
@@ -160,6 +167,66 @@ pub fn plausible_limits(kind: EffectKind, robot: &Robot, mean_reference_tension_
             format!("a weight per metre within 1 +- {CABLE_WEIGHT_LIMIT} x the robot file's"),
             "a rope off by half its weight per metre is another rope, two or three diameter steps away",
         )],
+        _ => time_and_motion_limits(kind, robot, mean_reference_tension_n),
+    }
+}
+
+/// The limits of the effects of time and motion (drift, backlash, friction).
+fn time_and_motion_limits(kind: EffectKind, robot: &Robot, mean_reference_tension_n: f64) -> Vec<PlausibleLimit> {
+    match kind {
+        EffectKind::EncoderDrift => {
+            let largest = ENCODER_TIME_LIMIT_FACTOR * encoder_drift_range_mm_per_row(robot).1;
+            (0..CABLE_COUNT)
+                .map(|i| {
+                    one(
+                        i,
+                        largest,
+                        format!("a creep of at most {largest} mm per row"),
+                        "a drum losing more per pose would be decimetres off within a session",
+                    )
+                })
+                .collect()
+        }
+        EffectKind::EncoderBacklash => {
+            let largest = ENCODER_TIME_LIMIT_FACTOR * encoder_backlash_range_mm(robot).1;
+            (0..CABLE_COUNT)
+                .map(|i| {
+                    one(
+                        i,
+                        largest,
+                        format!("a backlash of at most {largest} mm"),
+                        "a dead band that wide is a broken gearbox",
+                    )
+                })
+                .collect()
+        }
+        EffectKind::LoadCellDrift => vec![one(
+            0,
+            LOAD_CELL_DRIFT_LIMIT * mean_reference_tension_n,
+            format!(
+                "a creep of at most {:.2} N per row ({} % of the mean reference tension)",
+                LOAD_CELL_DRIFT_LIMIT * mean_reference_tension_n,
+                LOAD_CELL_DRIFT_LIMIT * 100.0
+            ),
+            "a gauge whose zero moves that fast is faulty",
+        )],
+        EffectKind::LoadCellFriction => vec![one(
+            0,
+            LOAD_CELL_FRICTION_LIMIT,
+            format!("a friction mu theta of at most {LOAD_CELL_FRICTION_LIMIT}"),
+            "a pulley that holds a fifth of the tension is seized",
+        )],
+        _ => Vec::new(),
+    }
+}
+
+/// The limit `largest` of parameter `index` alone.
+fn one(index: usize, largest: f64, limit: String, why: &str) -> PlausibleLimit {
+    PlausibleLimit {
+        parameters: vec![index],
+        largest,
+        limit,
+        why: why.to_string(),
     }
 }
 

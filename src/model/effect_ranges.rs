@@ -42,7 +42,7 @@ pub struct EffectRange {
 pub fn effect_ranges(robot: &Robot) -> Vec<EffectRange> {
     let (ea_low, ea_high) = axial_stiffness_range_n(robot);
     let (r_low, r_high) = pulley_radius_range_m(robot);
-    vec![
+    let mut ranges = vec![
         EffectRange {
             effect: "elastic".into(),
             range: format!("EA {ea_low:.3e} .. {ea_high:.3e} N (log-uniform)"),
@@ -110,6 +110,44 @@ pub fn effect_ranges(robot: &Robot) -> Vec<EffectRange> {
             ),
             justification: "a rope of the next diameter (weight ~ d^2: 10-20 % per size step) or with a coating the datasheet leaves out".into(),
         },
+    ];
+    ranges.extend(time_and_motion_ranges(robot));
+    ranges
+}
+
+/// The ranges of the effects of time and motion (drift, backlash, friction).
+fn time_and_motion_ranges(robot: &Robot) -> Vec<EffectRange> {
+    vec![
+        EffectRange {
+            effect: "encoder-drift".into(),
+            range: {
+                let (low, high) = encoder_drift_range_mm_per_row(robot);
+                format!("{low} .. {high} mm per row per drum, random signs")
+            },
+            justification: "rope creep and slip on the drum, or a counter losing counts: a fraction of a millimetre per pose, more on long heavy ropes".into(),
+        },
+        EffectRange {
+            effect: "encoder-backlash".into(),
+            range: {
+                let (low, high) = encoder_backlash_range_mm(robot);
+                format!("half dead band {low} .. {high} mm per drum, random signs")
+            },
+            justification: "gearbox backlash of a few arc-minutes between a motor-side encoder and the drum, times the drum radius".into(),
+        },
+        EffectRange {
+            effect: "loadcell-drift".into(),
+            range: format!(
+                "{} .. {} % of the mean reference tension per row, random sign",
+                LOAD_CELL_DRIFT_LOW * 100.0,
+                LOAD_CELL_DRIFT_HIGH * 100.0
+            ),
+            justification: "zero drift of a strain-gauge cell with temperature and creep over a session".into(),
+        },
+        EffectRange {
+            effect: "loadcell-friction".into(),
+            range: format!("k = mu theta {LOAD_CELL_FRICTION_LOW} .. {LOAD_CELL_FRICTION_HIGH}"),
+            justification: "a rolling-bearing pulley (mu 0.01-0.03 at the rope) with a wrap of a quarter to half a turn before a drum-side load cell".into(),
+        },
     ]
 }
 
@@ -133,6 +171,14 @@ pub const CABLE_WEIGHT_HIGH: f64 = 0.20;
 pub const SEGMENTS_LOW: f64 = 10.0;
 /// The number of elements of a finite-element cable: most plausible.
 pub const SEGMENTS_HIGH: f64 = 100.0;
+/// The load cell's creep per row: smallest plausible share of the mean reference tension.
+pub const LOAD_CELL_DRIFT_LOW: f64 = 0.0005;
+/// The load cell's creep per row: largest typical share of the mean reference tension.
+pub const LOAD_CELL_DRIFT_HIGH: f64 = 0.002;
+/// Friction `mu theta` of a pulley before a drum-side load cell: smallest plausible.
+pub const LOAD_CELL_FRICTION_LOW: f64 = 0.01;
+/// See [`LOAD_CELL_FRICTION_LOW`]: largest typical.
+pub const LOAD_CELL_FRICTION_HIGH: f64 = 0.05;
 
 /// The smallest plausible magnitude of `kind` for `robot` as the effect
 /// variable's values (gains as errors, elastic as the compliance in 1/MN,
@@ -141,7 +187,9 @@ pub const SEGMENTS_HIGH: f64 = 100.0;
 /// off by 5 % of `mean_reference_tension_n` and 2 % in gain, a 5 cm
 /// centre-of-mass shift along the diagonal, the finest plausible chain, a
 /// localiser turned by 0.5 degrees about the diagonal of its axes, a platform
-/// 3 % and cables 5 % heavier than the robot file says.
+/// 3 % and cables 5 % heavier than the robot file says, the slowest encoder
+/// creep and smallest backlash with alternating signs, the slowest load-cell
+/// creep and the least pulley friction.
 pub fn smallest_plausible(kind: EffectKind, robot: &Robot, mean_reference_tension_n: f64) -> Vec<f64> {
     match kind {
         EffectKind::Elastic => vec![1e6 / axial_stiffness_range_n(robot).1],
@@ -157,6 +205,16 @@ pub fn smallest_plausible(kind: EffectKind, robot: &Robot, mean_reference_tensio
         EffectKind::LocaliserMount => vec![LOCALISER_MOUNT_LOW_DEG / 3f64.sqrt(); 3],
         EffectKind::PlatformWeight => vec![PLATFORM_WEIGHT_LOW],
         EffectKind::CableWeight => vec![CABLE_WEIGHT_LOW],
+        EffectKind::EncoderDrift => {
+            let low = encoder_drift_range_mm_per_row(robot).0;
+            vec![low, -low, low, -low]
+        }
+        EffectKind::EncoderBacklash => {
+            let low = encoder_backlash_range_mm(robot).0;
+            vec![low, -low, low, -low]
+        }
+        EffectKind::LoadCellDrift => vec![LOAD_CELL_DRIFT_LOW * mean_reference_tension_n],
+        EffectKind::LoadCellFriction => vec![LOAD_CELL_FRICTION_LOW],
     }
 }
 
@@ -191,6 +249,26 @@ pub fn com_shift_range_m(robot: &Robot) -> (f64, f64) {
         (0.05, 0.25)
     } else {
         (0.05, 0.20)
+    }
+}
+
+/// Each drum's encoder creep, millimetres per row (low, high): long heavy
+/// ropes creep and slip more.
+pub fn encoder_drift_range_mm_per_row(robot: &Robot) -> (f64, f64) {
+    if is_large(robot) {
+        (0.2, 1.0)
+    } else {
+        (0.05, 0.2)
+    }
+}
+
+/// Each drum's backlash (half the dead band), millimetres (low, high): a few
+/// arc-minutes of gear play times the drum's radius.
+pub fn encoder_backlash_range_mm(robot: &Robot) -> (f64, f64) {
+    if is_large(robot) {
+        (1.0, 5.0)
+    } else {
+        (0.2, 1.0)
     }
 }
 

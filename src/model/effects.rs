@@ -22,6 +22,14 @@
 //! | `localiser-mount` | `rx_deg`, `ry_deg`, `rz_deg` (the localiser's mounting rotation, a rotation vector in the platform frame, degrees) |
 //! | `platform-weight` | `scale` (the platform's true weight over the robot file's `platform_weight_n`, > 0) |
 //! | `cable-weight` | `scale` (the cables' true weight per metre over the robot file's `cable_weight_n_per_m`, > 0) |
+//! | `encoder-drift` | `rate_m` (all four drums) or `rate1_m` .. `rate4_m` (the reading's creep, m per row) |
+//! | `encoder-backlash` | `b_m` (all four drums) or `b1_m` .. `b4_m` (the reading's shift when the cable was last paid out, m; minus when reeled in) |
+//! | `loadcell-drift` | `rate_n` (the load cell's creep, N per row) |
+//! | `loadcell-friction` | `k` (friction `mu theta` of a pulley between the cable and a drum-side load cell, 0 <= k < 1) |
+//!
+//! The last four live in time and motion ([`crate::model::measurement::ReadingOrder`]):
+//! a pose's readings depend on its row and on the direction each cable last
+//! moved in ([`Effects::time_and_motion`]).
 //!
 //! ```
 //! use sagcal::model::effect_kind::EffectKind;
@@ -45,6 +53,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::model::measurement::{PoseMeasurement, ReadingOrder};
 use crate::model::robot::CABLE_COUNT;
 
 /// Effects acting on a robot beyond the closed-form model. [`Default`]: none.
@@ -118,6 +127,50 @@ pub struct Effects {
     /// parameter `lambda = w L / f_h` of the catenary (eq. 2-3) scales.
     #[serde(skip_serializing_if = "is_one")]
     pub cable_weight_scale: f64,
+    /// Per drum (robot order), the encoder reading's creep, metres per row
+    /// (`encoder-drift:rate_m`): a reading taken at row `k` is off by `k` x
+    /// the rate (slip of the rope on its drum, a counter losing counts).
+    #[serde(skip_serializing_if = "is_zero4")]
+    pub encoder_drift_m_per_row: [f64; CABLE_COUNT],
+    /// Per drum, half the dead band between the encoder and the drum, metres
+    /// (`encoder-backlash:b_m`): the reading is `+b` off after the cable was
+    /// paid out and `-b` off after it was reeled in (gear backlash, an
+    /// encoder on the motor's side of the gearbox).
+    #[serde(skip_serializing_if = "is_zero4")]
+    pub encoder_backlash_m: [f64; CABLE_COUNT],
+    /// The load cell's creep, newtons per row (`loadcell-drift:rate_n`): a
+    /// zero point that wanders with time (temperature, creep of the gauge).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub load_cell_drift_n_per_row: f64,
+    /// Friction `k = mu theta` of a pulley between the cable and a load cell
+    /// on the drum's side (`loadcell-friction:k`).
+    ///
+    /// By the capstan (Euler-Eytelwein) relation the drum-side tension is
+    /// `T exp(-mu theta s)` of the platform-side `T`, `s = +1` after the cable
+    /// was paid out (friction holds against the platform) and `-1` after it
+    /// was reeled in; to first order the load cell reads `T (1 - k s)`.
+    /// Physically `k >= 0`.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub load_cell_friction: f64,
+}
+
+/// What time and motion add to one pose's readings ([`Effects::time_and_motion`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeAndMotion {
+    /// Added to each encoder reading (robot order), metres.
+    pub encoder_shift_m: [f64; CABLE_COUNT],
+    /// Added to the load cell's reading, newtons.
+    pub load_cell_shift_n: f64,
+    /// Multiplies the load cell's tension term (`1 - k s`).
+    pub load_cell_factor: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+fn is_zero4(v: &[f64; CABLE_COUNT]) -> bool {
+    v.iter().all(|x| *x == 0.0)
 }
 
 fn is_one(x: &f64) -> bool {
@@ -142,13 +195,17 @@ impl Default for Effects {
             localiser_mount_deg: [0.0; 3],
             platform_weight_scale: 1.0,
             cable_weight_scale: 1.0,
+            encoder_drift_m_per_row: [0.0; CABLE_COUNT],
+            encoder_backlash_m: [0.0; CABLE_COUNT],
+            load_cell_drift_n_per_row: 0.0,
+            load_cell_friction: 0.0,
         }
     }
 }
 
 /// The effect names accepted by [`Effects::apply_spec`], with their parameters.
 pub const EFFECT_NAMES: &str =
-    "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m, segments:n, localiser-mount:rx_deg,ry_deg,rz_deg, platform-weight:scale, cable-weight:scale";
+    "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m, segments:n, localiser-mount:rx_deg,ry_deg,rz_deg, platform-weight:scale, cable-weight:scale, encoder-drift:rate_m|rate1_m..rate4_m, encoder-backlash:b_m|b1_m..b4_m, loadcell-drift:rate_n, loadcell-friction:k";
 
 /// The parameters [`Effects::apply_spec`] accepts for the effect `name`; `None` for no effect.
 fn spec_parameters(name: &str) -> Option<&'static [&'static str]> {
@@ -161,6 +218,10 @@ fn spec_parameters(name: &str) -> Option<&'static [&'static str]> {
         "segments" => &["n"],
         "localiser-mount" => &["rx_deg", "ry_deg", "rz_deg"],
         "platform-weight" | "cable-weight" => &["scale"],
+        "encoder-drift" => &["rate_m", "rate1_m", "rate2_m", "rate3_m", "rate4_m"],
+        "encoder-backlash" => &["b_m", "b1_m", "b2_m", "b3_m", "b4_m"],
+        "loadcell-drift" => &["rate_n"],
+        "loadcell-friction" => &["k"],
         _ => return None,
     })
 }
@@ -273,6 +334,12 @@ impl Effects {
                 }
                 ("platform-weight", _) => next.platform_weight_scale = positive("weight scale")?,
                 ("cable-weight", _) => next.cable_weight_scale = positive("weight scale")?,
+                ("encoder-drift", "rate_m") => next.encoder_drift_m_per_row = [value; CABLE_COUNT],
+                ("encoder-drift", k) => next.encoder_drift_m_per_row[drum(k, "rate")] = value,
+                ("encoder-backlash", "b_m") => next.encoder_backlash_m = [value; CABLE_COUNT],
+                ("encoder-backlash", k) => next.encoder_backlash_m[drum(k, "b")] = value,
+                ("loadcell-drift", _) => next.load_cell_drift_n_per_row = value,
+                ("loadcell-friction", _) => next.load_cell_friction = friction(name, key, value)?,
                 _ => unreachable!("parameter names are checked above"),
             }
         }
@@ -330,6 +397,26 @@ impl Effects {
                 return Err(format!("`{name}` must be finite and > 0, got {scale}"));
             }
         }
+        for (name, values) in [
+            ("encoder_drift_m_per_row", self.encoder_drift_m_per_row),
+            ("encoder_backlash_m", self.encoder_backlash_m),
+        ] {
+            if !values.iter().all(|x| x.is_finite()) {
+                return Err(format!("`{name}` must be finite, got {values:?}"));
+            }
+        }
+        if !self.load_cell_drift_n_per_row.is_finite() {
+            return Err(format!(
+                "`load_cell_drift_n_per_row` must be finite, got {}",
+                self.load_cell_drift_n_per_row
+            ));
+        }
+        if !(0.0..1.0).contains(&self.load_cell_friction) {
+            return Err(format!(
+                "`load_cell_friction` must be >= 0 and < 1, got {}",
+                self.load_cell_friction
+            ));
+        }
         Ok(())
     }
 
@@ -379,8 +466,80 @@ impl Effects {
         if self.cable_weight_scale != 1.0 {
             specs.push(format!("cable-weight:scale={}", self.cable_weight_scale));
         }
+        for (name, key, values) in [
+            ("encoder-drift", "rate", self.encoder_drift_m_per_row),
+            ("encoder-backlash", "b", self.encoder_backlash_m),
+        ] {
+            if values.iter().any(|x| *x != 0.0) {
+                let parts: Vec<String> = values
+                    .iter()
+                    .enumerate()
+                    .map(|(i, x)| format!("{key}{}_m={x}", i + 1))
+                    .collect();
+                specs.push(format!("{name}:{}", parts.join(",")));
+            }
+        }
+        if self.load_cell_drift_n_per_row != 0.0 {
+            specs.push(format!("loadcell-drift:rate_n={}", self.load_cell_drift_n_per_row));
+        }
+        if self.load_cell_friction != 0.0 {
+            specs.push(format!("loadcell-friction:k={}", self.load_cell_friction));
+        }
         specs
     }
+
+    /// What the time-and-motion effects add to the readings of the pose at
+    /// `order` whose load cell reads `reference_cable` (robot order): encoder
+    /// `i` gains `rate_i row + b_i s_i`, the load cell reads
+    /// `bias + gain (1 - k s_ref) T + rate row` ([`Effects::load_cell_friction`]),
+    /// `s` the direction of last motion.
+    pub fn time_and_motion(&self, order: &ReadingOrder, reference_cable: usize) -> TimeAndMotion {
+        let row = order.row as f64;
+        let direction = order.direction.map(f64::from);
+        TimeAndMotion {
+            encoder_shift_m: std::array::from_fn(|i| {
+                self.encoder_drift_m_per_row[i] * row + self.encoder_backlash_m[i] * direction[i]
+            }),
+            load_cell_shift_n: self.load_cell_drift_n_per_row * row,
+            load_cell_factor: 1.0 - self.load_cell_friction * direction[reference_cable.min(CABLE_COUNT - 1)],
+        }
+    }
+}
+
+impl Effects {
+    /// `m`'s readings as they would be without the effects of time and
+    /// motion ([`Effects::time_and_motion`]): each encoder less its shift, the
+    /// load cell's tension term divided by the friction's factor. A pose
+    /// without an order is returned as it is.
+    pub fn without_time_and_motion(&self, m: &PoseMeasurement, reference_cable: usize) -> PoseMeasurement {
+        let Some(order) = m.order else {
+            return *m;
+        };
+        let now = self.time_and_motion(&order, reference_cable);
+        let tension_term = m.reference_tension_n - self.load_cell_bias_n - now.load_cell_shift_n;
+        PoseMeasurement {
+            encoder_lengths_m: std::array::from_fn(|i| m.encoder_lengths_m[i] - now.encoder_shift_m[i]),
+            reference_tension_n: self.load_cell_bias_n + tension_term / now.load_cell_factor,
+            ..*m
+        }
+    }
+}
+
+/// A pulley friction `mu theta` given as `value`: in `[0, 1)`.
+fn friction(name: &str, key: &str, value: f64) -> Result<f64, String> {
+    if (0.0..1.0).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!(
+            "effect `{name}`: parameter `{key}` (friction mu theta) must be >= 0 and < 1, got {value}"
+        ))
+    }
+}
+
+/// The drum of a per-drum parameter `rate1_m` .. `rate4_m` (0-based).
+fn drum(key: &str, prefix: &str) -> usize {
+    let digit = key[prefix.len()..].trim_end_matches("_m");
+    digit.parse::<usize>().expect("rate1_m..rate4_m, b1_m..b4_m") - 1
 }
 
 impl std::fmt::Display for Effects {
@@ -427,6 +586,11 @@ mod tests {
             "localiser-mount:rx_deg=0.5,rz_deg=-1.5",
             "platform-weight:scale=1.11",
             "cable-weight:scale=0.9",
+            "encoder-drift:rate_m=1e-4",
+            "encoder-drift:rate2_m=-2e-4",
+            "encoder-backlash:b3_m=0.002",
+            "loadcell-drift:rate_n=0.3",
+            "loadcell-friction:k=0.02",
         ])
         .unwrap();
         assert_eq!(e.axial_stiffness_n, Some(3e6));
@@ -439,6 +603,18 @@ mod tests {
         assert_eq!(e.inverse_segments_squared(), 1.0 / 144.0);
         assert_eq!(e.localiser_mount_deg, [0.5, 0.0, -1.5]);
         assert_eq!((e.platform_weight_scale, e.cable_weight_scale), (1.11, 0.9));
+        assert_eq!(e.encoder_drift_m_per_row, [1e-4, -2e-4, 1e-4, 1e-4]);
+        assert_eq!(e.encoder_backlash_m, [0.0, 0.0, 0.002, 0.0]);
+        assert_eq!((e.load_cell_drift_n_per_row, e.load_cell_friction), (0.3, 0.02));
+        // Row 10, cable 3 last paid out, the reference cable 1 reeled in:
+        // 10 x 1e-4 + 0.002 on cable 3, 10 x 0.3 N and a factor 1 + 0.02 on the load cell.
+        let order = ReadingOrder {
+            row: 10,
+            direction: [-1, 0, 1, 0],
+        };
+        let shift = e.time_and_motion(&order, 0);
+        assert!((shift.encoder_shift_m[2] - 0.003).abs() < 1e-15 && (shift.encoder_shift_m[1] + 2e-3).abs() < 1e-15);
+        assert!((shift.load_cell_shift_n - 3.0).abs() < 1e-12 && (shift.load_cell_factor - 1.02).abs() < 1e-15);
         // The specifications parse back to the same effects.
         let specs = e.specs();
         let again = parsed(&specs.iter().map(String::as_str).collect::<Vec<_>>()).unwrap();
@@ -476,6 +652,11 @@ mod tests {
                 &["effect `platform-weight`", "`scale`", "> 0"],
             ),
             ("cable-weight:scale=-1", &["effect `cable-weight`", "`scale`", "> 0"]),
+            (
+                "loadcell-friction:k=-0.01",
+                &["effect `loadcell-friction`", "`k`", ">= 0"],
+            ),
+            ("encoder-drift:rate5_m=1", &["unknown parameter `rate5_m`"]),
         ];
         for (spec, needles) in cases {
             let mut effects = Effects::default();

@@ -10,6 +10,28 @@
 //! assert!(excluded.without(Sensor::Encoder(1)).without(Sensor::LoadCell).is_empty());
 //! assert_eq!(Sensor::ALL.len(), 4 + 1 + 3 + 3); // encoders, load cell, localiser position and orientation
 //! ```
+//!
+//! Rows of a measurement file are in the order the robot took them; each
+//! pose then knows its row and its cables' directions of last motion:
+//!
+//! ```
+//! use sagcal::model::measurement::{mark_time_order, PoseMeasurement, ReadingOrder};
+//! let pose = |lengths: [f64; 4]| PoseMeasurement {
+//!     line: 0,
+//!     position_m: [0.0; 3],
+//!     roll_deg: 0.0,
+//!     pitch_deg: 0.0,
+//!     yaw_deg: 0.0,
+//!     encoder_lengths_m: lengths,
+//!     reference_tension_n: 100.0,
+//!     excluded: Default::default(),
+//!     order: None,
+//! };
+//! let mut rows = vec![pose([1.0, 2.0, 3.0, 4.0]), pose([1.5, 1.0, 3.0, 4.2])];
+//! mark_time_order(&mut rows);
+//! assert_eq!(rows[0].order, Some(ReadingOrder { row: 1, direction: [0; 4] }));
+//! assert_eq!(rows[1].order, Some(ReadingOrder { row: 2, direction: [1, -1, 0, 1] }));
+//! ```
 
 use serde::{Deserialize, Serialize};
 
@@ -38,6 +60,44 @@ pub struct PoseMeasurement {
     /// snooping, `crate::calib::gross_errors`); empty as read from a file.
     #[serde(default, skip_serializing_if = "ReadingSet::is_empty")]
     pub excluded: ReadingSet,
+    /// Where the pose stands in the order the robot took its poses in (its
+    /// row and each cable's direction of last motion); `None` where that
+    /// order is unknown (a RecurDyn log, an authors' folder). Set by
+    /// [`mark_time_order`] for rows known to be in time order.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub order: Option<ReadingOrder>,
+}
+
+/// A pose's place in time and motion: the faults that live there (a drift
+/// with the row, a friction or backlash that depends on the direction of the
+/// last motion) are functions of it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ReadingOrder {
+    /// The row, counted from 1 in the order the poses were taken.
+    pub row: usize,
+    /// Per cable (robot order): +1 when its encoder reading grew since the
+    /// previous row (paid out), -1 when it shrank (reeled in), 0 for the
+    /// first row (the motion that led there is unknown) or no motion.
+    pub direction: [i8; 4],
+}
+
+/// Mark `measurements` as rows in the order the robot took them: row `k + 1`
+/// for the `k`-th, and each cable's direction of last motion from the sign of
+/// its encoder reading's change since the previous row ([`ReadingOrder`]).
+pub fn mark_time_order(measurements: &mut [PoseMeasurement]) {
+    let mut previous: Option<[f64; 4]> = None;
+    for (k, m) in measurements.iter_mut().enumerate() {
+        let direction = std::array::from_fn(|i| match previous {
+            Some(before) => match m.encoder_lengths_m[i] - before[i] {
+                d if d > 0.0 => 1,
+                d if d < 0.0 => -1,
+                _ => 0,
+            },
+            None => 0,
+        });
+        previous = Some(m.encoder_lengths_m);
+        m.order = Some(ReadingOrder { row: k + 1, direction });
+    }
 }
 
 impl PoseMeasurement {

@@ -104,6 +104,7 @@ pub fn noise_free_reading(truth: &Robot, equilibrium: &Equilibrium) -> PoseMeasu
         encoder_lengths_m: std::array::from_fn(|i| equilibrium.cable_lengths_m[i] + truth.length_offsets_m[i]),
         reference_tension_n: equilibrium.tensions[truth.reference_cable].magnitude_n(),
         excluded: Default::default(),
+        order: None,
     }
 }
 

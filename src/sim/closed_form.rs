@@ -36,7 +36,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::model::geometry;
-use crate::model::measurement::PoseMeasurement;
+use crate::model::measurement::{mark_time_order, PoseMeasurement};
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::SensorNoise;
@@ -328,13 +328,16 @@ impl SensorSampler {
             encoder_lengths_m,
             reference_tension_n: reference_tension_n + self.load_cell.sample(rng),
             excluded: Default::default(),
+            order: None,
         }
     }
 }
 
 /// What the robot's sensors read at these equilibria: encoder = catenary
-/// length + the robot's length offset + noise; load cell = reference tension
-/// + noise; localiser pose = true pose perturbed on its tangent space.
+/// length + the robot's length offset + noise; load cell = reference
+/// tension + noise; localiser pose = true pose perturbed on its tangent
+/// space. The robot visits the equilibria in their order: the rows are
+/// marked so ([`mark_time_order`]).
 pub fn measure(
     robot: &Robot,
     equilibria: &[Equilibrium],
@@ -342,11 +345,13 @@ pub fn measure(
     rng: &mut impl Rng,
 ) -> Vec<PoseMeasurement> {
     let sensors = SensorSampler::new(noise);
-    equilibria
+    let mut rows: Vec<PoseMeasurement> = equilibria
         .iter()
         .map(|eq| {
             let lengths = std::array::from_fn(|i| eq.cable_lengths_m[i] + robot.length_offsets_m[i]);
             sensors.read(&eq.pose, lengths, eq.tensions[robot.reference_cable].magnitude_n(), rng)
         })
-        .collect()
+        .collect();
+    mark_time_order(&mut rows);
+    rows
 }

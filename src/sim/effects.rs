@@ -46,9 +46,9 @@ use rand::Rng;
 
 use crate::error::{Error, Result};
 use crate::model::effects::Effects;
-use crate::model::measurement::PoseMeasurement;
+use crate::model::measurement::{mark_time_order, PoseMeasurement, ReadingOrder};
 use crate::model::pose::PlatformPose;
-use crate::model::robot::Robot;
+use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::SensorNoise;
 use crate::model::statics::Equilibrium;
 use crate::sim::closed_form::SensorSampler;
@@ -127,6 +127,14 @@ pub fn solve_with_effects(
 /// in the order of [`crate::sim::closed_form::measure`], so with no effect the
 /// same seed gives the same noise. Every pose is solved before any noise is
 /// drawn; a pose without an equilibrium is an error naming it (nothing is skipped).
+///
+/// The robot visits the equilibria in their order, so the effects of time
+/// and motion ([`Effects::time_and_motion`]) act with the row and each
+/// cable's true direction of last motion: the sign of its paid-out length's
+/// change since the previous pose, and for the first pose since the middle
+/// of the poses' lengths (where the robot starts). The rows come back marked
+/// as a reader marks a measurement file's ([`mark_time_order`]: directions
+/// from the readings, none for the first row).
 pub fn measure_with_effects(
     robot: &Robot,
     effects: &Effects,
@@ -137,16 +145,52 @@ pub fn measure_with_effects(
 ) -> Result<Vec<PoseMeasurement>> {
     let solved = solve_with_effects(robot, effects, equilibria, segments)?;
     let sensors = SensorSampler::new(noise);
-    Ok(solved
+    let orders = true_orders(&solved);
+    let mut rows: Vec<PoseMeasurement> = solved
         .iter()
-        .map(|eq| {
-            let lengths =
-                std::array::from_fn(|i| effects.encoder_gain[i] * eq.paid_out_lengths_m[i] + robot.length_offsets_m[i]);
+        .zip(&orders)
+        .map(|(eq, order)| {
+            let now = effects.time_and_motion(order, robot.reference_cable);
+            let lengths = std::array::from_fn(|i| {
+                effects.encoder_gain[i] * eq.paid_out_lengths_m[i] + robot.length_offsets_m[i] + now.encoder_shift_m[i]
+            });
             let force = eq.cables[robot.reference_cable].platform_force_n.norm();
-            let tension = effects.load_cell_bias_n + effects.load_cell_gain * force;
+            let tension = effects.load_cell_bias_n
+                + effects.load_cell_gain * now.load_cell_factor * force
+                + now.load_cell_shift_n;
             sensors.read(&localiser_reading(&eq.pose, effects), lengths, tension, rng)
         })
-        .collect())
+        .collect();
+    mark_time_order(&mut rows);
+    Ok(rows)
+}
+
+/// Each pose's row and each cable's true direction of last motion (module
+/// docs of [`measure_with_effects`]): the paid-out length's change since the
+/// previous pose, the first pose's since the mean over the poses.
+fn true_orders(solved: &[DiscretisedEquilibrium]) -> Vec<ReadingOrder> {
+    let count = solved.len().max(1) as f64;
+    let start: [f64; CABLE_COUNT] =
+        std::array::from_fn(|i| solved.iter().map(|eq| eq.paid_out_lengths_m[i]).sum::<f64>() / count);
+    let mut previous = start;
+    solved
+        .iter()
+        .enumerate()
+        .map(|(k, eq)| {
+            let direction = std::array::from_fn(|i| {
+                let change = eq.paid_out_lengths_m[i] - previous[i];
+                if change > 0.0 {
+                    1
+                } else if change < 0.0 {
+                    -1
+                } else {
+                    0
+                }
+            });
+            previous = eq.paid_out_lengths_m;
+            ReadingOrder { row: k + 1, direction }
+        })
+        .collect()
 }
 
 /// The pose a localiser mounted with `effects.localiser_mount_deg` reports at

@@ -28,6 +28,7 @@ fn rows(robot: &Robot) -> Vec<PoseMeasurement> {
             encoder_lengths_m: std::array::from_fn(|i| (robot.anchors_m[i] - p).norm()),
             reference_tension_n: reference_tension_magnitude_guess(robot, p),
             excluded: Default::default(),
+            order: None,
         });
     }
     out
