@@ -280,6 +280,7 @@ JACOBIAN_BLOCKS: dict[str, tuple[str, str]] = {
     "reference_tension_n": ("jacobian_reference_tension", "`reference_tension_n`, columns `[f_h, f_v]`"),
     "anchors_m": ("jacobian_anchors", "`anchors_m`, columns `[slot 0 x, y, z, slot 1 x, y, z, ...]`"),
     "length_offsets_m": ("jacobian_length_offsets", "`length_offsets_m`, columns in slot order"),
+    "attachments_m": ("jacobian_attachments", "`attachments_m`, columns `[slot 0 x, y, z, slot 1 x, y, z, ...]`"),
     "com_offset_m": ("jacobian_com_offset", "`com_offset_m`, columns `[x, y, z]`"),
     "platform_weight_n": ("jacobian_platform_weight", "`platform_weight_n`"),
     "cable_weight_n_per_m": ("jacobian_cable_weight", "`cable_weight_n_per_m`"),
@@ -329,7 +330,7 @@ FUNCTIONS = (
     FunctionSpec(
         factors.cable_geometry,
         "geometry",
-        ("pose", "reference_tension_n", "anchors_m", "com_offset_m", "platform_weight_n"),
+        ("pose", "reference_tension_n", "anchors_m", "attachments_m", "com_offset_m", "platform_weight_n"),
     ),
     FunctionSpec(
         factors.extended_cable,

@@ -22,6 +22,7 @@
 /// * `jacobian_pose` (16x6): derivative of `geometry` with respect to the pose, columns `[dtheta (3), dp (3)]` of the retraction `(R * Exp(dtheta), p + dp)` (`src/model/pose.rs`).
 /// * `jacobian_reference_tension` (16x2): derivative of `geometry` with respect to `reference_tension_n`, columns `[f_h, f_v]`.
 /// * `jacobian_anchors` (16x12): derivative of `geometry` with respect to `anchors_m`, columns `[slot 0 x, y, z, slot 1 x, y, z, ...]`.
+/// * `jacobian_attachments` (16x12): derivative of `geometry` with respect to `attachments_m`, columns `[slot 0 x, y, z, slot 1 x, y, z, ...]`.
 /// * `jacobian_com_offset` (16x3): derivative of `geometry` with respect to `com_offset_m`, columns `[x, y, z]`.
 /// * `jacobian_platform_weight` (16x1): derivative of `geometry` with respect to `platform_weight_n`.
 #[allow(clippy::too_many_arguments)]
@@ -37,19 +38,20 @@ pub fn cable_geometry(
     jacobian_pose: Option<&mut nalgebra::SMatrix<f64, 16, 6>>,
     jacobian_reference_tension: Option<&mut nalgebra::SMatrix<f64, 16, 2>>,
     jacobian_anchors: Option<&mut nalgebra::SMatrix<f64, 16, 12>>,
+    jacobian_attachments: Option<&mut nalgebra::SMatrix<f64, 16, 12>>,
     jacobian_com_offset: Option<&mut nalgebra::SMatrix<f64, 16, 3>>,
     jacobian_platform_weight: Option<&mut nalgebra::SVector<f64, 16>>,
 ) -> nalgebra::SVector<f64, 16> {
-    // Total ops: 1623
+    // Total ops: 2405
 
-    // Intermediate terms (437)
-    let tmp0: f64 = 2.0_f64 * rotation_xyzw[3];
-    let tmp1: f64 = tmp0 * rotation_xyzw[1];
-    let tmp2: f64 = 2.0_f64 * rotation_xyzw[0];
-    let tmp3: f64 = tmp2 * rotation_xyzw[2];
+    // Intermediate terms (574)
+    let tmp0: f64 = 2.0_f64 * rotation_xyzw[1];
+    let tmp1: f64 = tmp0 * rotation_xyzw[3];
+    let tmp2: f64 = 2.0_f64 * rotation_xyzw[2];
+    let tmp3: f64 = tmp2 * rotation_xyzw[0];
     let tmp4: f64 = tmp1 + tmp3;
-    let tmp5: f64 = tmp0 * rotation_xyzw[2];
-    let tmp6: f64 = tmp2 * rotation_xyzw[1];
+    let tmp5: f64 = tmp2 * rotation_xyzw[3];
+    let tmp6: f64 = tmp0 * rotation_xyzw[0];
     let tmp7: f64 = -tmp5 + tmp6;
     let tmp8: f64 = -2.0_f64 * (rotation_xyzw[2] * rotation_xyzw[2]);
     let tmp9: f64 = 1.0_f64 - 2.0_f64 * (rotation_xyzw[1] * rotation_xyzw[1]);
@@ -57,8 +59,8 @@ pub fn cable_geometry(
     let tmp11: f64 = tmp10 * attachments_m[(0, 0)] + tmp4 * attachments_m[(2, 0)] + tmp7 * attachments_m[(1, 0)];
     let tmp12: f64 = tmp11 - anchors_m[(0, 0)] + position_m[0];
     let tmp13: f64 = tmp12 * tmp12;
-    let tmp14: f64 = tmp2 * rotation_xyzw[3];
-    let tmp15: f64 = 2.0_f64 * rotation_xyzw[1] * rotation_xyzw[2];
+    let tmp14: f64 = 2.0_f64 * rotation_xyzw[0] * rotation_xyzw[3];
+    let tmp15: f64 = tmp0 * rotation_xyzw[2];
     let tmp16: f64 = -tmp14 + tmp15;
     let tmp17: f64 = tmp5 + tmp6;
     let tmp18: f64 = -2.0_f64 * (rotation_xyzw[0] * rotation_xyzw[0]);
@@ -80,616 +82,804 @@ pub fn cable_geometry(
     let tmp34: f64 = tmp33 * tmp33;
     let tmp35: f64 = tmp31 + tmp34 + epsilon;
     let tmp36: f64 = tmp35.sqrt();
-    let tmp37: f64 = 1.0_f64 / tmp24;
-    let tmp38: f64 = tmp21 * tmp37;
-    let tmp39: f64 = tmp12 * tmp37;
-    let tmp40: f64 = tmp11 * tmp38 - tmp20 * tmp39;
-    let tmp41: f64 = tmp16 * attachments_m[(2, 2)] + tmp17 * attachments_m[(0, 2)] + tmp19 * attachments_m[(1, 2)];
-    let tmp42: f64 = tmp41 - anchors_m[(1, 2)] + position_m[1];
-    let tmp43: f64 = tmp10 * attachments_m[(0, 2)] + tmp4 * attachments_m[(2, 2)] + tmp7 * attachments_m[(1, 2)];
-    let tmp44: f64 = tmp43 - anchors_m[(0, 2)] + position_m[0];
-    let tmp45: f64 = tmp44 * tmp44;
-    let tmp46: f64 = tmp42 * tmp42;
-    let tmp47: f64 = tmp45 + tmp46 + epsilon;
-    let tmp48: f64 = tmp47.sqrt();
-    let tmp49: f64 = 1.0_f64 / tmp48;
-    let tmp50: f64 = tmp42 * tmp49;
-    let tmp51: f64 = tmp10 * attachments_m[(0, 3)] + tmp4 * attachments_m[(2, 3)] + tmp7 * attachments_m[(1, 3)];
-    let tmp52: f64 = tmp51 - anchors_m[(0, 3)] + position_m[0];
-    let tmp53: f64 = tmp52 * tmp52;
-    let tmp54: f64 = tmp16 * attachments_m[(2, 3)] + tmp17 * attachments_m[(0, 3)] + tmp19 * attachments_m[(1, 3)];
-    let tmp55: f64 = tmp54 - anchors_m[(1, 3)] + position_m[1];
-    let tmp56: f64 = tmp55 * tmp55;
-    let tmp57: f64 = tmp53 + tmp56 + epsilon;
-    let tmp58: f64 = tmp57.sqrt();
-    let tmp59: f64 = 1.0_f64 / tmp58;
-    let tmp60: f64 = tmp52 * tmp59;
-    let tmp61: f64 = tmp55 * tmp59;
-    let tmp62: f64 = tmp44 * tmp49;
-    let tmp63: f64 = -tmp50 * tmp60 + tmp61 * tmp62;
-    let tmp64: f64 = tmp51 * tmp61 - tmp54 * tmp60;
-    let tmp65: f64 = -tmp41 * tmp62 + tmp43 * tmp50;
-    let tmp66: f64 = tmp50 * tmp64 - tmp61 * tmp65;
-    let tmp67: f64 = 1.0_f64 / tmp36;
-    let tmp68: f64 = tmp30 * tmp67;
-    let tmp69: f64 = tmp60 * tmp65 - tmp62 * tmp64;
-    let tmp70: f64 = tmp33 * tmp67;
-    let tmp71: f64 = tmp29 * tmp70 - tmp32 * tmp68;
-    let tmp72: f64 = -tmp63 * tmp71 - tmp66 * tmp68 - tmp69 * tmp70;
-    let tmp73: f64 = 1.0_f64 / (tmp72 + epsilon * tmp72.signum());
-    let tmp74: f64 = tmp63 * tmp73;
-    let tmp75: f64 = tmp40 * tmp74;
-    let tmp76: f64 = tmp69 * tmp73;
-    let tmp77: f64 = tmp38 * tmp76;
-    let tmp78: f64 = tmp66 * tmp73;
-    let tmp79: f64 = tmp39 * reference_tension_n[0];
-    let tmp80: f64 = tmp75 * reference_tension_n[0] + tmp77 * reference_tension_n[0] + tmp78 * tmp79;
-    let tmp81: f64 = platform_weight_n - reference_tension_n[1];
-    let tmp82: f64 = -tmp41 * tmp51 + tmp43 * tmp54;
-    let tmp83: f64 = -tmp41 + tmp54;
-    let tmp84: f64 = -tmp43 + tmp51;
-    let tmp85: f64 = -tmp29 * tmp83 + tmp32 * tmp84 + tmp82;
-    let tmp86: f64 = 1.0_f64 / (tmp85 + epsilon * tmp85.signum());
-    let tmp87: f64 = tmp82 * tmp86;
-    let tmp88: f64 = tmp28 * tmp39;
-    let tmp89: f64 = tmp62 * tmp71 - tmp65 * tmp68;
-    let tmp90: f64 = tmp73 * tmp89;
-    let tmp91: f64 = tmp38 * reference_tension_n[0];
-    let tmp92: f64 = -tmp50 * tmp71 + tmp65 * tmp70;
-    let tmp93: f64 = tmp73 * tmp92;
-    let tmp94: f64 = tmp39 * tmp93;
-    let tmp95: f64 = tmp50 * tmp68 - tmp62 * tmp70;
-    let tmp96: f64 = tmp73 * tmp95;
-    let tmp97: f64 = tmp40 * tmp96;
-    let tmp98: f64 = tmp90 * tmp91 + tmp94 * reference_tension_n[0] + tmp97 * reference_tension_n[0];
-    let tmp99: f64 = tmp25 * attachments_m[(1, 3)] + tmp26 * attachments_m[(0, 3)] + tmp27 * attachments_m[(2, 3)];
-    let tmp100: f64 = tmp98 * tmp99;
-    let tmp101: f64 = tmp25 * attachments_m[(1, 1)] + tmp26 * attachments_m[(0, 1)] + tmp27 * attachments_m[(2, 1)];
-    let tmp102: f64 = tmp101 * tmp80;
-    let tmp103: f64 = tmp60 * tmp70 - tmp61 * tmp68;
-    let tmp104: f64 = tmp103 * tmp73;
-    let tmp105: f64 = tmp104 * tmp40;
-    let tmp106: f64 = -tmp60 * tmp71 + tmp64 * tmp68;
-    let tmp107: f64 = tmp106 * tmp73;
-    let tmp108: f64 = tmp61 * tmp71 - tmp64 * tmp70;
-    let tmp109: f64 = tmp108 * tmp73;
-    let tmp110: f64 = tmp109 * tmp39;
-    let tmp111: f64 = tmp105 * reference_tension_n[0] + tmp107 * tmp91 + tmp110 * reference_tension_n[0];
-    let tmp112: f64 = tmp25 * attachments_m[(1, 2)] + tmp26 * attachments_m[(0, 2)] + tmp27 * attachments_m[(2, 2)];
-    let tmp113: f64 = tmp111 * tmp112;
-    let tmp114: f64 = tmp10 * com_offset_m[0] + tmp4 * com_offset_m[2] + tmp7 * com_offset_m[1];
-    let tmp115: f64 = tmp100 * tmp60 + tmp102 * tmp68 + tmp11 * reference_tension_n[1] + tmp113 * tmp62
-        - tmp114 * platform_weight_n
-        + tmp88 * reference_tension_n[0];
-    let tmp116: f64 = tmp83 * tmp86;
-    let tmp117: f64 = tmp16 * com_offset_m[2] + tmp17 * com_offset_m[0] + tmp19 * com_offset_m[1];
-    let tmp118: f64 = tmp28 * tmp38;
-    let tmp119: f64 = -tmp100 * tmp61 - tmp102 * tmp70 - tmp113 * tmp50 + tmp117 * platform_weight_n
-        - tmp118 * reference_tension_n[0]
-        - tmp20 * reference_tension_n[1];
-    let tmp120: f64 = tmp84 * tmp86;
-    let tmp121: f64 = tmp115 * tmp116 + tmp119 * tmp120 + tmp81 * tmp87;
-    let tmp122: f64 = tmp86 * (-tmp29 * tmp54 + tmp32 * tmp51);
-    let tmp123: f64 = tmp86 * (tmp32 - tmp54);
-    let tmp124: f64 = tmp86 * (tmp29 - tmp51);
-    let tmp125: f64 = tmp115 * tmp123 + tmp119 * tmp124 + tmp122 * tmp81;
-    let tmp126: f64 = tmp86 * (-tmp32 + tmp41);
-    let tmp127: f64 = tmp86 * (tmp29 * tmp41 - tmp32 * tmp43);
-    let tmp128: f64 = tmp86 * (-tmp29 + tmp43);
-    let tmp129: f64 = tmp115 * tmp126 + tmp119 * tmp128 + tmp127 * tmp81;
-    let tmp130: f64 = tmp4 * attachments_m[(1, 0)] - tmp7 * attachments_m[(2, 0)];
-    let tmp131: f64 = tmp16 * attachments_m[(1, 0)] - tmp19 * attachments_m[(2, 0)];
-    let tmp132: f64 = tmp130 * tmp39 + tmp131 * tmp38;
-    let tmp133: f64 = -tmp25 * attachments_m[(2, 0)] + tmp27 * attachments_m[(1, 0)];
-    let tmp134: f64 = tmp4 * attachments_m[(1, 1)] - tmp7 * attachments_m[(2, 1)];
-    let tmp135: f64 = tmp16 * attachments_m[(1, 1)] - tmp19 * attachments_m[(2, 1)];
-    let tmp136: f64 = tmp134 * tmp68 + tmp135 * tmp70;
-    let tmp137: f64 = 1.0_f64 / tmp23;
-    let tmp138: f64 = tmp137 * tmp21;
-    let tmp139: f64 = tmp131 * tmp37;
-    let tmp140: f64 = reference_tension_n[0] * (-tmp132 * tmp138 + tmp139);
-    let tmp141: f64 = tmp135 * tmp67;
-    let tmp142: f64 = 1.0_f64 / tmp35;
-    let tmp143: f64 = tmp142 * tmp30;
-    let tmp144: f64 = tmp134 * tmp67 - tmp136 * tmp143;
-    let tmp145: f64 = tmp142 * tmp33;
-    let tmp146: f64 = -tmp136 * tmp145 + tmp141;
-    let tmp147: f64 = tmp16 * attachments_m[(1, 2)] - tmp19 * attachments_m[(2, 2)];
-    let tmp148: f64 = tmp147 * tmp49;
-    let tmp149: f64 = 1.0_f64 / tmp47;
-    let tmp150: f64 = tmp4 * attachments_m[(1, 2)] - tmp7 * attachments_m[(2, 2)];
-    let tmp151: f64 = tmp147 * tmp50 + tmp150 * tmp62;
-    let tmp152: f64 = tmp149 * tmp151;
-    let tmp153: f64 = tmp148 - tmp152 * tmp42;
-    let tmp154: f64 = tmp150 * tmp49 - tmp152 * tmp44;
-    let tmp155: f64 = tmp4 * attachments_m[(1, 3)] - tmp7 * attachments_m[(2, 3)];
-    let tmp156: f64 = tmp16 * attachments_m[(1, 3)] - tmp19 * attachments_m[(2, 3)];
-    let tmp157: f64 = tmp155 * tmp60 + tmp156 * tmp61;
-    let tmp158: f64 = 1.0_f64 / tmp57;
-    let tmp159: f64 = tmp158 * tmp55;
-    let tmp160: f64 = tmp156 * tmp59;
-    let tmp161: f64 = -tmp157 * tmp159 + tmp160;
-    let tmp162: f64 = tmp158 * tmp52;
-    let tmp163: f64 = tmp155 * tmp59 - tmp157 * tmp162;
-    let tmp164: f64 = tmp12 * tmp137;
-    let tmp165: f64 = reference_tension_n[0] * (tmp130 * tmp37 - tmp132 * tmp164);
-    let tmp166: f64 = tmp12 * reference_tension_n[0];
-    let tmp167: f64 = tmp11 * tmp140 - tmp111 * (tmp148 * tmp44 - tmp150 * tmp50 - tmp153 * tmp43 + tmp154 * tmp41)
-        + tmp130 * tmp91
-        - tmp139 * tmp166
-        - tmp165 * tmp20
-        - tmp80 * (-tmp134 * tmp70 + tmp141 * tmp30 + tmp144 * tmp32 - tmp146 * tmp29)
-        - tmp98 * (-tmp155 * tmp61 + tmp160 * tmp52 - tmp161 * tmp51 + tmp163 * tmp54);
-    let tmp168: f64 = tmp144 * tmp80;
-    let tmp169: f64 = tmp163 * tmp98;
-    let tmp170: f64 = tmp111 * tmp154;
-    let tmp171: f64 = tmp73 * (tmp165 + tmp168 + tmp169 + tmp170);
-    let tmp172: f64 = tmp111 * tmp153;
-    let tmp173: f64 = tmp146 * tmp80;
-    let tmp174: f64 = tmp161 * tmp98;
-    let tmp175: f64 = tmp140 + tmp172 + tmp173 + tmp174;
-    let tmp176: f64 = tmp167 * tmp74 + tmp171 * tmp66 + tmp175 * tmp76;
-    let tmp177: f64 = tmp101 * tmp68;
-    let tmp178: f64 = -tmp25 * attachments_m[(2, 2)] + tmp27 * attachments_m[(1, 2)];
-    let tmp179: f64 = tmp111 * tmp62;
-    let tmp180: f64 = tmp167 * tmp96 + tmp171 * tmp92 + tmp175 * tmp90;
-    let tmp181: f64 = tmp60 * tmp99;
-    let tmp182: f64 = tmp104 * tmp167 + tmp107 * tmp175 + tmp108 * tmp171;
-    let tmp183: f64 = tmp112 * tmp62;
-    let tmp184: f64 = -tmp25 * attachments_m[(2, 1)] + tmp27 * attachments_m[(1, 1)];
-    let tmp185: f64 = tmp68 * tmp80;
-    let tmp186: f64 = -tmp25 * attachments_m[(2, 3)] + tmp27 * attachments_m[(1, 3)];
-    let tmp187: f64 = tmp60 * tmp98;
-    let tmp188: f64 = tmp101 * tmp168
-        + tmp112 * tmp170
-        + tmp121 * tmp134
-        + tmp125 * tmp150
-        + tmp129 * tmp155
-        + tmp130 * reference_tension_n[1]
-        + tmp133 * tmp79
-        + tmp165 * tmp28
-        + tmp169 * tmp99
-        + tmp176 * tmp177
+    let tmp37: f64 = tmp10 * attachments_m[(0, 3)] + tmp4 * attachments_m[(2, 3)] + tmp7 * attachments_m[(1, 3)];
+    let tmp38: f64 = tmp37 - anchors_m[(0, 3)] + position_m[0];
+    let tmp39: f64 = tmp38 * tmp38;
+    let tmp40: f64 = tmp16 * attachments_m[(2, 3)] + tmp17 * attachments_m[(0, 3)] + tmp19 * attachments_m[(1, 3)];
+    let tmp41: f64 = tmp40 - anchors_m[(1, 3)] + position_m[1];
+    let tmp42: f64 = tmp41 * tmp41;
+    let tmp43: f64 = tmp39 + tmp42 + epsilon;
+    let tmp44: f64 = tmp43.sqrt();
+    let tmp45: f64 = 1.0_f64 / tmp44;
+    let tmp46: f64 = tmp38 * tmp45;
+    let tmp47: f64 = tmp16 * attachments_m[(2, 2)] + tmp17 * attachments_m[(0, 2)] + tmp19 * attachments_m[(1, 2)];
+    let tmp48: f64 = tmp47 - anchors_m[(1, 2)] + position_m[1];
+    let tmp49: f64 = tmp10 * attachments_m[(0, 2)] + tmp4 * attachments_m[(2, 2)] + tmp7 * attachments_m[(1, 2)];
+    let tmp50: f64 = tmp49 - anchors_m[(0, 2)] + position_m[0];
+    let tmp51: f64 = tmp50 * tmp50;
+    let tmp52: f64 = tmp48 * tmp48;
+    let tmp53: f64 = tmp51 + tmp52 + epsilon;
+    let tmp54: f64 = tmp53.sqrt();
+    let tmp55: f64 = 1.0_f64 / tmp54;
+    let tmp56: f64 = tmp48 * tmp55;
+    let tmp57: f64 = tmp50 * tmp55;
+    let tmp58: f64 = tmp41 * tmp45;
+    let tmp59: f64 = -tmp46 * tmp56 + tmp57 * tmp58;
+    let tmp60: f64 = tmp37 * tmp58 - tmp40 * tmp46;
+    let tmp61: f64 = -tmp47 * tmp57 + tmp49 * tmp56;
+    let tmp62: f64 = tmp56 * tmp60 - tmp58 * tmp61;
+    let tmp63: f64 = 1.0_f64 / tmp36;
+    let tmp64: f64 = tmp30 * tmp63;
+    let tmp65: f64 = tmp46 * tmp61 - tmp57 * tmp60;
+    let tmp66: f64 = tmp33 * tmp63;
+    let tmp67: f64 = tmp29 * tmp66 - tmp32 * tmp64;
+    let tmp68: f64 = -tmp59 * tmp67 - tmp62 * tmp64 - tmp65 * tmp66;
+    let tmp69: f64 = 1.0_f64 / (tmp68 + epsilon * tmp68.signum());
+    let tmp70: f64 = 1.0_f64 / tmp24;
+    let tmp71: f64 = tmp21 * tmp70;
+    let tmp72: f64 = tmp12 * tmp70;
+    let tmp73: f64 = tmp69 * (tmp11 * tmp71 - tmp20 * tmp72);
+    let tmp74: f64 = tmp59 * tmp73;
+    let tmp75: f64 = tmp65 * tmp69;
+    let tmp76: f64 = tmp75 * reference_tension_n[0];
+    let tmp77: f64 = tmp62 * tmp69;
+    let tmp78: f64 = tmp72 * reference_tension_n[0];
+    let tmp79: f64 = tmp71 * tmp76 + tmp74 * reference_tension_n[0] + tmp77 * tmp78;
+    let tmp80: f64 = platform_weight_n - reference_tension_n[1];
+    let tmp81: f64 = -tmp37 * tmp47 + tmp40 * tmp49;
+    let tmp82: f64 = tmp40 - tmp47;
+    let tmp83: f64 = tmp37 - tmp49;
+    let tmp84: f64 = -tmp29 * tmp82 + tmp32 * tmp83 + tmp81;
+    let tmp85: f64 = 1.0_f64 / (tmp84 + epsilon * tmp84.signum());
+    let tmp86: f64 = tmp81 * tmp85;
+    let tmp87: f64 = tmp28 * reference_tension_n[0];
+    let tmp88: f64 = tmp69 * (tmp57 * tmp67 - tmp61 * tmp64);
+    let tmp89: f64 = tmp88 * reference_tension_n[0];
+    let tmp90: f64 = tmp69 * (-tmp56 * tmp67 + tmp61 * tmp66);
+    let tmp91: f64 = tmp56 * tmp64 - tmp57 * tmp66;
+    let tmp92: f64 = tmp73 * tmp91;
+    let tmp93: f64 = tmp71 * tmp89 + tmp78 * tmp90 + tmp92 * reference_tension_n[0];
+    let tmp94: f64 = tmp25 * attachments_m[(1, 3)] + tmp26 * attachments_m[(0, 3)] + tmp27 * attachments_m[(2, 3)];
+    let tmp95: f64 = tmp93 * tmp94;
+    let tmp96: f64 = tmp25 * attachments_m[(1, 1)] + tmp26 * attachments_m[(0, 1)] + tmp27 * attachments_m[(2, 1)];
+    let tmp97: f64 = tmp79 * tmp96;
+    let tmp98: f64 = tmp46 * tmp66 - tmp58 * tmp64;
+    let tmp99: f64 = tmp73 * tmp98;
+    let tmp100: f64 = -tmp46 * tmp67 + tmp60 * tmp64;
+    let tmp101: f64 = tmp100 * tmp69;
+    let tmp102: f64 = tmp71 * reference_tension_n[0];
+    let tmp103: f64 = tmp58 * tmp67 - tmp60 * tmp66;
+    let tmp104: f64 = tmp103 * tmp69;
+    let tmp105: f64 = tmp101 * tmp102 + tmp104 * tmp78 + tmp99 * reference_tension_n[0];
+    let tmp106: f64 = tmp25 * attachments_m[(1, 2)] + tmp26 * attachments_m[(0, 2)] + tmp27 * attachments_m[(2, 2)];
+    let tmp107: f64 = tmp105 * tmp106;
+    let tmp108: f64 = tmp10 * com_offset_m[0] + tmp4 * com_offset_m[2] + tmp7 * com_offset_m[1];
+    let tmp109: f64 = tmp107 * tmp57 - tmp108 * platform_weight_n
+        + tmp11 * reference_tension_n[1]
+        + tmp46 * tmp95
+        + tmp64 * tmp97
+        + tmp72 * tmp87;
+    let tmp110: f64 = tmp82 * tmp85;
+    let tmp111: f64 = tmp16 * com_offset_m[2] + tmp17 * com_offset_m[0] + tmp19 * com_offset_m[1];
+    let tmp112: f64 = -tmp107 * tmp56 + tmp111 * platform_weight_n
+        - tmp20 * reference_tension_n[1]
+        - tmp58 * tmp95
+        - tmp66 * tmp97
+        - tmp71 * tmp87;
+    let tmp113: f64 = tmp83 * tmp85;
+    let tmp114: f64 = tmp109 * tmp110 + tmp112 * tmp113 + tmp80 * tmp86;
+    let tmp115: f64 = tmp85 * (-tmp29 * tmp40 + tmp32 * tmp37);
+    let tmp116: f64 = tmp85 * (tmp32 - tmp40);
+    let tmp117: f64 = tmp85 * (tmp29 - tmp37);
+    let tmp118: f64 = tmp109 * tmp116 + tmp112 * tmp117 + tmp115 * tmp80;
+    let tmp119: f64 = tmp85 * (-tmp32 + tmp47);
+    let tmp120: f64 = tmp85 * (tmp29 * tmp47 - tmp32 * tmp49);
+    let tmp121: f64 = tmp85 * (-tmp29 + tmp49);
+    let tmp122: f64 = tmp109 * tmp119 + tmp112 * tmp121 + tmp120 * tmp80;
+    let tmp123: f64 = tmp4 * attachments_m[(1, 0)] - tmp7 * attachments_m[(2, 0)];
+    let tmp124: f64 = tmp16 * attachments_m[(1, 0)] - tmp19 * attachments_m[(2, 0)];
+    let tmp125: f64 = tmp124 * tmp70;
+    let tmp126: f64 = tmp123 * tmp72 + tmp125 * tmp21;
+    let tmp127: f64 = -tmp25 * attachments_m[(2, 0)] + tmp27 * attachments_m[(1, 0)];
+    let tmp128: f64 = tmp4 * attachments_m[(1, 1)] - tmp7 * attachments_m[(2, 1)];
+    let tmp129: f64 = tmp16 * attachments_m[(1, 1)] - tmp19 * attachments_m[(2, 1)];
+    let tmp130: f64 = tmp129 * tmp63;
+    let tmp131: f64 = tmp128 * tmp64 + tmp130 * tmp33;
+    let tmp132: f64 = 1.0_f64 / tmp23;
+    let tmp133: f64 = tmp132 * tmp21;
+    let tmp134: f64 = reference_tension_n[0] * (tmp125 - tmp126 * tmp133);
+    let tmp135: f64 = 1.0_f64 / tmp35;
+    let tmp136: f64 = tmp135 * tmp30;
+    let tmp137: f64 = tmp128 * tmp63 - tmp131 * tmp136;
+    let tmp138: f64 = tmp135 * tmp33;
+    let tmp139: f64 = tmp130 - tmp131 * tmp138;
+    let tmp140: f64 = tmp16 * attachments_m[(1, 2)] - tmp19 * attachments_m[(2, 2)];
+    let tmp141: f64 = tmp140 * tmp55;
+    let tmp142: f64 = tmp4 * attachments_m[(1, 2)] - tmp7 * attachments_m[(2, 2)];
+    let tmp143: f64 = tmp141 * tmp48 + tmp142 * tmp57;
+    let tmp144: f64 = 1.0_f64 / tmp53;
+    let tmp145: f64 = tmp144 * tmp48;
+    let tmp146: f64 = tmp141 - tmp143 * tmp145;
+    let tmp147: f64 = tmp144 * tmp50;
+    let tmp148: f64 = tmp142 * tmp55 - tmp143 * tmp147;
+    let tmp149: f64 = tmp4 * attachments_m[(1, 3)] - tmp7 * attachments_m[(2, 3)];
+    let tmp150: f64 = tmp16 * attachments_m[(1, 3)] - tmp19 * attachments_m[(2, 3)];
+    let tmp151: f64 = tmp150 * tmp45;
+    let tmp152: f64 = tmp149 * tmp46 + tmp151 * tmp41;
+    let tmp153: f64 = 1.0_f64 / tmp43;
+    let tmp154: f64 = tmp153 * tmp41;
+    let tmp155: f64 = tmp151 - tmp152 * tmp154;
+    let tmp156: f64 = tmp153 * tmp38;
+    let tmp157: f64 = tmp149 * tmp45 - tmp152 * tmp156;
+    let tmp158: f64 = tmp12 * tmp132;
+    let tmp159: f64 = reference_tension_n[0] * (tmp123 * tmp70 - tmp126 * tmp158);
+    let tmp160: f64 = tmp102 * tmp123 - tmp105 * (tmp140 * tmp57 - tmp142 * tmp56 - tmp146 * tmp49 + tmp148 * tmp47)
+        + tmp11 * tmp134
+        - tmp124 * tmp78
+        - tmp159 * tmp20
+        - tmp79 * (-tmp128 * tmp66 + tmp129 * tmp64 + tmp137 * tmp32 - tmp139 * tmp29)
+        - tmp93 * (-tmp149 * tmp58 + tmp150 * tmp46 - tmp155 * tmp37 + tmp157 * tmp40);
+    let tmp161: f64 = tmp59 * tmp69;
+    let tmp162: f64 = tmp137 * tmp79;
+    let tmp163: f64 = tmp157 * tmp93;
+    let tmp164: f64 = tmp105 * tmp148;
+    let tmp165: f64 = tmp159 + tmp162 + tmp163 + tmp164;
+    let tmp166: f64 = tmp105 * tmp146;
+    let tmp167: f64 = tmp139 * tmp79;
+    let tmp168: f64 = tmp155 * tmp93;
+    let tmp169: f64 = tmp134 + tmp166 + tmp167 + tmp168;
+    let tmp170: f64 = tmp160 * tmp161 + tmp165 * tmp77 + tmp169 * tmp75;
+    let tmp171: f64 = tmp64 * tmp96;
+    let tmp172: f64 = -tmp25 * attachments_m[(2, 2)] + tmp27 * attachments_m[(1, 2)];
+    let tmp173: f64 = tmp105 * tmp57;
+    let tmp174: f64 = tmp69 * tmp91;
+    let tmp175: f64 = tmp160 * tmp174 + tmp165 * tmp90 + tmp169 * tmp88;
+    let tmp176: f64 = tmp46 * tmp94;
+    let tmp177: f64 = tmp69 * tmp98;
+    let tmp178: f64 = tmp101 * tmp169 + tmp104 * tmp165 + tmp160 * tmp177;
+    let tmp179: f64 = tmp106 * tmp57;
+    let tmp180: f64 = -tmp25 * attachments_m[(2, 1)] + tmp27 * attachments_m[(1, 1)];
+    let tmp181: f64 = tmp64 * tmp79;
+    let tmp182: f64 = -tmp25 * attachments_m[(2, 3)] + tmp27 * attachments_m[(1, 3)];
+    let tmp183: f64 = tmp46 * tmp93;
+    let tmp184: f64 = tmp106 * tmp164
+        + tmp114 * tmp128
+        + tmp118 * tmp142
+        + tmp122 * tmp149
+        + tmp123 * reference_tension_n[1]
+        + tmp127 * tmp78
+        + tmp159 * tmp28
+        + tmp162 * tmp96
+        + tmp163 * tmp94
+        + tmp170 * tmp171
+        + tmp172 * tmp173
+        + tmp175 * tmp176
         + tmp178 * tmp179
         + tmp180 * tmp181
         + tmp182 * tmp183
-        + tmp184 * tmp185
-        + tmp186 * tmp187
         - platform_weight_n * (tmp4 * com_offset_m[1] - tmp7 * com_offset_m[2]);
-    let tmp189: f64 = tmp112 * tmp50;
-    let tmp190: f64 = tmp61 * tmp98;
-    let tmp191: f64 = tmp61 * tmp99;
-    let tmp192: f64 = tmp70 * tmp80;
-    let tmp193: f64 = tmp101 * tmp70;
-    let tmp194: f64 = tmp111 * tmp50;
-    let tmp195: f64 = -tmp101 * tmp173
-        - tmp112 * tmp172
-        - tmp121 * tmp135
-        - tmp125 * tmp147
-        - tmp129 * tmp156
-        - tmp131 * reference_tension_n[1]
-        - tmp133 * tmp91
-        - tmp140 * tmp28
-        - tmp174 * tmp99
-        - tmp176 * tmp193
-        - tmp178 * tmp194
-        - tmp180 * tmp191
-        - tmp182 * tmp189
-        - tmp184 * tmp192
-        - tmp186 * tmp190
+    let tmp185: f64 = tmp106 * tmp56;
+    let tmp186: f64 = tmp58 * tmp93;
+    let tmp187: f64 = tmp58 * tmp94;
+    let tmp188: f64 = tmp66 * tmp79;
+    let tmp189: f64 = tmp66 * tmp96;
+    let tmp190: f64 = tmp105 * tmp56;
+    let tmp191: f64 = -tmp102 * tmp127
+        - tmp106 * tmp166
+        - tmp114 * tmp129
+        - tmp118 * tmp140
+        - tmp122 * tmp150
+        - tmp124 * reference_tension_n[1]
+        - tmp134 * tmp28
+        - tmp167 * tmp96
+        - tmp168 * tmp94
+        - tmp170 * tmp189
+        - tmp172 * tmp190
+        - tmp175 * tmp187
+        - tmp178 * tmp185
+        - tmp180 * tmp188
+        - tmp182 * tmp186
         + platform_weight_n * (tmp16 * com_offset_m[1] - tmp19 * com_offset_m[2]);
-    let tmp196: f64 = tmp10 * attachments_m[(2, 0)] - tmp4 * attachments_m[(0, 0)];
-    let tmp197: f64 = -tmp16 * attachments_m[(0, 0)] + tmp17 * attachments_m[(2, 0)];
-    let tmp198: f64 = tmp196 * tmp39 + tmp197 * tmp38;
-    let tmp199: f64 = tmp26 * attachments_m[(2, 0)] - tmp27 * attachments_m[(0, 0)];
-    let tmp200: f64 = tmp10 * attachments_m[(2, 1)] - tmp4 * attachments_m[(0, 1)];
-    let tmp201: f64 = -tmp16 * attachments_m[(0, 1)] + tmp17 * attachments_m[(2, 1)];
-    let tmp202: f64 = tmp200 * tmp68 + tmp201 * tmp70;
-    let tmp203: f64 = tmp201 * tmp67;
-    let tmp204: f64 = -tmp145 * tmp202 + tmp203;
-    let tmp205: f64 = tmp204 * tmp80;
-    let tmp206: f64 = tmp10 * attachments_m[(2, 3)] - tmp4 * attachments_m[(0, 3)];
-    let tmp207: f64 = -tmp16 * attachments_m[(0, 3)] + tmp17 * attachments_m[(2, 3)];
-    let tmp208: f64 = tmp206 * tmp60 + tmp207 * tmp61;
-    let tmp209: f64 = tmp207 * tmp59;
-    let tmp210: f64 = -tmp159 * tmp208 + tmp209;
-    let tmp211: f64 = tmp210 * tmp98;
-    let tmp212: f64 = tmp10 * attachments_m[(2, 2)] - tmp4 * attachments_m[(0, 2)];
-    let tmp213: f64 = -tmp16 * attachments_m[(0, 2)] + tmp17 * attachments_m[(2, 2)];
-    let tmp214: f64 = tmp212 * tmp62 + tmp213 * tmp50;
-    let tmp215: f64 = tmp149 * tmp214;
-    let tmp216: f64 = tmp213 * tmp49 - tmp215 * tmp42;
-    let tmp217: f64 = tmp111 * tmp216;
-    let tmp218: f64 = tmp137 * tmp198;
-    let tmp219: f64 = tmp197 * tmp37;
-    let tmp220: f64 = reference_tension_n[0] * (-tmp21 * tmp218 + tmp219);
-    let tmp221: f64 = tmp205 + tmp211 + tmp217 + tmp220;
-    let tmp222: f64 = -tmp162 * tmp208 + tmp206 * tmp59;
-    let tmp223: f64 = tmp222 * tmp98;
-    let tmp224: f64 = -tmp143 * tmp202 + tmp200 * tmp67;
-    let tmp225: f64 = tmp224 * tmp80;
-    let tmp226: f64 = tmp212 * tmp49 - tmp215 * tmp44;
-    let tmp227: f64 = tmp111 * tmp226;
-    let tmp228: f64 = reference_tension_n[0] * (-tmp12 * tmp218 + tmp196 * tmp37);
-    let tmp229: f64 = tmp223 + tmp225 + tmp227 + tmp228;
-    let tmp230: f64 = tmp11 * tmp220
-        - tmp111 * (-tmp212 * tmp50 + tmp213 * tmp62 - tmp216 * tmp43 + tmp226 * tmp41)
-        - tmp166 * tmp219
-        + tmp196 * tmp91
-        - tmp20 * tmp228
-        - tmp80 * (-tmp200 * tmp70 + tmp203 * tmp30 - tmp204 * tmp29 + tmp224 * tmp32)
-        - tmp98 * (-tmp206 * tmp61 + tmp209 * tmp52 - tmp210 * tmp51 + tmp222 * tmp54);
-    let tmp231: f64 = tmp221 * tmp76 + tmp229 * tmp78 + tmp230 * tmp74;
+    let tmp192: f64 = tmp10 * attachments_m[(2, 0)] - tmp4 * attachments_m[(0, 0)];
+    let tmp193: f64 = -tmp16 * attachments_m[(0, 0)] + tmp17 * attachments_m[(2, 0)];
+    let tmp194: f64 = tmp193 * tmp70;
+    let tmp195: f64 = tmp192 * tmp72 + tmp194 * tmp21;
+    let tmp196: f64 = tmp26 * attachments_m[(2, 0)] - tmp27 * attachments_m[(0, 0)];
+    let tmp197: f64 = tmp10 * attachments_m[(2, 1)] - tmp4 * attachments_m[(0, 1)];
+    let tmp198: f64 = -tmp16 * attachments_m[(0, 1)] + tmp17 * attachments_m[(2, 1)];
+    let tmp199: f64 = tmp198 * tmp63;
+    let tmp200: f64 = tmp197 * tmp64 + tmp199 * tmp33;
+    let tmp201: f64 = -tmp138 * tmp200 + tmp199;
+    let tmp202: f64 = tmp201 * tmp79;
+    let tmp203: f64 = tmp10 * attachments_m[(2, 3)] - tmp4 * attachments_m[(0, 3)];
+    let tmp204: f64 = -tmp16 * attachments_m[(0, 3)] + tmp17 * attachments_m[(2, 3)];
+    let tmp205: f64 = tmp204 * tmp45;
+    let tmp206: f64 = tmp203 * tmp46 + tmp205 * tmp41;
+    let tmp207: f64 = -tmp154 * tmp206 + tmp205;
+    let tmp208: f64 = tmp207 * tmp93;
+    let tmp209: f64 = tmp10 * attachments_m[(2, 2)] - tmp4 * attachments_m[(0, 2)];
+    let tmp210: f64 = -tmp16 * attachments_m[(0, 2)] + tmp17 * attachments_m[(2, 2)];
+    let tmp211: f64 = tmp210 * tmp55;
+    let tmp212: f64 = tmp209 * tmp57 + tmp211 * tmp48;
+    let tmp213: f64 = -tmp145 * tmp212 + tmp211;
+    let tmp214: f64 = tmp105 * tmp213;
+    let tmp215: f64 = reference_tension_n[0] * (-tmp133 * tmp195 + tmp194);
+    let tmp216: f64 = tmp202 + tmp208 + tmp214 + tmp215;
+    let tmp217: f64 = tmp203 * tmp45;
+    let tmp218: f64 = -tmp156 * tmp206 + tmp217;
+    let tmp219: f64 = tmp218 * tmp93;
+    let tmp220: f64 = tmp197 * tmp63;
+    let tmp221: f64 = -tmp136 * tmp200 + tmp220;
+    let tmp222: f64 = tmp221 * tmp79;
+    let tmp223: f64 = tmp209 * tmp55;
+    let tmp224: f64 = -tmp147 * tmp212 + tmp223;
+    let tmp225: f64 = tmp105 * tmp224;
+    let tmp226: f64 = tmp192 * tmp70;
+    let tmp227: f64 = reference_tension_n[0] * (-tmp158 * tmp195 + tmp226);
+    let tmp228: f64 = tmp219 + tmp222 + tmp225 + tmp227;
+    let tmp229: f64 = tmp21 * reference_tension_n[0];
+    let tmp230: f64 = -tmp105 * (tmp211 * tmp50 - tmp213 * tmp49 - tmp223 * tmp48 + tmp224 * tmp47) + tmp11 * tmp215
+        - tmp12 * tmp194 * reference_tension_n[0]
+        - tmp20 * tmp227
+        + tmp226 * tmp229
+        - tmp79 * (tmp199 * tmp30 - tmp201 * tmp29 - tmp220 * tmp33 + tmp221 * tmp32)
+        - tmp93 * (tmp205 * tmp38 - tmp207 * tmp37 - tmp217 * tmp41 + tmp218 * tmp40);
+    let tmp231: f64 = tmp161 * tmp230 + tmp216 * tmp75 + tmp228 * tmp77;
     let tmp232: f64 = tmp26 * attachments_m[(2, 3)] - tmp27 * attachments_m[(0, 3)];
     let tmp233: f64 = tmp26 * attachments_m[(2, 2)] - tmp27 * attachments_m[(0, 2)];
-    let tmp234: f64 = tmp221 * tmp90 + tmp229 * tmp93 + tmp230 * tmp96;
-    let tmp235: f64 = tmp104 * tmp230 + tmp107 * tmp221 + tmp109 * tmp229;
+    let tmp234: f64 = tmp174 * tmp230 + tmp216 * tmp88 + tmp228 * tmp90;
+    let tmp235: f64 = tmp101 * tmp216 + tmp104 * tmp228 + tmp177 * tmp230;
     let tmp236: f64 = tmp26 * attachments_m[(2, 1)] - tmp27 * attachments_m[(0, 1)];
-    let tmp237: f64 = tmp236 * tmp80;
-    let tmp238: f64 = tmp101 * tmp225
-        + tmp112 * tmp227
-        + tmp121 * tmp200
-        + tmp125 * tmp212
-        + tmp129 * tmp206
-        + tmp177 * tmp231
-        + tmp179 * tmp233
-        + tmp181 * tmp234
-        + tmp183 * tmp235
-        + tmp187 * tmp232
-        + tmp196 * reference_tension_n[1]
-        + tmp199 * tmp79
-        + tmp223 * tmp99
-        + tmp228 * tmp28
-        + tmp237 * tmp68
+    let tmp237: f64 = tmp106 * tmp225
+        + tmp114 * tmp197
+        + tmp118 * tmp209
+        + tmp122 * tmp203
+        + tmp171 * tmp231
+        + tmp173 * tmp233
+        + tmp176 * tmp234
+        + tmp179 * tmp235
+        + tmp181 * tmp236
+        + tmp183 * tmp232
+        + tmp192 * reference_tension_n[1]
+        + tmp196 * tmp78
+        + tmp219 * tmp94
+        + tmp222 * tmp96
+        + tmp227 * tmp28
         - platform_weight_n * (tmp10 * com_offset_m[2] - tmp4 * com_offset_m[0]);
-    let tmp239: f64 = -tmp101 * tmp205
-        - tmp112 * tmp217
-        - tmp121 * tmp201
-        - tmp125 * tmp213
-        - tmp129 * tmp207
-        - tmp189 * tmp235
-        - tmp190 * tmp232
-        - tmp191 * tmp234
-        - tmp193 * tmp231
-        - tmp194 * tmp233
-        - tmp197 * reference_tension_n[1]
-        - tmp199 * tmp91
-        - tmp211 * tmp99
-        - tmp220 * tmp28
-        - tmp237 * tmp70
+    let tmp238: f64 = -tmp102 * tmp196
+        - tmp106 * tmp214
+        - tmp114 * tmp198
+        - tmp118 * tmp210
+        - tmp122 * tmp204
+        - tmp185 * tmp235
+        - tmp186 * tmp232
+        - tmp187 * tmp234
+        - tmp188 * tmp236
+        - tmp189 * tmp231
+        - tmp190 * tmp233
+        - tmp193 * reference_tension_n[1]
+        - tmp202 * tmp96
+        - tmp208 * tmp94
+        - tmp215 * tmp28
         + platform_weight_n * (-tmp16 * com_offset_m[0] + tmp17 * com_offset_m[2]);
-    let tmp240: f64 = -tmp10 * attachments_m[(1, 0)] + tmp7 * attachments_m[(0, 0)];
-    let tmp241: f64 = tmp240 * tmp37;
-    let tmp242: f64 = -tmp17 * attachments_m[(1, 0)] + tmp19 * attachments_m[(0, 0)];
-    let tmp243: f64 = tmp12 * tmp241 + tmp242 * tmp38;
-    let tmp244: f64 = tmp25 * attachments_m[(0, 0)] - tmp26 * attachments_m[(1, 0)];
-    let tmp245: f64 = -tmp17 * attachments_m[(1, 1)] + tmp19 * attachments_m[(0, 1)];
+    let tmp239: f64 = -tmp10 * attachments_m[(1, 0)] + tmp7 * attachments_m[(0, 0)];
+    let tmp240: f64 = -tmp17 * attachments_m[(1, 0)] + tmp19 * attachments_m[(0, 0)];
+    let tmp241: f64 = tmp240 * tmp70;
+    let tmp242: f64 = tmp21 * tmp241 + tmp239 * tmp72;
+    let tmp243: f64 = tmp25 * attachments_m[(0, 0)] - tmp26 * attachments_m[(1, 0)];
+    let tmp244: f64 = -tmp17 * attachments_m[(1, 1)] + tmp19 * attachments_m[(0, 1)];
+    let tmp245: f64 = tmp244 * tmp63;
     let tmp246: f64 = -tmp10 * attachments_m[(1, 1)] + tmp7 * attachments_m[(0, 1)];
-    let tmp247: f64 = tmp246 * tmp67;
-    let tmp248: f64 = tmp245 * tmp70 + tmp247 * tmp30;
-    let tmp249: f64 = reference_tension_n[0] * (-tmp138 * tmp243 + tmp242 * tmp37);
-    let tmp250: f64 = -tmp143 * tmp248 + tmp247;
-    let tmp251: f64 = -tmp145 * tmp248 + tmp245 * tmp67;
+    let tmp247: f64 = tmp246 * tmp63;
+    let tmp248: f64 = tmp245 * tmp33 + tmp247 * tmp30;
+    let tmp249: f64 = reference_tension_n[0] * (-tmp133 * tmp242 + tmp241);
+    let tmp250: f64 = -tmp136 * tmp248 + tmp247;
+    let tmp251: f64 = -tmp138 * tmp248 + tmp245;
     let tmp252: f64 = -tmp17 * attachments_m[(1, 2)] + tmp19 * attachments_m[(0, 2)];
-    let tmp253: f64 = -tmp10 * attachments_m[(1, 2)] + tmp7 * attachments_m[(0, 2)];
-    let tmp254: f64 = tmp253 * tmp49;
-    let tmp255: f64 = tmp252 * tmp50 + tmp254 * tmp44;
-    let tmp256: f64 = tmp149 * tmp255;
-    let tmp257: f64 = tmp252 * tmp49 - tmp256 * tmp42;
-    let tmp258: f64 = tmp254 - tmp256 * tmp44;
-    let tmp259: f64 = -tmp17 * attachments_m[(1, 3)] + tmp19 * attachments_m[(0, 3)];
-    let tmp260: f64 = -tmp10 * attachments_m[(1, 3)] + tmp7 * attachments_m[(0, 3)];
-    let tmp261: f64 = tmp260 * tmp59;
-    let tmp262: f64 = tmp259 * tmp61 + tmp261 * tmp52;
-    let tmp263: f64 = -tmp159 * tmp262 + tmp259 * tmp59;
-    let tmp264: f64 = -tmp162 * tmp262 + tmp261;
-    let tmp265: f64 = reference_tension_n[0] * (-tmp164 * tmp243 + tmp241);
-    let tmp266: f64 =
-        tmp11 * tmp249 - tmp111 * (tmp252 * tmp62 - tmp253 * tmp50 - tmp257 * tmp43 + tmp258 * tmp41) - tmp20 * tmp265
-            + tmp240 * tmp91
-            - tmp242 * tmp79
-            - tmp80 * (tmp245 * tmp68 - tmp246 * tmp70 + tmp250 * tmp32 - tmp251 * tmp29)
-            - tmp98 * (tmp259 * tmp60 - tmp260 * tmp61 - tmp263 * tmp51 + tmp264 * tmp54);
-    let tmp267: f64 = tmp111 * tmp258;
-    let tmp268: f64 = tmp250 * tmp80;
-    let tmp269: f64 = tmp264 * tmp98;
-    let tmp270: f64 = tmp265 + tmp267 + tmp268 + tmp269;
-    let tmp271: f64 = tmp251 * tmp80;
-    let tmp272: f64 = tmp111 * tmp257;
-    let tmp273: f64 = tmp263 * tmp98;
-    let tmp274: f64 = tmp73 * (tmp249 + tmp271 + tmp272 + tmp273);
-    let tmp275: f64 = tmp266 * tmp74 + tmp270 * tmp78 + tmp274 * tmp69;
-    let tmp276: f64 = tmp25 * attachments_m[(0, 1)] - tmp26 * attachments_m[(1, 1)];
-    let tmp277: f64 = tmp266 * tmp96 + tmp270 * tmp93 + tmp274 * tmp89;
-    let tmp278: f64 = tmp25 * attachments_m[(0, 3)] - tmp26 * attachments_m[(1, 3)];
-    let tmp279: f64 = tmp278 * tmp98;
-    let tmp280: f64 = tmp25 * attachments_m[(0, 2)] - tmp26 * attachments_m[(1, 2)];
-    let tmp281: f64 = tmp104 * tmp266 + tmp106 * tmp274 + tmp109 * tmp270;
-    let tmp282: f64 = -tmp101 * tmp271
-        - tmp112 * tmp272
-        - tmp121 * tmp245
-        - tmp125 * tmp252
-        - tmp129 * tmp259
-        - tmp189 * tmp281
-        - tmp191 * tmp277
-        - tmp192 * tmp276
-        - tmp193 * tmp275
-        - tmp194 * tmp280
-        - tmp242 * reference_tension_n[1]
-        - tmp244 * tmp91
+    let tmp253: f64 = tmp252 * tmp55;
+    let tmp254: f64 = -tmp10 * attachments_m[(1, 2)] + tmp7 * attachments_m[(0, 2)];
+    let tmp255: f64 = tmp254 * tmp55;
+    let tmp256: f64 = tmp253 * tmp48 + tmp255 * tmp50;
+    let tmp257: f64 = tmp144 * tmp256;
+    let tmp258: f64 = tmp253 - tmp257 * tmp48;
+    let tmp259: f64 = tmp255 - tmp257 * tmp50;
+    let tmp260: f64 = -tmp17 * attachments_m[(1, 3)] + tmp19 * attachments_m[(0, 3)];
+    let tmp261: f64 = -tmp10 * attachments_m[(1, 3)] + tmp7 * attachments_m[(0, 3)];
+    let tmp262: f64 = tmp261 * tmp45;
+    let tmp263: f64 = tmp260 * tmp45;
+    let tmp264: f64 = tmp261 * tmp46 + tmp263 * tmp41;
+    let tmp265: f64 = -tmp154 * tmp264 + tmp263;
+    let tmp266: f64 = -tmp156 * tmp264 + tmp262;
+    let tmp267: f64 = tmp239 * tmp70;
+    let tmp268: f64 = reference_tension_n[0] * (-tmp158 * tmp242 + tmp267);
+    let tmp269: f64 = -tmp105 * (tmp252 * tmp57 - tmp255 * tmp48 - tmp258 * tmp49 + tmp259 * tmp47) + tmp11 * tmp249
+        - tmp20 * tmp268
+        + tmp229 * tmp267
+        - tmp240 * tmp78
+        - tmp79 * (tmp244 * tmp64 - tmp247 * tmp33 + tmp250 * tmp32 - tmp251 * tmp29)
+        - tmp93 * (tmp260 * tmp46 - tmp262 * tmp41 - tmp265 * tmp37 + tmp266 * tmp40);
+    let tmp270: f64 = tmp105 * tmp259;
+    let tmp271: f64 = tmp250 * tmp79;
+    let tmp272: f64 = tmp266 * tmp93;
+    let tmp273: f64 = tmp268 + tmp270 + tmp271 + tmp272;
+    let tmp274: f64 = tmp251 * tmp79;
+    let tmp275: f64 = tmp105 * tmp258;
+    let tmp276: f64 = tmp265 * tmp93;
+    let tmp277: f64 = tmp249 + tmp274 + tmp275 + tmp276;
+    let tmp278: f64 = tmp161 * tmp269 + tmp273 * tmp77 + tmp277 * tmp75;
+    let tmp279: f64 = tmp25 * attachments_m[(0, 1)] - tmp26 * attachments_m[(1, 1)];
+    let tmp280: f64 = tmp174 * tmp269 + tmp273 * tmp90 + tmp277 * tmp88;
+    let tmp281: f64 = tmp25 * attachments_m[(0, 3)] - tmp26 * attachments_m[(1, 3)];
+    let tmp282: f64 = tmp25 * attachments_m[(0, 2)] - tmp26 * attachments_m[(1, 2)];
+    let tmp283: f64 = tmp101 * tmp277 + tmp104 * tmp273 + tmp177 * tmp269;
+    let tmp284: f64 = -tmp102 * tmp243
+        - tmp106 * tmp275
+        - tmp114 * tmp244
+        - tmp118 * tmp252
+        - tmp122 * tmp260
+        - tmp185 * tmp283
+        - tmp186 * tmp281
+        - tmp187 * tmp280
+        - tmp188 * tmp279
+        - tmp189 * tmp278
+        - tmp190 * tmp282
+        - tmp240 * reference_tension_n[1]
         - tmp249 * tmp28
-        - tmp273 * tmp99
-        - tmp279 * tmp61
+        - tmp274 * tmp96
+        - tmp276 * tmp94
         + platform_weight_n * (-tmp17 * com_offset_m[1] + tmp19 * com_offset_m[0]);
-    let tmp283: f64 = tmp101 * tmp268
-        + tmp112 * tmp267
-        + tmp121 * tmp246
-        + tmp125 * tmp253
-        + tmp129 * tmp260
-        + tmp177 * tmp275
-        + tmp179 * tmp280
-        + tmp181 * tmp277
+    let tmp285: f64 = tmp106 * tmp270
+        + tmp114 * tmp246
+        + tmp118 * tmp254
+        + tmp122 * tmp261
+        + tmp171 * tmp278
+        + tmp173 * tmp282
+        + tmp176 * tmp280
+        + tmp179 * tmp283
+        + tmp181 * tmp279
         + tmp183 * tmp281
-        + tmp185 * tmp276
-        + tmp240 * reference_tension_n[1]
-        + tmp244 * tmp79
-        + tmp265 * tmp28
-        + tmp269 * tmp99
-        + tmp279 * tmp60
+        + tmp239 * reference_tension_n[1]
+        + tmp243 * tmp78
+        + tmp268 * tmp28
+        + tmp271 * tmp96
+        + tmp272 * tmp94
         - platform_weight_n * (-tmp10 * com_offset_m[1] + tmp7 * com_offset_m[0]);
-    let tmp284: f64 = 1.0_f64 / (tmp57 * tmp57.sqrt());
-    let tmp285: f64 = tmp284 * tmp53;
-    let tmp286: f64 = -tmp285 + tmp59;
-    let tmp287: f64 = tmp284 * tmp52 * tmp55;
-    let tmp288: f64 = tmp287 * tmp51;
-    let tmp289: f64 = 1.0_f64 / (tmp35 * tmp35.sqrt());
-    let tmp290: f64 = tmp289 * tmp31;
-    let tmp291: f64 = -tmp290 + tmp67;
-    let tmp292: f64 = tmp289 * tmp30 * tmp33;
-    let tmp293: f64 = tmp29 * tmp292;
-    let tmp294: f64 = 1.0_f64 / (tmp47 * tmp47.sqrt());
-    let tmp295: f64 = tmp294 * tmp42 * tmp44;
-    let tmp296: f64 = tmp295 * tmp43;
-    let tmp297: f64 = tmp294 * tmp45;
-    let tmp298: f64 = -tmp297 + tmp49;
-    let tmp299: f64 = 1.0_f64 / (tmp23 * tmp23.sqrt());
-    let tmp300: f64 = tmp166 * tmp21 * tmp299;
-    let tmp301: f64 = tmp11 * tmp300;
-    let tmp302: f64 = tmp13 * tmp299;
-    let tmp303: f64 = reference_tension_n[0] * (-tmp302 + tmp37);
-    let tmp304: f64 = -tmp111 * (tmp296 + tmp298 * tmp41)
-        - tmp20 * tmp303
-        - tmp301
-        - tmp80 * (tmp291 * tmp32 + tmp293)
-        - tmp98 * (tmp286 * tmp54 + tmp288);
-    let tmp305: f64 = tmp286 * tmp98;
-    let tmp306: f64 = tmp111 * tmp298;
-    let tmp307: f64 = tmp291 * tmp80;
-    let tmp308: f64 = tmp303 + tmp305 + tmp306 + tmp307;
-    let tmp309: f64 = tmp111 * tmp295;
-    let tmp310: f64 = tmp292 * tmp80;
-    let tmp311: f64 = tmp287 * tmp98;
-    let tmp312: f64 = -tmp300 - tmp309 - tmp310 - tmp311;
-    let tmp313: f64 = tmp304 * tmp74 + tmp308 * tmp78 + tmp312 * tmp76;
-    let tmp314: f64 = tmp312 * tmp73;
-    let tmp315: f64 = tmp304 * tmp73;
-    let tmp316: f64 = tmp103 * tmp315 + tmp106 * tmp314 + tmp109 * tmp308;
-    let tmp317: f64 = tmp308 * tmp93 + tmp312 * tmp90 + tmp315 * tmp95;
-    let tmp318: f64 = tmp101 * tmp307
-        + tmp112 * tmp306
-        + tmp177 * tmp313
-        + tmp181 * tmp317
-        + tmp183 * tmp316
-        + tmp28 * tmp303
-        + tmp305 * tmp99;
-    let tmp319: f64 = tmp113 * tmp295;
-    let tmp320: f64 = tmp28 * tmp300;
-    let tmp321: f64 = tmp100 * tmp287;
-    let tmp322: f64 = tmp102 * tmp292;
-    let tmp323: f64 = -tmp189 * tmp316 - tmp191 * tmp317 - tmp193 * tmp313 + tmp319 + tmp320 + tmp321 + tmp322;
-    let tmp324: f64 = tmp22 * tmp299;
-    let tmp325: f64 = reference_tension_n[0] * (-tmp324 + tmp37);
-    let tmp326: f64 = tmp294 * tmp46;
-    let tmp327: f64 = -tmp326 + tmp49;
-    let tmp328: f64 = tmp111 * tmp327;
-    let tmp329: f64 = tmp284 * tmp56;
-    let tmp330: f64 = -tmp329 + tmp59;
-    let tmp331: f64 = tmp330 * tmp98;
-    let tmp332: f64 = tmp289 * tmp34;
-    let tmp333: f64 = -tmp332 + tmp67;
-    let tmp334: f64 = tmp333 * tmp80;
-    let tmp335: f64 = tmp325 + tmp328 + tmp331 + tmp334;
-    let tmp336: f64 = tmp287 * tmp54;
-    let tmp337: f64 = tmp292 * tmp32;
-    let tmp338: f64 = tmp295 * tmp41;
-    let tmp339: f64 = tmp20 * tmp300;
-    let tmp340: f64 = tmp11 * tmp325 - tmp111 * (-tmp327 * tmp43 - tmp338) + tmp339
-        - tmp80 * (-tmp29 * tmp333 - tmp337)
-        - tmp98 * (-tmp330 * tmp51 - tmp336);
-    let tmp341: f64 = tmp314 * tmp66 + tmp335 * tmp76 + tmp340 * tmp74;
-    let tmp342: f64 = -tmp319;
-    let tmp343: f64 = -tmp320;
-    let tmp344: f64 = -tmp321;
-    let tmp345: f64 = tmp104 * tmp340 + tmp107 * tmp335 + tmp109 * tmp312;
-    let tmp346: f64 = tmp314 * tmp92 + tmp335 * tmp90 + tmp340 * tmp96;
+    let tmp286: f64 = 1.0_f64 / (tmp43 * tmp43.sqrt());
+    let tmp287: f64 = tmp286 * tmp39;
+    let tmp288: f64 = -tmp287 + tmp45;
+    let tmp289: f64 = tmp286 * tmp38 * tmp41;
+    let tmp290: f64 = tmp289 * tmp37;
+    let tmp291: f64 = 1.0_f64 / (tmp35 * tmp35.sqrt());
+    let tmp292: f64 = tmp291 * tmp31;
+    let tmp293: f64 = -tmp292 + tmp63;
+    let tmp294: f64 = tmp291 * tmp30 * tmp33;
+    let tmp295: f64 = tmp29 * tmp294;
+    let tmp296: f64 = 1.0_f64 / (tmp53 * tmp53.sqrt());
+    let tmp297: f64 = tmp296 * tmp48 * tmp50;
+    let tmp298: f64 = tmp297 * tmp49;
+    let tmp299: f64 = tmp296 * tmp51;
+    let tmp300: f64 = -tmp299 + tmp55;
+    let tmp301: f64 = tmp11 * reference_tension_n[0];
+    let tmp302: f64 = 1.0_f64 / (tmp23 * tmp23.sqrt());
+    let tmp303: f64 = tmp12 * tmp302;
+    let tmp304: f64 = tmp21 * tmp303;
+    let tmp305: f64 = tmp301 * tmp304;
+    let tmp306: f64 = tmp13 * tmp302;
+    let tmp307: f64 = reference_tension_n[0] * (-tmp306 + tmp70);
+    let tmp308: f64 = -tmp105 * (tmp298 + tmp300 * tmp47)
+        - tmp20 * tmp307
+        - tmp305
+        - tmp79 * (tmp293 * tmp32 + tmp295)
+        - tmp93 * (tmp288 * tmp40 + tmp290);
+    let tmp309: f64 = tmp288 * tmp93;
+    let tmp310: f64 = tmp105 * tmp300;
+    let tmp311: f64 = tmp293 * tmp79;
+    let tmp312: f64 = tmp307 + tmp309 + tmp310 + tmp311;
+    let tmp313: f64 = tmp229 * tmp303;
+    let tmp314: f64 = tmp294 * tmp79;
+    let tmp315: f64 = -tmp105 * tmp297 - tmp289 * tmp93 - tmp313 - tmp314;
+    let tmp316: f64 = tmp161 * tmp308 + tmp312 * tmp77 + tmp315 * tmp75;
+    let tmp317: f64 = tmp315 * tmp69;
+    let tmp318: f64 = tmp100 * tmp317 + tmp104 * tmp312 + tmp177 * tmp308;
+    let tmp319: f64 = tmp174 * tmp308 + tmp312 * tmp90 + tmp315 * tmp88;
+    let tmp320: f64 = tmp106 * tmp310
+        + tmp171 * tmp316
+        + tmp176 * tmp319
+        + tmp179 * tmp318
+        + tmp28 * tmp307
+        + tmp309 * tmp94
+        + tmp311 * tmp96;
+    let tmp321: f64 = tmp107 * tmp297;
+    let tmp322: f64 = tmp304 * tmp87;
+    let tmp323: f64 = tmp289 * tmp95;
+    let tmp324: f64 = tmp294 * tmp97;
+    let tmp325: f64 = -tmp185 * tmp318 - tmp187 * tmp319 - tmp189 * tmp316 + tmp321 + tmp322 + tmp323 + tmp324;
+    let tmp326: f64 = tmp22 * tmp302;
+    let tmp327: f64 = reference_tension_n[0] * (-tmp326 + tmp70);
+    let tmp328: f64 = tmp296 * tmp52;
+    let tmp329: f64 = -tmp328 + tmp55;
+    let tmp330: f64 = tmp105 * tmp329;
+    let tmp331: f64 = tmp286 * tmp42;
+    let tmp332: f64 = -tmp331 + tmp45;
+    let tmp333: f64 = tmp332 * tmp93;
+    let tmp334: f64 = tmp291 * tmp34;
+    let tmp335: f64 = -tmp334 + tmp63;
+    let tmp336: f64 = tmp335 * tmp79;
+    let tmp337: f64 = tmp327 + tmp330 + tmp333 + tmp336;
+    let tmp338: f64 = tmp289 * tmp40;
+    let tmp339: f64 = tmp294 * tmp32;
+    let tmp340: f64 = tmp297 * tmp47;
+    let tmp341: f64 = tmp20 * reference_tension_n[0];
+    let tmp342: f64 = tmp304 * tmp341;
+    let tmp343: f64 = -tmp105 * (-tmp329 * tmp49 - tmp340) + tmp11 * tmp327 + tmp342
+        - tmp79 * (-tmp29 * tmp335 - tmp339)
+        - tmp93 * (-tmp332 * tmp37 - tmp338);
+    let tmp344: f64 = tmp343 * tmp69;
+    let tmp345: f64 = tmp317 * tmp62 + tmp337 * tmp75 + tmp344 * tmp59;
+    let tmp346: f64 = -tmp321;
     let tmp347: f64 = -tmp322;
-    let tmp348: f64 = tmp177 * tmp341 + tmp181 * tmp346 + tmp183 * tmp345 + tmp342 + tmp343 + tmp344 + tmp347;
-    let tmp349: f64 = -tmp101 * tmp334
-        - tmp112 * tmp328
+    let tmp348: f64 = -tmp323;
+    let tmp349: f64 = tmp101 * tmp337 + tmp103 * tmp317 + tmp177 * tmp343;
+    let tmp350: f64 = tmp315 * tmp90 + tmp337 * tmp88 + tmp344 * tmp91;
+    let tmp351: f64 = -tmp324;
+    let tmp352: f64 = tmp171 * tmp345 + tmp176 * tmp350 + tmp179 * tmp349 + tmp346 + tmp347 + tmp348 + tmp351;
+    let tmp353: f64 = -tmp106 * tmp330
+        - tmp185 * tmp349
+        - tmp187 * tmp350
         - tmp189 * tmp345
-        - tmp191 * tmp346
-        - tmp193 * tmp341
-        - tmp28 * tmp325
-        - tmp331 * tmp99;
-    let tmp350: f64 = tmp39 * tmp78 + tmp75 + tmp77;
-    let tmp351: f64 = tmp38 * tmp90 + tmp94 + tmp97;
-    let tmp352: f64 = tmp105 + tmp107 * tmp38 + tmp110;
-    let tmp353: f64 = tmp177 * tmp350 + tmp181 * tmp351 + tmp183 * tmp352 + tmp88;
-    let tmp354: f64 = -tmp118 - tmp189 * tmp352 - tmp191 * tmp351 - tmp193 * tmp350;
-    let tmp355: f64 = -tmp37;
-    let tmp356: f64 = reference_tension_n[0] * (tmp302 + tmp355);
-    let tmp357: f64 = -tmp20 * tmp356 + tmp301;
-    let tmp358: f64 = tmp300 * tmp76 + tmp356 * tmp78 + tmp357 * tmp74;
-    let tmp359: f64 = tmp300 * tmp90 + tmp356 * tmp93 + tmp357 * tmp96;
-    let tmp360: f64 = tmp104 * tmp357 + tmp107 * tmp300 + tmp109 * tmp356;
-    let tmp361: f64 = -tmp189 * tmp360 - tmp191 * tmp359 - tmp193 * tmp358 + tmp343;
-    let tmp362: f64 = tmp177 * tmp358 + tmp181 * tmp359 + tmp183 * tmp360 + tmp28 * tmp356;
-    let tmp363: f64 = reference_tension_n[0] * (tmp324 + tmp355);
-    let tmp364: f64 = tmp11 * tmp363 - tmp339;
-    let tmp365: f64 = tmp300 * tmp78 + tmp363 * tmp76 + tmp364 * tmp74;
-    let tmp366: f64 = tmp300 * tmp93 + tmp363 * tmp90 + tmp364 * tmp96;
-    let tmp367: f64 = tmp104 * tmp364 + tmp107 * tmp363 + tmp109 * tmp300;
-    let tmp368: f64 = -tmp189 * tmp367 - tmp191 * tmp366 - tmp193 * tmp365 - tmp28 * tmp363;
-    let tmp369: f64 = tmp177 * tmp365 + tmp181 * tmp366 + tmp183 * tmp367 + tmp320;
-    let tmp370: f64 = -tmp67;
-    let tmp371: f64 = tmp290 + tmp370;
-    let tmp372: f64 = -tmp293 + tmp32 * tmp371;
-    let tmp373: f64 = tmp74 * tmp80;
-    let tmp374: f64 = tmp371 * tmp80;
-    let tmp375: f64 = tmp310 * tmp76 - tmp372 * tmp373 + tmp374 * tmp78;
-    let tmp376: f64 = tmp372 * tmp80;
-    let tmp377: f64 = tmp310 * tmp90 + tmp374 * tmp93 - tmp376 * tmp96;
-    let tmp378: f64 = -tmp104 * tmp376 + tmp107 * tmp310 + tmp109 * tmp374;
-    let tmp379: f64 = -tmp189 * tmp378 - tmp191 * tmp377 - tmp193 * tmp375 + tmp347;
-    let tmp380: f64 = tmp102 * tmp371 + tmp177 * tmp375 + tmp181 * tmp377 + tmp183 * tmp378;
-    let tmp381: f64 = tmp332 + tmp370;
-    let tmp382: f64 = tmp381 * tmp80;
-    let tmp383: f64 = -tmp29 * tmp381 + tmp337;
-    let tmp384: f64 = tmp310 * tmp78 - tmp373 * tmp383 + tmp382 * tmp76;
-    let tmp385: f64 = tmp383 * tmp80;
-    let tmp386: f64 = -tmp104 * tmp385 + tmp107 * tmp382 + tmp109 * tmp310;
-    let tmp387: f64 = tmp310 * tmp93 + tmp382 * tmp90 - tmp385 * tmp96;
-    let tmp388: f64 = tmp177 * tmp384 + tmp181 * tmp387 + tmp183 * tmp386 + tmp322;
-    let tmp389: f64 = -tmp102 * tmp381 - tmp189 * tmp386 - tmp191 * tmp387 - tmp193 * tmp384;
-    let tmp390: f64 = -tmp49;
-    let tmp391: f64 = tmp297 + tmp390;
-    let tmp392: f64 = -tmp296 + tmp391 * tmp41;
-    let tmp393: f64 = tmp111 * tmp74;
-    let tmp394: f64 = tmp111 * tmp391;
-    let tmp395: f64 = tmp309 * tmp76 - tmp392 * tmp393 + tmp394 * tmp78;
-    let tmp396: f64 = tmp104 * tmp111;
-    let tmp397: f64 = tmp107 * tmp309 + tmp109 * tmp394 - tmp392 * tmp396;
-    let tmp398: f64 = tmp111 * tmp96;
-    let tmp399: f64 = tmp309 * tmp90 - tmp392 * tmp398 + tmp394 * tmp93;
-    let tmp400: f64 = tmp113 * tmp391 + tmp177 * tmp395 + tmp181 * tmp399 + tmp183 * tmp397;
-    let tmp401: f64 = -tmp189 * tmp397 - tmp191 * tmp399 - tmp193 * tmp395 + tmp342;
-    let tmp402: f64 = tmp326 + tmp390;
-    let tmp403: f64 = tmp338 - tmp402 * tmp43;
-    let tmp404: f64 = tmp111 * tmp402;
-    let tmp405: f64 = tmp309 * tmp78 - tmp393 * tmp403 + tmp404 * tmp76;
-    let tmp406: f64 = tmp107 * tmp404 + tmp109 * tmp309 - tmp396 * tmp403;
-    let tmp407: f64 = tmp309 * tmp93 - tmp398 * tmp403 + tmp404 * tmp90;
-    let tmp408: f64 = -tmp113 * tmp402 - tmp189 * tmp406 - tmp191 * tmp407 - tmp193 * tmp405;
-    let tmp409: f64 = tmp177 * tmp405 + tmp181 * tmp407 + tmp183 * tmp406 + tmp319;
-    let tmp410: f64 = -tmp59;
-    let tmp411: f64 = tmp285 + tmp410;
-    let tmp412: f64 = tmp411 * tmp98;
-    let tmp413: f64 = -tmp288 + tmp411 * tmp54;
-    let tmp414: f64 = tmp413 * tmp98;
-    let tmp415: f64 = tmp311 * tmp76 + tmp412 * tmp78 - tmp414 * tmp74;
-    let tmp416: f64 = tmp96 * tmp98;
-    let tmp417: f64 = tmp311 * tmp90 + tmp412 * tmp93 - tmp413 * tmp416;
-    let tmp418: f64 = -tmp104 * tmp414 + tmp107 * tmp311 + tmp109 * tmp412;
-    let tmp419: f64 = tmp100 * tmp411 + tmp177 * tmp415 + tmp181 * tmp417 + tmp183 * tmp418;
-    let tmp420: f64 = -tmp189 * tmp418 - tmp191 * tmp417 - tmp193 * tmp415 + tmp344;
-    let tmp421: f64 = tmp329 + tmp410;
-    let tmp422: f64 = tmp421 * tmp98;
-    let tmp423: f64 = tmp336 - tmp421 * tmp51;
-    let tmp424: f64 = tmp423 * tmp98;
-    let tmp425: f64 = tmp311 * tmp78 + tmp422 * tmp76 - tmp424 * tmp74;
-    let tmp426: f64 = tmp311 * tmp93 - tmp416 * tmp423 + tmp422 * tmp90;
-    let tmp427: f64 = -tmp104 * tmp424 + tmp107 * tmp422 + tmp109 * tmp311;
-    let tmp428: f64 = -tmp100 * tmp421 - tmp189 * tmp427 - tmp191 * tmp426 - tmp193 * tmp425;
-    let tmp429: f64 = tmp177 * tmp425 + tmp181 * tmp426 + tmp183 * tmp427 + tmp321;
-    let tmp430: f64 = tmp120 * platform_weight_n;
-    let tmp431: f64 = tmp10 * platform_weight_n;
-    let tmp432: f64 = tmp124 * platform_weight_n;
-    let tmp433: f64 = tmp128 * platform_weight_n;
-    let tmp434: f64 = tmp7 * platform_weight_n;
-    let tmp435: f64 = tmp16 * platform_weight_n;
-    let tmp436: f64 = tmp4 * platform_weight_n;
+        - tmp28 * tmp327
+        - tmp333 * tmp94
+        - tmp336 * tmp96;
+    let tmp354: f64 = tmp71 * tmp75 + tmp72 * tmp77 + tmp74;
+    let tmp355: f64 = tmp71 * tmp88 + tmp72 * tmp90 + tmp92;
+    let tmp356: f64 = tmp101 * tmp71 + tmp104 * tmp72 + tmp99;
+    let tmp357: f64 = tmp171 * tmp354 + tmp176 * tmp355 + tmp179 * tmp356 + tmp28 * tmp72;
+    let tmp358: f64 = -tmp185 * tmp356 - tmp187 * tmp355 - tmp189 * tmp354 - tmp28 * tmp71;
+    let tmp359: f64 = -tmp70;
+    let tmp360: f64 = tmp306 + tmp359;
+    let tmp361: f64 = tmp305 - tmp341 * tmp360;
+    let tmp362: f64 = tmp77 * reference_tension_n[0];
+    let tmp363: f64 = tmp161 * tmp361 + tmp304 * tmp76 + tmp360 * tmp362;
+    let tmp364: f64 = tmp90 * reference_tension_n[0];
+    let tmp365: f64 = tmp174 * tmp361 + tmp304 * tmp89 + tmp360 * tmp364;
+    let tmp366: f64 = tmp104 * reference_tension_n[0];
+    let tmp367: f64 = tmp101 * tmp313 + tmp177 * tmp361 + tmp360 * tmp366;
+    let tmp368: f64 = -tmp185 * tmp367 - tmp187 * tmp365 - tmp189 * tmp363 + tmp347;
+    let tmp369: f64 = tmp171 * tmp363 + tmp176 * tmp365 + tmp179 * tmp367 + tmp360 * tmp87;
+    let tmp370: f64 = tmp326 + tmp359;
+    let tmp371: f64 = tmp301 * tmp370 - tmp342;
+    let tmp372: f64 = tmp161 * tmp371 + tmp313 * tmp77 + tmp370 * tmp76;
+    let tmp373: f64 = tmp174 * tmp371 + tmp313 * tmp90 + tmp370 * tmp89;
+    let tmp374: f64 = tmp101 * reference_tension_n[0];
+    let tmp375: f64 = tmp177 * tmp371 + tmp304 * tmp366 + tmp370 * tmp374;
+    let tmp376: f64 = -tmp185 * tmp375 - tmp187 * tmp373 - tmp189 * tmp372 - tmp370 * tmp87;
+    let tmp377: f64 = tmp171 * tmp372 + tmp176 * tmp373 + tmp179 * tmp375 + tmp322;
+    let tmp378: f64 = -tmp63;
+    let tmp379: f64 = tmp292 + tmp378;
+    let tmp380: f64 = -tmp295 + tmp32 * tmp379;
+    let tmp381: f64 = tmp161 * tmp79;
+    let tmp382: f64 = tmp77 * tmp79;
+    let tmp383: f64 = tmp314 * tmp75 + tmp379 * tmp382 - tmp380 * tmp381;
+    let tmp384: f64 = tmp174 * tmp79;
+    let tmp385: f64 = tmp79 * tmp90;
+    let tmp386: f64 = tmp314 * tmp88 + tmp379 * tmp385 - tmp380 * tmp384;
+    let tmp387: f64 = tmp177 * tmp79;
+    let tmp388: f64 = tmp101 * tmp79;
+    let tmp389: f64 = tmp104 * tmp79;
+    let tmp390: f64 = tmp294 * tmp388 + tmp379 * tmp389 - tmp380 * tmp387;
+    let tmp391: f64 = -tmp185 * tmp390 - tmp187 * tmp386 - tmp189 * tmp383 + tmp351;
+    let tmp392: f64 = tmp171 * tmp383 + tmp176 * tmp386 + tmp179 * tmp390 + tmp379 * tmp97;
+    let tmp393: f64 = tmp334 + tmp378;
+    let tmp394: f64 = tmp393 * tmp79;
+    let tmp395: f64 = -tmp29 * tmp393 + tmp339;
+    let tmp396: f64 = tmp294 * tmp382 - tmp381 * tmp395 + tmp394 * tmp75;
+    let tmp397: f64 = tmp101 * tmp394 + tmp294 * tmp389 - tmp387 * tmp395;
+    let tmp398: f64 = tmp294 * tmp385 - tmp384 * tmp395 + tmp394 * tmp88;
+    let tmp399: f64 = tmp171 * tmp396 + tmp176 * tmp398 + tmp179 * tmp397 + tmp324;
+    let tmp400: f64 = -tmp185 * tmp397 - tmp187 * tmp398 - tmp189 * tmp396 - tmp393 * tmp97;
+    let tmp401: f64 = -tmp55;
+    let tmp402: f64 = tmp299 + tmp401;
+    let tmp403: f64 = -tmp298 + tmp402 * tmp47;
+    let tmp404: f64 = tmp105 * tmp161;
+    let tmp405: f64 = tmp105 * tmp75;
+    let tmp406: f64 = tmp105 * tmp77;
+    let tmp407: f64 = tmp297 * tmp405 + tmp402 * tmp406 - tmp403 * tmp404;
+    let tmp408: f64 = tmp101 * tmp105;
+    let tmp409: f64 = tmp104 * tmp105;
+    let tmp410: f64 = tmp105 * tmp177;
+    let tmp411: f64 = tmp297 * tmp408 + tmp402 * tmp409 - tmp403 * tmp410;
+    let tmp412: f64 = tmp105 * tmp90;
+    let tmp413: f64 = tmp105 * tmp88;
+    let tmp414: f64 = tmp105 * tmp174;
+    let tmp415: f64 = tmp297 * tmp413 + tmp402 * tmp412 - tmp403 * tmp414;
+    let tmp416: f64 = tmp107 * tmp402 + tmp171 * tmp407 + tmp176 * tmp415 + tmp179 * tmp411;
+    let tmp417: f64 = -tmp185 * tmp411 - tmp187 * tmp415 - tmp189 * tmp407 + tmp346;
+    let tmp418: f64 = tmp328 + tmp401;
+    let tmp419: f64 = tmp340 - tmp418 * tmp49;
+    let tmp420: f64 = tmp297 * tmp406 - tmp404 * tmp419 + tmp405 * tmp418;
+    let tmp421: f64 = tmp297 * tmp409 + tmp408 * tmp418 - tmp410 * tmp419;
+    let tmp422: f64 = tmp297 * tmp412 + tmp413 * tmp418 - tmp414 * tmp419;
+    let tmp423: f64 = -tmp107 * tmp418 - tmp185 * tmp421 - tmp187 * tmp422 - tmp189 * tmp420;
+    let tmp424: f64 = tmp171 * tmp420 + tmp176 * tmp422 + tmp179 * tmp421 + tmp321;
+    let tmp425: f64 = tmp75 * tmp93;
+    let tmp426: f64 = -tmp45;
+    let tmp427: f64 = tmp287 + tmp426;
+    let tmp428: f64 = tmp77 * tmp93;
+    let tmp429: f64 = -tmp290 + tmp40 * tmp427;
+    let tmp430: f64 = tmp161 * tmp93;
+    let tmp431: f64 = tmp289 * tmp425 + tmp427 * tmp428 - tmp429 * tmp430;
+    let tmp432: f64 = tmp90 * tmp93;
+    let tmp433: f64 = tmp174 * tmp93;
+    let tmp434: f64 = tmp88 * tmp93;
+    let tmp435: f64 = tmp289 * tmp434 + tmp427 * tmp432 - tmp429 * tmp433;
+    let tmp436: f64 = tmp177 * tmp93;
+    let tmp437: f64 = tmp101 * tmp93;
+    let tmp438: f64 = tmp104 * tmp93;
+    let tmp439: f64 = tmp289 * tmp437 + tmp427 * tmp438 - tmp429 * tmp436;
+    let tmp440: f64 = tmp171 * tmp431 + tmp176 * tmp435 + tmp179 * tmp439 + tmp427 * tmp95;
+    let tmp441: f64 = -tmp185 * tmp439 - tmp187 * tmp435 - tmp189 * tmp431 + tmp348;
+    let tmp442: f64 = tmp331 + tmp426;
+    let tmp443: f64 = tmp338 - tmp37 * tmp442;
+    let tmp444: f64 = tmp289 * tmp428 + tmp425 * tmp442 - tmp430 * tmp443;
+    let tmp445: f64 = tmp289 * tmp432 - tmp433 * tmp443 + tmp434 * tmp442;
+    let tmp446: f64 = tmp289 * tmp438 - tmp436 * tmp443 + tmp437 * tmp442;
+    let tmp447: f64 = -tmp185 * tmp446 - tmp187 * tmp445 - tmp189 * tmp444 - tmp442 * tmp95;
+    let tmp448: f64 = tmp171 * tmp444 + tmp176 * tmp445 + tmp179 * tmp446 + tmp323;
+    let tmp449: f64 = tmp10 * tmp72 + tmp17 * tmp71;
+    let tmp450: f64 = -tmp26;
+    let tmp451: f64 = tmp10 * tmp70 - tmp158 * tmp449;
+    let tmp452: f64 = -tmp133 * tmp449 + tmp17 * tmp70;
+    let tmp453: f64 = tmp10 * tmp102 - tmp17 * tmp78 + tmp301 * tmp452 - tmp341 * tmp451;
+    let tmp454: f64 = tmp161 * tmp453 + tmp362 * tmp451 + tmp452 * tmp76;
+    let tmp455: f64 = tmp174 * tmp453 + tmp364 * tmp451 + tmp452 * tmp89;
+    let tmp456: f64 = tmp177 * tmp453 + tmp366 * tmp451 + tmp374 * tmp452;
+    let tmp457: f64 = tmp10 * reference_tension_n[1]
+        + tmp171 * tmp454
+        + tmp176 * tmp455
+        + tmp179 * tmp456
+        + tmp26 * tmp78
+        + tmp451 * tmp87;
+    let tmp458: f64 = -tmp102 * tmp26
+        - tmp17 * reference_tension_n[1]
+        - tmp185 * tmp456
+        - tmp187 * tmp455
+        - tmp189 * tmp454
+        - tmp452 * tmp87;
+    let tmp459: f64 = tmp19 * tmp71 + tmp7 * tmp72;
+    let tmp460: f64 = -tmp25;
+    let tmp461: f64 = -tmp133 * tmp459 + tmp19 * tmp70;
+    let tmp462: f64 = -tmp158 * tmp459 + tmp7 * tmp70;
+    let tmp463: f64 = tmp462 * reference_tension_n[0];
+    let tmp464: f64 = tmp102 * tmp7 - tmp19 * tmp78 + tmp301 * tmp461 - tmp341 * tmp462;
+    let tmp465: f64 = tmp161 * tmp464 + tmp461 * tmp76 + tmp463 * tmp77;
+    let tmp466: f64 = tmp104 * tmp463 + tmp177 * tmp464 + tmp374 * tmp461;
+    let tmp467: f64 = tmp174 * tmp464 + tmp461 * tmp89 + tmp463 * tmp90;
+    let tmp468: f64 = -tmp102 * tmp25
+        - tmp185 * tmp466
+        - tmp187 * tmp467
+        - tmp189 * tmp465
+        - tmp19 * reference_tension_n[1]
+        - tmp461 * tmp87;
+    let tmp469: f64 = tmp171 * tmp465
+        + tmp176 * tmp467
+        + tmp179 * tmp466
+        + tmp25 * tmp78
+        + tmp462 * tmp87
+        + tmp7 * reference_tension_n[1];
+    let tmp470: f64 = tmp16 * tmp71 + tmp4 * tmp72;
+    let tmp471: f64 = -tmp27;
+    let tmp472: f64 = -tmp158 * tmp470 + tmp4 * tmp70;
+    let tmp473: f64 = -tmp133 * tmp470 + tmp16 * tmp70;
+    let tmp474: f64 = tmp102 * tmp4 - tmp16 * tmp78 + tmp301 * tmp473 - tmp341 * tmp472;
+    let tmp475: f64 = tmp161 * tmp474 + tmp362 * tmp472 + tmp473 * tmp76;
+    let tmp476: f64 = tmp177 * tmp474 + tmp366 * tmp472 + tmp374 * tmp473;
+    let tmp477: f64 = tmp174 * tmp474 + tmp364 * tmp472 + tmp473 * tmp89;
+    let tmp478: f64 = tmp171 * tmp475
+        + tmp176 * tmp477
+        + tmp179 * tmp476
+        + tmp27 * tmp78
+        + tmp4 * reference_tension_n[1]
+        + tmp472 * tmp87;
+    let tmp479: f64 = -tmp102 * tmp27
+        - tmp16 * reference_tension_n[1]
+        - tmp185 * tmp476
+        - tmp187 * tmp477
+        - tmp189 * tmp475
+        - tmp473 * tmp87;
+    let tmp480: f64 = tmp10 * tmp64 + tmp17 * tmp66;
+    let tmp481: f64 = tmp10 * tmp63 - tmp136 * tmp480;
+    let tmp482: f64 = -tmp138 * tmp480 + tmp17 * tmp63;
+    let tmp483: f64 = -tmp10 * tmp66 + tmp17 * tmp64 - tmp29 * tmp482 + tmp32 * tmp481;
+    let tmp484: f64 = tmp75 * tmp79;
+    let tmp485: f64 = -tmp381 * tmp483 + tmp382 * tmp481 + tmp482 * tmp484;
+    let tmp486: f64 = tmp79 * tmp88;
+    let tmp487: f64 = -tmp384 * tmp483 + tmp385 * tmp481 + tmp482 * tmp486;
+    let tmp488: f64 = -tmp387 * tmp483 + tmp388 * tmp482 + tmp389 * tmp481;
+    let tmp489: f64 =
+        -tmp114 * tmp17 - tmp185 * tmp488 - tmp187 * tmp487 - tmp188 * tmp26 - tmp189 * tmp485 - tmp482 * tmp97;
+    let tmp490: f64 =
+        tmp10 * tmp114 + tmp171 * tmp485 + tmp176 * tmp487 + tmp179 * tmp488 + tmp181 * tmp26 + tmp481 * tmp97;
+    let tmp491: f64 = tmp19 * tmp66 + tmp64 * tmp7;
+    let tmp492: f64 = -tmp138 * tmp491 + tmp19 * tmp63;
+    let tmp493: f64 = -tmp136 * tmp491 + tmp63 * tmp7;
+    let tmp494: f64 = tmp19 * tmp64 - tmp29 * tmp492 + tmp32 * tmp493 - tmp66 * tmp7;
+    let tmp495: f64 = -tmp381 * tmp494 + tmp382 * tmp493 + tmp484 * tmp492;
+    let tmp496: f64 = -tmp387 * tmp494 + tmp388 * tmp492 + tmp389 * tmp493;
+    let tmp497: f64 = -tmp384 * tmp494 + tmp385 * tmp493 + tmp486 * tmp492;
+    let tmp498: f64 =
+        -tmp114 * tmp19 - tmp185 * tmp496 - tmp187 * tmp497 - tmp188 * tmp25 - tmp189 * tmp495 - tmp492 * tmp97;
+    let tmp499: f64 =
+        tmp114 * tmp7 + tmp171 * tmp495 + tmp176 * tmp497 + tmp179 * tmp496 + tmp181 * tmp25 + tmp493 * tmp97;
+    let tmp500: f64 = tmp16 * tmp66 + tmp4 * tmp64;
+    let tmp501: f64 = -tmp138 * tmp500 + tmp16 * tmp63;
+    let tmp502: f64 = -tmp136 * tmp500 + tmp4 * tmp63;
+    let tmp503: f64 = tmp16 * tmp64 - tmp29 * tmp501 + tmp32 * tmp502 - tmp4 * tmp66;
+    let tmp504: f64 = -tmp381 * tmp503 + tmp382 * tmp502 + tmp484 * tmp501;
+    let tmp505: f64 = -tmp384 * tmp503 + tmp385 * tmp502 + tmp486 * tmp501;
+    let tmp506: f64 = -tmp387 * tmp503 + tmp388 * tmp501 + tmp389 * tmp502;
+    let tmp507: f64 =
+        tmp114 * tmp4 + tmp171 * tmp504 + tmp176 * tmp505 + tmp179 * tmp506 + tmp181 * tmp27 + tmp502 * tmp97;
+    let tmp508: f64 =
+        -tmp114 * tmp16 - tmp185 * tmp506 - tmp187 * tmp505 - tmp188 * tmp27 - tmp189 * tmp504 - tmp501 * tmp97;
+    let tmp509: f64 = tmp10 * tmp57 + tmp17 * tmp56;
+    let tmp510: f64 = -tmp145 * tmp509 + tmp17 * tmp55;
+    let tmp511: f64 = tmp10 * tmp55 - tmp147 * tmp509;
+    let tmp512: f64 = -tmp10 * tmp56 + tmp17 * tmp57 + tmp47 * tmp511 - tmp49 * tmp510;
+    let tmp513: f64 = tmp105 * tmp511;
+    let tmp514: f64 = -tmp404 * tmp512 + tmp405 * tmp510 + tmp513 * tmp77;
+    let tmp515: f64 = tmp412 * tmp511 + tmp413 * tmp510 - tmp414 * tmp512;
+    let tmp516: f64 = tmp104 * tmp513 + tmp408 * tmp510 - tmp410 * tmp512;
+    let tmp517: f64 =
+        tmp10 * tmp118 + tmp107 * tmp511 + tmp171 * tmp514 + tmp173 * tmp26 + tmp176 * tmp515 + tmp179 * tmp516;
+    let tmp518: f64 =
+        -tmp107 * tmp510 - tmp118 * tmp17 - tmp185 * tmp516 - tmp187 * tmp515 - tmp189 * tmp514 - tmp190 * tmp26;
+    let tmp519: f64 = tmp19 * tmp56 + tmp57 * tmp7;
+    let tmp520: f64 = tmp144 * tmp519;
+    let tmp521: f64 = -tmp50 * tmp520 + tmp55 * tmp7;
+    let tmp522: f64 = tmp19 * tmp55 - tmp48 * tmp520;
+    let tmp523: f64 = tmp19 * tmp57 + tmp47 * tmp521 - tmp49 * tmp522 - tmp56 * tmp7;
+    let tmp524: f64 = -tmp404 * tmp523 + tmp405 * tmp522 + tmp406 * tmp521;
+    let tmp525: f64 = tmp412 * tmp521 + tmp413 * tmp522 - tmp414 * tmp523;
+    let tmp526: f64 = tmp408 * tmp522 + tmp409 * tmp521 - tmp410 * tmp523;
+    let tmp527: f64 =
+        tmp107 * tmp521 + tmp118 * tmp7 + tmp171 * tmp524 + tmp173 * tmp25 + tmp176 * tmp525 + tmp179 * tmp526;
+    let tmp528: f64 =
+        -tmp107 * tmp522 - tmp118 * tmp19 - tmp185 * tmp526 - tmp187 * tmp525 - tmp189 * tmp524 - tmp190 * tmp25;
+    let tmp529: f64 = tmp16 * tmp56 + tmp4 * tmp57;
+    let tmp530: f64 = -tmp147 * tmp529 + tmp4 * tmp55;
+    let tmp531: f64 = -tmp145 * tmp529 + tmp16 * tmp55;
+    let tmp532: f64 = tmp16 * tmp57 - tmp4 * tmp56 + tmp47 * tmp530 - tmp49 * tmp531;
+    let tmp533: f64 = -tmp404 * tmp532 + tmp405 * tmp531 + tmp406 * tmp530;
+    let tmp534: f64 = tmp412 * tmp530 + tmp413 * tmp531 - tmp414 * tmp532;
+    let tmp535: f64 = tmp408 * tmp531 + tmp409 * tmp530 - tmp410 * tmp532;
+    let tmp536: f64 =
+        tmp107 * tmp530 + tmp118 * tmp4 + tmp171 * tmp533 + tmp173 * tmp27 + tmp176 * tmp534 + tmp179 * tmp535;
+    let tmp537: f64 =
+        -tmp107 * tmp531 - tmp118 * tmp16 - tmp185 * tmp535 - tmp187 * tmp534 - tmp189 * tmp533 - tmp190 * tmp27;
+    let tmp538: f64 = tmp10 * tmp46 + tmp17 * tmp58;
+    let tmp539: f64 = -tmp154 * tmp538 + tmp17 * tmp45;
+    let tmp540: f64 = tmp10 * tmp45 - tmp156 * tmp538;
+    let tmp541: f64 = -tmp10 * tmp58 + tmp17 * tmp46 - tmp37 * tmp539 + tmp40 * tmp540;
+    let tmp542: f64 = tmp541 * tmp93;
+    let tmp543: f64 = -tmp161 * tmp542 + tmp425 * tmp539 + tmp428 * tmp540;
+    let tmp544: f64 = -tmp174 * tmp542 + tmp432 * tmp540 + tmp434 * tmp539;
+    let tmp545: f64 = -tmp436 * tmp541 + tmp437 * tmp539 + tmp438 * tmp540;
+    let tmp546: f64 =
+        -tmp122 * tmp17 - tmp185 * tmp545 - tmp186 * tmp26 - tmp187 * tmp544 - tmp189 * tmp543 - tmp539 * tmp95;
+    let tmp547: f64 =
+        tmp10 * tmp122 + tmp171 * tmp543 + tmp176 * tmp544 + tmp179 * tmp545 + tmp183 * tmp26 + tmp540 * tmp95;
+    let tmp548: f64 = tmp19 * tmp58 + tmp46 * tmp7;
+    let tmp549: f64 = -tmp154 * tmp548 + tmp19 * tmp45;
+    let tmp550: f64 = -tmp156 * tmp548 + tmp45 * tmp7;
+    let tmp551: f64 = tmp19 * tmp46 - tmp37 * tmp549 + tmp40 * tmp550 - tmp58 * tmp7;
+    let tmp552: f64 = tmp550 * tmp93;
+    let tmp553: f64 = tmp425 * tmp549 - tmp430 * tmp551 + tmp552 * tmp77;
+    let tmp554: f64 = tmp432 * tmp550 - tmp433 * tmp551 + tmp434 * tmp549;
+    let tmp555: f64 = tmp104 * tmp552 - tmp436 * tmp551 + tmp437 * tmp549;
+    let tmp556: f64 =
+        -tmp122 * tmp19 - tmp185 * tmp555 - tmp186 * tmp25 - tmp187 * tmp554 - tmp189 * tmp553 - tmp549 * tmp95;
+    let tmp557: f64 =
+        tmp122 * tmp7 + tmp171 * tmp553 + tmp176 * tmp554 + tmp179 * tmp555 + tmp183 * tmp25 + tmp550 * tmp95;
+    let tmp558: f64 = tmp16 * tmp58 + tmp4 * tmp46;
+    let tmp559: f64 = -tmp154 * tmp558 + tmp16 * tmp45;
+    let tmp560: f64 = tmp559 * tmp93;
+    let tmp561: f64 = -tmp156 * tmp558 + tmp4 * tmp45;
+    let tmp562: f64 = tmp16 * tmp46 - tmp37 * tmp559 - tmp4 * tmp58 + tmp40 * tmp561;
+    let tmp563: f64 = tmp428 * tmp561 - tmp430 * tmp562 + tmp560 * tmp75;
+    let tmp564: f64 = tmp432 * tmp561 - tmp433 * tmp562 + tmp560 * tmp88;
+    let tmp565: f64 = tmp101 * tmp560 - tmp436 * tmp562 + tmp438 * tmp561;
+    let tmp566: f64 =
+        -tmp122 * tmp16 - tmp185 * tmp565 - tmp186 * tmp27 - tmp187 * tmp564 - tmp189 * tmp563 - tmp559 * tmp95;
+    let tmp567: f64 =
+        tmp122 * tmp4 + tmp171 * tmp563 + tmp176 * tmp564 + tmp179 * tmp565 + tmp183 * tmp27 + tmp561 * tmp95;
+    let tmp568: f64 = tmp17 * platform_weight_n;
+    let tmp569: f64 = tmp10 * platform_weight_n;
+    let tmp570: f64 = tmp7 * platform_weight_n;
+    let tmp571: f64 = tmp19 * platform_weight_n;
+    let tmp572: f64 = tmp16 * platform_weight_n;
+    let tmp573: f64 = tmp4 * platform_weight_n;
 
-    // Output terms (6)
+    // Output terms (7)
     if let Some(jacobian_pose) = jacobian_pose {
-        jacobian_pose[(0, 0)] = tmp132;
+        jacobian_pose[(0, 0)] = tmp126;
         jacobian_pose[(1, 0)] = 0.0;
         jacobian_pose[(2, 0)] = 0.0;
-        jacobian_pose[(3, 0)] = -tmp133;
-        jacobian_pose[(4, 0)] = tmp136;
-        jacobian_pose[(5, 0)] = tmp176;
-        jacobian_pose[(6, 0)] = tmp116 * tmp188 + tmp120 * tmp195;
-        jacobian_pose[(7, 0)] = -tmp184;
-        jacobian_pose[(8, 0)] = tmp151;
-        jacobian_pose[(9, 0)] = tmp182;
-        jacobian_pose[(10, 0)] = tmp123 * tmp188 + tmp124 * tmp195;
-        jacobian_pose[(11, 0)] = -tmp178;
-        jacobian_pose[(12, 0)] = tmp157;
-        jacobian_pose[(13, 0)] = tmp180;
-        jacobian_pose[(14, 0)] = tmp126 * tmp188 + tmp128 * tmp195;
-        jacobian_pose[(15, 0)] = -tmp186;
-        jacobian_pose[(0, 1)] = tmp198;
+        jacobian_pose[(3, 0)] = -tmp127;
+        jacobian_pose[(4, 0)] = tmp131;
+        jacobian_pose[(5, 0)] = tmp170;
+        jacobian_pose[(6, 0)] = tmp110 * tmp184 + tmp113 * tmp191;
+        jacobian_pose[(7, 0)] = -tmp180;
+        jacobian_pose[(8, 0)] = tmp143;
+        jacobian_pose[(9, 0)] = tmp178;
+        jacobian_pose[(10, 0)] = tmp116 * tmp184 + tmp117 * tmp191;
+        jacobian_pose[(11, 0)] = -tmp172;
+        jacobian_pose[(12, 0)] = tmp152;
+        jacobian_pose[(13, 0)] = tmp175;
+        jacobian_pose[(14, 0)] = tmp119 * tmp184 + tmp121 * tmp191;
+        jacobian_pose[(15, 0)] = -tmp182;
+        jacobian_pose[(0, 1)] = tmp195;
         jacobian_pose[(1, 1)] = 0.0;
         jacobian_pose[(2, 1)] = 0.0;
-        jacobian_pose[(3, 1)] = -tmp199;
-        jacobian_pose[(4, 1)] = tmp202;
+        jacobian_pose[(3, 1)] = -tmp196;
+        jacobian_pose[(4, 1)] = tmp200;
         jacobian_pose[(5, 1)] = tmp231;
-        jacobian_pose[(6, 1)] = tmp116 * tmp238 + tmp120 * tmp239;
+        jacobian_pose[(6, 1)] = tmp110 * tmp237 + tmp113 * tmp238;
         jacobian_pose[(7, 1)] = -tmp236;
-        jacobian_pose[(8, 1)] = tmp214;
+        jacobian_pose[(8, 1)] = tmp212;
         jacobian_pose[(9, 1)] = tmp235;
-        jacobian_pose[(10, 1)] = tmp123 * tmp238 + tmp124 * tmp239;
+        jacobian_pose[(10, 1)] = tmp116 * tmp237 + tmp117 * tmp238;
         jacobian_pose[(11, 1)] = -tmp233;
-        jacobian_pose[(12, 1)] = tmp208;
+        jacobian_pose[(12, 1)] = tmp206;
         jacobian_pose[(13, 1)] = tmp234;
-        jacobian_pose[(14, 1)] = tmp126 * tmp238 + tmp128 * tmp239;
+        jacobian_pose[(14, 1)] = tmp119 * tmp237 + tmp121 * tmp238;
         jacobian_pose[(15, 1)] = -tmp232;
-        jacobian_pose[(0, 2)] = tmp243;
+        jacobian_pose[(0, 2)] = tmp242;
         jacobian_pose[(1, 2)] = 0.0;
         jacobian_pose[(2, 2)] = 0.0;
-        jacobian_pose[(3, 2)] = -tmp244;
+        jacobian_pose[(3, 2)] = -tmp243;
         jacobian_pose[(4, 2)] = tmp248;
-        jacobian_pose[(5, 2)] = tmp275;
-        jacobian_pose[(6, 2)] = tmp116 * tmp283 + tmp120 * tmp282;
-        jacobian_pose[(7, 2)] = -tmp276;
-        jacobian_pose[(8, 2)] = tmp255;
-        jacobian_pose[(9, 2)] = tmp281;
-        jacobian_pose[(10, 2)] = tmp123 * tmp283 + tmp124 * tmp282;
-        jacobian_pose[(11, 2)] = -tmp280;
-        jacobian_pose[(12, 2)] = tmp262;
-        jacobian_pose[(13, 2)] = tmp277;
-        jacobian_pose[(14, 2)] = tmp126 * tmp283 + tmp128 * tmp282;
-        jacobian_pose[(15, 2)] = -tmp278;
-        jacobian_pose[(0, 3)] = tmp39;
+        jacobian_pose[(5, 2)] = tmp278;
+        jacobian_pose[(6, 2)] = tmp110 * tmp285 + tmp113 * tmp284;
+        jacobian_pose[(7, 2)] = -tmp279;
+        jacobian_pose[(8, 2)] = tmp256;
+        jacobian_pose[(9, 2)] = tmp283;
+        jacobian_pose[(10, 2)] = tmp116 * tmp285 + tmp117 * tmp284;
+        jacobian_pose[(11, 2)] = -tmp282;
+        jacobian_pose[(12, 2)] = tmp264;
+        jacobian_pose[(13, 2)] = tmp280;
+        jacobian_pose[(14, 2)] = tmp119 * tmp285 + tmp121 * tmp284;
+        jacobian_pose[(15, 2)] = -tmp281;
+        jacobian_pose[(0, 3)] = tmp72;
         jacobian_pose[(1, 3)] = 0.0;
         jacobian_pose[(2, 3)] = 0.0;
         jacobian_pose[(3, 3)] = 0.0;
-        jacobian_pose[(4, 3)] = tmp68;
-        jacobian_pose[(5, 3)] = tmp313;
-        jacobian_pose[(6, 3)] = tmp116 * tmp318 + tmp120 * tmp323;
+        jacobian_pose[(4, 3)] = tmp64;
+        jacobian_pose[(5, 3)] = tmp316;
+        jacobian_pose[(6, 3)] = tmp110 * tmp320 + tmp113 * tmp325;
         jacobian_pose[(7, 3)] = 0.0;
-        jacobian_pose[(8, 3)] = tmp62;
-        jacobian_pose[(9, 3)] = tmp316;
-        jacobian_pose[(10, 3)] = tmp123 * tmp318 + tmp124 * tmp323;
+        jacobian_pose[(8, 3)] = tmp57;
+        jacobian_pose[(9, 3)] = tmp318;
+        jacobian_pose[(10, 3)] = tmp116 * tmp320 + tmp117 * tmp325;
         jacobian_pose[(11, 3)] = 0.0;
-        jacobian_pose[(12, 3)] = tmp60;
-        jacobian_pose[(13, 3)] = tmp317;
-        jacobian_pose[(14, 3)] = tmp126 * tmp318 + tmp128 * tmp323;
+        jacobian_pose[(12, 3)] = tmp46;
+        jacobian_pose[(13, 3)] = tmp319;
+        jacobian_pose[(14, 3)] = tmp119 * tmp320 + tmp121 * tmp325;
         jacobian_pose[(15, 3)] = 0.0;
-        jacobian_pose[(0, 4)] = tmp38;
+        jacobian_pose[(0, 4)] = tmp71;
         jacobian_pose[(1, 4)] = 0.0;
         jacobian_pose[(2, 4)] = 0.0;
         jacobian_pose[(3, 4)] = 0.0;
-        jacobian_pose[(4, 4)] = tmp70;
-        jacobian_pose[(5, 4)] = tmp341;
-        jacobian_pose[(6, 4)] = tmp116 * tmp348 + tmp120 * tmp349;
+        jacobian_pose[(4, 4)] = tmp66;
+        jacobian_pose[(5, 4)] = tmp345;
+        jacobian_pose[(6, 4)] = tmp110 * tmp352 + tmp113 * tmp353;
         jacobian_pose[(7, 4)] = 0.0;
-        jacobian_pose[(8, 4)] = tmp50;
-        jacobian_pose[(9, 4)] = tmp345;
-        jacobian_pose[(10, 4)] = tmp123 * tmp348 + tmp124 * tmp349;
+        jacobian_pose[(8, 4)] = tmp56;
+        jacobian_pose[(9, 4)] = tmp349;
+        jacobian_pose[(10, 4)] = tmp116 * tmp352 + tmp117 * tmp353;
         jacobian_pose[(11, 4)] = 0.0;
-        jacobian_pose[(12, 4)] = tmp61;
-        jacobian_pose[(13, 4)] = tmp346;
-        jacobian_pose[(14, 4)] = tmp126 * tmp348 + tmp128 * tmp349;
+        jacobian_pose[(12, 4)] = tmp58;
+        jacobian_pose[(13, 4)] = tmp350;
+        jacobian_pose[(14, 4)] = tmp119 * tmp352 + tmp121 * tmp353;
         jacobian_pose[(15, 4)] = 0.0;
         jacobian_pose[(0, 5)] = 0.0;
         jacobian_pose[(1, 5)] = 0.0;
@@ -714,16 +904,16 @@ pub fn cable_geometry(
         jacobian_reference_tension[(2, 0)] = 0.0;
         jacobian_reference_tension[(3, 0)] = 0.0;
         jacobian_reference_tension[(4, 0)] = 0.0;
-        jacobian_reference_tension[(5, 0)] = tmp350;
-        jacobian_reference_tension[(6, 0)] = tmp116 * tmp353 + tmp120 * tmp354;
+        jacobian_reference_tension[(5, 0)] = tmp354;
+        jacobian_reference_tension[(6, 0)] = tmp110 * tmp357 + tmp113 * tmp358;
         jacobian_reference_tension[(7, 0)] = 0.0;
         jacobian_reference_tension[(8, 0)] = 0.0;
-        jacobian_reference_tension[(9, 0)] = tmp352;
-        jacobian_reference_tension[(10, 0)] = tmp123 * tmp353 + tmp124 * tmp354;
+        jacobian_reference_tension[(9, 0)] = tmp356;
+        jacobian_reference_tension[(10, 0)] = tmp116 * tmp357 + tmp117 * tmp358;
         jacobian_reference_tension[(11, 0)] = 0.0;
         jacobian_reference_tension[(12, 0)] = 0.0;
-        jacobian_reference_tension[(13, 0)] = tmp351;
-        jacobian_reference_tension[(14, 0)] = tmp126 * tmp353 + tmp128 * tmp354;
+        jacobian_reference_tension[(13, 0)] = tmp355;
+        jacobian_reference_tension[(14, 0)] = tmp119 * tmp357 + tmp121 * tmp358;
         jacobian_reference_tension[(15, 0)] = 0.0;
         jacobian_reference_tension[(0, 1)] = 0.0;
         jacobian_reference_tension[(1, 1)] = 0.0;
@@ -731,49 +921,49 @@ pub fn cable_geometry(
         jacobian_reference_tension[(3, 1)] = 0.0;
         jacobian_reference_tension[(4, 1)] = 0.0;
         jacobian_reference_tension[(5, 1)] = 0.0;
-        jacobian_reference_tension[(6, 1)] = tmp11 * tmp116 - tmp120 * tmp20 - tmp87;
+        jacobian_reference_tension[(6, 1)] = tmp11 * tmp110 - tmp113 * tmp20 - tmp86;
         jacobian_reference_tension[(7, 1)] = 0.0;
         jacobian_reference_tension[(8, 1)] = 0.0;
         jacobian_reference_tension[(9, 1)] = 0.0;
-        jacobian_reference_tension[(10, 1)] = tmp11 * tmp123 - tmp122 - tmp124 * tmp20;
+        jacobian_reference_tension[(10, 1)] = tmp11 * tmp116 - tmp115 - tmp117 * tmp20;
         jacobian_reference_tension[(11, 1)] = 0.0;
         jacobian_reference_tension[(12, 1)] = 0.0;
         jacobian_reference_tension[(13, 1)] = 0.0;
-        jacobian_reference_tension[(14, 1)] = tmp11 * tmp126 - tmp127 - tmp128 * tmp20;
+        jacobian_reference_tension[(14, 1)] = tmp11 * tmp119 - tmp120 - tmp121 * tmp20;
         jacobian_reference_tension[(15, 1)] = 0.0;
     }
     if let Some(jacobian_anchors) = jacobian_anchors {
-        jacobian_anchors[(0, 0)] = -tmp39;
+        jacobian_anchors[(0, 0)] = -tmp72;
         jacobian_anchors[(1, 0)] = 0.0;
         jacobian_anchors[(2, 0)] = 0.0;
         jacobian_anchors[(3, 0)] = 0.0;
         jacobian_anchors[(4, 0)] = 0.0;
-        jacobian_anchors[(5, 0)] = tmp358;
-        jacobian_anchors[(6, 0)] = tmp116 * tmp362 + tmp120 * tmp361;
+        jacobian_anchors[(5, 0)] = tmp363;
+        jacobian_anchors[(6, 0)] = tmp110 * tmp369 + tmp113 * tmp368;
         jacobian_anchors[(7, 0)] = 0.0;
         jacobian_anchors[(8, 0)] = 0.0;
-        jacobian_anchors[(9, 0)] = tmp360;
-        jacobian_anchors[(10, 0)] = tmp123 * tmp362 + tmp124 * tmp361;
+        jacobian_anchors[(9, 0)] = tmp367;
+        jacobian_anchors[(10, 0)] = tmp116 * tmp369 + tmp117 * tmp368;
         jacobian_anchors[(11, 0)] = 0.0;
         jacobian_anchors[(12, 0)] = 0.0;
-        jacobian_anchors[(13, 0)] = tmp359;
-        jacobian_anchors[(14, 0)] = tmp126 * tmp362 + tmp128 * tmp361;
+        jacobian_anchors[(13, 0)] = tmp365;
+        jacobian_anchors[(14, 0)] = tmp119 * tmp369 + tmp121 * tmp368;
         jacobian_anchors[(15, 0)] = 0.0;
-        jacobian_anchors[(0, 1)] = -tmp38;
+        jacobian_anchors[(0, 1)] = -tmp71;
         jacobian_anchors[(1, 1)] = 0.0;
         jacobian_anchors[(2, 1)] = 0.0;
         jacobian_anchors[(3, 1)] = 0.0;
         jacobian_anchors[(4, 1)] = 0.0;
-        jacobian_anchors[(5, 1)] = tmp365;
-        jacobian_anchors[(6, 1)] = tmp116 * tmp369 + tmp120 * tmp368;
+        jacobian_anchors[(5, 1)] = tmp372;
+        jacobian_anchors[(6, 1)] = tmp110 * tmp377 + tmp113 * tmp376;
         jacobian_anchors[(7, 1)] = 0.0;
         jacobian_anchors[(8, 1)] = 0.0;
-        jacobian_anchors[(9, 1)] = tmp367;
-        jacobian_anchors[(10, 1)] = tmp123 * tmp369 + tmp124 * tmp368;
+        jacobian_anchors[(9, 1)] = tmp375;
+        jacobian_anchors[(10, 1)] = tmp116 * tmp377 + tmp117 * tmp376;
         jacobian_anchors[(11, 1)] = 0.0;
         jacobian_anchors[(12, 1)] = 0.0;
-        jacobian_anchors[(13, 1)] = tmp366;
-        jacobian_anchors[(14, 1)] = tmp126 * tmp369 + tmp128 * tmp368;
+        jacobian_anchors[(13, 1)] = tmp373;
+        jacobian_anchors[(14, 1)] = tmp119 * tmp377 + tmp121 * tmp376;
         jacobian_anchors[(15, 1)] = 0.0;
         jacobian_anchors[(0, 2)] = 0.0;
         jacobian_anchors[(1, 2)] = 0.0;
@@ -795,33 +985,33 @@ pub fn cable_geometry(
         jacobian_anchors[(1, 3)] = 0.0;
         jacobian_anchors[(2, 3)] = 0.0;
         jacobian_anchors[(3, 3)] = 0.0;
-        jacobian_anchors[(4, 3)] = -tmp68;
-        jacobian_anchors[(5, 3)] = tmp375;
-        jacobian_anchors[(6, 3)] = tmp116 * tmp380 + tmp120 * tmp379;
+        jacobian_anchors[(4, 3)] = -tmp64;
+        jacobian_anchors[(5, 3)] = tmp383;
+        jacobian_anchors[(6, 3)] = tmp110 * tmp392 + tmp113 * tmp391;
         jacobian_anchors[(7, 3)] = 0.0;
         jacobian_anchors[(8, 3)] = 0.0;
-        jacobian_anchors[(9, 3)] = tmp378;
-        jacobian_anchors[(10, 3)] = tmp123 * tmp380 + tmp124 * tmp379;
+        jacobian_anchors[(9, 3)] = tmp390;
+        jacobian_anchors[(10, 3)] = tmp116 * tmp392 + tmp117 * tmp391;
         jacobian_anchors[(11, 3)] = 0.0;
         jacobian_anchors[(12, 3)] = 0.0;
-        jacobian_anchors[(13, 3)] = tmp377;
-        jacobian_anchors[(14, 3)] = tmp126 * tmp380 + tmp128 * tmp379;
+        jacobian_anchors[(13, 3)] = tmp386;
+        jacobian_anchors[(14, 3)] = tmp119 * tmp392 + tmp121 * tmp391;
         jacobian_anchors[(15, 3)] = 0.0;
         jacobian_anchors[(0, 4)] = 0.0;
         jacobian_anchors[(1, 4)] = 0.0;
         jacobian_anchors[(2, 4)] = 0.0;
         jacobian_anchors[(3, 4)] = 0.0;
-        jacobian_anchors[(4, 4)] = -tmp70;
-        jacobian_anchors[(5, 4)] = tmp384;
-        jacobian_anchors[(6, 4)] = tmp116 * tmp388 + tmp120 * tmp389;
+        jacobian_anchors[(4, 4)] = -tmp66;
+        jacobian_anchors[(5, 4)] = tmp396;
+        jacobian_anchors[(6, 4)] = tmp110 * tmp399 + tmp113 * tmp400;
         jacobian_anchors[(7, 4)] = 0.0;
         jacobian_anchors[(8, 4)] = 0.0;
-        jacobian_anchors[(9, 4)] = tmp386;
-        jacobian_anchors[(10, 4)] = tmp123 * tmp388 + tmp124 * tmp389;
+        jacobian_anchors[(9, 4)] = tmp397;
+        jacobian_anchors[(10, 4)] = tmp116 * tmp399 + tmp117 * tmp400;
         jacobian_anchors[(11, 4)] = 0.0;
         jacobian_anchors[(12, 4)] = 0.0;
-        jacobian_anchors[(13, 4)] = tmp387;
-        jacobian_anchors[(14, 4)] = tmp126 * tmp388 + tmp128 * tmp389;
+        jacobian_anchors[(13, 4)] = tmp398;
+        jacobian_anchors[(14, 4)] = tmp119 * tmp399 + tmp121 * tmp400;
         jacobian_anchors[(15, 4)] = 0.0;
         jacobian_anchors[(0, 5)] = 0.0;
         jacobian_anchors[(1, 5)] = 0.0;
@@ -844,32 +1034,32 @@ pub fn cable_geometry(
         jacobian_anchors[(2, 6)] = 0.0;
         jacobian_anchors[(3, 6)] = 0.0;
         jacobian_anchors[(4, 6)] = 0.0;
-        jacobian_anchors[(5, 6)] = tmp395;
-        jacobian_anchors[(6, 6)] = tmp116 * tmp400 + tmp120 * tmp401;
+        jacobian_anchors[(5, 6)] = tmp407;
+        jacobian_anchors[(6, 6)] = tmp110 * tmp416 + tmp113 * tmp417;
         jacobian_anchors[(7, 6)] = 0.0;
-        jacobian_anchors[(8, 6)] = -tmp62;
-        jacobian_anchors[(9, 6)] = tmp397;
-        jacobian_anchors[(10, 6)] = tmp123 * tmp400 + tmp124 * tmp401;
+        jacobian_anchors[(8, 6)] = -tmp57;
+        jacobian_anchors[(9, 6)] = tmp411;
+        jacobian_anchors[(10, 6)] = tmp116 * tmp416 + tmp117 * tmp417;
         jacobian_anchors[(11, 6)] = 0.0;
         jacobian_anchors[(12, 6)] = 0.0;
-        jacobian_anchors[(13, 6)] = tmp399;
-        jacobian_anchors[(14, 6)] = tmp126 * tmp400 + tmp128 * tmp401;
+        jacobian_anchors[(13, 6)] = tmp415;
+        jacobian_anchors[(14, 6)] = tmp119 * tmp416 + tmp121 * tmp417;
         jacobian_anchors[(15, 6)] = 0.0;
         jacobian_anchors[(0, 7)] = 0.0;
         jacobian_anchors[(1, 7)] = 0.0;
         jacobian_anchors[(2, 7)] = 0.0;
         jacobian_anchors[(3, 7)] = 0.0;
         jacobian_anchors[(4, 7)] = 0.0;
-        jacobian_anchors[(5, 7)] = tmp405;
-        jacobian_anchors[(6, 7)] = tmp116 * tmp409 + tmp120 * tmp408;
+        jacobian_anchors[(5, 7)] = tmp420;
+        jacobian_anchors[(6, 7)] = tmp110 * tmp424 + tmp113 * tmp423;
         jacobian_anchors[(7, 7)] = 0.0;
-        jacobian_anchors[(8, 7)] = -tmp50;
-        jacobian_anchors[(9, 7)] = tmp406;
-        jacobian_anchors[(10, 7)] = tmp123 * tmp409 + tmp124 * tmp408;
+        jacobian_anchors[(8, 7)] = -tmp56;
+        jacobian_anchors[(9, 7)] = tmp421;
+        jacobian_anchors[(10, 7)] = tmp116 * tmp424 + tmp117 * tmp423;
         jacobian_anchors[(11, 7)] = 0.0;
         jacobian_anchors[(12, 7)] = 0.0;
-        jacobian_anchors[(13, 7)] = tmp407;
-        jacobian_anchors[(14, 7)] = tmp126 * tmp409 + tmp128 * tmp408;
+        jacobian_anchors[(13, 7)] = tmp422;
+        jacobian_anchors[(14, 7)] = tmp119 * tmp424 + tmp121 * tmp423;
         jacobian_anchors[(15, 7)] = 0.0;
         jacobian_anchors[(0, 8)] = 0.0;
         jacobian_anchors[(1, 8)] = 0.0;
@@ -892,32 +1082,32 @@ pub fn cable_geometry(
         jacobian_anchors[(2, 9)] = 0.0;
         jacobian_anchors[(3, 9)] = 0.0;
         jacobian_anchors[(4, 9)] = 0.0;
-        jacobian_anchors[(5, 9)] = tmp415;
-        jacobian_anchors[(6, 9)] = tmp116 * tmp419 + tmp120 * tmp420;
+        jacobian_anchors[(5, 9)] = tmp431;
+        jacobian_anchors[(6, 9)] = tmp110 * tmp440 + tmp113 * tmp441;
         jacobian_anchors[(7, 9)] = 0.0;
         jacobian_anchors[(8, 9)] = 0.0;
-        jacobian_anchors[(9, 9)] = tmp418;
-        jacobian_anchors[(10, 9)] = tmp123 * tmp419 + tmp124 * tmp420;
+        jacobian_anchors[(9, 9)] = tmp439;
+        jacobian_anchors[(10, 9)] = tmp116 * tmp440 + tmp117 * tmp441;
         jacobian_anchors[(11, 9)] = 0.0;
-        jacobian_anchors[(12, 9)] = -tmp60;
-        jacobian_anchors[(13, 9)] = tmp417;
-        jacobian_anchors[(14, 9)] = tmp126 * tmp419 + tmp128 * tmp420;
+        jacobian_anchors[(12, 9)] = -tmp46;
+        jacobian_anchors[(13, 9)] = tmp435;
+        jacobian_anchors[(14, 9)] = tmp119 * tmp440 + tmp121 * tmp441;
         jacobian_anchors[(15, 9)] = 0.0;
         jacobian_anchors[(0, 10)] = 0.0;
         jacobian_anchors[(1, 10)] = 0.0;
         jacobian_anchors[(2, 10)] = 0.0;
         jacobian_anchors[(3, 10)] = 0.0;
         jacobian_anchors[(4, 10)] = 0.0;
-        jacobian_anchors[(5, 10)] = tmp425;
-        jacobian_anchors[(6, 10)] = tmp116 * tmp429 + tmp120 * tmp428;
+        jacobian_anchors[(5, 10)] = tmp444;
+        jacobian_anchors[(6, 10)] = tmp110 * tmp448 + tmp113 * tmp447;
         jacobian_anchors[(7, 10)] = 0.0;
         jacobian_anchors[(8, 10)] = 0.0;
-        jacobian_anchors[(9, 10)] = tmp427;
-        jacobian_anchors[(10, 10)] = tmp123 * tmp429 + tmp124 * tmp428;
+        jacobian_anchors[(9, 10)] = tmp446;
+        jacobian_anchors[(10, 10)] = tmp116 * tmp448 + tmp117 * tmp447;
         jacobian_anchors[(11, 10)] = 0.0;
-        jacobian_anchors[(12, 10)] = -tmp61;
-        jacobian_anchors[(13, 10)] = tmp426;
-        jacobian_anchors[(14, 10)] = tmp126 * tmp429 + tmp128 * tmp428;
+        jacobian_anchors[(12, 10)] = -tmp58;
+        jacobian_anchors[(13, 10)] = tmp445;
+        jacobian_anchors[(14, 10)] = tmp119 * tmp448 + tmp121 * tmp447;
         jacobian_anchors[(15, 10)] = 0.0;
         jacobian_anchors[(0, 11)] = 0.0;
         jacobian_anchors[(1, 11)] = 0.0;
@@ -936,6 +1126,200 @@ pub fn cable_geometry(
         jacobian_anchors[(14, 11)] = 0.0;
         jacobian_anchors[(15, 11)] = 1.0_f64;
     }
+    if let Some(jacobian_attachments) = jacobian_attachments {
+        jacobian_attachments[(0, 0)] = tmp449;
+        jacobian_attachments[(1, 0)] = 0.0;
+        jacobian_attachments[(2, 0)] = 0.0;
+        jacobian_attachments[(3, 0)] = tmp450;
+        jacobian_attachments[(4, 0)] = 0.0;
+        jacobian_attachments[(5, 0)] = tmp454;
+        jacobian_attachments[(6, 0)] = tmp110 * tmp457 + tmp113 * tmp458;
+        jacobian_attachments[(7, 0)] = 0.0;
+        jacobian_attachments[(8, 0)] = 0.0;
+        jacobian_attachments[(9, 0)] = tmp456;
+        jacobian_attachments[(10, 0)] = tmp116 * tmp457 + tmp117 * tmp458;
+        jacobian_attachments[(11, 0)] = 0.0;
+        jacobian_attachments[(12, 0)] = 0.0;
+        jacobian_attachments[(13, 0)] = tmp455;
+        jacobian_attachments[(14, 0)] = tmp119 * tmp457 + tmp121 * tmp458;
+        jacobian_attachments[(15, 0)] = 0.0;
+        jacobian_attachments[(0, 1)] = tmp459;
+        jacobian_attachments[(1, 1)] = 0.0;
+        jacobian_attachments[(2, 1)] = 0.0;
+        jacobian_attachments[(3, 1)] = tmp460;
+        jacobian_attachments[(4, 1)] = 0.0;
+        jacobian_attachments[(5, 1)] = tmp465;
+        jacobian_attachments[(6, 1)] = tmp110 * tmp469 + tmp113 * tmp468;
+        jacobian_attachments[(7, 1)] = 0.0;
+        jacobian_attachments[(8, 1)] = 0.0;
+        jacobian_attachments[(9, 1)] = tmp466;
+        jacobian_attachments[(10, 1)] = tmp116 * tmp469 + tmp117 * tmp468;
+        jacobian_attachments[(11, 1)] = 0.0;
+        jacobian_attachments[(12, 1)] = 0.0;
+        jacobian_attachments[(13, 1)] = tmp467;
+        jacobian_attachments[(14, 1)] = tmp119 * tmp469 + tmp121 * tmp468;
+        jacobian_attachments[(15, 1)] = 0.0;
+        jacobian_attachments[(0, 2)] = tmp470;
+        jacobian_attachments[(1, 2)] = 0.0;
+        jacobian_attachments[(2, 2)] = 0.0;
+        jacobian_attachments[(3, 2)] = tmp471;
+        jacobian_attachments[(4, 2)] = 0.0;
+        jacobian_attachments[(5, 2)] = tmp475;
+        jacobian_attachments[(6, 2)] = tmp110 * tmp478 + tmp113 * tmp479;
+        jacobian_attachments[(7, 2)] = 0.0;
+        jacobian_attachments[(8, 2)] = 0.0;
+        jacobian_attachments[(9, 2)] = tmp476;
+        jacobian_attachments[(10, 2)] = tmp116 * tmp478 + tmp117 * tmp479;
+        jacobian_attachments[(11, 2)] = 0.0;
+        jacobian_attachments[(12, 2)] = 0.0;
+        jacobian_attachments[(13, 2)] = tmp477;
+        jacobian_attachments[(14, 2)] = tmp119 * tmp478 + tmp121 * tmp479;
+        jacobian_attachments[(15, 2)] = 0.0;
+        jacobian_attachments[(0, 3)] = 0.0;
+        jacobian_attachments[(1, 3)] = 0.0;
+        jacobian_attachments[(2, 3)] = 0.0;
+        jacobian_attachments[(3, 3)] = 0.0;
+        jacobian_attachments[(4, 3)] = tmp480;
+        jacobian_attachments[(5, 3)] = tmp485;
+        jacobian_attachments[(6, 3)] = tmp110 * tmp490 + tmp113 * tmp489;
+        jacobian_attachments[(7, 3)] = tmp450;
+        jacobian_attachments[(8, 3)] = 0.0;
+        jacobian_attachments[(9, 3)] = tmp488;
+        jacobian_attachments[(10, 3)] = tmp116 * tmp490 + tmp117 * tmp489;
+        jacobian_attachments[(11, 3)] = 0.0;
+        jacobian_attachments[(12, 3)] = 0.0;
+        jacobian_attachments[(13, 3)] = tmp487;
+        jacobian_attachments[(14, 3)] = tmp119 * tmp490 + tmp121 * tmp489;
+        jacobian_attachments[(15, 3)] = 0.0;
+        jacobian_attachments[(0, 4)] = 0.0;
+        jacobian_attachments[(1, 4)] = 0.0;
+        jacobian_attachments[(2, 4)] = 0.0;
+        jacobian_attachments[(3, 4)] = 0.0;
+        jacobian_attachments[(4, 4)] = tmp491;
+        jacobian_attachments[(5, 4)] = tmp495;
+        jacobian_attachments[(6, 4)] = tmp110 * tmp499 + tmp113 * tmp498;
+        jacobian_attachments[(7, 4)] = tmp460;
+        jacobian_attachments[(8, 4)] = 0.0;
+        jacobian_attachments[(9, 4)] = tmp496;
+        jacobian_attachments[(10, 4)] = tmp116 * tmp499 + tmp117 * tmp498;
+        jacobian_attachments[(11, 4)] = 0.0;
+        jacobian_attachments[(12, 4)] = 0.0;
+        jacobian_attachments[(13, 4)] = tmp497;
+        jacobian_attachments[(14, 4)] = tmp119 * tmp499 + tmp121 * tmp498;
+        jacobian_attachments[(15, 4)] = 0.0;
+        jacobian_attachments[(0, 5)] = 0.0;
+        jacobian_attachments[(1, 5)] = 0.0;
+        jacobian_attachments[(2, 5)] = 0.0;
+        jacobian_attachments[(3, 5)] = 0.0;
+        jacobian_attachments[(4, 5)] = tmp500;
+        jacobian_attachments[(5, 5)] = tmp504;
+        jacobian_attachments[(6, 5)] = tmp110 * tmp507 + tmp113 * tmp508;
+        jacobian_attachments[(7, 5)] = tmp471;
+        jacobian_attachments[(8, 5)] = 0.0;
+        jacobian_attachments[(9, 5)] = tmp506;
+        jacobian_attachments[(10, 5)] = tmp116 * tmp507 + tmp117 * tmp508;
+        jacobian_attachments[(11, 5)] = 0.0;
+        jacobian_attachments[(12, 5)] = 0.0;
+        jacobian_attachments[(13, 5)] = tmp505;
+        jacobian_attachments[(14, 5)] = tmp119 * tmp507 + tmp121 * tmp508;
+        jacobian_attachments[(15, 5)] = 0.0;
+        jacobian_attachments[(0, 6)] = 0.0;
+        jacobian_attachments[(1, 6)] = 0.0;
+        jacobian_attachments[(2, 6)] = 0.0;
+        jacobian_attachments[(3, 6)] = 0.0;
+        jacobian_attachments[(4, 6)] = 0.0;
+        jacobian_attachments[(5, 6)] = tmp514;
+        jacobian_attachments[(6, 6)] = tmp110 * tmp517 + tmp113 * tmp518;
+        jacobian_attachments[(7, 6)] = 0.0;
+        jacobian_attachments[(8, 6)] = tmp509;
+        jacobian_attachments[(9, 6)] = tmp516;
+        jacobian_attachments[(10, 6)] = tmp116 * tmp517 + tmp117 * tmp518;
+        jacobian_attachments[(11, 6)] = tmp450;
+        jacobian_attachments[(12, 6)] = 0.0;
+        jacobian_attachments[(13, 6)] = tmp515;
+        jacobian_attachments[(14, 6)] = tmp119 * tmp517 + tmp121 * tmp518;
+        jacobian_attachments[(15, 6)] = 0.0;
+        jacobian_attachments[(0, 7)] = 0.0;
+        jacobian_attachments[(1, 7)] = 0.0;
+        jacobian_attachments[(2, 7)] = 0.0;
+        jacobian_attachments[(3, 7)] = 0.0;
+        jacobian_attachments[(4, 7)] = 0.0;
+        jacobian_attachments[(5, 7)] = tmp524;
+        jacobian_attachments[(6, 7)] = tmp110 * tmp527 + tmp113 * tmp528;
+        jacobian_attachments[(7, 7)] = 0.0;
+        jacobian_attachments[(8, 7)] = tmp519;
+        jacobian_attachments[(9, 7)] = tmp526;
+        jacobian_attachments[(10, 7)] = tmp116 * tmp527 + tmp117 * tmp528;
+        jacobian_attachments[(11, 7)] = tmp460;
+        jacobian_attachments[(12, 7)] = 0.0;
+        jacobian_attachments[(13, 7)] = tmp525;
+        jacobian_attachments[(14, 7)] = tmp119 * tmp527 + tmp121 * tmp528;
+        jacobian_attachments[(15, 7)] = 0.0;
+        jacobian_attachments[(0, 8)] = 0.0;
+        jacobian_attachments[(1, 8)] = 0.0;
+        jacobian_attachments[(2, 8)] = 0.0;
+        jacobian_attachments[(3, 8)] = 0.0;
+        jacobian_attachments[(4, 8)] = 0.0;
+        jacobian_attachments[(5, 8)] = tmp533;
+        jacobian_attachments[(6, 8)] = tmp110 * tmp536 + tmp113 * tmp537;
+        jacobian_attachments[(7, 8)] = 0.0;
+        jacobian_attachments[(8, 8)] = tmp529;
+        jacobian_attachments[(9, 8)] = tmp535;
+        jacobian_attachments[(10, 8)] = tmp116 * tmp536 + tmp117 * tmp537;
+        jacobian_attachments[(11, 8)] = tmp471;
+        jacobian_attachments[(12, 8)] = 0.0;
+        jacobian_attachments[(13, 8)] = tmp534;
+        jacobian_attachments[(14, 8)] = tmp119 * tmp536 + tmp121 * tmp537;
+        jacobian_attachments[(15, 8)] = 0.0;
+        jacobian_attachments[(0, 9)] = 0.0;
+        jacobian_attachments[(1, 9)] = 0.0;
+        jacobian_attachments[(2, 9)] = 0.0;
+        jacobian_attachments[(3, 9)] = 0.0;
+        jacobian_attachments[(4, 9)] = 0.0;
+        jacobian_attachments[(5, 9)] = tmp543;
+        jacobian_attachments[(6, 9)] = tmp110 * tmp547 + tmp113 * tmp546;
+        jacobian_attachments[(7, 9)] = 0.0;
+        jacobian_attachments[(8, 9)] = 0.0;
+        jacobian_attachments[(9, 9)] = tmp545;
+        jacobian_attachments[(10, 9)] = tmp116 * tmp547 + tmp117 * tmp546;
+        jacobian_attachments[(11, 9)] = 0.0;
+        jacobian_attachments[(12, 9)] = tmp538;
+        jacobian_attachments[(13, 9)] = tmp544;
+        jacobian_attachments[(14, 9)] = tmp119 * tmp547 + tmp121 * tmp546;
+        jacobian_attachments[(15, 9)] = tmp450;
+        jacobian_attachments[(0, 10)] = 0.0;
+        jacobian_attachments[(1, 10)] = 0.0;
+        jacobian_attachments[(2, 10)] = 0.0;
+        jacobian_attachments[(3, 10)] = 0.0;
+        jacobian_attachments[(4, 10)] = 0.0;
+        jacobian_attachments[(5, 10)] = tmp553;
+        jacobian_attachments[(6, 10)] = tmp110 * tmp557 + tmp113 * tmp556;
+        jacobian_attachments[(7, 10)] = 0.0;
+        jacobian_attachments[(8, 10)] = 0.0;
+        jacobian_attachments[(9, 10)] = tmp555;
+        jacobian_attachments[(10, 10)] = tmp116 * tmp557 + tmp117 * tmp556;
+        jacobian_attachments[(11, 10)] = 0.0;
+        jacobian_attachments[(12, 10)] = tmp548;
+        jacobian_attachments[(13, 10)] = tmp554;
+        jacobian_attachments[(14, 10)] = tmp119 * tmp557 + tmp121 * tmp556;
+        jacobian_attachments[(15, 10)] = tmp460;
+        jacobian_attachments[(0, 11)] = 0.0;
+        jacobian_attachments[(1, 11)] = 0.0;
+        jacobian_attachments[(2, 11)] = 0.0;
+        jacobian_attachments[(3, 11)] = 0.0;
+        jacobian_attachments[(4, 11)] = 0.0;
+        jacobian_attachments[(5, 11)] = tmp563;
+        jacobian_attachments[(6, 11)] = tmp110 * tmp567 + tmp113 * tmp566;
+        jacobian_attachments[(7, 11)] = 0.0;
+        jacobian_attachments[(8, 11)] = 0.0;
+        jacobian_attachments[(9, 11)] = tmp565;
+        jacobian_attachments[(10, 11)] = tmp116 * tmp567 + tmp117 * tmp566;
+        jacobian_attachments[(11, 11)] = 0.0;
+        jacobian_attachments[(12, 11)] = tmp558;
+        jacobian_attachments[(13, 11)] = tmp564;
+        jacobian_attachments[(14, 11)] = tmp119 * tmp567 + tmp121 * tmp566;
+        jacobian_attachments[(15, 11)] = tmp471;
+    }
     if let Some(jacobian_com_offset) = jacobian_com_offset {
         jacobian_com_offset[(0, 0)] = 0.0;
         jacobian_com_offset[(1, 0)] = 0.0;
@@ -943,15 +1327,15 @@ pub fn cable_geometry(
         jacobian_com_offset[(3, 0)] = 0.0;
         jacobian_com_offset[(4, 0)] = 0.0;
         jacobian_com_offset[(5, 0)] = 0.0;
-        jacobian_com_offset[(6, 0)] = -tmp116 * tmp431 + tmp17 * tmp430;
+        jacobian_com_offset[(6, 0)] = -tmp110 * tmp569 + tmp113 * tmp568;
         jacobian_com_offset[(7, 0)] = 0.0;
         jacobian_com_offset[(8, 0)] = 0.0;
         jacobian_com_offset[(9, 0)] = 0.0;
-        jacobian_com_offset[(10, 0)] = -tmp123 * tmp431 + tmp17 * tmp432;
+        jacobian_com_offset[(10, 0)] = -tmp116 * tmp569 + tmp117 * tmp568;
         jacobian_com_offset[(11, 0)] = 0.0;
         jacobian_com_offset[(12, 0)] = 0.0;
         jacobian_com_offset[(13, 0)] = 0.0;
-        jacobian_com_offset[(14, 0)] = -tmp126 * tmp431 + tmp17 * tmp433;
+        jacobian_com_offset[(14, 0)] = -tmp119 * tmp569 + tmp121 * tmp568;
         jacobian_com_offset[(15, 0)] = 0.0;
         jacobian_com_offset[(0, 1)] = 0.0;
         jacobian_com_offset[(1, 1)] = 0.0;
@@ -959,15 +1343,15 @@ pub fn cable_geometry(
         jacobian_com_offset[(3, 1)] = 0.0;
         jacobian_com_offset[(4, 1)] = 0.0;
         jacobian_com_offset[(5, 1)] = 0.0;
-        jacobian_com_offset[(6, 1)] = -tmp116 * tmp434 + tmp19 * tmp430;
+        jacobian_com_offset[(6, 1)] = -tmp110 * tmp570 + tmp113 * tmp571;
         jacobian_com_offset[(7, 1)] = 0.0;
         jacobian_com_offset[(8, 1)] = 0.0;
         jacobian_com_offset[(9, 1)] = 0.0;
-        jacobian_com_offset[(10, 1)] = -tmp123 * tmp434 + tmp19 * tmp432;
+        jacobian_com_offset[(10, 1)] = -tmp116 * tmp570 + tmp117 * tmp571;
         jacobian_com_offset[(11, 1)] = 0.0;
         jacobian_com_offset[(12, 1)] = 0.0;
         jacobian_com_offset[(13, 1)] = 0.0;
-        jacobian_com_offset[(14, 1)] = -tmp126 * tmp434 + tmp19 * tmp433;
+        jacobian_com_offset[(14, 1)] = -tmp119 * tmp570 + tmp121 * tmp571;
         jacobian_com_offset[(15, 1)] = 0.0;
         jacobian_com_offset[(0, 2)] = 0.0;
         jacobian_com_offset[(1, 2)] = 0.0;
@@ -975,15 +1359,15 @@ pub fn cable_geometry(
         jacobian_com_offset[(3, 2)] = 0.0;
         jacobian_com_offset[(4, 2)] = 0.0;
         jacobian_com_offset[(5, 2)] = 0.0;
-        jacobian_com_offset[(6, 2)] = -tmp116 * tmp436 + tmp120 * tmp435;
+        jacobian_com_offset[(6, 2)] = -tmp110 * tmp573 + tmp113 * tmp572;
         jacobian_com_offset[(7, 2)] = 0.0;
         jacobian_com_offset[(8, 2)] = 0.0;
         jacobian_com_offset[(9, 2)] = 0.0;
-        jacobian_com_offset[(10, 2)] = -tmp123 * tmp436 + tmp16 * tmp432;
+        jacobian_com_offset[(10, 2)] = -tmp116 * tmp573 + tmp117 * tmp572;
         jacobian_com_offset[(11, 2)] = 0.0;
         jacobian_com_offset[(12, 2)] = 0.0;
         jacobian_com_offset[(13, 2)] = 0.0;
-        jacobian_com_offset[(14, 2)] = -tmp126 * tmp436 + tmp128 * tmp435;
+        jacobian_com_offset[(14, 2)] = -tmp119 * tmp573 + tmp121 * tmp572;
         jacobian_com_offset[(15, 2)] = 0.0;
     }
     if let Some(jacobian_platform_weight) = jacobian_platform_weight {
@@ -993,15 +1377,15 @@ pub fn cable_geometry(
         jacobian_platform_weight[3] = 0.0;
         jacobian_platform_weight[4] = 0.0;
         jacobian_platform_weight[5] = 0.0;
-        jacobian_platform_weight[6] = -tmp114 * tmp116 + tmp117 * tmp120 + tmp87;
+        jacobian_platform_weight[6] = -tmp108 * tmp110 + tmp111 * tmp113 + tmp86;
         jacobian_platform_weight[7] = 0.0;
         jacobian_platform_weight[8] = 0.0;
         jacobian_platform_weight[9] = 0.0;
-        jacobian_platform_weight[10] = -tmp114 * tmp123 + tmp117 * tmp124 + tmp122;
+        jacobian_platform_weight[10] = -tmp108 * tmp116 + tmp111 * tmp117 + tmp115;
         jacobian_platform_weight[11] = 0.0;
         jacobian_platform_weight[12] = 0.0;
         jacobian_platform_weight[13] = 0.0;
-        jacobian_platform_weight[14] = -tmp114 * tmp126 + tmp117 * tmp128 + tmp127;
+        jacobian_platform_weight[14] = -tmp108 * tmp119 + tmp111 * tmp121 + tmp120;
         jacobian_platform_weight[15] = 0.0;
     }
     nalgebra::SVector::<f64, 16>::from([
@@ -1010,16 +1394,16 @@ pub fn cable_geometry(
         reference_tension_n[1],
         -tmp28 + anchors_m[(2, 0)] - position_m[2],
         tmp36,
-        tmp80,
-        tmp121,
-        -tmp101 + anchors_m[(2, 1)] - position_m[2],
-        tmp48,
-        tmp111,
-        tmp125,
-        -tmp112 + anchors_m[(2, 2)] - position_m[2],
-        tmp58,
-        tmp98,
-        tmp129,
-        -tmp99 + anchors_m[(2, 3)] - position_m[2],
+        tmp79,
+        tmp114,
+        -tmp96 + anchors_m[(2, 1)] - position_m[2],
+        tmp54,
+        tmp105,
+        tmp118,
+        -tmp106 + anchors_m[(2, 2)] - position_m[2],
+        tmp44,
+        tmp93,
+        tmp122,
+        -tmp94 + anchors_m[(2, 3)] - position_m[2],
     ])
 }

@@ -157,6 +157,7 @@ fn extended_jacobians_match_central_differences() {
         "encoder-backlash:b1_m=0.002,b2_m=-0.001,b3_m=0.003,b4_m=0.0015",
         "loadcell-drift:rate_n=0.5",
         "loadcell-friction:k=0.02",
+        "attachments:dx1_m=0.01,dy1_m=-0.02,dx3_m=0.015,dy4_m=0.01",
     ];
     robot.effects = effects(&all);
     let eqs = equilibria(&robot, 3);
@@ -258,6 +259,12 @@ fn extended_model_matches_the_discretised_simulator() {
         ("small", &["elastic:ea_n=2e5", "pulley:radius_m=0.05"][..], 0.005, 1e-4),
         ("large", &["platform-weight:scale=1.1"][..], 0.1, 2e-4),
         ("large", &["cable-weight:scale=0.85"][..], 0.1, 2e-4),
+        (
+            "large",
+            &["attachments:dx1_m=0.02,dy1_m=-0.015,dx2_m=-0.01,dy3_m=0.02,dx4_m=0.015"][..],
+            0.003,
+            2e-4,
+        ),
         (
             "small",
             &["platform-weight:scale=0.9", "cable-weight:scale=1.15"][..],

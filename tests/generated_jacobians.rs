@@ -193,6 +193,8 @@ enum Block {
     Pose,
     ReferenceTension,
     Anchors,
+    /// The attachments in the platform frame (`cable_geometry`'s `attachments_m`).
+    Attachments,
     LengthOffsets,
     ComOffset,
     /// The four cables' spans (`extended_cable`'s `span_m`, one column per slot).
@@ -220,7 +222,7 @@ impl Block {
         match self {
             Block::Pose => 6,
             Block::ReferenceTension => 2,
-            Block::Anchors => 12,
+            Block::Anchors | Block::Attachments => 12,
             Block::LengthOffsets => 4,
             Block::ComOffset | Block::LocaliserMount => 3,
             Block::Span | Block::HorizontalTension | Block::VerticalTension => 4,
@@ -241,6 +243,7 @@ impl Block {
             Block::Pose => 1e-3,
             Block::ReferenceTension => 1e-4 * point.reference_tension_n[k].abs().max(1.0),
             Block::Anchors | Block::LengthOffsets => 1e-3,
+            Block::Attachments => 1e-4,
             Block::ComOffset => 1e-4,
             Block::Span => 1e-4 * point.cable_spans_m[k].abs().max(1.0),
             Block::HorizontalTension => 1e-4 * point.cable_horizontal_tensions_n[k].abs().max(1.0),
@@ -265,6 +268,7 @@ impl Block {
             }
             Block::ReferenceTension => moved.reference_tension_n[k] += t,
             Block::Anchors => moved.anchors_m[(k % 3, k / 3)] += t,
+            Block::Attachments => moved.attachments_m[(k % 3, k / 3)] += t,
             Block::LengthOffsets => moved.length_offsets_m[k] += t,
             Block::ComOffset => moved.com_offset_m[k] += t,
             Block::Span => moved.cable_spans_m[k] += t,
@@ -356,7 +360,7 @@ fn rigid_length(p: &Point) -> Evaluation {
 }
 
 fn geometry(p: &Point) -> Evaluation {
-    let mut j = (nan(), nan(), nan(), nan(), nan());
+    let mut j = (nan(), nan(), nan(), nan(), nan(), nan());
     let value = calls::geometry(p, Some(&mut j));
     (column(value), calls::geometry_blocks(&j))
 }
@@ -434,6 +438,7 @@ const FUNCTIONS: [Function; 11] = [
             Block::Pose,
             Block::ReferenceTension,
             Block::Anchors,
+            Block::Attachments,
             Block::ComOffset,
             Block::PlatformWeight,
         ],

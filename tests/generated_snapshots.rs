@@ -326,9 +326,10 @@ fn rigid_length_residual_outputs() {
 #[test]
 fn cable_geometry_outputs() {
     let x = inputs();
-    let (mut pose, mut reference, mut anchors, mut com, mut weight) = (
+    let (mut pose, mut reference, mut anchors, mut attachments, mut com, mut weight) = (
         nan::<16, 6>(),
         nan::<16, 2>(),
+        nan::<16, 12>(),
         nan::<16, 12>(),
         nan::<16, 3>(),
         nan::<16, 1>(),
@@ -345,6 +346,7 @@ fn cable_geometry_outputs() {
         Some(&mut pose),
         Some(&mut reference),
         Some(&mut anchors),
+        Some(&mut attachments),
         Some(&mut com),
         Some(&mut weight),
     );
@@ -353,6 +355,7 @@ fn cable_geometry_outputs() {
     format_block(&mut out, "jacobian_pose", &pose);
     format_block(&mut out, "jacobian_reference_tension", &reference);
     format_block(&mut out, "jacobian_anchors", &anchors);
+    format_block(&mut out, "jacobian_attachments", &attachments);
     format_block(&mut out, "jacobian_com_offset", &com);
     format_block(&mut out, "jacobian_platform_weight", &weight);
     insta::assert_snapshot!(out);
@@ -372,6 +375,7 @@ fn extended_cable_outputs() {
         &x.com_offset_m,
         x.platform_weight_n,
         EPSILON,
+        None,
         None,
         None,
         None,

@@ -33,7 +33,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::{DMatrix, DVector, SMatrix, Vector2, Vector3, Vector4};
+use nalgebra::{DMatrix, DVector, Matrix3x4, SMatrix, Vector2, Vector3, Vector4};
 
 use super::factors::{
     gather_anchors, gather_offsets, pose_arguments, rows_to_cables, slots_to_cables, split_anchor_jacobian,
@@ -46,6 +46,7 @@ use crate::model::measurement::ReadingOrder;
 use crate::model::robot::CABLE_COUNT;
 
 pub use super::load_cell_factor::LoadCellFactor;
+pub use super::mounted_pose_prior::MountedPosePriorFactor;
 
 /// The effect parameters of the extended model, one variable per effect.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -86,6 +87,11 @@ pub struct EffectVariables {
     pub load_cell_drift: VariableId,
     /// `[k]`, friction `mu theta` of a pulley before a drum-side load cell (reading `T (1 - k s)`).
     pub load_cell_friction: VariableId,
+    /// `[dx_1, dy_1, .., dx_4, dy_4]`, each cable's attachment point moved
+    /// horizontally from the robot file's, platform frame, metres, robot
+    /// cable order (a vertical move is not identifiable from nearly level
+    /// poses, as for the centre of mass).
+    pub attachment_shift: VariableId,
 }
 
 impl EffectVariables {
@@ -106,6 +112,7 @@ impl EffectVariables {
             EffectKind::EncoderBacklash => self.encoder_backlash,
             EffectKind::LoadCellDrift => self.load_cell_drift,
             EffectKind::LoadCellFriction => self.load_cell_friction,
+            EffectKind::Attachments => self.attachment_shift,
         }
     }
 }
@@ -128,6 +135,8 @@ struct EffectArguments {
     /// Encoder drift (mm per row) and backlash (mm), slot order.
     drift_mm_per_row: Vector4<f64>,
     backlash_mm: Vector4<f64>,
+    /// The robot file's attachments moved by the shift, platform frame, column = slot.
+    attachments_m: Matrix3x4<f64>,
 }
 
 fn effect_arguments(values: &Values, slots: &SlotOrder, effects: &EffectVariables) -> EffectArguments {
@@ -146,21 +155,30 @@ fn effect_arguments(values: &Values, slots: &SlotOrder, effects: &EffectVariable
         nominal_cable_weight_n_per_m: slots.cable_weight_n_per_m,
         drift_mm_per_row: Vector4::from_fn(|slot, _| values.vector(effects.encoder_drift)[slots.cables[slot]]),
         backlash_mm: Vector4::from_fn(|slot, _| values.vector(effects.encoder_backlash)[slots.cables[slot]]),
+        attachments_m: {
+            let shift = values.vector(effects.attachment_shift);
+            let mut moved = slots.attachments_m;
+            for (slot, &cable) in slots.cables.iter().enumerate() {
+                moved[(0, slot)] += shift[2 * cable];
+                moved[(1, slot)] += shift[2 * cable + 1];
+            }
+            moved
+        },
     }
 }
 
 /// Number of geometry columns chained through `generated::extended_cable`:
 /// pose (6), reference tension (2), anchors (12, slot order), centre of mass (3),
 /// then compliance (1), pulley radius (1), `1/n^2` (1), the platform's weight
-/// error (1) and the cables' weight error (1).
-const CHAIN_COLUMNS: usize = 28;
+/// error (1), the cables' weight error (1) and the attachments' horizontal
+/// shifts (8, `[x, y]` per slot).
+const CHAIN_COLUMNS: usize = 36;
 
 /// The extended cable model of one pose: per slot the paid-out length and
 /// `drop - h` (the attachment residual), with Jacobians by the chain rule
 /// through `generated::cable_geometry` and `generated::extended_cable`.
 /// Computed once per point for the pose's length and height factors
 /// ([`ExtendedMemo`]).
-#[derive(Default)]
 pub struct ExtendedCables {
     /// Paid-out length per slot, metres.
     paid_out_m: Vector4<f64>,
@@ -173,10 +191,21 @@ pub struct ExtendedCables {
     d_height: SMatrix<f64, 4, CHAIN_COLUMNS>,
 }
 
+impl Default for ExtendedCables {
+    fn default() -> Self {
+        Self {
+            paid_out_m: Vector4::zeros(),
+            height_residual_m: Vector4::zeros(),
+            d_paid_out: SMatrix::zeros(),
+            d_height: SMatrix::zeros(),
+        }
+    }
+}
+
 /// Inputs of [`extended_cables`] that change with the variables: pose 7,
 /// reference tension 2, anchors 12, compliance, pulley radius, centre of mass 3, `1/n^2`,
-/// the platform's and the cables' weights.
-const EXTENDED_INPUTS: usize = 29;
+/// the platform's and the cables' weights, the attachments' horizontal coordinates 8.
+const EXTENDED_INPUTS: usize = 37;
 
 /// The last [`ExtendedCables`] of a graph, read by the length and height
 /// factors of the pose it was computed for (one call per pose and point
@@ -209,10 +238,44 @@ fn shared_extended_cables<R>(
     inputs[26] = effects.inverse_segments_squared;
     inputs[27] = effects.platform_weight_n;
     inputs[28] = effects.cable_weight_n_per_m;
+    for slot in 0..CABLE_COUNT {
+        inputs[29 + 2 * slot] = effects.attachments_m[(0, slot)];
+        inputs[30 + 2 * slot] = effects.attachments_m[(1, slot)];
+    }
     let evaluate = |out: &mut ExtendedCables, want: bool| {
         *out = extended_cables(values, slots, globals, pose, effects, want);
     };
     memo.read(&inputs, want_jacobians, evaluate, read)
+}
+
+/// The Jacobians of `generated::cable_geometry`'s 16 rows.
+#[derive(Default)]
+struct GeometryJacobians {
+    pose: SMatrix<f64, 16, 6>,
+    tension: SMatrix<f64, 16, 2>,
+    anchors: SMatrix<f64, 16, 12>,
+    attachments: SMatrix<f64, 16, 12>,
+    com: SMatrix<f64, 16, 3>,
+    weight: nalgebra::SVector<f64, 16>,
+}
+
+impl GeometryJacobians {
+    /// Geometry row `row`'s columns `[pose 6, tension 2, anchors 12, com 3,
+    /// platform weight error 1, attachments' horizontal coordinates 8 ([x, y]
+    /// per slot)]`; the weight error scales the file's `nominal_platform_weight_n`.
+    fn row(&self, row: usize, nominal_platform_weight_n: f64) -> SMatrix<f64, 1, 32> {
+        let mut r = SMatrix::<f64, 1, 32>::zeros();
+        r.fixed_columns_mut::<6>(0).copy_from(&self.pose.row(row));
+        r.fixed_columns_mut::<2>(6).copy_from(&self.tension.row(row));
+        r.fixed_columns_mut::<12>(8).copy_from(&self.anchors.row(row));
+        r.fixed_columns_mut::<3>(20).copy_from(&self.com.row(row));
+        r[23] = self.weight[row] * nominal_platform_weight_n;
+        for s in 0..CABLE_COUNT {
+            r[24 + 2 * s] = self.attachments[(row, 3 * s)];
+            r[25 + 2 * s] = self.attachments[(row, 3 * s + 1)];
+        }
+        r
+    }
 }
 
 fn extended_cables(
@@ -226,26 +289,23 @@ fn extended_cables(
     let (position, rotation) = pose_arguments(values, pose.pose);
     let tension = tension_argument(values, pose.reference_tension);
     let anchors = gather_anchors(values, slots, globals);
-    let mut j_pose = SMatrix::<f64, 16, 6>::zeros();
-    let mut j_tension = SMatrix::<f64, 16, 2>::zeros();
-    let mut j_anchors = SMatrix::<f64, 16, 12>::zeros();
-    let mut j_com = SMatrix::<f64, 16, 3>::zeros();
-    let mut j_weight = nalgebra::SVector::<f64, 16>::zeros();
+    let mut j = GeometryJacobians::default();
     let w = want_jacobians;
     let geometry = generated::cable_geometry(
         &position,
         &rotation,
         &tension,
         &anchors,
-        &slots.attachments_m,
+        &effects.attachments_m,
         &effects.com_offset_m,
         effects.platform_weight_n,
         EPSILON,
-        w.then_some(&mut j_pose),
-        w.then_some(&mut j_tension),
-        w.then_some(&mut j_anchors),
-        w.then_some(&mut j_com),
-        w.then_some(&mut j_weight),
+        w.then_some(&mut j.pose),
+        w.then_some(&mut j.tension),
+        w.then_some(&mut j.anchors),
+        w.then_some(&mut j.attachments),
+        w.then_some(&mut j.com),
+        w.then_some(&mut j.weight),
     );
     let mut out = ExtendedCables {
         paid_out_m: Vector4::zeros(),
@@ -280,17 +340,7 @@ fn extended_cables(
         if !w {
             continue;
         }
-        // Columns of the geometry rows [L, f_h, f_v, h] of this slot; the
-        // platform's weight error (column 23 here) scales the file's weight.
-        let geometry_row = |k: usize| -> SMatrix<f64, 1, 24> {
-            let mut r = SMatrix::<f64, 1, 24>::zeros();
-            r.fixed_columns_mut::<6>(0).copy_from(&j_pose.row(row + k));
-            r.fixed_columns_mut::<2>(6).copy_from(&j_tension.row(row + k));
-            r.fixed_columns_mut::<12>(8).copy_from(&j_anchors.row(row + k));
-            r.fixed_columns_mut::<3>(20).copy_from(&j_com.row(row + k));
-            r[23] = j_weight[row + k] * effects.nominal_platform_weight_n;
-            r
-        };
+        let geometry_row = |k: usize| j.row(row + k, effects.nominal_platform_weight_n);
         let (g_span, g_fh, g_fv, g_h) = (geometry_row(0), geometry_row(1), geometry_row(2), geometry_row(3));
         let paid = g_span * d_span[0] + g_fh * d_fh[0] + g_fv * d_fv[0];
         let height = g_span * d_span[1] + g_fh * d_fh[1] + g_fv * d_fv[1] - g_h;
@@ -302,6 +352,12 @@ fn extended_cables(
             .copy_from(&height.fixed_columns::<23>(0));
         out.d_paid_out[(slot, 26)] = paid[23];
         out.d_height[(slot, 26)] = height[23];
+        out.d_paid_out
+            .fixed_view_mut::<1, 8>(slot, 28)
+            .copy_from(&paid.fixed_columns::<8>(24));
+        out.d_height
+            .fixed_view_mut::<1, 8>(slot, 28)
+            .copy_from(&height.fixed_columns::<8>(24));
         out.d_paid_out[(slot, 27)] = d_cable_weight[0] * effects.nominal_cable_weight_n_per_m;
         out.d_height[(slot, 27)] = d_cable_weight[1] * effects.nominal_cable_weight_n_per_m;
         out.d_paid_out[(slot, 23)] = d_compliance[0];
@@ -322,6 +378,7 @@ struct EffectBlocks {
     segments: usize,
     platform_weight: usize,
     cable_weight: usize,
+    attachments: usize,
 }
 
 /// Copy chained columns `[pose, tension, anchors, com, compliance, radius,
@@ -344,6 +401,14 @@ fn split_chain(
     blocks[at.segments].copy_from(&jacobian.fixed_columns::<1>(25));
     blocks[at.platform_weight].copy_from(&jacobian.fixed_columns::<1>(26));
     blocks[at.cable_weight].copy_from(&jacobian.fixed_columns::<1>(27));
+    // The attachments' shifts: chained in slot order, the variable in cable order.
+    for (slot, &cable) in slots.cables.iter().enumerate() {
+        for axis in 0..2 {
+            blocks[at.attachments]
+                .column_mut(2 * cable + axis)
+                .copy_from(&jacobian.column(28 + 2 * slot + axis));
+        }
+    }
 }
 
 /// Extended length factor: `(1 + g_i) paid_out_i + l_i^0 - z_i^enc` with the
@@ -400,6 +465,7 @@ impl ExtendedLengthFactor {
             effects.cable_weight_error,
             effects.encoder_drift,
             effects.encoder_backlash,
+            effects.attachment_shift,
         ]);
         Self {
             variables,
@@ -471,6 +537,7 @@ impl ExtendedLengthFactor {
                 segments: 14,
                 platform_weight: 16,
                 cable_weight: 17,
+                attachments: 20,
             };
             split_chain(&chained, s, blocks, at);
             blocks[6..10].iter_mut().for_each(|b| b.fill(0.0));
@@ -521,6 +588,7 @@ impl ExtendedHeightFactor {
             effects.inverse_segments_squared,
             effects.platform_weight_error,
             effects.cable_weight_error,
+            effects.attachment_shift,
         ]);
         Self {
             variables,
@@ -554,6 +622,7 @@ impl Factor for ExtendedHeightFactor {
                     segments: 9,
                     platform_weight: 10,
                     cable_weight: 11,
+                    attachments: 12,
                 };
                 split_chain(&cables.d_height, s, blocks, at);
                 rows_to_cables(s, blocks);
@@ -567,81 +636,5 @@ impl Factor for ExtendedHeightFactor {
     }
     fn kind(&self) -> &'static str {
         "attachment_height"
-    }
-}
-
-/// Pose prior factor of a localiser mounted with a rotation (the
-/// `localiser-mount` effect): `[Log(M R_prior^-1 R); p - p_prior]` with
-/// `M = Exp(m)`, `m` the mount variable in degrees
-/// (`generated::mounted_pose_prior_residual`). With `m = 0` it equals
-/// [`super::factors::PosePriorFactor`] with the orientation rows.
-pub struct MountedPosePriorFactor {
-    variables: [VariableId; 2],
-    prior_position_m: Vector3<f64>,
-    prior_rotation_xyzw: Vector4<f64>,
-    sigmas: DVector<f64>,
-    kernel: RobustKernel,
-}
-
-impl MountedPosePriorFactor {
-    /// The localiser's pose `prior` with position sigma `position_sigma_m` and
-    /// orientation sigma `orientation_sigma_rad`; `mount` is the `[rx, ry, rz]` (degrees) variable.
-    pub fn new(
-        pose: VariableId,
-        mount: VariableId,
-        prior: &crate::model::PlatformPose,
-        position_sigma_m: f64,
-        orientation_sigma_rad: f64,
-        kernel: RobustKernel,
-    ) -> Self {
-        let (rot, pos) = (orientation_sigma_rad, position_sigma_m);
-        Self {
-            variables: [pose, mount],
-            prior_position_m: prior.position_m,
-            prior_rotation_xyzw: prior.rotation_xyzw(),
-            sigmas: DVector::from_row_slice(&[rot, rot, rot, pos, pos, pos]),
-            kernel,
-        }
-    }
-}
-
-impl Factor for MountedPosePriorFactor {
-    fn variables(&self) -> &[VariableId] {
-        &self.variables
-    }
-    fn residual_dim(&self) -> usize {
-        6
-    }
-    fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
-        let (position, rotation) = pose_arguments(values, self.variables[0]);
-        let mount_rad = Vector3::from_iterator(values.vector(self.variables[1]).iter().map(|d| d.to_radians()));
-        let mut j_pose = SMatrix::<f64, 6, 6>::zeros();
-        let mut j_mount = SMatrix::<f64, 6, 3>::zeros();
-        let want = jacobians.is_some();
-        let r = generated::mounted_pose_prior_residual(
-            &position,
-            &rotation,
-            &self.prior_position_m,
-            &self.prior_rotation_xyzw,
-            &mount_rad,
-            EPSILON,
-            want.then_some(&mut j_pose),
-            want.then_some(&mut j_mount),
-        );
-        if let Some(blocks) = jacobians {
-            blocks[0].copy_from(&j_pose);
-            // The variable is in degrees: d/d(deg) = d/d(rad) * pi / 180.
-            blocks[1].copy_from(&(j_mount * 1f64.to_radians()));
-        }
-        Some(DVector::from_column_slice(r.as_slice()))
-    }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.kernel
-    }
-    fn kind(&self) -> &'static str {
-        "pose_prior"
     }
 }

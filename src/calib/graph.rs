@@ -401,6 +401,10 @@ fn insert_effect_variables(values: &mut Values, robot: &Robot, free: EffectSet) 
         encoder_backlash: vector("encoder backlash (mm)", &e.encoder_backlash_m.map(|b| b * 1e3)),
         load_cell_drift: vector("load cell drift (N per row)", &[e.load_cell_drift_n_per_row]),
         load_cell_friction: vector("load cell friction", &[e.load_cell_friction]),
+        attachment_shift: vector(
+            "attachment shifts",
+            &e.attachment_shift_m.iter().flatten().copied().collect::<Vec<_>>(),
+        ),
     };
     for kind in EffectKind::ALL {
         values.set_fixed(variables.of(kind), !free.contains(kind));
@@ -434,6 +438,10 @@ pub fn effects_from_graph(template: &Robot, built: &CalibrationGraph) -> Option<
         encoder_backlash_m: std::array::from_fn(|i| values.vector(vars.encoder_backlash)[i] * 1e-3),
         load_cell_drift_n_per_row: values.vector(vars.load_cell_drift)[0],
         load_cell_friction: values.vector(vars.load_cell_friction)[0],
+        attachment_shift_m: {
+            let shift = values.vector(vars.attachment_shift);
+            std::array::from_fn(|i| [shift[2 * i], shift[2 * i + 1]])
+        },
     })
 }
 

@@ -101,6 +101,7 @@ pub mod gross_errors;
 mod init;
 mod load_cell_factor;
 pub mod mistakes;
+mod mounted_pose_prior;
 mod options;
 mod orientation;
 mod predict;
@@ -546,6 +547,7 @@ pub fn without_estimated(effects: &Effects, estimates: &[EffectEstimate]) -> Eff
             EffectKind::EncoderBacklash => out.encoder_backlash_m = neutral.encoder_backlash_m,
             EffectKind::LoadCellDrift => out.load_cell_drift_n_per_row = neutral.load_cell_drift_n_per_row,
             EffectKind::LoadCellFriction => out.load_cell_friction = neutral.load_cell_friction,
+            EffectKind::Attachments => out.attachment_shift_m = neutral.attachment_shift_m,
         }
     }
     out

@@ -87,7 +87,7 @@ pub fn predict_with_effects(robot: &Robot, start: &Equilibrium, load_cell_n: f64
         .find(|f| f.kind() == "catenary_length")
         .and_then(|f| f.evaluate(values, None))
         .ok_or_else(|| Error::NoEquilibrium("the extended model's cables went slack".into()))?;
-    let mut shifted = robot.clone();
+    let mut shifted = crate::model::robot::with_true_attachments(robot, &robot.effects);
     shifted.com_offset_m += Vector3::from(robot.effects.com_shift_m);
     Ok(Equilibrium {
         pose,

@@ -144,7 +144,7 @@ fn effect_help() -> String {
     format!(
         "A physical effect the closed-form model lacks, `NAME:PARAM=VALUE[,PARAM=VALUE...]` \
          (repeatable): {}. The data then come from the discretised simulator.",
-        sagcal::model::effects::EFFECT_NAMES
+        sagcal::model::effect_specs::EFFECT_NAMES
     )
 }
 

@@ -114,6 +114,8 @@ pub(super) fn winning_driver(effect: EffectKind) -> (&'static str, &'static str)
         EffectKind::EncoderBacklash => ("encoder", DIRECTION_DRIVER),
         EffectKind::LoadCellDrift => ("load_cell", ROW_DRIVER),
         EffectKind::LoadCellFriction => ("load_cell", DIRECTION_DRIVER),
+        // A moved attachment shifts the platform's balance, as a centre of mass does.
+        EffectKind::Attachments => ("encoder", DRIVERS[0]),
     }
 }
 

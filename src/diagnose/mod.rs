@@ -79,6 +79,7 @@
 
 mod candidates;
 mod drivers;
+mod equivalent_fits;
 mod explanation;
 mod missing_terms;
 mod prediction;
@@ -366,7 +367,7 @@ pub fn diagnose(
     )?;
     let reason = report::reason(&selection, &base, options, &not_predictive, &explanation);
     let undetectable = report::undetectable(&selection);
-    let equivalent_fits = report::equivalent_fits(&model.result.effect_estimates);
+    let equivalent_fits = equivalent_fits::equivalent_fits(&model.result.effect_estimates, robot);
     Ok(Diagnosis {
         robot: robot.name.clone(),
         poses_used: base.used.len(),

@@ -137,6 +137,21 @@ fn keep_predictive(
         kept = extended;
         kept_cv = cv;
     }
+    // Each kept effect predicted beside the others; the model as a whole
+    // must also predict better than the baseline (freed orientations join
+    // without that check, and may carry an effect that only predicts beside them).
+    if !kept.hypotheses.is_empty() && kept_cv >= baseline_cv_rms {
+        removed.push(NotPredictive {
+            hypothesis: kept.name(),
+            model: "none".into(),
+            cv_rms_with: kept_cv,
+            cv_rms_without: baseline_cv_rms,
+            anchor_mse_with_m2: None,
+            anchor_mse_without_m2: None,
+            why: "together they do not lower the baseline's held-out residual".into(),
+        });
+        return (Model::baseline(base), baseline_cv_rms, removed);
+    }
     (kept, kept_cv, removed)
 }
 

@@ -12,7 +12,6 @@ use super::{Baseline, DiagnoseOptions};
 use crate::calib::gross_errors::ExcludedReading;
 use crate::calib::mistakes::Mistake;
 use crate::calib::{CalibrationError, EffectEstimate, OrientationPrior, ParameterUncertainty};
-use crate::model::effect_kind::EffectKind;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::SensorNoise;
 
@@ -237,47 +236,6 @@ fn selection_reason(selection: &Selection, base: &Baseline, options: &DiagnoseOp
         );
     }
     text
-}
-
-/// Where the final model holds an effect of
-/// [`super::candidates::WEIGHT_SCALING`], the fits that the data cannot tell
-/// from it: with the platform's weight scale `p`, the cables' `c` and the
-/// load cell's gain `g` (1 where the model lacks the effect), every
-/// `(s p, s c, g / s)` predicts the same readings; one line per choice of
-/// `s` that makes one of the model's own effects neutral.
-pub(super) fn equivalent_fits(effects: &[EffectEstimate]) -> Vec<String> {
-    let scale = |kind: EffectKind, index: usize| effects.iter().find(|e| e.effect == kind).map(|e| e.values[index]);
-    let (platform, cable, gain) = (
-        scale(EffectKind::PlatformWeight, 0),
-        scale(EffectKind::CableWeight, 0),
-        scale(EffectKind::LoadCell, 1),
-    );
-    if platform.is_none() && cable.is_none() {
-        return Vec::new();
-    }
-    let (p, c, g) = (platform.unwrap_or(1.0), cable.unwrap_or(1.0), gain.unwrap_or(1.0));
-    let mut scales = Vec::new();
-    if platform.is_some() {
-        scales.push(1.0 / p);
-    }
-    if cable.is_some() {
-        scales.push(1.0 / c);
-    }
-    if gain.is_some() {
-        scales.push(g);
-    }
-    scales
-        .into_iter()
-        .map(|s| {
-            format!(
-                "the same fit: platform weight x {:.4}, cable weight x {:.4}, load-cell gain {:.4} \
-                 (scaling both weights scales every tension alike; only the load cell sees it)",
-                s * p,
-                s * c,
-                g / s
-            )
-        })
-        .collect()
 }
 
 /// The candidates of the last step whose power at their smallest plausible

@@ -96,7 +96,7 @@ pub(super) fn own_sensor(kind: EffectKind) -> &'static str {
         | EffectKind::CommonGain
         | EffectKind::Segments => "catenary_length",
         EffectKind::LoadCell => "reference_tension",
-        EffectKind::Com | EffectKind::LocaliserMount => "pose_prior",
+        EffectKind::Com | EffectKind::LocaliserMount | EffectKind::Attachments => "pose_prior",
         // A heavier platform pulls every cable harder: the sag, and so the
         // lengths, change with it; heavier cables sag more.
         EffectKind::PlatformWeight | EffectKind::CableWeight => "catenary_length",
@@ -212,6 +212,12 @@ fn describe(estimate: &EffectEstimate, limit: &PlausibleLimit) -> String {
         }
         EffectKind::LoadCellDrift => format!("a load cell creeping {value:.3} +- {value_sigma:.3} N per row"),
         EffectKind::LoadCellFriction => format!("a pulley friction mu theta of {value:.4} +- {value_sigma:.1e}"),
+        EffectKind::Attachments => format!(
+            "cable {}'s attachment moved by {:.1} +- {:.1} cm",
+            first / 2 + 1,
+            norm * 100.0,
+            sigma * 100.0
+        ),
     }
 }
 
@@ -239,6 +245,7 @@ fn stands_for(kind: EffectKind) -> &'static str {
         EffectKind::LoadCellFriction => {
             "something that changes the tension the load cell sees with the direction of motion"
         }
+        EffectKind::Attachments => "something that moves the cables' ends or the platform's balance",
     }
 }
 

@@ -6,9 +6,9 @@ use rand::Rng;
 
 use crate::model::effect_kind::EffectKind;
 use crate::model::effect_ranges::{
-    axial_stiffness_range_n, com_shift_range_m, encoder_backlash_range_mm, encoder_drift_range_mm_per_row,
-    pulley_radius_range_m, CABLE_WEIGHT_HIGH, CABLE_WEIGHT_LOW, COMMON_GAIN_HIGH, COMMON_GAIN_LOW,
-    LOAD_CELL_DRIFT_HIGH, LOAD_CELL_DRIFT_LOW, LOAD_CELL_FRICTION_HIGH, LOAD_CELL_FRICTION_LOW,
+    attachment_shift_range_m, axial_stiffness_range_n, com_shift_range_m, encoder_backlash_range_mm,
+    encoder_drift_range_mm_per_row, pulley_radius_range_m, CABLE_WEIGHT_HIGH, CABLE_WEIGHT_LOW, COMMON_GAIN_HIGH,
+    COMMON_GAIN_LOW, LOAD_CELL_DRIFT_HIGH, LOAD_CELL_DRIFT_LOW, LOAD_CELL_FRICTION_HIGH, LOAD_CELL_FRICTION_LOW,
     LOCALISER_MOUNT_HIGH_DEG, LOCALISER_MOUNT_LOW_DEG, PLATFORM_WEIGHT_HIGH, PLATFORM_WEIGHT_LOW, SEGMENTS_HIGH,
     SEGMENTS_LOW,
 };
@@ -157,6 +157,14 @@ fn draw_effect(robot: &Robot, effect: EffectKind, mean_reference_tension_n: f64,
         }
         EffectKind::LoadCellFriction => {
             e.load_cell_friction = rng.random_range(LOAD_CELL_FRICTION_LOW..LOAD_CELL_FRICTION_HIGH);
+        }
+        EffectKind::Attachments => {
+            let (low, high) = attachment_shift_range_m(robot);
+            e.attachment_shift_m = std::array::from_fn(|_| {
+                let magnitude = rng.random_range(low..high);
+                let angle = rng.random_range(0.0..std::f64::consts::TAU);
+                [magnitude * angle.cos(), magnitude * angle.sin()]
+            });
         }
     }
 }

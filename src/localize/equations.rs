@@ -80,7 +80,10 @@ impl SlotRobot {
         Self {
             cables,
             anchors_m: Matrix3x4::from_fn(|r, s| robot.anchors_m[cables[s]][r]),
-            attachments_m: Matrix3x4::from_fn(|r, s| robot.attachments_m[cables[s]][r]),
+            attachments_m: Matrix3x4::from_fn(|r, s| {
+                let shift = effects.attachment_shift_m[cables[s]];
+                robot.attachments_m[cables[s]][r] + if r < 2 { shift[r] } else { 0.0 }
+            }),
             com_offset_m: robot.com_offset_m + Vector3::from(effects.com_shift_m),
             platform_weight_n: robot.platform_weight_n * effects.platform_weight_scale,
             cable_weight_n_per_m: robot.cable_weight_n_per_m * effects.cable_weight_scale,
@@ -187,6 +190,7 @@ pub fn model_at_pose(robot: &SlotRobot, pose: &PlatformPose, reference_n: &Vecto
         EPSILON,
         Some(&mut j_pose),
         Some(&mut j_tension),
+        None,
         None,
         None,
         None,
@@ -304,6 +308,7 @@ pub fn parameter_partials(
         None,
         None,
         Some(&mut j_anchors),
+        None,
         None,
         None,
     );

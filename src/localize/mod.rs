@@ -211,7 +211,7 @@ impl Localizer {
                 options.false_alarm
             )));
         }
-        let mut shifted = robot.clone();
+        let mut shifted = crate::model::robot::with_true_attachments(robot, &robot.effects);
         shifted.com_offset_m += Vector3::from(robot.effects.com_shift_m);
         let mount =
             UnitQuaternion::from_scaled_axis(Vector3::from(robot.effects.localiser_mount_deg).map(f64::to_radians));

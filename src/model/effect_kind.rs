@@ -66,11 +66,14 @@ pub enum EffectKind {
     /// Friction of a pulley between the cable and a drum-side load cell
     /// (reading `T (1 - k s)`); one parameter `k = mu theta`. Needs rows in time order.
     LoadCellFriction,
+    /// Each cable's attachment point moved horizontally from the robot
+    /// file's (platform frame); eight parameters, metres.
+    Attachments,
 }
 
 impl EffectKind {
     /// Every effect of the catalogue, in report order.
-    pub const ALL: [EffectKind; 14] = [
+    pub const ALL: [EffectKind; 15] = [
         EffectKind::Elastic,
         EffectKind::Pulley,
         EffectKind::EncoderScale,
@@ -85,6 +88,7 @@ impl EffectKind {
         EffectKind::EncoderBacklash,
         EffectKind::LoadCellDrift,
         EffectKind::LoadCellFriction,
+        EffectKind::Attachments,
     ];
 
     /// The name used on the command line and in reports (`elastic`, `encoder-scale`, ...).
@@ -104,6 +108,7 @@ impl EffectKind {
             EffectKind::EncoderBacklash => "encoder-backlash",
             EffectKind::LoadCellDrift => "loadcell-drift",
             EffectKind::LoadCellFriction => "loadcell-friction",
+            EffectKind::Attachments => "attachments",
         }
     }
 
@@ -136,6 +141,7 @@ impl EffectKind {
             EffectKind::EncoderBacklash => &["backlash1_mm", "backlash2_mm", "backlash3_mm", "backlash4_mm"],
             EffectKind::LoadCellDrift => &["drift_n_per_row"],
             EffectKind::LoadCellFriction => &["friction"],
+            EffectKind::Attachments => &["dx1_m", "dy1_m", "dx2_m", "dy2_m", "dx3_m", "dy3_m", "dx4_m", "dy4_m"],
         }
     }
 
@@ -162,6 +168,7 @@ impl EffectKind {
             EffectKind::EncoderBacklash => effects.encoder_backlash_m.map(|b| b * 1e3).to_vec(),
             EffectKind::LoadCellDrift => vec![effects.load_cell_drift_n_per_row],
             EffectKind::LoadCellFriction => vec![effects.load_cell_friction],
+            EffectKind::Attachments => effects.attachment_shift_m.iter().flatten().copied().collect(),
         }
     }
 
@@ -218,9 +225,17 @@ impl EffectKind {
     }
 
     /// The effect that contains this one as a special case, if any: the
-    /// common encoder gain is the per-drum gains with four equal values.
+    /// common encoder gain is the per-drum gains with four equal values; a
+    /// centre-of-mass shift is, to within the platform's small tilts and
+    /// turns, the four attachments moved together the other way (the anchors
+    /// take up their moved ends; `diagnose` keeps the shift unless the data
+    /// reject it).
     pub fn nested_in(self) -> Option<EffectKind> {
-        (self == EffectKind::CommonGain).then_some(EffectKind::EncoderScale)
+        match self {
+            EffectKind::CommonGain => Some(EffectKind::EncoderScale),
+            EffectKind::Com => Some(EffectKind::Attachments),
+            _ => None,
+        }
     }
 }
 

@@ -23,6 +23,7 @@
 //! | `encoder-backlash` | 5 x the typical range's top per drum (25 mm large, 5 mm small) | a dead band that wide is a broken gearbox, felt by hand |
 //! | `loadcell-drift` | 1 % of the mean reference tension per row | a gauge whose zero moves that fast is faulty and fails its own zero check |
 //! | `loadcell-friction` | `mu theta` 0.2 | a pulley that holds a fifth of the tension is seized (a plain bush's mu 0.15 over more than a quarter turn) |
+//! | `attachments` | a quarter of the platform's attachment radius per attachment | a point that far off its drawing would be seen on the platform |
 //!
 //! ```
 //! use sagcal::model::effect_limits::plausible_limits;
@@ -216,6 +217,17 @@ fn time_and_motion_limits(kind: EffectKind, robot: &Robot, mean_reference_tensio
             format!("a friction mu theta of at most {LOAD_CELL_FRICTION_LIMIT}"),
             "a pulley that holds a fifth of the tension is seized",
         )],
+        EffectKind::Attachments => {
+            let largest = 0.25 * attachment_radius_m(robot);
+            (0..CABLE_COUNT)
+                .map(|i| PlausibleLimit {
+                    parameters: vec![2 * i, 2 * i + 1],
+                    largest,
+                    limit: format!("a move of at most {:.1} cm", largest * 100.0),
+                    why: "an attachment that far off its drawing would be seen on the platform".into(),
+                })
+                .collect()
+        }
         _ => Vec::new(),
     }
 }

@@ -144,6 +144,14 @@ fn time_and_motion_ranges(robot: &Robot) -> Vec<EffectRange> {
             justification: "zero drift of a strain-gauge cell with temperature and creep over a session".into(),
         },
         EffectRange {
+            effect: "attachments".into(),
+            range: {
+                let (low, high) = attachment_shift_range_m(robot);
+                format!("{:.1} .. {:.1} cm per attachment, random direction", low * 100.0, high * 100.0)
+            },
+            justification: "an eyelet drilled or a shackle hung off the platform's drawing".into(),
+        },
+        EffectRange {
             effect: "loadcell-friction".into(),
             range: format!("k = mu theta {LOAD_CELL_FRICTION_LOW} .. {LOAD_CELL_FRICTION_HIGH}"),
             justification: "a rolling-bearing pulley (mu 0.01-0.03 at the rope) with a wrap of a quarter to half a turn before a drum-side load cell".into(),
@@ -189,7 +197,8 @@ pub const LOAD_CELL_FRICTION_HIGH: f64 = 0.05;
 /// localiser turned by 0.5 degrees about the diagonal of its axes, a platform
 /// 3 % and cables 5 % heavier than the robot file says, the slowest encoder
 /// creep and smallest backlash with alternating signs, the slowest load-cell
-/// creep and the least pulley friction.
+/// creep and the least pulley friction, and each attachment moved by the
+/// least misplacement, in turn along +x, +y, -x, -y.
 pub fn smallest_plausible(kind: EffectKind, robot: &Robot, mean_reference_tension_n: f64) -> Vec<f64> {
     match kind {
         EffectKind::Elastic => vec![1e6 / axial_stiffness_range_n(robot).1],
@@ -215,6 +224,10 @@ pub fn smallest_plausible(kind: EffectKind, robot: &Robot, mean_reference_tensio
         }
         EffectKind::LoadCellDrift => vec![LOAD_CELL_DRIFT_LOW * mean_reference_tension_n],
         EffectKind::LoadCellFriction => vec![LOAD_CELL_FRICTION_LOW],
+        EffectKind::Attachments => {
+            let low = attachment_shift_range_m(robot).0;
+            vec![low, 0.0, 0.0, low, -low, 0.0, 0.0, -low]
+        }
     }
 }
 
@@ -249,6 +262,17 @@ pub fn com_shift_range_m(robot: &Robot) -> (f64, f64) {
         (0.05, 0.25)
     } else {
         (0.05, 0.20)
+    }
+}
+
+/// Each attachment point's horizontal misplacement, metres (low, high): a
+/// drilled eyelet or a hung shackle off its drawing, in proportion to the
+/// platform's size.
+pub fn attachment_shift_range_m(robot: &Robot) -> (f64, f64) {
+    if is_large(robot) {
+        (0.005, 0.02)
+    } else {
+        (0.002, 0.01)
     }
 }
 

@@ -26,6 +26,7 @@
 //! | `encoder-backlash` | `b_m` (all four drums) or `b1_m` .. `b4_m` (the reading's shift when the cable was last paid out, m; minus when reeled in) |
 //! | `loadcell-drift` | `rate_n` (the load cell's creep, N per row) |
 //! | `loadcell-friction` | `k` (friction `mu theta` of a pulley between the cable and a drum-side load cell, 0 <= k < 1) |
+//! | `attachments` | `dx1_m`, `dy1_m` .. `dx4_m`, `dy4_m` (each cable's attachment point moved horizontally from the robot file's, platform frame, m) |
 //!
 //! The last four live in time and motion ([`crate::model::measurement::ReadingOrder`]):
 //! a pose's readings depend on its row and on the direction each cable last
@@ -152,6 +153,13 @@ pub struct Effects {
     /// Physically `k >= 0`.
     #[serde(skip_serializing_if = "is_zero")]
     pub load_cell_friction: f64,
+    /// Per cable (robot order), its attachment point's horizontal move from
+    /// the robot file's, `[dx, dy]` in the platform frame, metres
+    /// (`attachments:dx1_m,dy1_m,...`): an eyelet drilled or a shackle hung
+    /// off the drawing. It moves the cable's end and its moment arm about
+    /// the platform (eq. 9-11).
+    #[serde(skip_serializing_if = "is_zero42")]
+    pub attachment_shift_m: [[f64; 2]; CABLE_COUNT],
 }
 
 /// What time and motion add to one pose's readings ([`Effects::time_and_motion`]).
@@ -171,6 +179,10 @@ fn is_zero(x: &f64) -> bool {
 
 fn is_zero4(v: &[f64; CABLE_COUNT]) -> bool {
     v.iter().all(|x| *x == 0.0)
+}
+
+fn is_zero42(v: &[[f64; 2]; CABLE_COUNT]) -> bool {
+    v.iter().flatten().all(|x| *x == 0.0)
 }
 
 fn is_one(x: &f64) -> bool {
@@ -199,31 +211,9 @@ impl Default for Effects {
             encoder_backlash_m: [0.0; CABLE_COUNT],
             load_cell_drift_n_per_row: 0.0,
             load_cell_friction: 0.0,
+            attachment_shift_m: [[0.0; 2]; CABLE_COUNT],
         }
     }
-}
-
-/// The effect names accepted by [`Effects::apply_spec`], with their parameters.
-pub const EFFECT_NAMES: &str =
-    "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m, segments:n, localiser-mount:rx_deg,ry_deg,rz_deg, platform-weight:scale, cable-weight:scale, encoder-drift:rate_m|rate1_m..rate4_m, encoder-backlash:b_m|b1_m..b4_m, loadcell-drift:rate_n, loadcell-friction:k";
-
-/// The parameters [`Effects::apply_spec`] accepts for the effect `name`; `None` for no effect.
-fn spec_parameters(name: &str) -> Option<&'static [&'static str]> {
-    Some(match name {
-        "elastic" => &["ea_n"],
-        "pulley" => &["radius_m"],
-        "encoder-scale" => &["gain", "gain1", "gain2", "gain3", "gain4"],
-        "loadcell" => &["bias_n", "gain"],
-        "com" => &["dx_m", "dy_m", "dz_m"],
-        "segments" => &["n"],
-        "localiser-mount" => &["rx_deg", "ry_deg", "rz_deg"],
-        "platform-weight" | "cable-weight" => &["scale"],
-        "encoder-drift" => &["rate_m", "rate1_m", "rate2_m", "rate3_m", "rate4_m"],
-        "encoder-backlash" => &["b_m", "b1_m", "b2_m", "b3_m", "b4_m"],
-        "loadcell-drift" => &["rate_n"],
-        "loadcell-friction" => &["k"],
-        _ => return None,
-    })
 }
 
 impl Effects {
@@ -242,109 +232,6 @@ impl Effects {
     /// True when no effect is present (the closed-form model describes the robot).
     pub fn is_none(&self) -> bool {
         *self == Self::default()
-    }
-
-    /// Apply one `NAME:PARAM=VALUE[,PARAM=VALUE...]` specification, e.g.
-    /// `elastic:ea_n=3e6`, `encoder-scale:gain1=1.001,gain3=0.999` or
-    /// `com:dx_m=0.02,dz_m=-0.05`. Parameters not given keep their values.
-    /// On error `self` is unchanged and the message names the effect and parameter.
-    pub fn apply_spec(&mut self, spec: &str) -> Result<(), String> {
-        let spec = spec.trim();
-        let (name, params) = spec.split_once(':').ok_or_else(|| {
-            format!("effect `{spec}`: expected NAME:PARAM=VALUE[,PARAM=VALUE...] (effects: {EFFECT_NAMES})")
-        })?;
-        let name = name.trim();
-        let known =
-            spec_parameters(name).ok_or_else(|| format!("unknown effect `{name}` (effects: {EFFECT_NAMES})"))?;
-        if params.trim().is_empty() {
-            return Err(format!(
-                "effect `{name}`: no parameters given (parameters: {})",
-                known.join(", ")
-            ));
-        }
-        let mut next = *self;
-        for param in params.split(',') {
-            let param = param.trim();
-            let (key, value) = param
-                .split_once('=')
-                .ok_or_else(|| format!("effect `{name}`: parameter `{param}` has no `=VALUE`"))?;
-            let key = key.trim();
-            if !known.contains(&key) {
-                return Err(format!(
-                    "effect `{name}`: unknown parameter `{key}` (parameters: {})",
-                    known.join(", ")
-                ));
-            }
-            let value: f64 = value
-                .trim()
-                .parse()
-                .map_err(|_| format!("effect `{name}`: parameter `{key}`: `{}` is not a number", value.trim()))?;
-            if !value.is_finite() {
-                return Err(format!(
-                    "effect `{name}`: parameter `{key}` must be finite, got {value}"
-                ));
-            }
-            let positive = |what: &str| {
-                if value > 0.0 {
-                    Ok(value)
-                } else {
-                    Err(format!(
-                        "effect `{name}`: parameter `{key}` ({what}) must be > 0, got {value}"
-                    ))
-                }
-            };
-            match (name, key) {
-                ("elastic", _) => next.axial_stiffness_n = Some(positive("axial stiffness EA, N")?),
-                ("pulley", _) => {
-                    if value < 0.0 {
-                        return Err(format!(
-                            "effect `{name}`: parameter `{key}` (pulley radius, m) must be >= 0, got {value}"
-                        ));
-                    }
-                    next.pulley_radius_m = value;
-                }
-                ("encoder-scale", "gain") => next.encoder_gain = [positive("encoder gain")?; CABLE_COUNT],
-                ("encoder-scale", k) => {
-                    let cable: usize = k["gain".len()..].parse().expect("gain1..gain4");
-                    next.encoder_gain[cable - 1] = positive("encoder gain")?;
-                }
-                ("loadcell", "bias_n") => next.load_cell_bias_n = value,
-                ("loadcell", _) => next.load_cell_gain = positive("load-cell gain")?,
-                ("com", k) => {
-                    let axis = ["dx_m", "dy_m", "dz_m"]
-                        .iter()
-                        .position(|a| *a == k)
-                        .expect("known axis");
-                    next.com_shift_m[axis] = value;
-                }
-                ("segments", _) => {
-                    if value < 1.0 {
-                        return Err(format!(
-                            "effect `{name}`: parameter `{key}` (number of cable elements) must be >= 1, got {value}"
-                        ));
-                    }
-                    next.cable_segments = Some(value);
-                }
-                ("localiser-mount", k) => {
-                    let axis = ["rx_deg", "ry_deg", "rz_deg"]
-                        .iter()
-                        .position(|a| *a == k)
-                        .expect("known axis");
-                    next.localiser_mount_deg[axis] = value;
-                }
-                ("platform-weight", _) => next.platform_weight_scale = positive("weight scale")?,
-                ("cable-weight", _) => next.cable_weight_scale = positive("weight scale")?,
-                ("encoder-drift", "rate_m") => next.encoder_drift_m_per_row = [value; CABLE_COUNT],
-                ("encoder-drift", k) => next.encoder_drift_m_per_row[drum(k, "rate")] = value,
-                ("encoder-backlash", "b_m") => next.encoder_backlash_m = [value; CABLE_COUNT],
-                ("encoder-backlash", k) => next.encoder_backlash_m[drum(k, "b")] = value,
-                ("loadcell-drift", _) => next.load_cell_drift_n_per_row = value,
-                ("loadcell-friction", _) => next.load_cell_friction = friction(name, key, value)?,
-                _ => unreachable!("parameter names are checked above"),
-            }
-        }
-        *self = next;
-        Ok(())
     }
 
     /// Check values read from a file: the same rules as [`Effects::apply_spec`].
@@ -411,6 +298,12 @@ impl Effects {
                 self.load_cell_drift_n_per_row
             ));
         }
+        if !self.attachment_shift_m.iter().flatten().all(|x| x.is_finite()) {
+            return Err(format!(
+                "`attachment_shift_m` must be finite, got {:?}",
+                self.attachment_shift_m
+            ));
+        }
         if !(0.0..1.0).contains(&self.load_cell_friction) {
             return Err(format!(
                 "`load_cell_friction` must be >= 0 and < 1, got {}",
@@ -418,74 +311,6 @@ impl Effects {
             ));
         }
         Ok(())
-    }
-
-    /// The effects present, as specifications [`Effects::apply_spec`] accepts (empty: none).
-    pub fn specs(&self) -> Vec<String> {
-        let none = Self::default();
-        let mut specs = Vec::new();
-        if let Some(ea) = self.axial_stiffness_n {
-            specs.push(format!("elastic:ea_n={ea:e}"));
-        }
-        if self.pulley_radius_m != none.pulley_radius_m {
-            specs.push(format!("pulley:radius_m={}", self.pulley_radius_m));
-        }
-        if self.encoder_gain != none.encoder_gain {
-            let g = self.encoder_gain;
-            if g.iter().all(|x| *x == g[0]) {
-                specs.push(format!("encoder-scale:gain={}", g[0]));
-            } else {
-                let parts: Vec<String> = g
-                    .iter()
-                    .enumerate()
-                    .map(|(i, x)| format!("gain{}={x}", i + 1))
-                    .collect();
-                specs.push(format!("encoder-scale:{}", parts.join(",")));
-            }
-        }
-        if self.load_cell_bias_n != none.load_cell_bias_n || self.load_cell_gain != none.load_cell_gain {
-            specs.push(format!(
-                "loadcell:bias_n={},gain={}",
-                self.load_cell_bias_n, self.load_cell_gain
-            ));
-        }
-        if self.com_shift_m != none.com_shift_m {
-            let [x, y, z] = self.com_shift_m;
-            specs.push(format!("com:dx_m={x},dy_m={y},dz_m={z}"));
-        }
-        if let Some(n) = self.cable_segments {
-            specs.push(format!("segments:n={n}"));
-        }
-        if self.localiser_mount_deg != none.localiser_mount_deg {
-            let [x, y, z] = self.localiser_mount_deg;
-            specs.push(format!("localiser-mount:rx_deg={x},ry_deg={y},rz_deg={z}"));
-        }
-        if self.platform_weight_scale != 1.0 {
-            specs.push(format!("platform-weight:scale={}", self.platform_weight_scale));
-        }
-        if self.cable_weight_scale != 1.0 {
-            specs.push(format!("cable-weight:scale={}", self.cable_weight_scale));
-        }
-        for (name, key, values) in [
-            ("encoder-drift", "rate", self.encoder_drift_m_per_row),
-            ("encoder-backlash", "b", self.encoder_backlash_m),
-        ] {
-            if values.iter().any(|x| *x != 0.0) {
-                let parts: Vec<String> = values
-                    .iter()
-                    .enumerate()
-                    .map(|(i, x)| format!("{key}{}_m={x}", i + 1))
-                    .collect();
-                specs.push(format!("{name}:{}", parts.join(",")));
-            }
-        }
-        if self.load_cell_drift_n_per_row != 0.0 {
-            specs.push(format!("loadcell-drift:rate_n={}", self.load_cell_drift_n_per_row));
-        }
-        if self.load_cell_friction != 0.0 {
-            specs.push(format!("loadcell-friction:k={}", self.load_cell_friction));
-        }
-        specs
     }
 
     /// What the time-and-motion effects add to the readings of the pose at
@@ -525,45 +350,12 @@ impl Effects {
     }
 }
 
-/// A pulley friction `mu theta` given as `value`: in `[0, 1)`.
-fn friction(name: &str, key: &str, value: f64) -> Result<f64, String> {
-    if (0.0..1.0).contains(&value) {
-        Ok(value)
-    } else {
-        Err(format!(
-            "effect `{name}`: parameter `{key}` (friction mu theta) must be >= 0 and < 1, got {value}"
-        ))
-    }
-}
-
-/// The drum of a per-drum parameter `rate1_m` .. `rate4_m` (0-based).
-fn drum(key: &str, prefix: &str) -> usize {
-    let digit = key[prefix.len()..].trim_end_matches("_m");
-    digit.parse::<usize>().expect("rate1_m..rate4_m, b1_m..b4_m") - 1
-}
-
-impl std::fmt::Display for Effects {
-    /// `none`, or the specifications joined by spaces.
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let specs = self.specs();
-        if specs.is_empty() {
-            f.write_str("none")
-        } else {
-            f.write_str(&specs.join(" "))
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn parsed(specs: &[&str]) -> Result<Effects, String> {
-        let mut effects = Effects::default();
-        for spec in specs {
-            effects.apply_spec(spec)?;
-        }
-        Ok(effects)
+        Effects::from_specs(specs)
     }
 
     #[test]
@@ -571,108 +363,6 @@ mod tests {
         assert!(Effects::default().is_none());
         assert_eq!(Effects::default().to_string(), "none");
         assert!(!parsed(&["loadcell:bias_n=0.5"]).unwrap().is_none());
-    }
-
-    #[test]
-    fn parses_every_effect() {
-        let e = parsed(&[
-            "elastic:ea_n=3e6",
-            "pulley:radius_m=0.2",
-            "encoder-scale:gain=1.002",
-            "encoder-scale:gain1=1.001,gain3=0.999",
-            "loadcell:bias_n=3,gain=1.01",
-            "com:dx_m=0.02,dz_m=-0.05",
-            "segments:n=12",
-            "localiser-mount:rx_deg=0.5,rz_deg=-1.5",
-            "platform-weight:scale=1.11",
-            "cable-weight:scale=0.9",
-            "encoder-drift:rate_m=1e-4",
-            "encoder-drift:rate2_m=-2e-4",
-            "encoder-backlash:b3_m=0.002",
-            "loadcell-drift:rate_n=0.3",
-            "loadcell-friction:k=0.02",
-        ])
-        .unwrap();
-        assert_eq!(e.axial_stiffness_n, Some(3e6));
-        assert_eq!(e.pulley_radius_m, 0.2);
-        assert_eq!(e.encoder_gain, [1.001, 1.002, 0.999, 1.002]);
-        assert_eq!(e.load_cell_bias_n, 3.0);
-        assert_eq!(e.load_cell_gain, 1.01);
-        assert_eq!(e.com_shift_m, [0.02, 0.0, -0.05]);
-        assert_eq!(e.cable_segments, Some(12.0));
-        assert_eq!(e.inverse_segments_squared(), 1.0 / 144.0);
-        assert_eq!(e.localiser_mount_deg, [0.5, 0.0, -1.5]);
-        assert_eq!((e.platform_weight_scale, e.cable_weight_scale), (1.11, 0.9));
-        assert_eq!(e.encoder_drift_m_per_row, [1e-4, -2e-4, 1e-4, 1e-4]);
-        assert_eq!(e.encoder_backlash_m, [0.0, 0.0, 0.002, 0.0]);
-        assert_eq!((e.load_cell_drift_n_per_row, e.load_cell_friction), (0.3, 0.02));
-        // Row 10, cable 3 last paid out, the reference cable 1 reeled in:
-        // 10 x 1e-4 + 0.002 on cable 3, 10 x 0.3 N and a factor 1 + 0.02 on the load cell.
-        let order = ReadingOrder {
-            row: 10,
-            direction: [-1, 0, 1, 0],
-        };
-        let shift = e.time_and_motion(&order, 0);
-        assert!((shift.encoder_shift_m[2] - 0.003).abs() < 1e-15 && (shift.encoder_shift_m[1] + 2e-3).abs() < 1e-15);
-        assert!((shift.load_cell_shift_n - 3.0).abs() < 1e-12 && (shift.load_cell_factor - 1.02).abs() < 1e-15);
-        // The specifications parse back to the same effects.
-        let specs = e.specs();
-        let again = parsed(&specs.iter().map(String::as_str).collect::<Vec<_>>()).unwrap();
-        assert_eq!(again, e);
-    }
-
-    #[test]
-    fn errors_name_the_effect_and_parameter() {
-        let cases = [
-            ("stretchy:ea_n=1", &["unknown effect `stretchy`"][..]),
-            ("elastic", &["effect `elastic`", "NAME:PARAM=VALUE"]),
-            ("elastic:", &["effect `elastic`", "no parameters"]),
-            (
-                "elastic:ea=3e6",
-                &["effect `elastic`", "unknown parameter `ea`", "ea_n"],
-            ),
-            ("elastic:ea_n", &["effect `elastic`", "`ea_n` has no `=VALUE`"]),
-            ("elastic:ea_n=abc", &["`ea_n`", "`abc` is not a number"]),
-            ("elastic:ea_n=inf", &["`ea_n` must be finite"]),
-            ("elastic:ea_n=NaN", &["`ea_n` must be finite"]),
-            ("elastic:ea_n=0", &["effect `elastic`", "`ea_n`", "must be > 0"]),
-            ("elastic:ea_n=-1e6", &["`ea_n`", "must be > 0"]),
-            ("pulley:radius_m=-0.1", &["effect `pulley`", "`radius_m`", ">= 0"]),
-            ("encoder-scale:gain=0", &["effect `encoder-scale`", "`gain`", "> 0"]),
-            ("encoder-scale:gain5=1", &["unknown parameter `gain5`"]),
-            ("loadcell:gain=-1", &["effect `loadcell`", "`gain`", "> 0"]),
-            (
-                "loadcell:bias_n=3,offset=1",
-                &["effect `loadcell`", "unknown parameter `offset`"],
-            ),
-            ("com:dx=0.1", &["effect `com`", "unknown parameter `dx`"]),
-            ("segments:n=0.5", &["effect `segments`", "`n`", ">= 1"]),
-            (
-                "platform-weight:scale=0",
-                &["effect `platform-weight`", "`scale`", "> 0"],
-            ),
-            ("cable-weight:scale=-1", &["effect `cable-weight`", "`scale`", "> 0"]),
-            (
-                "loadcell-friction:k=-0.01",
-                &["effect `loadcell-friction`", "`k`", ">= 0"],
-            ),
-            ("encoder-drift:rate5_m=1", &["unknown parameter `rate5_m`"]),
-        ];
-        for (spec, needles) in cases {
-            let mut effects = Effects::default();
-            let message = effects.apply_spec(spec).expect_err(spec);
-            for needle in needles {
-                assert!(message.contains(needle), "{spec}: `{message}` lacks `{needle}`");
-            }
-            assert!(effects.is_none(), "{spec}: a failed spec must not change the effects");
-        }
-    }
-
-    #[test]
-    fn pulley_radius_zero_is_allowed_and_later_specs_override() {
-        let e = parsed(&["pulley:radius_m=0", "loadcell:gain=2", "loadcell:gain=1.5"]).unwrap();
-        assert_eq!(e.pulley_radius_m, 0.0);
-        assert_eq!(e.load_cell_gain, 1.5);
     }
 
     #[test]

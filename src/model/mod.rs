@@ -31,6 +31,7 @@ pub mod catenary;
 pub mod effect_kind;
 pub mod effect_limits;
 pub mod effect_ranges;
+pub mod effect_specs;
 pub mod effects;
 pub mod geometry;
 pub mod measurement;

@@ -97,6 +97,17 @@ pub struct Workspace {
     pub max_m: [f64; 3],
 }
 
+/// `robot` with its attachment points where `effects` puts them: each moved
+/// horizontally by `effects.attachment_shift_m` (`attachments`), platform frame.
+pub fn with_true_attachments(robot: &Robot, effects: &Effects) -> Robot {
+    let mut true_robot = robot.clone();
+    for (attachment, [dx, dy]) in true_robot.attachments_m.iter_mut().zip(effects.attachment_shift_m) {
+        attachment.x += dx;
+        attachment.y += dy;
+    }
+    true_robot
+}
+
 /// `robot` as it truly is under `effects`' weight errors: the platform's
 /// weight and the cables' weight per metre times their scales
 /// (`platform-weight`, `cable-weight`).

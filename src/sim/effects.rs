@@ -67,12 +67,13 @@ pub fn discretised_options(robot: &Robot, effects: &Effects, segments: usize) ->
     }
 }
 
-/// The robot as it truly is under `effects`' weight errors: the platform's
-/// weight and the cables' weight per metre scaled (`platform-weight`,
-/// `cable-weight`); the commanded cable lengths still come from the robot
-/// file's (wrong) weights, as a controller's would.
+/// The robot as it truly is under `effects`' errors of the robot file: the
+/// platform's weight and the cables' weight per metre scaled
+/// (`platform-weight`, `cable-weight`), the attachment points moved
+/// (`attachments`); the commanded cable lengths still come from the robot
+/// file, as a controller's would.
 pub fn weighed(robot: &Robot, effects: &Effects) -> Robot {
-    crate::model::robot::with_true_weights(robot, effects)
+    crate::model::robot::with_true_attachments(&crate::model::robot::with_true_weights(robot, effects), effects)
 }
 
 /// The discretised robot's equilibrium under each closed-form equilibrium's

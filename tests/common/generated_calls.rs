@@ -193,12 +193,12 @@ pub fn rigid_length(p: &Point, j: Option<&mut (M<4, 6>, M<4, 12>, M<4, 4>)>) -> 
 }
 
 /// The Jacobians of `cable_geometry`: pose, reference tension, anchors, centre of mass, platform weight.
-pub type GeometryJacobians = (M<16, 6>, M<16, 2>, M<16, 12>, M<16, 3>, M<16, 1>);
+pub type GeometryJacobians = (M<16, 6>, M<16, 2>, M<16, 12>, M<16, 12>, M<16, 3>, M<16, 1>);
 
 pub fn geometry(p: &Point, j: Option<&mut GeometryJacobians>) -> SVector<f64, 16> {
-    let (pose, reference, anchors, com, weight) = match j {
-        Some((a, b, c, d, e)) => (Some(a), Some(b), Some(c), Some(d), Some(e)),
-        None => (None, None, None, None, None),
+    let (pose, reference, anchors, attachments, com, weight) = match j {
+        Some((a, b, c, d, e, f)) => (Some(a), Some(b), Some(c), Some(d), Some(e), Some(f)),
+        None => (None, None, None, None, None, None),
     };
     generated::cable_geometry(
         &p.pose.position_m,
@@ -212,6 +212,7 @@ pub fn geometry(p: &Point, j: Option<&mut GeometryJacobians>) -> SVector<f64, 16
         pose,
         reference,
         anchors,
+        attachments,
         com,
         weight,
     )
@@ -225,6 +226,7 @@ pub fn geometry_blocks(j: &GeometryJacobians) -> Vec<DMatrix<f64>> {
         dynamic(&j.2),
         dynamic(&j.3),
         dynamic(&j.4),
+        dynamic(&j.5),
     ]
 }
 
