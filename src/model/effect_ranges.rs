@@ -197,8 +197,8 @@ pub const LOAD_CELL_FRICTION_HIGH: f64 = 0.05;
 /// localiser turned by 0.5 degrees about the diagonal of its axes, a platform
 /// 3 % and cables 5 % heavier than the robot file says, the slowest encoder
 /// creep and smallest backlash with alternating signs, the slowest load-cell
-/// creep and the least pulley friction, and each attachment moved by the
-/// least misplacement, in turn along +x, +y, -x, -y.
+/// creep and the least pulley friction, and each attachment moved outward
+/// by the least misplacement.
 pub fn smallest_plausible(kind: EffectKind, robot: &Robot, mean_reference_tension_n: f64) -> Vec<f64> {
     match kind {
         EffectKind::Elastic => vec![1e6 / axial_stiffness_range_n(robot).1],
@@ -225,8 +225,18 @@ pub fn smallest_plausible(kind: EffectKind, robot: &Robot, mean_reference_tensio
         EffectKind::LoadCellDrift => vec![LOAD_CELL_DRIFT_LOW * mean_reference_tension_n],
         EffectKind::LoadCellFriction => vec![LOAD_CELL_FRICTION_LOW],
         EffectKind::Attachments => {
+            // Outward from the platform's centre: a change of the pattern's
+            // size, which neither a centre-of-mass shift (a common move) nor
+            // a localiser's turn (a common turn) can fit.
             let low = attachment_shift_range_m(robot).0;
-            vec![low, 0.0, 0.0, low, -low, 0.0, 0.0, -low]
+            robot
+                .attachments_m
+                .iter()
+                .flat_map(|b| {
+                    let radius = b.x.hypot(b.y).max(f64::MIN_POSITIVE);
+                    [low * b.x / radius, low * b.y / radius]
+                })
+                .collect()
         }
     }
 }

@@ -1,14 +1,15 @@
-//! The hypotheses of time and motion: encoder drift and backlash, load-cell
-//! drift and pulley friction. Data from the discretised simulator (the
-//! robot visits its poses in order; each reading depends on its row and on
-//! the true direction each cable last moved in), truth off the nominal
-//! large robot, each case seeded and printed.
+//! The hypotheses of time and motion (encoder drift and backlash, load-cell
+//! drift and pulley friction) and the attachment points, at the weak end of
+//! their ranges. Data from the discretised simulator (the robot visits its
+//! poses in order; each reading depends on its row and on the true
+//! direction each cable last moved in), truth off the nominal robot, each
+//! case seeded and printed.
 //!
 //! At the weak end of each range ([`smallest_plausible`]) the report states
 //! the power of its test; where that power is at least 0.9 the effect must
 //! be named, and where it is below, the report must say it is not
 //! detectable. The rates over many seeds are measured by the ignored test
-//! `weak_end_rates` (`cargo test --release --test diagnose_time_and_motion
+//! `weak_end_rates` (`cargo test --release --test diagnose_weak_end
 //! -- --ignored --nocapture`).
 
 use nalgebra::Vector3;
@@ -36,6 +37,15 @@ const TIME_AND_MOTION: [EffectKind; 4] = [
     EffectKind::LoadCellFriction,
 ];
 
+/// The hypotheses checked at their weak end: time and motion, and the attachments.
+const WEAK_END: [EffectKind; 5] = [
+    EffectKind::EncoderDrift,
+    EffectKind::EncoderBacklash,
+    EffectKind::LoadCellDrift,
+    EffectKind::LoadCellFriction,
+    EffectKind::Attachments,
+];
+
 /// `kind` at the smallest plausible magnitude for `robot`, as effects
 /// (`mean_tension_n` scales the load cell's drift).
 fn weakest(kind: EffectKind, robot: &Robot, mean_tension_n: f64) -> Effects {
@@ -46,7 +56,8 @@ fn weakest(kind: EffectKind, robot: &Robot, mean_tension_n: f64) -> Effects {
         EffectKind::EncoderBacklash => e.encoder_backlash_m = std::array::from_fn(|i| v[i] * 1e-3),
         EffectKind::LoadCellDrift => e.load_cell_drift_n_per_row = v[0],
         EffectKind::LoadCellFriction => e.load_cell_friction = v[0],
-        _ => unreachable!("time and motion only"),
+        EffectKind::Attachments => e.attachment_shift_m = std::array::from_fn(|i| [v[2 * i], v[2 * i + 1]]),
+        _ => unreachable!("the hypotheses of WEAK_END only"),
     }
     e
 }
@@ -95,7 +106,7 @@ fn stated_power(d: &Diagnosis, kind: EffectKind) -> f64 {
 #[test]
 fn the_weak_end_is_named_at_the_power_the_report_states() {
     for noise in [NoisePreset::Paper, NoisePreset::Authors] {
-        for (k, kind) in TIME_AND_MOTION.into_iter().enumerate() {
+        for (k, kind) in WEAK_END.into_iter().enumerate() {
             let seed = 60 + k as u64;
             let d = run("large", kind, noise, seed);
             let power = stated_power(&d, kind);
@@ -152,7 +163,7 @@ fn weak_end_rates() {
     const SEEDS: u64 = 20;
     for name in ["large", "small"] {
         for noise in [NoisePreset::Paper, NoisePreset::Authors] {
-            for kind in TIME_AND_MOTION {
+            for kind in WEAK_END {
                 let mut named = 0;
                 let mut power = 0.0;
                 for seed in 0..SEEDS {
