@@ -8,18 +8,19 @@
 //! data with the hidden effect in the catalogue are named and explained, so
 //! each test can tell the two apart.
 
-use nalgebra::Vector3;
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+#[path = "common/truth.rs"]
+mod truth;
+
 use sagcal::calib::CalibrationOptions;
 use sagcal::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
 use sagcal::model::effect_kind::EffectKind;
 use sagcal::model::effects::Effects;
 use sagcal::model::measurement::PoseMeasurement;
 use sagcal::model::sensors::NoisePreset;
-use sagcal::model::{Robot, CABLE_COUNT};
-use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
+use sagcal::model::Robot;
+use sagcal::sim::closed_form::measure;
 use sagcal::sim::effects::measure_with_effects;
+use truth::truth_off_nominal;
 
 const POSES: usize = 35;
 
@@ -27,15 +28,7 @@ const POSES: usize = 35;
 /// measured at `POSES` poses with the authors' noise, `effects` acting (the
 /// discretised simulator, 100 elements per cable) or none (the closed form).
 fn case(seed: u64, change: impl Fn(&mut Robot), effects: &[&str]) -> (Robot, Vec<PoseMeasurement>, Robot) {
-    let nominal = Robot::builtin("large").unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut truth = nominal.clone();
-    for i in 0..CABLE_COUNT {
-        truth.anchors_m[i] += Vector3::from_fn(|_, _| rng.random_range(-0.3..0.3));
-        truth.length_offsets_m[i] = rng.random_range(-3.0..3.0);
-    }
-    change(&mut truth);
-    let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), POSES, &mut rng).unwrap();
+    let (nominal, mut truth, equilibria, mut rng) = truth_off_nominal("large", seed, POSES, change);
     let sigmas = NoisePreset::Authors.sigmas(truth.platform_weight_n);
     let measurements = if effects.is_empty() {
         measure(&truth, &equilibria, &sigmas, &mut rng)

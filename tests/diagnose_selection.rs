@@ -7,8 +7,11 @@
 //! the selected model predicts poses it was not fitted on better than the
 //! baseline.
 
+#[path = "common/truth.rs"]
+mod truth;
+
 use nalgebra::Vector3;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sagcal::calib::{calibrate, predict_with_effects, CalibrationOptions, OrientationPrior};
 use sagcal::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
@@ -19,6 +22,7 @@ use sagcal::model::statics::{self, StaticsOptions};
 use sagcal::model::{Robot, CABLE_COUNT};
 use sagcal::sim::closed_form::{sample_equilibria, Workspace};
 use sagcal::sim::effects::measure_with_effects;
+use truth::truth_off_nominal;
 
 /// Segments per cable of the discretised truth (fewer than the sweep's 50, for speed).
 const SEGMENTS: usize = 40;
@@ -27,18 +31,8 @@ const SEGMENTS: usize = 40;
 /// offsets of metres, `effects` acting, and `poses` measured with `noise`;
 /// returns the truth, the measurements and the nominal robot as the guess.
 fn case(effects: &[&str], noise: NoisePreset, poses: usize, seed: u64) -> (Robot, Vec<PoseMeasurement>, Robot) {
-    let nominal = Robot::builtin("large").unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut truth = nominal.clone();
-    for i in 0..CABLE_COUNT {
-        truth.anchors_m[i] += Vector3::from_fn(|_, _| rng.random_range(-0.3..0.3));
-        truth.length_offsets_m[i] = rng.random_range(-3.0..3.0);
-    }
-    let mut e = Effects::default();
-    for spec in effects {
-        e.apply_spec(spec).unwrap();
-    }
-    let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), poses, &mut rng).unwrap();
+    let (nominal, mut truth, equilibria, mut rng) = truth_off_nominal("large", seed, poses, |_| {});
+    let e = Effects::from_specs(effects).unwrap();
     let sigmas = noise.sigmas(truth.platform_weight_n);
     let measurements = measure_with_effects(&truth, &e, &equilibria, &sigmas, SEGMENTS, &mut rng).unwrap();
     truth.effects = e;

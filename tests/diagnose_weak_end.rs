@@ -12,9 +12,9 @@
 //! `weak_end_rates` (`cargo test --release --test diagnose_weak_end
 //! -- --ignored --nocapture`).
 
-use nalgebra::Vector3;
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+#[path = "common/truth.rs"]
+mod truth;
+
 use sagcal::calib::CalibrationOptions;
 use sagcal::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
 use sagcal::model::effect_kind::EffectKind;
@@ -22,9 +22,9 @@ use sagcal::model::effect_ranges::smallest_plausible;
 use sagcal::model::effects::Effects;
 use sagcal::model::measurement::PoseMeasurement;
 use sagcal::model::sensors::NoisePreset;
-use sagcal::model::{Robot, CABLE_COUNT};
-use sagcal::sim::closed_form::{sample_equilibria, Workspace};
+use sagcal::model::Robot;
 use sagcal::sim::effects::measure_with_effects;
+use truth::truth_off_nominal;
 
 const POSES: usize = 35;
 const SEGMENTS: usize = 40;
@@ -65,14 +65,7 @@ fn weakest(kind: EffectKind, robot: &Robot, mean_tension_n: f64) -> Effects {
 /// A truth off the nominal `robot` (0.3 m per anchor coordinate, offsets of
 /// metres) with `kind` at its weak end, measured at [`POSES`] poses in order.
 fn case(name: &str, kind: EffectKind, noise: NoisePreset, seed: u64) -> (Robot, Vec<PoseMeasurement>, Robot) {
-    let nominal = Robot::builtin(name).unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut truth = nominal.clone();
-    for i in 0..CABLE_COUNT {
-        truth.anchors_m[i] += Vector3::from_fn(|_, _| rng.random_range(-0.3..0.3));
-        truth.length_offsets_m[i] = rng.random_range(-3.0..3.0);
-    }
-    let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), POSES, &mut rng).unwrap();
+    let (nominal, mut truth, equilibria, mut rng) = truth_off_nominal(name, seed, POSES, |_| {});
     let mean_tension_n = equilibria
         .iter()
         .map(|eq| eq.tensions[truth.reference_cable].magnitude_n())

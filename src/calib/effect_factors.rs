@@ -1,4 +1,4 @@
-//! Factors of the extended model (issue 4): the calibration factors with the
+//! Factors of the extended model: the calibration factors with the
 //! physical effects of [`crate::model::effects`] as extra parameter variables
 //! ([`EffectVariables`]). The length and attachment factors chain two
 //! generated functions (derived in `codegen/factors.py`):

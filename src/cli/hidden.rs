@@ -250,7 +250,7 @@ fn score(robot: &str, noise: NoisePreset, hidden: &str, group: &[&HiddenCase]) -
     }
 }
 
-/// Per robot and noise reading: the rates the issue asks for.
+/// Per robot and noise reading: the scores of the sweep (detection, false alarms, anchors, honesty, unseen poses).
 fn summaries(robots: &[Robot], noises: &[NoisePreset], scores: &[EffectScore], cases: &[HiddenCase]) -> Vec<Summary> {
     let rate = |num: usize, den: usize| if den == 0 { f64::NAN } else { num as f64 / den as f64 };
     let mut out = Vec::new();

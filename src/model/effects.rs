@@ -367,9 +367,24 @@ mod tests {
 
     #[test]
     fn toml_round_trip_and_validation() {
-        let e = parsed(&["elastic:ea_n=3e6", "com:dy_m=0.01"]).unwrap();
+        let e = parsed(&[
+            "elastic:ea_n=3e6",
+            "com:dy_m=0.01",
+            "encoder-drift:rate3_m=-1e-4",
+            "encoder-backlash:b_m=0.002",
+            "loadcell-drift:rate_n=0.4",
+            "loadcell-friction:k=0.03",
+            "attachments:dx2_m=0.01,dy3_m=-0.005",
+        ])
+        .unwrap();
         let text = toml::to_string(&e).unwrap();
         assert_eq!(toml::from_str::<Effects>(&text).unwrap(), e);
+        // A robot file's `[effects]` with a friction no pulley has is refused by name.
+        let seized: Effects = toml::from_str("load_cell_friction = 1.5").unwrap();
+        assert!(seized.validate().unwrap_err().contains("load_cell_friction"));
+        let shifted: Effects =
+            toml::from_str("attachment_shift_m = [[0.01, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]]").unwrap();
+        assert_eq!(shifted.attachment_shift_m[0], [0.01, 0.0]);
         let partial: Effects = toml::from_str("pulley_radius_m = 0.1").unwrap();
         assert_eq!(partial.pulley_radius_m, 0.1);
         assert_eq!(partial.encoder_gain, [1.0; 4]);

@@ -112,7 +112,8 @@ pub fn check_masses(robot: &Robot) -> Result<(), String> {
 }
 
 /// Check `effects` against `robot`'s size (module docs): the pulley radius
-/// at most [`MAX_PULLEY_FRACTION`] of the closest anchors' distance.
+/// at most [`MAX_PULLEY_FRACTION`] of the closest anchors' distance, and no
+/// attachment moved by more than the platform's attachment radius.
 pub fn check_effects(robot: &Robot, effects: &Effects) -> Result<(), String> {
     let (_, closest, (i, j)) = anchor_distances(robot);
     let r = effects.pulley_radius_m;
@@ -123,6 +124,20 @@ pub fn check_effects(robot: &Robot, effects: &Effects) -> Result<(), String> {
              their neighbours and no longer act as the anchor points the model has",
             i + 1,
             j + 1
+        ));
+    }
+    let platform_radius_m = robot.attachments_m.iter().map(|b| b.x.hypot(b.y)).fold(0.0, f64::max);
+    if let Some((k, [dx, dy])) = effects
+        .attachment_shift_m
+        .iter()
+        .enumerate()
+        .find(|(_, [dx, dy])| dx.hypot(*dy) > platform_radius_m)
+    {
+        return Err(format!(
+            "field `attachment_shift_m`: attachment {} moved by {:.3} m, more than the platform's attachment \
+             radius of {platform_radius_m:.3} m: the point would no longer be on the platform",
+            k + 1,
+            dx.hypot(*dy)
         ));
     }
     check_masses(&crate::model::robot::with_true_weights(robot, effects)).map_err(|e| {
@@ -209,5 +224,17 @@ mod tests {
         effects.pulley_radius_m = 0.46;
         let message = check_effects(&robot, &effects).unwrap_err();
         assert!(message.contains("the 4.500 m between anchors 1 and 4"), "{message}");
+    }
+
+    #[test]
+    fn an_attachment_stays_on_the_platform() {
+        let robot = Robot::builtin("large").unwrap();
+        let radius = 0.21 * 2f64.sqrt();
+        let mut effects = robot.effects;
+        effects.attachment_shift_m[2] = [0.99 * radius, 0.0];
+        assert!(check_effects(&robot, &effects).is_ok());
+        effects.attachment_shift_m[2] = [0.0, -1.01 * radius];
+        let message = check_effects(&robot, &effects).unwrap_err();
+        assert!(message.contains("attachment 3 moved by 0.300 m"), "{message}");
     }
 }

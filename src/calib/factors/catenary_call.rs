@@ -1,4 +1,4 @@
-//! The one generated call a pose's catenary factors share (issue 18): the
+//! The one generated call a pose's catenary factors share: the
 //! length rows (eq. 14), height rows (eq. 15) and tensions (eq. 11) of
 //! [`generated::catenary_cable_residuals`], made by the first factor
 //! evaluated at a point and read by the others ([`SharedEvaluation`]).
