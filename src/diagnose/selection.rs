@@ -199,34 +199,16 @@ fn simplify_nested(
         };
         progress.grow(1);
         progress.step(&format!("nested check: {} for {}", inner.name(), outer.name()));
-        // The simpler effect alone, or (attachments) beside the localiser's
-        // mount, whose turn about z is the attachments' common turn.
-        let mut alternatives = vec![vec![inner]];
-        let mounted = model
-            .hypotheses
-            .contains(&Hypothesis::Effect(EffectKind::LocaliserMount));
-        if outer == EffectKind::Attachments
-            && !mounted
-            && search.options.candidates.contains(&EffectKind::LocaliserMount)
-        {
-            alternatives.push(vec![inner, EffectKind::LocaliserMount]);
-        }
-        for alternative in alternatives {
-            let mut hypotheses = model.hypotheses.clone();
-            hypotheses.remove(at);
-            hypotheses.extend(alternative.iter().map(|k| Hypothesis::Effect(*k)));
-            let Ok(simpler) = model.refit(hypotheses, search.base, search.measurements) else {
-                continue;
-            };
-            let simpler_count: usize = alternative.iter().map(|k| k.parameter_count()).sum();
-            let dof = outer.parameter_count().saturating_sub(simpler_count).max(1);
-            let lr = (simpler.chi_square - model.chi_square) / search.base.variance_factor;
-            if chi_square_survival(dof, lr.max(0.0)) >= p_threshold {
-                let names: Vec<&str> = alternative.iter().map(|k| k.name()).collect();
-                replaced.push(format!("{} by {}", outer.name(), names.join("+")));
-                model = simpler;
-                break;
-            }
+        let mut hypotheses = model.hypotheses.clone();
+        hypotheses[at] = Hypothesis::Effect(inner);
+        let Ok(simpler) = model.refit(hypotheses, search.base, search.measurements) else {
+            continue;
+        };
+        let dof = outer.parameter_count() - inner.parameter_count();
+        let lr = (simpler.chi_square - model.chi_square) / search.base.variance_factor;
+        if chi_square_survival(dof, lr.max(0.0)) >= p_threshold {
+            replaced.push(format!("{} by {}", outer.name(), inner.name()));
+            model = simpler;
         }
     }
     model
