@@ -295,6 +295,7 @@ fn jacobians(c: &mut Criterion) {
             Pose,
             reference,
             anchors,
+            Additive(|q| q.attachments_m.as_mut_slice()),
             com,
             Additive(|q| std::slice::from_mut(&mut q.platform_weight_n)),
         ],
