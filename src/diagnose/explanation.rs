@@ -32,8 +32,10 @@
 //! A model that does not explain the data names its causes only where they
 //! are needed beyond the terms proposed for the baseline
 //! ([`CausesGivenTerms`]: their likelihood ratio given
-//! those terms, at `false_alarm`); otherwise they fitted part of what is
-//! wrong as proxies, and the verdict is `unexplained`.
+//! those terms, at `false_alarm`, from the baseline and the model each
+//! refitted with the terms as corrections of the readings, `term_refit`);
+//! otherwise they fitted part of what is wrong as proxies, and the verdict
+//! is `unexplained`.
 //!
 //! With it: the share of the baseline's excess chi-square (above its degrees
 //! of freedom) that the final model leaves, the residual-driver
@@ -41,12 +43,15 @@
 
 use serde::Serialize;
 
-use super::candidates::{CandidateFit, Hypothesis, Model};
+use super::candidates::{CandidateFit, Hypothesis, Model, WEIGHT_SCALING};
 use super::drivers::{DriverTest, PoseSample};
 use super::missing_terms::{causes_given_terms, missing_terms, CausesGivenTerms, MissingTerm, TermsFound};
 use super::residual_tests::{factor_tests_at, measurement_components, FactorTest};
 use super::selection::SelectionStep;
-use super::stand_ins::{orientation_stand_in, own_sensor, partial_stand_in, stand_in, StandIn};
+use super::stand_ins::{
+    orientation_stand_in, own_sensor, partial_stand_in, stand_in, weight_family_plausible, StandIn,
+};
+use super::term_refit::fit_with_terms;
 use super::Baseline;
 use crate::calib::CalibrationGraph;
 use crate::error::Result;
@@ -144,7 +149,7 @@ impl Explanation {
         let mut parts = Vec::new();
         if let (false, Some(check)) = (self.explained_away.is_empty(), &self.causes_given_terms) {
             parts.push(format!(
-                "{} fit{} part of it, but not beyond the proposed terms (likelihood ratio {:.1} on {} dof given them, p = {:.2e}; {:.1} alone): a proxy, not a cause",
+                "{} fit{} part of it, but not beyond the terms that describe what the baseline misses (likelihood ratio {:.1} on {} dof given them, p = {:.2e}; {:.1} alone): a proxy, not a cause",
                 self.explained_away.join(", "),
                 if self.explained_away.len() == 1 { "s" } else { "" },
                 check.likelihood_ratio,
@@ -213,19 +218,7 @@ pub(super) fn explain(
     let constraints = CABLE_COUNT * base.used.len();
     let dof = (components + constraints).saturating_sub(unknowns).max(1);
     let tests = factor_tests_at(&graph.graph, components, dof, false_alarm);
-    let failing = |sensor: &str| tests.iter().find(|t| t.kind == sensor && !t.consistent);
-    let mut stand_ins: Vec<StandIn> = model
-        .result
-        .effect_estimates
-        .iter()
-        .filter_map(|e| {
-            stand_in(e, &base.result.robot, base.mean_reference_tension_n)
-                .or_else(|| failing(own_sensor(e.effect)).map(|t| partial_stand_in(e, t)))
-        })
-        .collect();
-    if model.hypotheses.contains(&Hypothesis::OrientationFree) {
-        stand_ins.push(orientation_stand_in());
-    }
+    let stand_ins = stand_ins_of(base, model, &tests);
     let mut causes: Vec<String> = model
         .hypotheses
         .iter()
@@ -258,16 +251,22 @@ pub(super) fn explain(
             true => base_terms()?,
             false => terms.clone(),
         };
-        if !described.proposed_keys.is_empty() {
+        if !described.describing_keys.is_empty() {
             let check = match stand_ins.is_empty() {
-                true => check_causes(base, (model, &graph, samples), base_samples, &described, false_alarm)?,
+                true => check_causes(
+                    base,
+                    (model, &graph, samples),
+                    base_samples,
+                    &described,
+                    (false_alarm, measurements),
+                )?,
                 false => {
                     // The causes alone: the final model without its stand-ins.
                     let alone = causes_alone(model, &stand_ins, base, measurements)?;
                     let alone_graph = super::candidates::rebuild(&alone.result, &base.used, &alone.options);
                     let alone_samples = super::drivers::samples(&alone.result, &base.used, &alone.options)?;
                     let fitted = (&alone, &alone_graph, alone_samples.as_slice());
-                    check_causes(base, fitted, base_samples, &described, false_alarm)?
+                    check_causes(base, fitted, base_samples, &described, (false_alarm, measurements))?
                 }
             };
             if !check.needed {
@@ -299,15 +298,39 @@ pub(super) fn explain(
     })
 }
 
-/// [`causes_given_terms`] of a fitted model (its graph and samples) against the baseline.
+/// The stand-ins of `model` (`stand_ins`), given its per-sensor tests.
+fn stand_ins_of(base: &Baseline, model: &Model, tests: &[FactorTest]) -> Vec<StandIn> {
+    let failing = |sensor: &str| tests.iter().find(|t| t.kind == sensor && !t.consistent);
+    let estimates = &model.result.effect_estimates;
+    // Two weight scalings fitted together are judged by their family.
+    let family_plausible = weight_family_plausible(estimates, &base.result.robot, base.mean_reference_tension_n);
+    let mut stand_ins: Vec<StandIn> = estimates
+        .iter()
+        .filter_map(|e| {
+            stand_in(e, &base.result.robot, base.mean_reference_tension_n)
+                .filter(|_| !(family_plausible && WEIGHT_SCALING.contains(&e.effect)))
+                .or_else(|| failing(own_sensor(e.effect)).map(|t| partial_stand_in(e, t)))
+        })
+        .collect();
+    if model.hypotheses.contains(&Hypothesis::OrientationFree) {
+        stand_ins.push(orientation_stand_in());
+    }
+    stand_ins
+}
+
+/// [`causes_given_terms`] of a fitted model (its graph and samples) against
+/// the baseline: the likelihood ratio of the causes given the terms from
+/// the baseline and the model each refitted with the terms as corrections of
+/// the readings ([`fit_with_terms`]); where a refit fails or does not
+/// converge, its first-order value.
 fn check_causes(
     base: &Baseline,
     (model, graph, samples): (&Model, &CalibrationGraph, &[PoseSample]),
     base_samples: &[PoseSample],
     described: &TermsFound,
-    false_alarm: f64,
+    (false_alarm, measurements): (f64, &[PoseMeasurement]),
 ) -> Result<CausesGivenTerms> {
-    causes_given_terms(
+    let first_order = causes_given_terms(
         ((&base.graph, base_samples), (graph, samples)),
         &base.used,
         described,
@@ -317,7 +340,23 @@ fn check_causes(
             model.options.free_effects.parameter_count(),
         ),
         false_alarm,
-    )
+    )?;
+    let known = &base.result.robot.effects;
+    let keys = &described.describing_keys;
+    let refitted =
+        fit_with_terms((&base.result, &base.options, known), measurements, base_samples, keys).and_then(|b| {
+            Ok((
+                b,
+                fit_with_terms((&model.result, &model.options, known), measurements, base_samples, keys)?,
+            ))
+        });
+    match refitted {
+        Ok((with_base, with_model)) if with_base.converged && with_model.converged => Ok(first_order.refitted(
+            (with_base.chi_square - with_model.chi_square) / base.variance_factor,
+            false_alarm,
+        )),
+        _ => Ok(first_order),
+    }
 }
 
 /// `model` without its stand-ins (freed orientations included), refitted.

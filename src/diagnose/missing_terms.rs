@@ -8,7 +8,8 @@
 //!   length, sag, elevation, wrap angle, platform height) and each pose
 //!   driver (platform x and y and, where the rows are in the order taken,
 //!   the row: a drift, and each cable's direction of last motion: friction,
-//!   backlash, hysteresis);
+//!   backlash, hysteresis), all four with one coefficient and each alone
+//!   with its own (a drum's gain is one encoder against its cable length);
 //! - the load cell against the same drivers, a per-cable driver taken at the
 //!   cable it reads (a gain error is then `c` newtons per newton of its
 //!   tension);
@@ -82,6 +83,16 @@ pub struct MissingTerm {
 /// strongest, and the report says how many more are missing.
 pub const MOST_PROPOSED: usize = 3;
 
+/// The most terms that describe what is wrong when the causes of a model
+/// that does not explain the data are checked against them
+/// (`CausesGivenTerms`): the same forward selection run on past
+/// [`MOST_PROPOSED`] while a term is beyond the limit given those chosen.
+/// A proxy absorbs the part of a missing fault that the first few terms
+/// leave (a centre-of-mass shift's tilt is three orientation terms, its
+/// pull on the sags more); a cause is named only when it is needed beyond
+/// everything the terms describe at the stated rate.
+pub const MOST_DESCRIBING: usize = 30;
+
 /// A missing term is named alike a proposed one when the proposed terms
 /// explain it away (it is within the limit given them) and this one
 /// carries at least this share of its information (the square of their
@@ -107,8 +118,11 @@ impl MissingTerm {
                 _ => driver.to_string(),
             },
         };
+        let cable = self.residual.strip_prefix("encoder_");
+        let one_encoder = cable.map(|i| format!("encoder {i} reading"));
         let reading = match self.residual.as_str() {
             "encoder" => "encoder reading",
+            _ if cable.is_some() => one_encoder.as_deref().unwrap_or("encoder reading"),
             "load_cell" => "load-cell reading",
             "position_x" => "localiser x",
             "position_y" => "localiser y",
@@ -117,7 +131,13 @@ impl MissingTerm {
             "orientation_y" => "localiser orientation about y",
             _ => "localiser orientation about z",
         };
-        let what = match (self.residual.as_str(), self.driver.as_str()) {
+        let encoder = if cable.is_some() {
+            "encoder"
+        } else {
+            self.residual.as_str()
+        };
+        let what = match (encoder, self.driver.as_str()) {
+            ("encoder", ROW_DRIVER) if cable.is_some() => ": the encoder drifts over time",
             ("encoder", ROW_DRIVER) => ": the encoders drift over time",
             ("load_cell", ROW_DRIVER) => ": the load cell drifts over time",
             ("encoder", DIRECTION_DRIVER) => ": the lengths depend on the direction of motion (backlash, hysteresis)",
@@ -142,10 +162,17 @@ impl MissingTerm {
     }
 }
 
-/// The readings whose residuals the terms describe: step 2's, and the
-/// localiser's orientation (its rotation error about world x, y, z, rad).
-const TERM_RESIDUALS: [&str; 8] = [
+/// The readings whose residuals the terms describe: step 2's, the
+/// localiser's orientation (its rotation error about world x, y, z, rad),
+/// and each encoder alone (`encoder_1`..`encoder_4`: each drum has its own
+/// hardware, and a fault of one drum, or one cable's share of a fault of the
+/// platform, is no common term).
+const TERM_RESIDUALS: [&str; 12] = [
     "encoder",
+    "encoder_1",
+    "encoder_2",
+    "encoder_3",
+    "encoder_4",
     "load_cell",
     "position_x",
     "position_y",
@@ -170,14 +197,22 @@ pub(super) struct TermsFound {
     pub limit: f64,
     /// The proposed terms' `(residual, driver)`.
     pub proposed_keys: Vec<(&'static str, &'static str)>,
+    /// The forward selection run on to [`MOST_DESCRIBING`] terms (the
+    /// proposed ones first), with their coefficients fitted jointly.
+    pub describing: Vec<MissingTerm>,
+    /// Their `(residual, driver)`.
+    pub describing_keys: Vec<(&'static str, &'static str)>,
 }
 
-/// Are a model's causes still needed once the terms proposed for the
-/// baseline are added to both? The likelihood ratio of the causes given the
+/// Are a model's causes still needed once the terms that describe what the
+/// baseline misses ([`MOST_DESCRIBING`]) are added to both? The likelihood ratio of the causes given the
 /// terms `T` is theirs alone less what `T` gains in the baseline plus what
 /// `T` gains in the model: `LR(C | T) = LR(C) - D_T(baseline) + D_T(model)`,
 /// each gain `D_T = b_T^T M_TT^-1 b_T` the chi-square drop of adding `T`
-/// by the score system (to first order). Causes whose evidence the terms
+/// by the score system (to first order); where the baseline and the model
+/// can each be refitted with the terms as corrections of the readings
+/// (`term_refit`), `LR(C | T)` is the difference of those refits'
+/// chi-squares instead (`refitted`). Causes whose evidence the terms
 /// explain as well are not needed: the data hold a fault that the terms
 /// describe, and the causes fitted part of it as proxies.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -194,6 +229,25 @@ pub struct CausesGivenTerms {
     pub p_value: f64,
     /// Whether `p_value` is below the false-alarm rate: the causes are needed.
     pub needed: bool,
+    /// Whether `likelihood_ratio` comes from the baseline and the model each
+    /// refitted with the terms as corrections of the readings (`term_refit`);
+    /// otherwise it is the first-order value above.
+    pub refitted: bool,
+}
+
+impl CausesGivenTerms {
+    /// This check with the likelihood ratio given the terms from refits
+    /// (`likelihood_ratio`), tested at `false_alarm`.
+    pub(super) fn refitted(self, likelihood_ratio: f64, false_alarm: f64) -> Self {
+        let p_value = chi_square_survival(self.dof, likelihood_ratio.max(0.0));
+        Self {
+            likelihood_ratio,
+            p_value,
+            needed: p_value < false_alarm,
+            refitted: true,
+            ..self
+        }
+    }
 }
 
 /// The fitted models that [`causes_given_terms`] compares: the graph at the
@@ -212,27 +266,26 @@ pub(super) fn causes_given_terms(
 ) -> Result<CausesGivenTerms> {
     let gain = |(graph, samples): FittedModel<'_>| -> Result<f64> {
         let directions: Vec<Direction> = terms
-            .proposed_keys
+            .describing_keys
             .iter()
             .map(|(residual, driver)| direction_of(graph, used, samples, residual, driver).0)
             .collect();
         let system = score_system(&graph.graph, &directions).map_err(Error::InvalidInput)?;
-        let inverse = system
-            .information
-            .clone()
-            .try_inverse()
+        let (_, drop) = system
+            .joint_fit()
             .ok_or_else(|| Error::InvalidInput("the proposed terms' information is singular".into()))?;
-        Ok(system.score.dot(&(inverse * &system.score)))
+        Ok(drop)
     };
     let likelihood_ratio = likelihood_ratio_alone - (gain(base)? - gain(model)?) / variance_factor;
     let p_value = chi_square_survival(dof, likelihood_ratio.max(0.0));
     Ok(CausesGivenTerms {
-        terms: terms.proposed.iter().map(MissingTerm::formula).collect(),
+        terms: terms.describing.iter().map(MissingTerm::formula).collect(),
         likelihood_ratio_alone,
         likelihood_ratio,
         dof,
         p_value,
         needed: p_value < false_alarm,
+        refitted: false,
     })
 }
 
@@ -256,6 +309,10 @@ pub(super) fn missing_terms(
     drivers.push(CONSTANT_DRIVER);
     for residual in TERM_RESIDUALS {
         for &driver in &drivers {
+            // One encoder's constant is its length offset, always fitted.
+            if residual.starts_with("encoder_") && driver == CONSTANT_DRIVER {
+                continue;
+            }
             let (direction, points) = direction_of(graph, used, samples, residual, driver);
             if points > 2 {
                 directions.push(direction);
@@ -283,8 +340,17 @@ pub(super) fn missing_terms(
     let beyond: Vec<usize> = (0..terms.len()).filter(|&j| alone[j].z.abs() > limit).collect();
     let mut missing: Vec<MissingTerm> = beyond.iter().map(|&j| alone[j].clone()).collect();
     missing.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
-    let chosen = system.forward_selection(limit_of, MOST_PROPOSED);
+    let describing_chosen = system.forward_selection(limit_of, MOST_DESCRIBING);
+    let chosen = describing_chosen[..describing_chosen.len().min(MOST_PROPOSED)].to_vec();
     let proposed_keys = chosen.iter().map(|&j| (terms[j].0, terms[j].1)).collect();
+    let describing_keys = describing_chosen.iter().map(|&j| (terms[j].0, terms[j].1)).collect();
+    let describing = describing_chosen
+        .iter()
+        .map(|&j| {
+            let others: Vec<usize> = describing_chosen.iter().copied().filter(|&k| k != j).collect();
+            term(j, &others)
+        })
+        .collect();
     let m = &system.information;
     let share = |j: usize, k: usize| m[(j, k)] * m[(j, k)] / (m[(j, j)] * m[(k, k)]);
     let proposed = chosen
@@ -312,36 +378,35 @@ pub(super) fn missing_terms(
         proposed,
         limit,
         proposed_keys,
+        describing,
+        describing_keys,
     })
 }
 
 /// The direction of the term `residual ~ driver` over the graph's factors
 /// (whitened: the centred driver over each row's sigma), and its readings.
 /// A factor with a reading left out takes no part.
-fn direction_of(
+pub(super) fn direction_of(
     graph: &CalibrationGraph,
     used: &[PoseMeasurement],
     samples: &[PoseSample],
     residual: &str,
     driver: &str,
 ) -> (Direction, usize) {
-    let (kind, sensors): (&str, Vec<Sensor>) = match residual {
-        "encoder" => ("catenary_length", (0..CABLE_COUNT).map(Sensor::Encoder).collect()),
-        "load_cell" => ("reference_tension", vec![Sensor::LoadCell]),
-        _ => (
-            "pose_prior",
-            (0..3)
-                .flat_map(|i| [Sensor::Position(i), Sensor::Orientation(i)])
-                .collect(),
-        ),
-    };
+    let (kind, sensors) = factor_of(residual);
     let whole = |k: usize| !sensors.iter().any(|s| used[k].excluded.contains(*s));
     let constant = (driver == CONSTANT_DRIVER).then_some(1.0);
+    // `encoder_i`: cable i's encoder alone (0-based here).
+    let one_cable = residual
+        .strip_prefix("encoder_")
+        .and_then(|i| i.parse::<usize>().ok())
+        .map(|i| i - 1);
     // Per pose: (row in the factor, driver value) of each reading in the test.
     let readings = |k: usize, rows: usize| -> Vec<(usize, f64)> {
         let s = &samples[k];
         let all: Vec<(usize, f64)> = match residual {
-            "encoder" => (0..CABLE_COUNT)
+            r if r.starts_with("encoder") => (0..CABLE_COUNT)
+                .filter(|i| one_cable.is_none_or(|c| c == *i))
                 .filter_map(|i| Some((i, constant.or_else(|| driver_value(s, driver, Some(i)))?)))
                 .collect(),
             "load_cell" => constant
@@ -371,20 +436,15 @@ fn direction_of(
         };
         all.into_iter().filter(|(_, x)| x.is_finite()).collect()
     };
-    // A pose whose every reading of this factor was left out has no factor
-    // (`push_masked`): the factors of this kind are the other poses', in order.
-    let mut poses_with_factor = (0..used.len()).filter(|&k| !sensors.iter().all(|s| used[k].excluded.contains(*s)));
-    let mut per_factor: Vec<Option<Vec<(usize, f64)>>> = Vec::with_capacity(graph.graph.factors.len());
-    for factor in &graph.graph.factors {
-        if factor.kind() != kind {
-            per_factor.push(None);
-            continue;
-        }
-        let k = poses_with_factor.next().unwrap_or(usize::MAX);
-        let rows = factor.residual_dim();
-        let usable = k < used.len() && whole(k) && (kind != "pose_prior" || rows >= 3);
-        per_factor.push(usable.then(|| readings(k, rows)));
-    }
+    let per_factor: Vec<Option<Vec<(usize, f64)>>> = factor_poses(graph, used, kind, &sensors)
+        .into_iter()
+        .zip(&graph.graph.factors)
+        .map(|(k, factor)| {
+            let rows = factor.residual_dim();
+            k.filter(|&k| whole(k) && (kind != "pose_prior" || rows >= 3))
+                .map(|k| readings(k, rows))
+        })
+        .collect();
     let values: Vec<f64> = per_factor.iter().flatten().flatten().map(|(_, x)| *x).collect();
     let points = values.len();
     // A bias is the constant itself; every other driver is centred.
@@ -406,4 +466,41 @@ fn direction_of(
         })
         .collect();
     (direction, points)
+}
+
+/// Per factor of the graph (graph order), the pose (index into `used`) of
+/// each factor of `kind` whose readings are `sensors`, `None` for the others.
+/// A pose whose every reading of such a factor was left out has no factor
+/// (`push_masked`): the factors of this kind are the other poses', in order.
+pub(super) fn factor_poses(
+    graph: &CalibrationGraph,
+    used: &[PoseMeasurement],
+    kind: &str,
+    sensors: &[Sensor],
+) -> Vec<Option<usize>> {
+    let mut poses_with_factor = (0..used.len()).filter(|&k| !sensors.iter().all(|s| used[k].excluded.contains(*s)));
+    graph
+        .graph
+        .factors
+        .iter()
+        .map(|factor| match factor.kind() == kind {
+            true => poses_with_factor.next(),
+            false => None,
+        })
+        .collect()
+}
+
+/// The kind of the factor that holds `residual`'s readings, and the sensors
+/// of its rows.
+pub(super) fn factor_of(residual: &str) -> (&'static str, Vec<Sensor>) {
+    match residual {
+        r if r.starts_with("encoder") => ("catenary_length", (0..CABLE_COUNT).map(Sensor::Encoder).collect()),
+        "load_cell" => ("reference_tension", vec![Sensor::LoadCell]),
+        _ => (
+            "pose_prior",
+            (0..3)
+                .flat_map(|i| [Sensor::Position(i), Sensor::Orientation(i)])
+                .collect(),
+        ),
+    }
 }

@@ -87,6 +87,7 @@ mod report;
 mod residual_tests;
 mod selection;
 mod stand_ins;
+mod term_refit;
 mod variance_components;
 pub mod verify;
 

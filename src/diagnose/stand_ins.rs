@@ -13,6 +13,14 @@
 //! lowers that sensor's misfit without explaining it, so it stands in for
 //! part of something the catalogue lacks.
 //!
+//! Two of the platform's weight, the cables' weight and the load cell's gain
+//! fitted together are judged as one: every `(s p, s c, g / s)` predicts
+//! the same readings ([`super::candidates::WEIGHT_SCALING`]), so neither
+//! value means anything alone, only the family does. Their values are a
+//! stand-in only when no member of the family is within every limit
+//! ([`weight_family_plausible`]); a family with a plausible member is that
+//! member's fit (the report prints it beside the verdict).
+//!
 //! The test: an estimate is beyond its limit when its magnitude (the norm of
 //! the limited parameters, in the effect variable's units) exceeds the limit
 //! by more than 3 standard deviations of that magnitude (its covariance
@@ -21,6 +29,7 @@
 
 use serde::Serialize;
 
+use super::candidates::WEIGHT_SCALING;
 use super::residual_tests::FactorTest;
 use crate::calib::EffectEstimate;
 use crate::model::effect_kind::EffectKind;
@@ -83,6 +92,60 @@ pub(super) fn stand_in(estimate: &EffectEstimate, robot: &Robot, mean_reference_
             limit: limit.limit.clone(),
             why: limit.why.clone(),
             stands_for: stands_for(kind).into(),
+        })
+}
+
+/// Whether `estimates` hold two of [`WEIGHT_SCALING`] whose family of equal
+/// fits (module docs) has a member within every plausible limit of the
+/// three: the platform's and the cables' weight scales `s p` and `s c`, and
+/// the load cell's gain `g / s` beside its bias (a bias does not scale).
+/// The family is searched over `s` from 1/4 to 4 on a grid of ratio 1.0007.
+pub(super) fn weight_family_plausible(
+    estimates: &[EffectEstimate],
+    robot: &Robot,
+    mean_reference_tension_n: f64,
+) -> bool {
+    let find = |kind: EffectKind| estimates.iter().find(|e| e.effect == kind);
+    if WEIGHT_SCALING.iter().filter(|k| find(**k).is_some()).count() < 2 {
+        return false;
+    }
+    // Each member as an estimate, scaled by `s` (a member the model lacks: 1 exactly).
+    let member = |kind: EffectKind, s: f64| -> EffectEstimate {
+        let names: Vec<String> = kind.parameter_names().iter().map(|n| n.to_string()).collect();
+        let n = names.len();
+        let (mut values, mut sigmas, mut covariance) = match find(kind) {
+            Some(e) => (e.values.clone(), e.sigmas.clone(), e.covariance.clone()),
+            None => (vec![0.0; n], vec![0.0; n], vec![vec![0.0; n]; n]),
+        };
+        // The scale is the last parameter (the load cell's gain after its bias).
+        let scale = n - 1;
+        if find(kind).is_none() {
+            values[scale] = 1.0;
+        }
+        let factor = if kind == EffectKind::LoadCell { 1.0 / s } else { s };
+        values[scale] *= factor;
+        sigmas[scale] *= factor;
+        for row in covariance.iter_mut() {
+            row[scale] *= factor;
+        }
+        for value in covariance[scale].iter_mut() {
+            *value *= factor;
+        }
+        EffectEstimate {
+            effect: kind,
+            names,
+            covariance,
+            values,
+            sigmas,
+        }
+    };
+    let steps = 4000;
+    (0..=steps)
+        .map(|k| 0.25 * 16f64.powf(k as f64 / steps as f64))
+        .any(|s| {
+            WEIGHT_SCALING
+                .iter()
+                .all(|kind| stand_in(&member(*kind, s), robot, mean_reference_tension_n).is_none())
         })
 }
 
@@ -264,6 +327,31 @@ mod tests {
                 .map(|r| (0..k).map(|c| if r == c { sigma * sigma } else { 0.0 }).collect())
                 .collect(),
         }
+    }
+
+    #[test]
+    fn two_weight_scalings_are_judged_by_their_family() {
+        let robot = Robot::builtin("large").unwrap();
+        let pair = |gain: f64, platform: f64| {
+            vec![
+                estimate(EffectKind::LoadCell, vec![-4.0, gain], 5e-3),
+                estimate(EffectKind::PlatformWeight, vec![platform], 1e-3),
+            ]
+        };
+        // A gain of 1.163 is beyond 10 % alone, but with a platform x 0.865 it
+        // is cables x 1.157 read by a gain of 1.005 (s = 1.157).
+        let fitted = pair(1.163, 0.865);
+        assert!(stand_in(&fitted[0], &robot, 500.0).is_some());
+        assert!(weight_family_plausible(&fitted, &robot, 500.0));
+        // Gain 2 with a platform x 0.3: the platform needs s >= 1.67, the
+        // cables s <= 1.5: no member of the family is plausible.
+        assert!(!weight_family_plausible(&pair(2.0, 0.3), &robot, 500.0));
+        // A bias beyond its limit does not scale away.
+        let mut biased = pair(1.163, 0.865);
+        biased[0].values[0] = 0.5 * 500.0;
+        assert!(!weight_family_plausible(&biased, &robot, 500.0));
+        // One scaling alone is judged by its own value.
+        assert!(!weight_family_plausible(&fitted[..1], &robot, 500.0));
     }
 
     #[test]

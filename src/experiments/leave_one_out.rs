@@ -6,7 +6,8 @@
 //! a cause). `none` on data with a detectable hidden effect is not honest.
 //! Two exceptions name an equivalent of the effect left out ([`honest`]): a
 //! platform weight, cable weight or load-cell gain left out is still in the
-//! catalogue as the other two together, which predict every reading alike
+//! catalogue as the other two together (each possibly as one of an
+//! ambiguous pair, `X|Y`), which predict every reading alike
 //! ([`crate::diagnose::WEIGHT_SCALING`]; the report gives the equivalent
 //! fit); and an effect that the full catalogue could not tell from another
 //! (`X|Y`) is honestly named by the other.
@@ -68,7 +69,8 @@ pub fn left_out_with(hidden: EffectKind) -> Vec<EffectKind> {
 /// hidden effect `h` left out:
 ///
 /// - exact: the two other members of [`WEIGHT_SCALING`] named together
-///   where `h` is one of them (they predict every reading alike);
+///   (either may be one of an ambiguous `X|Y`) where `h` is one of them
+///   (they predict every reading alike);
 /// - by the diagnosis' own test: `Y` where the full catalogue named `h|Y`
 ///   or `Y|h` (the data do not tell the two apart: their BICs are within
 ///   [`crate::diagnose::AMBIGUOUS_BIC`]).
@@ -85,8 +87,10 @@ pub fn honest(verdict: &str, hidden: &[EffectKind], left_out: &[EffectKind], ful
     let blind: Vec<EffectKind> = hidden.iter().copied().filter(|k| left_out.contains(k)).collect();
     for h in &blind {
         let pair: Vec<&str> = WEIGHT_SCALING.iter().filter(|k| *k != h).map(|k| k.name()).collect();
-        if WEIGHT_SCALING.contains(h) && pair.iter().all(|p| named.contains(p)) {
-            named.retain(|t| !pair.contains(t));
+        // A term `X|Y` names either of the two.
+        let names = |t: &&str, p: &str| t.split('|').any(|name| name == p);
+        if WEIGHT_SCALING.contains(h) && pair.iter().all(|p| named.iter().any(|t| names(t, p))) {
+            named.retain(|t| !pair.iter().any(|p| names(t, p)));
             accounted += 1;
             continue;
         }
@@ -134,6 +138,9 @@ mod tests {
         assert!(honest("loadcell+cable-weight", &[platform], &[platform], ""));
         assert!(honest("platform-weight+loadcell", &[cable], &[cable], ""));
         assert!(!honest("loadcell", &[platform], &[platform], ""));
+        // ... also where the verdict cannot tell one of the two from a rival.
+        assert!(honest("loadcell+cable-weight|segments", &[platform], &[platform], ""));
+        assert!(!honest("loadcell+segments", &[platform], &[platform], ""));
         // The pair names the platform weight left out; the shift still in
         // is missed (not detected), not replaced by a wrong cause.
         assert!(honest("loadcell+cable-weight", &[platform, com], &[platform], ""));

@@ -95,6 +95,17 @@ impl ScoreSystem {
         }
     }
 
+    /// Every term added at once: their coefficients fitted together,
+    /// `c = M^-1 b`, and the chi-square drop they make, `b^T M^-1 b` (to
+    /// first order: the Gauss-Newton step from the model's solution); `None`
+    /// where `M` is singular (terms the data do not tell apart).
+    pub fn joint_fit(&self) -> Option<(DVector<f64>, f64)> {
+        let inverse = self.information.clone().try_inverse()?;
+        let coefficients = inverse * &self.score;
+        let drop = self.score.dot(&coefficients);
+        Some((coefficients, drop))
+    }
+
     /// Forward selection of terms (a sparse regression of the residuals on
     /// the directions): at each step the term of largest `|z|` given those
     /// chosen, while it exceeds `limit(untested)` (`untested`: the testable
@@ -285,6 +296,27 @@ mod tests {
         let given = system.test(1, &[0]);
         assert!((given.coefficient - beta[3]).abs() < 1e-9, "{given:?} vs {}", beta[3]);
         assert!((given.sigma - inverse[(3, 3)].sqrt()).abs() < 1e-9);
+        // Both added at once: the last two coefficients of that regression,
+        // and the chi-square drop from the line's fit to the cubic's.
+        let (joint, drop) = system.joint_fit().unwrap();
+        assert!(
+            (joint[0] - beta[2]).abs() < 1e-9 && (joint[1] - beta[3]).abs() < 1e-9,
+            "{joint:?}"
+        );
+        let chi_square = |fit: &DVector<f64>, columns: usize| -> f64 {
+            xs.iter()
+                .zip(&ys)
+                .map(|(x, y)| ((0..columns).map(|j| fit[j] * x.powi(j as i32)).sum::<f64>() - y) / sigma)
+                .map(|r| r * r)
+                .sum()
+        };
+        let line = graph.values.vector(p).clone();
+        assert!(
+            (drop - (chi_square(&line, 2) - chi_square(&beta, 4))).abs() < 1e-6,
+            "{drop} vs {} - {}",
+            chi_square(&line, 2),
+            chi_square(&beta, 4)
+        );
         // The quadratic term is chosen (z about 14); the cubic one, of noise, is not after it.
         assert_eq!(system.forward_selection(|_| 3.0, 5), vec![0]);
         assert!(system.forward_selection(|_| 3.0, 0).is_empty());
