@@ -86,7 +86,7 @@ pub const MOST_PROPOSED: usize = 3;
 /// The most terms that describe what is wrong when the causes of a model
 /// that does not explain the data are checked against them
 /// (`CausesGivenTerms`): the same forward selection run on past
-/// [`MOST_PROPOSED`] while a term is beyond the limit given those chosen.
+/// the 3 terms proposed while a term is beyond the limit given those chosen.
 /// A proxy absorbs the part of a missing fault that the first few terms
 /// leave (a centre-of-mass shift's tilt is three orientation terms, its
 /// pull on the sags more); a cause is named only when it is needed beyond
@@ -205,7 +205,7 @@ pub(super) struct TermsFound {
 }
 
 /// Are a model's causes still needed once the terms that describe what the
-/// baseline misses ([`MOST_DESCRIBING`]) are added to both? The likelihood ratio of the causes given the
+/// baseline misses ([`crate::diagnose::MOST_DESCRIBING`]) are added to both? The likelihood ratio of the causes given the
 /// terms `T` is theirs alone less what `T` gains in the baseline plus what
 /// `T` gains in the model: `LR(C | T) = LR(C) - D_T(baseline) + D_T(model)`,
 /// each gain `D_T = b_T^T M_TT^-1 b_T` the chi-square drop of adding `T`

@@ -106,7 +106,7 @@ use crate::stats::{self, chi_square_quantile_999};
 pub use candidates::{power_against, CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER, WEIGHT_SCALING};
 pub use drivers::{DriverSeries, DriverTest, DRIVERS, DRIVER_T_LIMIT};
 pub use explanation::{Ambiguity, Explanation, AMBIGUOUS_BIC};
-pub use missing_terms::{CausesGivenTerms, MissingTerm, ALIKE_SHARE};
+pub use missing_terms::{CausesGivenTerms, MissingTerm, ALIKE_SHARE, MOST_DESCRIBING};
 pub use prediction::NotPredictive;
 pub use report::{error_over_sigma, Diagnosis, EffectFit, Gain};
 pub use residual_tests::{FactorTest, MEASUREMENT_KINDS};
