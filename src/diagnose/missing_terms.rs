@@ -205,8 +205,9 @@ pub(super) struct TermsFound {
 }
 
 /// Are a model's causes still needed once the terms that describe what the
-/// baseline misses ([`crate::diagnose::MOST_DESCRIBING`]) are added to both? The likelihood ratio of the causes given the
-/// terms `T` is theirs alone less what `T` gains in the baseline plus what
+/// baseline misses ([`crate::diagnose::MOST_DESCRIBING`]) are added to
+/// both? The likelihood ratio of the causes given the terms `T` is theirs
+/// alone less what `T` gains in the baseline plus what
 /// `T` gains in the model: `LR(C | T) = LR(C) - D_T(baseline) + D_T(model)`,
 /// each gain `D_T = b_T^T M_TT^-1 b_T` the chi-square drop of adding `T`
 /// by the score system (to first order); where the baseline and the model

@@ -26,7 +26,7 @@ use super::candidates::rebuild;
 use super::drivers::PoseSample;
 use super::missing_terms::{direction_of, factor_of, factor_poses};
 use super::residual_tests::total_chi_square;
-use crate::calib::{refine_with_effects, CalibrationOptions, CalibrationResult};
+use crate::calib::{refine_with_effects, CalibrationGraph, CalibrationOptions, CalibrationResult};
 use crate::error::{Error, Result};
 use crate::model::effects::Effects;
 use crate::model::measurement::{PoseMeasurement, Sensor};
@@ -85,7 +85,7 @@ pub(super) fn fit_with_terms(
         })
         .collect();
     let directions: Vec<Direction> = terms.iter().map(|t| t.direction.clone()).collect();
-    let step_at = |graph: &crate::calib::CalibrationGraph| -> Result<(Vec<f64>, f64, f64)> {
+    let step_at = |graph: &CalibrationGraph| -> Result<(Vec<f64>, f64, f64)> {
         let system = score_system(&graph.graph, &directions).map_err(Error::InvalidInput)?;
         let (step, gain) = system
             .joint_fit()
@@ -130,7 +130,7 @@ pub(super) fn fit_with_terms(
 fn correct(
     measurements: &mut [PoseMeasurement],
     used_index: &[usize],
-    graph: &crate::calib::CalibrationGraph,
+    graph: &CalibrationGraph,
     term: &TermRows,
     c: f64,
 ) {
