@@ -82,7 +82,7 @@ pub struct LmParams {
 
 impl Default for LmParams {
     /// 500 iterations, cost tolerance 1e-12, gradient 1e-10, step 1e-12,
-    /// lambda 1e-4 .. 1e16, local refinement on.
+    /// lambda 1e-10 .. 1e16, local refinement on.
     fn default() -> Self {
         Self {
             max_iterations: 500,
