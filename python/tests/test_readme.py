@@ -1,15 +1,13 @@
-"""The notebook-style example of python/README.md (and its copy in the
-repository's README) runs as written and prints what it shows under each cell."""
+"""The notebook-style example of python/README.md runs as written and prints
+what it shows under each cell. (The repository's README points to it rather
+than copying it.)"""
 
 import contextlib
 import io
 import re
 from pathlib import Path
 
-import pytest
-
 README = Path(__file__).resolve().parents[1] / "README.md"
-ROOT_README = Path(__file__).resolve().parents[2] / "README.md"
 
 
 def python_section(path):
@@ -20,8 +18,8 @@ def python_section(path):
     return text[start:] if end < 0 else text[start:end]
 
 
-@pytest.mark.parametrize("path", [README, ROOT_README], ids=["python/README.md", "README.md"])
-def test_the_readme_example_prints_what_it_shows(tmp_path, monkeypatch, path):
+def test_the_readme_example_prints_what_it_shows(tmp_path, monkeypatch):
+    path = README
     cells = re.findall(r"```python\n(.*?)```\n```text\n(.*?)```", python_section(path), flags=re.S)
     assert len(cells) >= 4, "python/README.md: expected ```python cells, each followed by its ```text output"
     monkeypatch.chdir(tmp_path)  # the example writes calibrated.toml here
