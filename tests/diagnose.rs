@@ -1,5 +1,5 @@
 //! `sagcal diagnose` and the hidden-effect experiment, fast subset (the full
-//! sweep is `sagcal experiment hidden-effects --seeds 20`, README): effects
+//! sweep is `sagcal experiment hidden-effects --seeds 20`, docs/results.md): effects
 //! hidden in discretised-simulator data are named, `none` is not rejected,
 //! the extension halves the anchor error, the pulley radius is shown not to be
 //! identifiable and is removed as a known geometry input.

@@ -149,7 +149,7 @@ fn rows_out_of_time_order_have_no_time_and_motion_hypotheses() {
 
 /// Over `SEEDS` seeds per robot, noise and effect: how often the weak end is
 /// named, beside the mean stated power. Ignored (minutes); its numbers are
-/// the README's.
+/// those of docs/diagnose.md.
 #[test]
 #[ignore]
 fn weak_end_rates() {

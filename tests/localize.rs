@@ -183,7 +183,7 @@ fn effects_round_trip_through_the_extended_model() {
             back.chi_square
         );
     }
-    // Elastic cables alone hang the platform lower than the inextensible model (by ~0.17 m, README).
+    // Elastic cables alone hang the platform lower than the inextensible model (by ~0.17 m, docs/diagnose.md).
     let mut elastic = robot("large");
     elastic.effects.apply_spec("elastic:ea_n=3e6").unwrap();
     let eq = &equilibria(&elastic, 1, 3)[0];

@@ -317,7 +317,7 @@ struct CalibrateArgs {
     /// Nominal robot description (TOML): the initial guess of anchors and offsets.
     #[arg(long)]
     robot: PathBuf,
-    /// Measurements: sagcal CSV (see README), a RecurDyn log, or the authors' dataset folder
+    /// Measurements: sagcal CSV (see docs/measurements.md), a RecurDyn log, or the authors' dataset folder
     /// (`pos_i_cpp_test.csv`, `R_i_cpp_test.csv`, `lc_meas_cpp_test.csv`, `forces_cpp_test.csv`).
     #[arg(long)]
     data: PathBuf,
