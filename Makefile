@@ -45,16 +45,21 @@ codegen: $(VENV)/.installed
 codegen-check: $(VENV)/.installed
 	$(PYTHON) codegen/generate.py --check generated
 
-## The README's test command: generated code up to date, every test of the crate,
-## then the Python package's tests.
-test: codegen-check
+## The README's test command: generated code up to date, the lint, every test of
+## the crate, then the Python package's tests.
+test: codegen-check lint
 	cargo test --all-targets
 	cargo test --doc
 	$(MAKE) python-test
 
+## What a reviewer runs: formatting, clippy with warnings denied (the crate and the
+## Python package), the API documentation with warnings denied.
 lint:
 	cargo fmt --all -- --check
+	cargo fmt --manifest-path python/Cargo.toml --all -- --check
 	cargo clippy --all-targets -- -D warnings
+	CARGO_TARGET_DIR=$(CURDIR)/target cargo clippy --manifest-path python/Cargo.toml --all-targets -- -D warnings
+	RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 
 ## Criterion benches: generated Jacobians (analytic vs numerical) and solver scaling.
 bench:
