@@ -449,7 +449,7 @@ fn circles(src: &Path) -> Vec<String> {
             };
             let to = match target.get(common) {
                 None => "mod".to_string(),
-                Some(name) if is_module(&[&scope[..], &[name.clone()]].concat()) => name.clone(),
+                Some(name) if is_module(&[&scope[..], std::slice::from_ref(name)].concat()) => name.clone(),
                 Some(item) => {
                     let scope_file = &modules[&scope].0;
                     re_exports(&code_of(scope_file), &scope, &is_module)
