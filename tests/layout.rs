@@ -510,9 +510,6 @@ const CIRCLES_TO_CUT: &[&str] = &[
     "experiments: hidden_effects <-> identifiability",
     "experiments: selection <-> table2",
     "graph: masked <-> mod",
-    "localize: equilibria <-> mod",
-    "model: effects <-> robot",
-    "model/statics: mod <-> solve",
     "solver: accumulate <-> covariance <-> gram_avx2 <-> linear_system <-> local <-> mod <-> redundancy <-> schur <-> schur_avx2 <-> score <-> system_cache",
 ];
 

@@ -15,7 +15,7 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use super::{pose_distance, ColdStart, Localized, Localizer, Readings};
+use super::localizer::{pose_distance, ColdStart, Localized, Localizer, Readings};
 use crate::error::Result;
 use crate::model::pose::PlatformPose;
 

@@ -54,8 +54,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::model::cables::CABLE_COUNT;
 use crate::model::measurement::{PoseMeasurement, ReadingOrder};
-use crate::model::robot::CABLE_COUNT;
 
 /// Effects acting on a robot beyond the closed-form model. [`Default`]: none.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

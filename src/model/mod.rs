@@ -27,6 +27,7 @@
 //! # Ok::<(), sagcal::Error>(())
 //! ```
 
+mod cables;
 pub mod catenary;
 pub mod effect_kind;
 pub mod effect_limits;

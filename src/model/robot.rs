@@ -18,10 +18,8 @@
 use nalgebra::{SMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 
+pub use crate::model::cables::CABLE_COUNT;
 use crate::model::effects::Effects;
-
-/// Number of cables of the suspended robot modelled by sagcal.
-pub const CABLE_COUNT: usize = 4;
 
 /// Number of calibrated parameters: the anchors' 12 coordinates, then the 4
 /// encoder length offsets.

@@ -5,7 +5,7 @@
 
 use nalgebra::{DMatrix, DVector, UnitQuaternion, Vector3, Vector6};
 
-use super::{
+use super::equations::{
     attachment_height_residuals, cable_geometry, cable_tensions, catenaries, CableTension, Equilibrium, StaticsOptions,
 };
 use crate::error::{Error, Result};
