@@ -17,7 +17,7 @@
 //! Each case's static poses close their family of equilibria by
 //! [`HiddenEffectOptions::closure`]: by default about half are the most level
 //! member, the others the member of a random yaw within
-//! [`DEFAULT_MAX_YAW_DEG`], as a robot settles wherever its statics put it.
+//! [`DEFAULT_MAX_YAW_DEG`](crate::sim::closed_form::DEFAULT_MAX_YAW_DEG), as a robot settles wherever its statics put it.
 //!
 //! # Scoring
 //!
@@ -75,50 +75,15 @@ use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::NoisePreset;
 use crate::model::statics::Equilibrium;
-use crate::sim::closed_form::{sample_equilibria, sample_equilibria_with, Closure, Workspace, DEFAULT_MAX_YAW_DEG};
+use crate::sim::closed_form::{sample_equilibria, sample_equilibria_with, Closure, Workspace};
 use crate::sim::effects::measure_with_effects;
 use crate::stats::{chi_square_critical, noncentral_chi_square_survival};
 
 pub use super::hidden_draws::{draw_effects, mid_range_effects, smallest_effects};
+pub use super::hidden_options::HiddenEffectOptions;
 pub use super::identifiability::{identifiability, Identifiability};
 use super::leave_one_out::{honest, left_out_with};
 pub use super::leave_one_out::{Catalogue, LeftOut};
-
-/// Settings of the experiment.
-#[derive(Debug, Clone, PartialEq)]
-pub struct HiddenEffectOptions {
-    /// Static poses per case.
-    pub poses: usize,
-    /// Sensor noise of the simulated data and of the calibration.
-    pub noise: NoisePreset,
-    /// Segments per cable of the discretised simulator.
-    pub segments: usize,
-    /// Folds of the diagnosis' cross-validation.
-    pub folds: usize,
-    /// How each pose closes its family of equilibria: the most level member
-    /// or one of a random yaw ([`Closure`]).
-    pub closure: Closure,
-    /// The diagnosis' catalogue: every effect, or also each hidden effect left out.
-    pub catalogue: Catalogue,
-}
-
-impl Default for HiddenEffectOptions {
-    /// 35 poses, the authors' noise, 50 segments, 5 folds, about half the
-    /// poses closed by a yaw within [`DEFAULT_MAX_YAW_DEG`] (the rest level).
-    fn default() -> Self {
-        Self {
-            poses: 35,
-            noise: NoisePreset::Authors,
-            segments: 50,
-            folds: 5,
-            closure: Closure::Mixed {
-                yaw_fraction: 0.5,
-                max_yaw_deg: DEFAULT_MAX_YAW_DEG,
-            },
-            catalogue: Catalogue::Full,
-        }
-    }
-}
 
 /// One case: what was hidden and what the diagnosis said.
 #[derive(Debug, Clone, PartialEq, Serialize)]

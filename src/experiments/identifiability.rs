@@ -11,7 +11,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-use super::hidden_effects::HiddenEffectOptions;
+use super::hidden_options::HiddenEffectOptions;
 use crate::calib::{build_graph, calibrate, CableModel, CalibrationError, CalibrationOptions};
 use crate::error::{Error, Result};
 use crate::model::effect_kind::{EffectKind, EffectSet};

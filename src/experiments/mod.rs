@@ -33,5 +33,6 @@ pub mod plan_candidates;
 pub mod pose_plan;
 pub mod selection;
 pub mod table2;
+mod trial;
 
 pub use held_out::{held_out_prediction, HeldOutPrediction};

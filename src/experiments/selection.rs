@@ -55,7 +55,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use super::table2::{
+use super::trial::{
     noisy_measurements, perturbed_guess, trial_inputs, trial_options, trial_stream, PoolPose, Protocol, TrialResult,
 };
 use crate::calib::{calibrate, CalibrationOptions, OrientationPrior};
