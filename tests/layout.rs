@@ -506,7 +506,6 @@ const CIRCLES_TO_CUT: &[&str] = &[
     "calib: gross_errors <-> mistakes <-> screen <-> snooping",
     "calib: mod <-> orientation <-> prepared <-> result <-> uncertainty",
     "calib/factors: catenary_call <-> mod <-> tension_guard",
-    "diagnose: candidates <-> drivers <-> explanation <-> missing_terms <-> mod <-> prediction <-> report <-> selection <-> stand_ins <-> term_refit",
     "graph: masked <-> mod",
     "solver: accumulate <-> covariance <-> gram_avx2 <-> linear_system <-> local <-> mod <-> redundancy <-> schur <-> schur_avx2 <-> score <-> system_cache",
 ];

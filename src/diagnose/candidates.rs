@@ -4,13 +4,12 @@
 
 use serde::Serialize;
 
+use super::baseline::Baseline;
+use super::fitted_graph::rebuild;
 use super::residual_tests::total_chi_square;
-use super::selection::Search;
-use super::Baseline;
-use crate::calib::gross_errors::graph_at_solution;
+use super::search::Search;
 use crate::calib::{
-    refine_with_effects, CableModel, CalibrationError, CalibrationGraph, CalibrationOptions, CalibrationResult,
-    EffectEstimate, OrientationPrior,
+    refine_with_effects, CalibrationError, CalibrationOptions, CalibrationResult, EffectEstimate, OrientationPrior,
 };
 use crate::error::Result;
 use crate::model::effect_kind::{EffectKind, EffectSet};
@@ -323,21 +322,6 @@ pub(super) fn parameters(estimate: &EffectEstimate) -> Vec<ParameterValue> {
             sigma: *sigma,
         })
         .collect()
-}
-
-/// The graph of a fitted calibration (values at the fit), with the effect
-/// variables set from the estimates (the robot file's effects cannot hold a
-/// negative compliance): [`graph_at_solution`] with the catenary model.
-pub(super) fn rebuild(
-    result: &CalibrationResult,
-    used: &[PoseMeasurement],
-    options: &CalibrationOptions,
-) -> CalibrationGraph {
-    let catenary = CalibrationOptions {
-        model: CableModel::Catenary,
-        ..*options
-    };
-    graph_at_solution(result, used, &catenary)
 }
 
 /// The test of `hypothesis` against `model` at a step where `tested`

@@ -9,7 +9,7 @@
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use super::candidates::rebuild;
+use super::fitted_graph::rebuild;
 use crate::calib::{CalibrationOptions, CalibrationResult};
 use crate::error::Result;
 use crate::model::effect_kind::EffectKind;

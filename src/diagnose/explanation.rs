@@ -43,6 +43,7 @@
 
 use serde::Serialize;
 
+use super::baseline::Baseline;
 use super::candidates::{CandidateFit, Hypothesis, Model, WEIGHT_SCALING};
 use super::drivers::{DriverTest, PoseSample};
 use super::missing_terms::{causes_given_terms, missing_terms, CausesGivenTerms, MissingTerm, TermsFound};
@@ -52,7 +53,6 @@ use super::stand_ins::{
     orientation_stand_in, own_sensor, partial_stand_in, stand_in, weight_family_plausible, StandIn,
 };
 use super::term_refit::fit_with_terms;
-use super::Baseline;
 use crate::calib::CalibrationGraph;
 use crate::error::Result;
 use crate::model::effect_kind::EffectKind;
@@ -211,7 +211,7 @@ pub(super) fn explain(
     (false_alarm, time_order): (f64, bool),
     measurements: &[PoseMeasurement],
 ) -> Result<Explanation> {
-    let graph = super::candidates::rebuild(&model.result, &base.used, &model.options);
+    let graph = super::fitted_graph::rebuild(&model.result, &base.used, &model.options);
     let components = measurement_components(&graph.graph);
     let effect_parameters = model.options.free_effects.parameter_count();
     let unknowns = 8 * base.used.len() + 4 * CABLE_COUNT + effect_parameters;
@@ -263,7 +263,7 @@ pub(super) fn explain(
                 false => {
                     // The causes alone: the final model without its stand-ins.
                     let alone = causes_alone(model, &stand_ins, base, measurements)?;
-                    let alone_graph = super::candidates::rebuild(&alone.result, &base.used, &alone.options);
+                    let alone_graph = super::fitted_graph::rebuild(&alone.result, &base.used, &alone.options);
                     let alone_samples = super::drivers::samples(&alone.result, &base.used, &alone.options)?;
                     let fitted = (&alone, &alone_graph, alone_samples.as_slice());
                     check_causes(base, fitted, base_samples, &described, (false_alarm, measurements))?

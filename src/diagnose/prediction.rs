@@ -23,8 +23,9 @@
 use serde::Serialize;
 
 use super::candidates::{Hypothesis, Model};
-use super::selection::{cross_validate, Search};
-use super::Progress;
+use super::progress::Progress;
+use super::search::Search;
+use super::selection::cross_validate;
 use crate::calib::{anchor_rms_bound_m, CalibrationResult};
 use crate::model::robot::CABLE_COUNT;
 

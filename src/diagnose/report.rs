@@ -2,13 +2,14 @@
 
 use serde::Serialize;
 
+use super::baseline::Baseline;
 use super::candidates::{parameters, CandidateFit, Hypothesis, ParameterValue, DETECTION_POWER};
 use super::drivers::{DriverSeries, DriverTest};
 use super::explanation::Explanation;
+use super::options::DiagnoseOptions;
 use super::prediction::NotPredictive;
 use super::residual_tests::FactorTest;
 use super::selection::{Selection, SelectionStep};
-use super::{Baseline, DiagnoseOptions};
 use crate::calib::gross_errors::ExcludedReading;
 use crate::calib::mistakes::Mistake;
 use crate::calib::{CalibrationError, EffectEstimate, OrientationPrior, ParameterUncertainty};

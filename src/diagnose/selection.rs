@@ -23,9 +23,11 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::candidates::{inadmissible, rebuild, test_hypothesis, CandidateFit, Hypothesis, Model};
+use super::candidates::{inadmissible, test_hypothesis, CandidateFit, Hypothesis, Model};
+use super::fitted_graph::rebuild;
+use super::progress::Progress;
 use super::residual_tests::MEASUREMENT_KINDS;
-use super::{Baseline, DiagnoseOptions, Progress};
+use super::search::Search;
 use crate::calib::{
     build_graph, CableModel, CalibrationGraph, CalibrationOptions, CalibrationResult, OrientationPrior,
 };
@@ -33,22 +35,9 @@ use crate::error::{Error, Result};
 use crate::graph::whitened_squared_norm;
 use crate::model::effect_kind::EffectKind;
 use crate::model::measurement::PoseMeasurement;
-use crate::model::robot::Robot;
 use crate::model::statics::CableTension;
 use crate::solver::optimize;
 use crate::stats::chi_square_survival;
-
-/// What the search works on.
-pub(super) struct Search<'a> {
-    /// The baseline fit.
-    pub base: &'a Baseline,
-    /// All measurements (the baseline's excluded poses stay out).
-    pub measurements: &'a [PoseMeasurement],
-    /// The truth, if known (for the report only).
-    pub truth: Option<&'a Robot>,
-    /// The options.
-    pub options: &'a DiagnoseOptions,
-}
 
 /// One step of the forward selection.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -22,8 +22,8 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use super::candidates::rebuild;
 use super::drivers::PoseSample;
+use super::fitted_graph::rebuild;
 use super::missing_terms::{direction_of, factor_of, factor_poses};
 use super::residual_tests::total_chi_square;
 use crate::calib::{refine_with_effects, CalibrationGraph, CalibrationOptions, CalibrationResult};
