@@ -1,17 +1,20 @@
 //! `sagcal.localize`: the calibrated robot's pose and tensions from its cable
-//! readings, row by row as `sagcal localize` does (`src/cli/localize.rs`).
+//! readings, row by row as `sagcal localize` does, with the library's
+//! settings and checks (`sagcal::localize::LocalizeSettings`).
 
 use std::path::PathBuf;
 
 use nalgebra::Vector3;
 use pyo3::prelude::*;
+use sagcal::calib::check_false_alarm;
+use sagcal::error::FrontEnd;
 use sagcal::io::readings::{read_readings, ReadingRow};
-use sagcal::localize::{LocalizeOptions, Localized, Localizer, Readings};
+use sagcal::localize::{require_pose_priors, LocalizeSettings, Localized, Localizer, Readings};
 use sagcal::model::pose::PlatformPose;
 
 use crate::arrays::{exact_rows, out1, out2, out3, rows, vector};
 use crate::data::as_path;
-use crate::options::{false_alarm as check_false_alarm, noise_preset};
+use crate::options::noise_preset;
 use crate::robot::Robot;
 use crate::{invalid, to_py};
 
@@ -192,22 +195,18 @@ pub fn localize(
         ),
     };
     if pose_prior {
-        if let Some(row) = input.iter().find(|r| r.localiser_pose.is_none()) {
-            return Err(to_py(sagcal::Error::Field {
-                path: label,
-                row: row.line,
-                field: "x_m".into(),
-                message: "--pose-prior needs a localiser pose on every row; this file has none".into(),
-            }));
-        }
+        let rows = input.iter().map(|r| (r.line, r.localiser_pose));
+        require_pose_priors(&label, rows, FrontEnd::Python).map_err(to_py)?;
     }
-    let noise = noise_preset(noise)?.sigmas(robot.platform_weight_n);
-    let options = LocalizeOptions {
+    let noise = noise_preset(noise)?;
+    let false_alarm = check_false_alarm(false_alarm, "false_alarm", FrontEnd::Python).map_err(to_py)?;
+    let localizer = LocalizeSettings {
         pose_prior,
-        false_alarm: check_false_alarm(false_alarm, "false_alarm")?,
-        ..LocalizeOptions::default()
-    };
-    let localizer = Localizer::with_options(robot, &noise, options).map_err(to_py)?;
+        false_alarm,
+        ..LocalizeSettings::new(noise)
+    }
+    .localizer(robot)
+    .map_err(to_py)?;
     Ok(py.detach(|| localize_rows(&localizer, &input)))
 }
 

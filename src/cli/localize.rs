@@ -2,9 +2,10 @@
 
 use serde::Serialize;
 
+use sagcal::error::FrontEnd;
 use sagcal::io::readings::{read_readings, ReadingsFile, ReadingsFormat};
 use sagcal::io::recurdyn::RejectedRow;
-use sagcal::localize::{LocalizeOptions, Localized, Localizer, Readings};
+use sagcal::localize::{require_pose_priors, LocalizeSettings, Localized, Localizer, Readings};
 use sagcal::model::pose::PlatformPose;
 use sagcal::model::Robot;
 use sagcal::plot::localize::{localize_plot_svg, LocalizePlot, PlottedPose};
@@ -81,14 +82,13 @@ struct Report {
 pub fn run(args: &LocalizeArgs) -> sagcal::Result<()> {
     let robot = Robot::from_file(&args.robot)?;
     let file = read_readings(&args.data, robot.reference_cable)?;
-    let noise = args.noise.sigmas(robot.platform_weight_n);
-    let options = LocalizeOptions {
+    let localizer = LocalizeSettings {
+        noise: args.noise,
         pose_prior: args.pose_prior,
         false_alarm: args.false_alarm,
         calibration_uncertainty: !args.no_calibration_uncertainty,
-        ..LocalizeOptions::default()
-    };
-    let localizer = Localizer::with_options(&robot, &noise, options)?;
+    }
+    .localizer(&robot)?;
     let mut report = localize_file(
         &args.robot.display().to_string(),
         &file,
@@ -137,14 +137,8 @@ fn localize_file(
     search: bool,
 ) -> sagcal::Result<Report> {
     if pose_prior {
-        if let Some(row) = file.rows.iter().find(|r| r.localiser_pose.is_none()) {
-            return Err(sagcal::Error::Field {
-                path: file.path.clone(),
-                row: row.line,
-                field: "x_m".into(),
-                message: "--pose-prior needs a localiser pose on every row; this file has none".into(),
-            });
-        }
+        let rows = file.rows.iter().map(|r| (r.line, r.localiser_pose));
+        require_pose_priors(&file.path, rows, FrontEnd::Cli)?;
     }
     let mut warm: Option<PlatformPose> = None;
     let mut rows = Vec::with_capacity(file.rows.len());

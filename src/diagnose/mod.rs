@@ -86,6 +86,7 @@ mod prediction;
 mod report;
 mod residual_tests;
 mod selection;
+mod settings;
 mod stand_ins;
 mod term_refit;
 mod variance_components;
@@ -111,6 +112,7 @@ pub use prediction::NotPredictive;
 pub use report::{error_over_sigma, Diagnosis, EffectFit, Gain};
 pub use residual_tests::{FactorTest, MEASUREMENT_KINDS};
 pub use selection::SelectionStep;
+pub use settings::DiagnoseSettings;
 pub use stand_ins::{StandIn, STAND_IN_SIGMAS};
 pub use variance_components::{noise_the_data_show, SMALLEST_NOISE_SCALE};
 

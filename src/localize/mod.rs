@@ -48,6 +48,7 @@ mod equations;
 mod equilibria;
 mod frame;
 mod newton;
+mod settings;
 pub mod stiffness;
 
 use nalgebra::{Matrix6, SMatrix, UnitQuaternion, Vector2, Vector3, Vector6};
@@ -59,6 +60,7 @@ pub use equations::{
 pub use equilibria::tilt_deg;
 pub use frame::Frame;
 use newton::{Observation, Solution};
+pub use settings::{require_pose_priors, LocalizeSettings};
 
 use crate::error::{Error, Result};
 use crate::model::pose::PlatformPose;
