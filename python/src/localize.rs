@@ -207,37 +207,26 @@ pub fn localize(
     }
     .localizer(robot)
     .map_err(to_py)?;
-    Ok(py.detach(|| localize_rows(&localizer, &input)))
+    py.detach(|| localize_rows(&localizer, &input))
 }
 
-/// Every row, warm-started from the last stable pose (as the command does).
-fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> Localization {
-    let mut warm: Option<PlatformPose> = None;
-    let mut found = Vec::with_capacity(input.len());
-    let mut flags = Vec::with_capacity(input.len());
-    for row in input {
-        if sagcal::cancel::requested() {
-            break;
-        }
-        let readings = Readings {
+/// Every row in order, as the command localises them
+/// (`sagcal::localize::Localizer::localize_sequence`, without the
+/// multistart search), stopping at a stop request.
+fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> PyResult<Localization> {
+    let readings: Vec<Readings> = input
+        .iter()
+        .map(|row| Readings {
             encoder_lengths_m: row.encoder_lengths_m,
             load_cell_n: row.load_cell_n,
             localiser_pose: row.localiser_pose,
-        };
-        match localizer.localize(&readings, warm.as_ref()) {
-            Ok(f) => {
-                if f.stable && localizer.frame_allows(&f) {
-                    warm = Some(f.pose);
-                }
-                flags.push(localizer.flag(&f));
-                found.push(Some(f));
-            }
-            Err(e) => {
-                flags.push(Some(e.to_string()));
-                found.push(None);
-            }
-        }
-    }
+        })
+        .collect();
+    let solved = localizer
+        .localize_sequence(&readings, false, &mut sagcal::cancel::requested)
+        .map_err(to_py)?;
+    let (found, flags): (Vec<Option<Localized>>, Vec<Option<String>>) =
+        solved.into_iter().map(|row| (row.found.ok(), row.flag)).unzip();
     let position_error_m = input.iter().all(|r| r.localiser_pose.is_some()).then(|| {
         input
             .iter()
@@ -248,12 +237,12 @@ fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> Localization {
             })
             .collect()
     });
-    Localization {
+    Ok(Localization {
         lines: input.iter().map(|r| r.line).collect(),
         found,
         flags,
         position_error_m,
-    }
+    })
 }
 
 /// Rows of readings from arrays, every value checked (finite; load cell positive).

@@ -140,30 +140,26 @@ fn localize_file(
         let rows = file.rows.iter().map(|r| (r.line, r.localiser_pose));
         require_pose_priors(&file.path, rows, FrontEnd::Cli)?;
     }
-    let mut warm: Option<PlatformPose> = None;
-    let mut rows = Vec::with_capacity(file.rows.len());
-    let mut plotted = Vec::new();
-    for row in &file.rows {
-        let readings = Readings {
+    let readings: Vec<Readings> = file
+        .rows
+        .iter()
+        .map(|row| Readings {
             encoder_lengths_m: row.encoder_lengths_m,
             load_cell_n: row.load_cell_n,
             localiser_pose: row.localiser_pose,
-        };
-        let result = localizer.localize(&readings, warm.as_ref());
-        let report = match result {
+        })
+        .collect();
+    let solved = localizer.localize_sequence(&readings, search, &mut || false)?;
+    let mut rows = Vec::with_capacity(file.rows.len());
+    let mut plotted = Vec::new();
+    for (row, solved) in file.rows.iter().zip(solved) {
+        let report = match &solved.found {
             Ok(found) => {
-                let mut report = row_report(row.line, &found, localizer.flag(&found), row.localiser_pose.as_ref());
-                if search {
-                    let reference = warm.or(readings.localiser_pose.filter(|_| pose_prior));
-                    let all = localizer.equilibria(&readings, reference.as_ref())?;
-                    let stable: Vec<_> = all.iter().filter(|l| l.stable).collect();
-                    report.equilibria = Some(all.len());
-                    report.stable_equilibria = Some(stable.len());
-                    report.ambiguity_m = stable
-                        .iter()
-                        .map(|l| (l.pose.position_m - found.pose.position_m).norm())
-                        .filter(|d| *d > 1e-6)
-                        .reduce(f64::max);
+                let mut report = row_report(row.line, found, solved.flag, row.localiser_pose.as_ref());
+                if let Some(search) = solved.search {
+                    report.equilibria = Some(search.equilibria);
+                    report.stable_equilibria = Some(search.stable);
+                    report.ambiguity_m = search.ambiguity_m;
                 }
                 let total = found.covariance + found.calibration_covariance.unwrap_or_default();
                 plotted.push(PlottedPose {
@@ -173,13 +169,9 @@ fn localize_file(
                     reference_m: row.localiser_pose.map(|p| p.position_m.into()),
                     flagged: report.flag.is_some(),
                 });
-                // A pose outside the frame is no start for the next row.
-                if found.stable && localizer.frame_allows(&found) {
-                    warm = Some(found.pose);
-                }
                 report
             }
-            Err(e) => flagged(row.line, e.to_string()),
+            Err(why) => flagged(row.line, why.clone()),
         };
         rows.push(report);
     }

@@ -48,6 +48,7 @@ mod equations;
 mod equilibria;
 mod frame;
 mod newton;
+mod sequence;
 mod settings;
 pub mod stiffness;
 
@@ -60,6 +61,7 @@ pub use equations::{
 pub use equilibria::tilt_deg;
 pub use frame::Frame;
 use newton::{Observation, Solution};
+pub use sequence::{EquilibriumSearch, SequenceRow};
 pub use settings::{require_pose_priors, LocalizeSettings};
 
 use crate::error::{Error, Result};
