@@ -1,36 +1,19 @@
 //! `sagcal.calibrate`: anchors and encoder offsets from measurements, the
-//! checked calibration of `sagcal calibrate` (`src/cli/calibrate.rs`), with
-//! the same options, the same result and the same errors.
+//! checked calibration of `sagcal calibrate`: the library's job
+//! (`sagcal::calib::calibrate_job`), with the same options, the same report
+//! and the same errors, a refusal naming `accept_inconsistent=True`.
 
 use pyo3::prelude::*;
-use sagcal::calib::gross_errors::{calibrate_checked, ExcludedReading, GrossErrorOptions, Verdict};
-use sagcal::calib::mistakes::Mistake;
+use sagcal::calib::gross_errors::Verdict;
 use sagcal::calib::report::CalibrationReport;
-use sagcal::calib::{CalibrationResult, ParameterUncertainty};
-use serde::Serialize;
+use sagcal::calib::{calibrate_job, CalibrationResult, CalibrationSettings, ParameterUncertainty};
+use sagcal::error::FrontEnd;
 
 use crate::arrays::{out1, out2, out3};
 use crate::json::to_python;
-use crate::options::{false_alarm, SolverArgs};
+use crate::options::SolverArgs;
 use crate::robot::Robot;
 use crate::to_py;
-
-/// The gross-error section of the command's JSON (`src/cli/gross_errors.rs`).
-#[derive(Serialize)]
-struct GrossErrorReport<'a> {
-    verdict: &'a Verdict,
-    excluded_readings: &'a [ExcludedReading],
-    mistakes: &'a [Mistake],
-    tests: &'a sagcal::calib::gross_errors::ConsistencyTest,
-}
-
-/// What `sagcal calibrate --json` prints.
-#[derive(Serialize)]
-struct CheckedReport<'a> {
-    #[serde(flatten)]
-    report: &'a CalibrationReport,
-    gross_errors: GrossErrorReport<'a>,
-}
 
 /// The result of :func:`calibrate`: the calibrated robot, the uncertainty of
 /// its anchors and offsets, the solver's account, the residual statistics
@@ -289,56 +272,37 @@ pub fn calibrate(
 ) -> PyResult<Calibration> {
     let nominal = robot.inner.clone();
     let data = crate::data::measurements(measurements, nominal.reference_cable)?;
-    let options = SolverArgs {
-        model,
-        noise,
-        encoder_sigma_m,
-        load_cell_sigma_n,
-        position_sigma_m,
-        orientation_prior,
-        robust_encoder,
-        robust_load_cell,
-        robust_pose,
-    }
-    .options(&nominal)?;
-    let check = GrossErrorOptions {
-        false_alarm: self::false_alarm(false_alarm, "false_alarm")?,
-        ..GrossErrorOptions::default()
-    };
-    let label = data.label.display().to_string();
-    let checked = py
-        .detach(|| calibrate_checked(&nominal, &data.poses, &options, &check))
-        .map_err(|e| {
-            to_py(sagcal::Error::InvalidInput(format!(
-                "{label}: no robot file is written: {e}"
-            )))
-        })?;
-    let lines: Vec<usize> = checked.rows.iter().map(|&row| data.line(row)).collect();
-    let report = CalibrationReport::new(&checked.result, &nominal, options.model, &lines, None);
-    if let Verdict::Inconsistent { reason } = &checked.verdict {
-        if !accept_inconsistent {
-            return Err(to_py(sagcal::Error::InvalidInput(format!(
-                "{label}: the calibration fails its own consistency tests, so no robot file is written \
-                 (--accept-inconsistent writes it anyway): {reason}"
-            ))));
+    let settings = CalibrationSettings {
+        solver: SolverArgs {
+            model,
+            noise,
+            encoder_sigma_m,
+            load_cell_sigma_n,
+            position_sigma_m,
+            orientation_prior,
+            robust_encoder,
+            robust_load_cell,
+            robust_pose,
         }
+        .settings()?,
+        false_alarm,
+        accept_inconsistent,
+    };
+    let source = data.label.display().to_string();
+    let mut job = py
+        .detach(|| calibrate_job(&nominal, &data.poses, &source, &settings, FrontEnd::Python))
+        .map_err(to_py)?;
+    if let Some(refusal) = job.refusal.take() {
+        return Err(to_py(refusal));
     }
-    let json = serde_json::to_value(CheckedReport {
-        report: &report,
-        gross_errors: GrossErrorReport {
-            verdict: &checked.verdict,
-            excluded_readings: &checked.excluded,
-            mistakes: &checked.mistakes,
-            tests: &checked.test,
-        },
-    })
-    .map_err(|e| crate::invalid(format!("cannot serialise the report as JSON: {e}")))?;
+    let json = serde_json::to_value(&job.report)
+        .map_err(|e| crate::invalid(format!("cannot serialise the report as JSON: {e}")))?;
     Ok(Calibration {
-        robot: checked.result.robot.clone(),
-        result: checked.result,
-        report,
+        robot: job.checked.result.robot.clone(),
+        result: job.checked.result,
+        report: job.report.report,
         json,
-        verdict: checked.verdict,
-        rows: checked.rows,
+        verdict: job.checked.verdict,
+        rows: job.checked.rows,
     })
 }

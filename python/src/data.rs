@@ -17,24 +17,13 @@ pub const ARRAY_LABEL: &str = "measurements";
 
 /// Measurements with the name of their source.
 pub struct Data {
-    /// The poses, in row order.
+    /// The poses, in row order (an array's with line 0: reports name them by their 1-based row).
     pub poses: Vec<PoseMeasurement>,
     /// The file (as given), or [`ARRAY_LABEL`] for an array.
     pub label: PathBuf,
     /// Whether the rows are in the order the poses were taken: a sagcal
     /// measurement file or an array (not a RecurDyn log or an authors' folder).
     pub rows_in_time_order: bool,
-}
-
-impl Data {
-    /// Per pose, the number that names it in reports: its file line, or its
-    /// 1-based row in an array.
-    pub fn line(&self, pose: usize) -> usize {
-        match self.poses[pose].line {
-            0 => pose + 1,
-            line => line,
-        }
-    }
 }
 
 /// Read `value`: a path (`str` or `os.PathLike`: sagcal CSV, RecurDyn log, or

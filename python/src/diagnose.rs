@@ -1,11 +1,12 @@
 //! `sagcal.diagnose`: what the calibration model gets wrong (`sagcal
-//! diagnose`, `src/cli/diagnose.rs`), with the same options and report.
+//! diagnose`), with the same options, checked by the library
+//! (`sagcal::diagnose::DiagnoseSettings`), and the same report.
 
 use std::sync::Mutex;
 
 use pyo3::prelude::*;
-use sagcal::diagnose::DiagnoseOptions;
-use sagcal::model::effect_kind::EffectKind;
+use sagcal::diagnose::DiagnoseSettings;
+use sagcal::error::FrontEnd;
 
 use crate::arrays::out2;
 use crate::json::to_python;
@@ -167,8 +168,8 @@ pub fn diagnose(
     let nominal = robot.inner.clone();
     let truth = truth.map(|t| t.inner.clone());
     let data = crate::data::measurements(measurements, nominal.reference_cable)?;
-    let mut options = DiagnoseOptions::new(
-        SolverArgs {
+    let options = DiagnoseSettings {
+        solver: SolverArgs {
             model,
             noise,
             encoder_sigma_m,
@@ -179,19 +180,15 @@ pub fn diagnose(
             robust_load_cell,
             robust_pose,
         }
-        .options(&nominal)?,
-    );
-    options.folds = folds;
-    options.false_alarm = false_alarm;
-    options.orientation_hypothesis = orientation_hypothesis;
-    options.rows_in_time_order = data.rows_in_time_order;
-    if let Some(list) = candidates {
-        options.candidates = list
-            .iter()
-            .map(|c| EffectKind::parse(c))
-            .collect::<Result<_, _>>()
-            .map_err(|e| invalid(format!("candidates: {e}")))?;
+        .settings()?,
+        candidates,
+        orientation_hypothesis,
+        folds,
+        false_alarm,
+        rows_in_time_order: data.rows_in_time_order,
     }
+    .options(&nominal, FrontEnd::Python)
+    .map_err(to_py)?;
     // The first exception the progress callback raised, re-raised after the run.
     let callback_error: Mutex<Option<PyErr>> = Mutex::new(None);
     let diagnosis = py

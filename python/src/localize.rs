@@ -1,17 +1,20 @@
 //! `sagcal.localize`: the calibrated robot's pose and tensions from its cable
-//! readings, row by row as `sagcal localize` does (`src/cli/localize.rs`).
+//! readings, row by row as `sagcal localize` does, with the library's
+//! settings and checks (`sagcal::localize::LocalizeSettings`).
 
 use std::path::PathBuf;
 
 use nalgebra::Vector3;
 use pyo3::prelude::*;
+use sagcal::calib::check_false_alarm;
+use sagcal::error::FrontEnd;
 use sagcal::io::readings::{read_readings, ReadingRow};
-use sagcal::localize::{LocalizeOptions, Localized, Localizer, Readings};
+use sagcal::localize::{require_pose_priors, LocalizeSettings, Localized, Localizer, Readings};
 use sagcal::model::pose::PlatformPose;
 
 use crate::arrays::{exact_rows, out1, out2, out3, rows, vector};
 use crate::data::as_path;
-use crate::options::{false_alarm as check_false_alarm, noise_preset};
+use crate::options::noise_preset;
 use crate::robot::Robot;
 use crate::{invalid, to_py};
 
@@ -192,53 +195,38 @@ pub fn localize(
         ),
     };
     if pose_prior {
-        if let Some(row) = input.iter().find(|r| r.localiser_pose.is_none()) {
-            return Err(to_py(sagcal::Error::Field {
-                path: label,
-                row: row.line,
-                field: "x_m".into(),
-                message: "--pose-prior needs a localiser pose on every row; this file has none".into(),
-            }));
-        }
+        let rows = input.iter().map(|r| (r.line, r.localiser_pose));
+        require_pose_priors(&label, rows, FrontEnd::Python).map_err(to_py)?;
     }
-    let noise = noise_preset(noise)?.sigmas(robot.platform_weight_n);
-    let options = LocalizeOptions {
+    let noise = noise_preset(noise)?;
+    let false_alarm = check_false_alarm(false_alarm, "false_alarm", FrontEnd::Python).map_err(to_py)?;
+    let localizer = LocalizeSettings {
         pose_prior,
-        false_alarm: check_false_alarm(false_alarm, "false_alarm")?,
-        ..LocalizeOptions::default()
-    };
-    let localizer = Localizer::with_options(robot, &noise, options).map_err(to_py)?;
-    Ok(py.detach(|| localize_rows(&localizer, &input)))
+        false_alarm,
+        ..LocalizeSettings::new(noise)
+    }
+    .localizer(robot)
+    .map_err(to_py)?;
+    py.detach(|| localize_rows(&localizer, &input))
 }
 
-/// Every row, warm-started from the last stable pose (as the command does).
-fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> Localization {
-    let mut warm: Option<PlatformPose> = None;
-    let mut found = Vec::with_capacity(input.len());
-    let mut flags = Vec::with_capacity(input.len());
-    for row in input {
-        if sagcal::cancel::requested() {
-            break;
-        }
-        let readings = Readings {
+/// Every row in order, as the command localises them
+/// (`sagcal::localize::Localizer::localize_sequence`, without the
+/// multistart search), stopping at a stop request.
+fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> PyResult<Localization> {
+    let readings: Vec<Readings> = input
+        .iter()
+        .map(|row| Readings {
             encoder_lengths_m: row.encoder_lengths_m,
             load_cell_n: row.load_cell_n,
             localiser_pose: row.localiser_pose,
-        };
-        match localizer.localize(&readings, warm.as_ref()) {
-            Ok(f) => {
-                if f.stable && localizer.frame_allows(&f) {
-                    warm = Some(f.pose);
-                }
-                flags.push(localizer.flag(&f));
-                found.push(Some(f));
-            }
-            Err(e) => {
-                flags.push(Some(e.to_string()));
-                found.push(None);
-            }
-        }
-    }
+        })
+        .collect();
+    let solved = localizer
+        .localize_sequence(&readings, false, &mut sagcal::cancel::requested)
+        .map_err(to_py)?;
+    let (found, flags): (Vec<Option<Localized>>, Vec<Option<String>>) =
+        solved.into_iter().map(|row| (row.found.ok(), row.flag)).unzip();
     let position_error_m = input.iter().all(|r| r.localiser_pose.is_some()).then(|| {
         input
             .iter()
@@ -249,12 +237,12 @@ fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> Localization {
             })
             .collect()
     });
-    Localization {
+    Ok(Localization {
         lines: input.iter().map(|r| r.line).collect(),
         found,
         flags,
         position_error_m,
-    }
+    })
 }
 
 /// Rows of readings from arrays, every value checked (finite; load cell positive).

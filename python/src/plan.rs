@@ -5,6 +5,7 @@
 
 use pyo3::prelude::*;
 use sagcal::calib::OrientationPrior;
+use sagcal::error::FrontEnd;
 use sagcal::experiments::pose_plan::{
     parse_workspace, plan_calibration, workspace_from_bounds, CandidateSource, PlanSettings, PlannedCalibration,
 };
@@ -216,6 +217,7 @@ pub fn plan(
         seed,
         criterion: parse("criterion", criterion, Criterion::parse)?,
         orientation_prior: parse("orientation_prior", orientation_prior, OrientationPrior::parse)?,
+        front_end: FrontEnd::Python,
     };
     let planned = py
         .detach(|| plan_calibration(&robot, &settings, &mut |_| {}))

@@ -5,14 +5,14 @@
 use pyo3::prelude::*;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use sagcal::error::FrontEnd;
 use sagcal::sim::closed_form::{measure, sample_equilibria_with, Closure, Workspace};
-use sagcal::sim::discretised::MAX_SEGMENTS;
-use sagcal::sim::effects::measure_with_effects;
+use sagcal::sim::effects::{measure_with_effects, simulation_truth};
 
 use crate::data::to_array;
 use crate::options::{noise_preset, parse};
 use crate::robot::Robot;
-use crate::{invalid, to_py};
+use crate::to_py;
 
 /// The result of :func:`simulate`: the measurements and the truth they came from.
 #[pyclass(module = "sagcal", name = "Simulation", frozen)]
@@ -82,21 +82,14 @@ pub fn simulate(
     segments: usize,
     closure: &str,
 ) -> PyResult<Simulation> {
-    let mut truth = robot.inner.clone();
-    if poses == 0 {
-        return Err(invalid("--poses must be at least 1"));
-    }
-    for spec in effects.iter().flatten() {
-        truth
-            .effects
-            .apply_spec(spec)
-            .map_err(|e| invalid(format!("--effect `{spec}`: {e}")))?;
-    }
-    if !truth.effects.is_none() && !(1..=MAX_SEGMENTS).contains(&segments) {
-        return Err(invalid(format!(
-            "--segments must be between 1 and {MAX_SEGMENTS}, got {segments}"
-        )));
-    }
+    let truth = simulation_truth(
+        &robot.inner,
+        poses,
+        &effects.unwrap_or_default(),
+        segments,
+        FrontEnd::Python,
+    )
+    .map_err(to_py)?;
     let noise = noise_preset(noise)?.sigmas(truth.platform_weight_n);
     let closure = parse("closure", closure, Closure::parse)?;
     let measurements = py

@@ -105,10 +105,36 @@ def test_simulate_errors_are_the_commands(cli, tmp_path):
     robot = ROOT / "robots" / "large.toml"
     out = tmp_path / "x.csv"
     large = sagcal.Robot.from_toml(robot)
+    # The command's words, naming the keyword where the command names its flag.
     expected = cli_error(cli("simulate", "--robot", robot, "--poses", "0", "--out", out, check=False))
-    assert message(lambda: sagcal.simulate(large, 0)) == expected
+    assert expected == "invalid input: --poses must be at least 1"
+    assert message(lambda: sagcal.simulate(large, 0)) == "invalid input: poses must be at least 1"
     expected = cli_error(
         cli("simulate", "--robot", robot, "--poses", "3", "--out", out, "--effect", "elastic:ea_n=-1", check=False)
     )
-    assert message(lambda: sagcal.simulate(large, 3, effects=["elastic:ea_n=-1"])) == expected
+    assert expected.startswith("invalid input: --effect `elastic:ea_n=-1`: ")
+    assert message(lambda: sagcal.simulate(large, 3, effects=["elastic:ea_n=-1"])) == expected.replace(
+        "--effect `", "effects `"
+    )
     assert not out.exists()
+
+
+def test_messages_name_keywords_not_flags(cli, problem):
+    folder, guess = problem["folder"], problem["guess"]
+    # A refused fit: the command's message, naming the keyword that accepts it in Python.
+    flags = ("calibrate", "--robot", folder / "guess.toml", "--data", folder / "data.csv", "--model", "rigid")
+    expected = cli_error(cli(*flags, check=False))
+    assert "(--accept-inconsistent writes it anyway): " in expected
+    python = expected.replace("(--accept-inconsistent writes it anyway)", "(accept_inconsistent=True returns it anyway)")
+    assert message(lambda: sagcal.calibrate(guess, folder / "data.csv", model="rigid")) == python
+    # A bad override and an unknown candidate effect, named by keyword.
+    assert message(lambda: sagcal.calibrate(guess, problem["measurements"], encoder_sigma_m=-1.0)) == (
+        "invalid input: encoder_sigma_m must be a positive number, got -1"
+    )
+    assert message(lambda: sagcal.diagnose(guess, problem["measurements"], candidates=["magic"])).startswith(
+        "invalid input: candidates: unknown effect `magic`"
+    )
+    # A localiser pose as a prior without one.
+    assert message(lambda: sagcal.localize(problem["truth"], problem["measurements"][:, 6:10], pose_prior=True)) == (
+        "readings: row 1, field `x_m`: pose_prior=True needs a localiser pose on every row; this file has none"
+    )

@@ -99,6 +99,7 @@ pub mod factors;
 mod graph;
 pub mod gross_errors;
 mod init;
+mod job;
 mod load_cell_factor;
 pub mod mistakes;
 mod mounted_pose_prior;
@@ -109,6 +110,7 @@ mod prepared;
 pub mod report;
 mod result;
 pub mod screen;
+mod settings;
 mod snooping;
 mod system_scope;
 mod uncertainty;
@@ -125,6 +127,7 @@ pub use graph::{
     build_graph, effects_from_graph, robot_from_graph, validate_measurements, CalibrationGraph, MIN_POSES,
 };
 pub use init::warm_start;
+pub use job::{calibrate_job, refusal, CalibrationJob};
 pub use options::{CableModel, CalibrationOptions, OrientationPrior, RobustKernels};
 pub use orientation::OrientationCheck;
 pub use predict::predict_with_effects;
@@ -132,6 +135,7 @@ pub use prepared::PreparedCalibration;
 pub use result::{
     factor_statistics, CalibrationResult, EffectEstimate, FactorStatistics, ParameterUncertainty, StageSummary,
 };
+pub use settings::{check_false_alarm, CalibrationSettings, SolverSettings};
 pub use uncertainty::{anchor_rms_bound_m, cramer_rao_bound, parameter_uncertainty, CalibrationError};
 
 /// Calibrate anchors and length offsets from `measurements`, starting from `initial`.

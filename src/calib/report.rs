@@ -1,4 +1,6 @@
-//! A calibration's result as a serialisable report (what `sagcal calibrate --json` prints).
+//! A calibration's result as a serialisable report, and the checked
+//! calibration's report with its gross-error tests ([`CheckedReport`]: what
+//! `sagcal calibrate --json` prints and `sagcal.calibrate(...).report` holds).
 //!
 //! ```
 //! use rand::SeedableRng;
@@ -29,6 +31,8 @@
 
 use serde::Serialize;
 
+use super::gross_errors::{CheckedCalibration, ConsistencyTest, ExcludedReading, Verdict};
+use super::mistakes::Mistake;
 use super::{
     CableModel, CalibrationError, CalibrationResult, FactorStatistics, OrientationCheck, ParameterUncertainty,
     StageSummary,
@@ -125,4 +129,46 @@ impl CalibrationReport {
             orientation_check: result.orientation_check,
         }
     }
+}
+
+/// What the gross-error tests found and did (the `gross_errors` section of
+/// the checked report).
+#[derive(Debug, Clone, Serialize)]
+pub struct GrossErrorReport {
+    /// `consistent`, or `inconsistent` with its reason.
+    pub verdict: Verdict,
+    /// Readings left out, each with its row, sensor, estimated error, `w` and explanation.
+    pub excluded_readings: Vec<ExcludedReading>,
+    /// For an inconsistent fit: the readings the search had left out before
+    /// it gave up (the fit reported uses them; omitted when empty).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub set_aside_readings: Vec<ExcludedReading>,
+    /// Common mistakes recognised (units, swapped cables, re-homing, poses outside the frame).
+    pub mistakes: Vec<Mistake>,
+    /// The tests of the final fit.
+    pub tests: ConsistencyTest,
+}
+
+impl GrossErrorReport {
+    /// The report of a checked calibration.
+    pub fn new(checked: &CheckedCalibration) -> Self {
+        Self {
+            verdict: checked.verdict.clone(),
+            excluded_readings: checked.excluded.clone(),
+            set_aside_readings: checked.set_aside.clone(),
+            mistakes: checked.mistakes.clone(),
+            tests: checked.test.clone(),
+        }
+    }
+}
+
+/// A checked calibration's report: the calibration's, with its gross-error
+/// tests beside it (what `sagcal calibrate --json` prints).
+#[derive(Debug, Clone, Serialize)]
+pub struct CheckedReport {
+    /// The calibration (its keys at the top level of the JSON).
+    #[serde(flatten)]
+    pub report: CalibrationReport,
+    /// The gross-error tests.
+    pub gross_errors: GrossErrorReport,
 }

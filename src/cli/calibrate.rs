@@ -1,14 +1,18 @@
 //! `sagcal calibrate`: anchors and offsets from a measurement file.
 
-use sagcal::calib::gross_errors::{calibrate_checked, GrossErrorOptions, Verdict};
+use sagcal::calib::gross_errors::Verdict;
 use sagcal::calib::report::CalibrationReport;
-use sagcal::calib::{CableModel, CalibrationOptions, CalibrationResult, OrientationPrior, ParameterUncertainty};
+use sagcal::calib::{
+    calibrate_job, CableModel, CalibrationOptions, CalibrationResult, CalibrationSettings, OrientationPrior,
+    ParameterUncertainty,
+};
+use sagcal::error::FrontEnd;
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::io::OutputSet;
 use sagcal::model::Robot;
 use sagcal::plot::{anchor_plot_svg, figure_bytes, AnchorPlot, AnchorPlotEntry};
 
-use super::gross_errors::{self, GrossErrorReport};
+use super::gross_errors;
 use super::output::{print_json, Table};
 use super::CalibrateArgs;
 
@@ -21,44 +25,27 @@ pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
             keep_rounded: false,
         },
     )?;
-    let options = args.solver.options(&nominal)?;
-    if !(args.false_alarm > 0.0 && args.false_alarm < 1.0) {
-        return Err(sagcal::Error::InvalidInput(format!(
-            "--false-alarm must be between 0 and 1, got {}",
-            args.false_alarm
-        )));
-    }
-    let check = GrossErrorOptions {
+    let settings = CalibrationSettings {
+        solver: args.solver.settings(),
         false_alarm: args.false_alarm,
-        ..GrossErrorOptions::default()
+        accept_inconsistent: args.accept_inconsistent,
     };
-    let checked = calibrate_checked(&nominal, &data.poses, &options, &check)
-        .map_err(|e| sagcal::Error::InvalidInput(format!("{}: no robot file is written: {e}", args.data.display())))?;
-    let result = &checked.result;
-    let lines: Vec<usize> = checked.measurements.iter().map(|p| p.line).collect();
-    let report = CalibrationReport::new(result, &nominal, options.model, &lines, None);
-    let gross = GrossErrorReport::new(&checked);
-    let refused = matches!(checked.verdict, Verdict::Inconsistent { .. }) && !args.accept_inconsistent;
-    if refused {
+    let source = args.data.display().to_string();
+    let mut job = calibrate_job(&nominal, &data.poses, &source, &settings, FrontEnd::Cli)?;
+    if let Some(refusal) = job.refusal.take() {
         // Nothing is written: the report goes out, then the error names the sensors.
         if !args.json {
-            print!("{}", render(&report, &options));
-            print!("{}", gross_errors::render(&gross));
+            print!("{}", render(&job.report.report, &job.options));
+            print!("{}", gross_errors::render(&job.report.gross_errors));
         }
-        let Verdict::Inconsistent { reason } = &checked.verdict else {
-            unreachable!("refused only when inconsistent")
-        };
-        return Err(sagcal::Error::InvalidInput(format!(
-            "{}: the calibration fails its own consistency tests, so no robot file is written \
-             (--accept-inconsistent writes it anyway): {reason}",
-            args.data.display()
-        )));
+        return Err(refusal);
     }
+    let result = &job.checked.result;
     // Files only after everything succeeded: all of them or none, none over an input.
     let mut outputs = OutputSet::new();
     outputs.input("--robot", &args.robot).input("--data", &args.data);
     if let Some(out) = &args.out {
-        outputs.file("--out", out, robot_text(&result.robot, &checked.verdict)?);
+        outputs.file("--out", out, robot_text(&result.robot, &job.checked.verdict)?);
     }
     if let Some(plot) = &args.plot {
         let positions: Vec<[f64; 3]> = data.poses.iter().map(|p| p.position_m).collect();
@@ -68,13 +55,10 @@ pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
     }
     outputs.write()?;
     if args.json {
-        print_json(&CheckedReport {
-            report,
-            gross_errors: gross,
-        })
+        print_json(&job.report)
     } else {
-        print!("{}", render(&report, &options));
-        print!("{}", gross_errors::render(&gross));
+        print!("{}", render(&job.report.report, &job.options));
+        print!("{}", gross_errors::render(&job.report.gross_errors));
         if let Some(out) = &args.out {
             println!("calibrated robot written to {}", out.display());
         }
@@ -95,14 +79,6 @@ pub fn robot_text(robot: &Robot, verdict: &Verdict) -> sagcal::Result<String> {
             &format!("# WARNING: written with --accept-inconsistent; the fit FAILS its consistency tests: {reason}\n");
     }
     Ok(format!("{header}{text}"))
-}
-
-/// The JSON of `sagcal calibrate`: the report and its gross-error tests.
-#[derive(serde::Serialize)]
-struct CheckedReport {
-    #[serde(flatten)]
-    report: CalibrationReport,
-    gross_errors: GrossErrorReport,
 }
 
 /// The anchor plot of a calibration (SVG).

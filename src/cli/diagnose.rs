@@ -2,10 +2,10 @@
 
 use std::path::Path;
 
-use sagcal::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
+use sagcal::diagnose::{diagnose, DiagnoseOptions, DiagnoseSettings, Diagnosis};
+use sagcal::error::FrontEnd;
 use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
 use sagcal::io::OutputSet;
-use sagcal::model::effect_kind::EffectKind;
 use sagcal::model::Robot;
 use sagcal::plot::residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
 
@@ -23,18 +23,18 @@ pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
             keep_rounded: false,
         },
     )?;
-    let mut options = DiagnoseOptions::new(args.solver.options(&nominal)?);
-    options.folds = args.folds;
-    options.false_alarm = args.false_alarm;
-    options.orientation_hypothesis = !args.no_orientation_hypothesis;
-    options.rows_in_time_order = data.format == MeasurementFormat::Sagcal;
-    if let Some(list) = &args.candidates {
-        options.candidates = list
-            .split(',')
-            .map(EffectKind::parse)
-            .collect::<Result<_, _>>()
-            .map_err(|e| sagcal::Error::InvalidInput(format!("--candidates: {e}")))?;
-    }
+    let settings = DiagnoseSettings {
+        solver: args.solver.settings(),
+        candidates: args
+            .candidates
+            .as_ref()
+            .map(|list| list.split(',').map(str::to_string).collect()),
+        orientation_hypothesis: !args.no_orientation_hypothesis,
+        folds: args.folds,
+        false_alarm: args.false_alarm,
+        rows_in_time_order: data.format == MeasurementFormat::Sagcal,
+    };
+    let options = settings.options(&nominal, FrontEnd::Cli)?;
     let bar = progress_bar(1, "{msg:40} [{bar:30}] {pos}/{len} fits, {elapsed}");
     let diagnosis = diagnose(
         &nominal,

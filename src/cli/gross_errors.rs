@@ -1,41 +1,9 @@
-//! The gross-error section of `sagcal calibrate`'s report (table and JSON).
+//! The gross-error section of `sagcal calibrate`'s report in words and tables.
 
-use serde::Serialize;
-
-use sagcal::calib::gross_errors::{CheckedCalibration, ConsistencyTest, ExcludedReading, Verdict};
-use sagcal::calib::mistakes::Mistake;
+use sagcal::calib::gross_errors::Verdict;
+use sagcal::calib::report::GrossErrorReport;
 
 use super::output::Table;
-
-/// What the gross-error tests found and did.
-#[derive(Debug, Clone, Serialize)]
-pub struct GrossErrorReport {
-    /// `consistent`, or `inconsistent` with its reason.
-    pub verdict: Verdict,
-    /// Readings left out, each with its row, sensor, estimated error, `w` and explanation.
-    pub excluded_readings: Vec<ExcludedReading>,
-    /// For an inconsistent fit: the readings the search had left out before
-    /// it gave up (the fit reported uses them; omitted when empty).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub set_aside_readings: Vec<ExcludedReading>,
-    /// Common mistakes recognised (units, swapped cables, re-homing, poses outside the frame).
-    pub mistakes: Vec<Mistake>,
-    /// The tests of the final fit.
-    pub tests: ConsistencyTest,
-}
-
-impl GrossErrorReport {
-    /// The report of a checked calibration.
-    pub fn new(checked: &CheckedCalibration) -> Self {
-        Self {
-            verdict: checked.verdict.clone(),
-            excluded_readings: checked.excluded.clone(),
-            set_aside_readings: checked.set_aside.clone(),
-            mistakes: checked.mistakes.clone(),
-            tests: checked.test.clone(),
-        }
-    }
-}
 
 /// The section in words and tables.
 pub fn render(report: &GrossErrorReport) -> String {

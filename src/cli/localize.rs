@@ -2,9 +2,10 @@
 
 use serde::Serialize;
 
+use sagcal::error::FrontEnd;
 use sagcal::io::readings::{read_readings, ReadingsFile, ReadingsFormat};
 use sagcal::io::recurdyn::RejectedRow;
-use sagcal::localize::{LocalizeOptions, Localized, Localizer, Readings};
+use sagcal::localize::{require_pose_priors, LocalizeSettings, Localized, Localizer, Readings};
 use sagcal::model::pose::PlatformPose;
 use sagcal::model::Robot;
 use sagcal::plot::localize::{localize_plot_svg, LocalizePlot, PlottedPose};
@@ -81,14 +82,13 @@ struct Report {
 pub fn run(args: &LocalizeArgs) -> sagcal::Result<()> {
     let robot = Robot::from_file(&args.robot)?;
     let file = read_readings(&args.data, robot.reference_cable)?;
-    let noise = args.noise.sigmas(robot.platform_weight_n);
-    let options = LocalizeOptions {
+    let localizer = LocalizeSettings {
+        noise: args.noise,
         pose_prior: args.pose_prior,
         false_alarm: args.false_alarm,
         calibration_uncertainty: !args.no_calibration_uncertainty,
-        ..LocalizeOptions::default()
-    };
-    let localizer = Localizer::with_options(&robot, &noise, options)?;
+    }
+    .localizer(&robot)?;
     let mut report = localize_file(
         &args.robot.display().to_string(),
         &file,
@@ -137,39 +137,29 @@ fn localize_file(
     search: bool,
 ) -> sagcal::Result<Report> {
     if pose_prior {
-        if let Some(row) = file.rows.iter().find(|r| r.localiser_pose.is_none()) {
-            return Err(sagcal::Error::Field {
-                path: file.path.clone(),
-                row: row.line,
-                field: "x_m".into(),
-                message: "--pose-prior needs a localiser pose on every row; this file has none".into(),
-            });
-        }
+        let rows = file.rows.iter().map(|r| (r.line, r.localiser_pose));
+        require_pose_priors(&file.path, rows, FrontEnd::Cli)?;
     }
-    let mut warm: Option<PlatformPose> = None;
-    let mut rows = Vec::with_capacity(file.rows.len());
-    let mut plotted = Vec::new();
-    for row in &file.rows {
-        let readings = Readings {
+    let readings: Vec<Readings> = file
+        .rows
+        .iter()
+        .map(|row| Readings {
             encoder_lengths_m: row.encoder_lengths_m,
             load_cell_n: row.load_cell_n,
             localiser_pose: row.localiser_pose,
-        };
-        let result = localizer.localize(&readings, warm.as_ref());
-        let report = match result {
+        })
+        .collect();
+    let solved = localizer.localize_sequence(&readings, search, &mut || false)?;
+    let mut rows = Vec::with_capacity(file.rows.len());
+    let mut plotted = Vec::new();
+    for (row, solved) in file.rows.iter().zip(solved) {
+        let report = match &solved.found {
             Ok(found) => {
-                let mut report = row_report(row.line, &found, localizer.flag(&found), row.localiser_pose.as_ref());
-                if search {
-                    let reference = warm.or(readings.localiser_pose.filter(|_| pose_prior));
-                    let all = localizer.equilibria(&readings, reference.as_ref())?;
-                    let stable: Vec<_> = all.iter().filter(|l| l.stable).collect();
-                    report.equilibria = Some(all.len());
-                    report.stable_equilibria = Some(stable.len());
-                    report.ambiguity_m = stable
-                        .iter()
-                        .map(|l| (l.pose.position_m - found.pose.position_m).norm())
-                        .filter(|d| *d > 1e-6)
-                        .reduce(f64::max);
+                let mut report = row_report(row.line, found, solved.flag, row.localiser_pose.as_ref());
+                if let Some(search) = solved.search {
+                    report.equilibria = Some(search.equilibria);
+                    report.stable_equilibria = Some(search.stable);
+                    report.ambiguity_m = search.ambiguity_m;
                 }
                 let total = found.covariance + found.calibration_covariance.unwrap_or_default();
                 plotted.push(PlottedPose {
@@ -179,13 +169,9 @@ fn localize_file(
                     reference_m: row.localiser_pose.map(|p| p.position_m.into()),
                     flagged: report.flag.is_some(),
                 });
-                // A pose outside the frame is no start for the next row.
-                if found.stable && localizer.frame_allows(&found) {
-                    warm = Some(found.pose);
-                }
                 report
             }
-            Err(e) => flagged(row.line, e.to_string()),
+            Err(why) => flagged(row.line, why.clone()),
         };
         rows.push(report);
     }

@@ -272,43 +272,21 @@ struct SolverArgs {
 }
 
 impl SolverArgs {
-    fn options(&self, robot: &sagcal::model::Robot) -> sagcal::Result<sagcal::calib::CalibrationOptions> {
-        let mut noise = self.noise.sigmas(robot.platform_weight_n);
-        for (value, target, name) in [
-            (self.encoder_sigma_m, &mut noise.encoder_sigma_m, "--encoder-sigma-m"),
-            (
-                self.load_cell_sigma_n,
-                &mut noise.load_cell_sigma_n,
-                "--load-cell-sigma-n",
-            ),
-            (self.position_sigma_m, &mut noise.position_sigma_m, "--position-sigma-m"),
-        ] {
-            if let Some(v) = value {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(sagcal::Error::InvalidInput(format!(
-                        "{name} must be a positive number, got {v}"
-                    )));
-                }
-                *target = v;
-            }
+    /// The library's solver settings these flags give.
+    fn settings(&self) -> sagcal::calib::SolverSettings {
+        sagcal::calib::SolverSettings {
+            model: self.model,
+            noise: self.noise,
+            encoder_sigma_m: self.encoder_sigma_m,
+            load_cell_sigma_n: self.load_cell_sigma_n,
+            position_sigma_m: self.position_sigma_m,
+            orientation_prior: self.orientation_prior,
+            robust: sagcal::calib::RobustKernels {
+                encoder: self.robust_encoder,
+                load_cell: self.robust_load_cell,
+                pose_prior: self.robust_pose,
+            },
         }
-        if [noise.encoder_sigma_m, noise.load_cell_sigma_n, noise.position_sigma_m]
-            .iter()
-            .any(|s| *s <= 0.0)
-        {
-            return Err(sagcal::Error::InvalidInput(
-                "sensor sigmas must be positive to weight the factors".into(),
-            ));
-        }
-        let mut options = sagcal::calib::CalibrationOptions::new(noise);
-        options.model = self.model;
-        options.orientation_prior = self.orientation_prior;
-        options.robust = sagcal::calib::RobustKernels {
-            encoder: self.robust_encoder,
-            load_cell: self.robust_load_cell,
-            pose_prior: self.robust_pose,
-        };
-        Ok(options)
     }
 }
 

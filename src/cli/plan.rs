@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use sagcal::error::FrontEnd;
 use sagcal::experiments::pose_plan::{plan_calibration, CandidateSource, PlanProgress, PlanReport, PlanSettings};
 use sagcal::io::measurements::{measurements_text, read_measurements, ReadOptions};
 use sagcal::io::OutputSet;
@@ -49,6 +50,7 @@ fn settings(args: &PlanArgs, robot: &Robot) -> sagcal::Result<PlanSettings> {
         seed: args.seed,
         criterion: args.criterion,
         orientation_prior: args.orientation_prior,
+        front_end: FrontEnd::Cli,
     })
 }
 

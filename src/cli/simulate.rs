@@ -4,13 +4,13 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use sagcal::error::FrontEnd;
 use sagcal::io::measurements::measurements_text;
 use sagcal::io::OutputSet;
 use sagcal::model::statics::Equilibrium;
 use sagcal::model::{PoseMeasurement, Robot};
 use sagcal::sim::closed_form::{measure, sample_equilibria_with, Closure, Workspace};
-use sagcal::sim::discretised::MAX_SEGMENTS;
-use sagcal::sim::effects::measure_with_effects;
+use sagcal::sim::effects::{measure_with_effects, simulation_truth};
 
 use super::SimulateArgs;
 
@@ -47,24 +47,10 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
 /// every `--effect` in order) and whether the file brought effects; checks
 /// `--poses` and, with effects, `--segments`.
 fn load_truth(args: &SimulateArgs) -> sagcal::Result<(Robot, bool)> {
-    let mut truth = Robot::from_file(&args.robot)?;
-    if args.poses == 0 {
-        return Err(sagcal::Error::InvalidInput("--poses must be at least 1".into()));
-    }
+    let robot = Robot::from_file(&args.robot)?;
     // The robot file's `[effects]` (if any), then every `--effect` in order.
-    let from_file = !truth.effects.is_none();
-    for spec in &args.effects {
-        truth
-            .effects
-            .apply_spec(spec)
-            .map_err(|e| sagcal::Error::InvalidInput(format!("--effect `{spec}`: {e}")))?;
-    }
-    if !truth.effects.is_none() && !(1..=MAX_SEGMENTS).contains(&args.segments) {
-        return Err(sagcal::Error::InvalidInput(format!(
-            "--segments must be between 1 and {MAX_SEGMENTS}, got {}",
-            args.segments
-        )));
-    }
+    let from_file = !robot.effects.is_none();
+    let truth = simulation_truth(&robot, args.poses, &args.effects, args.segments, FrontEnd::Cli)?;
     Ok((truth, from_file))
 }
 

@@ -29,7 +29,7 @@ use serde::Serialize;
 use super::plan_candidates::{draw_candidates_with_progress, filter_candidates, frame_workspace, CandidateSet};
 use super::table2::{pose_pool, Source};
 use crate::calib::{CalibrationOptions, OrientationPrior, MIN_POSES};
-use crate::error::{Error, Result};
+use crate::error::{Error, FrontEnd, Result};
 use crate::model::geometry::check_workspace;
 use crate::model::robot::{Robot, Workspace};
 use crate::model::sensors::NoisePreset;
@@ -76,12 +76,16 @@ pub struct PlanSettings {
     pub criterion: Criterion,
     /// The localiser's orientation as a prior in the bound.
     pub orientation_prior: OrientationPrior,
+    /// Who asks: a refused workspace is named as this front end spells it
+    /// (the report's [`PlanReport::candidates_from`] is the command's words
+    /// for both, so that the two reports are equal).
+    pub front_end: FrontEnd,
 }
 
 impl PlanSettings {
     /// `poses` poses with the command's defaults: paper noise,
     /// [`DEFAULT_CANDIDATES`] drawn in the default box, seed 1, A-optimal, no
-    /// orientation prior.
+    /// orientation prior; messages for the command line.
     pub fn new(poses: usize) -> Self {
         Self {
             poses,
@@ -93,6 +97,7 @@ impl PlanSettings {
             seed: 1,
             criterion: Criterion::A,
             orientation_prior: OrientationPrior::Off,
+            front_end: FrontEnd::Cli,
         }
     }
 }
@@ -225,6 +230,7 @@ fn candidates(
         }
         CandidateSource::Drawn { workspace, count } => (*workspace, *count),
     };
+    let given = workspace.is_some();
     let (workspace, from) = match (workspace, robot.workspace) {
         (Some(w), _) => (w, "--workspace"),
         (None, Some(w)) => (w, "the robot file's [workspace]"),
@@ -233,10 +239,16 @@ fn candidates(
             "the frame below the anchors (10 % margin, z 5-75 % of the anchors' height)",
         ),
     };
-    // A box the robot cannot hang its platform in is named before any pose is drawn.
+    // A box the robot cannot hang its platform in is named before any pose is
+    // drawn; a box the user gave, as the front end spells the option.
     check_workspace(robot, &workspace).map_err(|e| {
+        let named = if given {
+            settings.front_end.option("workspace")
+        } else {
+            from.to_string()
+        };
         Error::InvalidInput(format!(
-            "{from} {:?} .. {:?} m cannot give candidate poses for robot `{}`: {e}",
+            "{named} {:?} .. {:?} m cannot give candidate poses for robot `{}`: {e}",
             workspace.min_m, workspace.max_m, robot.name
         ))
     })?;

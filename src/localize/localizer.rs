@@ -107,7 +107,7 @@ pub struct Localizer {
     shifted: Robot,
     slots: SlotRobot,
     noise: SensorNoise,
-    options: LocalizeOptions,
+    pub(super) options: LocalizeOptions,
     /// The localiser's mounting rotation `M` (`[effects]`): it reads `R M`.
     mount: UnitQuaternion<f64>,
     critical: [f64; MEASUREMENT_ROWS],

@@ -49,6 +49,8 @@ mod equilibria;
 mod frame;
 mod localizer;
 mod newton;
+mod sequence;
+mod settings;
 pub mod stiffness;
 
 pub use equations::{
@@ -58,3 +60,5 @@ pub use equations::{
 pub use equilibria::tilt_deg;
 pub use frame::Frame;
 pub use localizer::{trilaterate, LocalizeOptions, Localized, Localizer, Readings};
+pub use sequence::{EquilibriumSearch, SequenceRow};
+pub use settings::{require_pose_priors, LocalizeSettings};

@@ -44,7 +44,7 @@
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::Rng;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, FrontEnd, Result};
 use crate::model::effects::Effects;
 use crate::model::measurement::{mark_time_order, PoseMeasurement, ReadingOrder};
 use crate::model::pose::PlatformPose;
@@ -52,7 +52,58 @@ use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::SensorNoise;
 use crate::model::statics::Equilibrium;
 use crate::sim::closed_form::SensorSampler;
-use crate::sim::discretised::{solve_forward, DiscretisedEquilibrium, DiscretisedOptions, InitialGuess};
+use crate::sim::discretised::{solve_forward, DiscretisedEquilibrium, DiscretisedOptions, InitialGuess, MAX_SEGMENTS};
+
+/// The true robot of a simulation of `poses` poses: `robot` with each of
+/// `specs` (`NAME:PARAM=VALUE[,PARAM=VALUE...]`, [`Effects::apply_spec`])
+/// applied in order, checked as `sagcal simulate` checks its flags: at least
+/// 1 pose, every spec valid and, with effects (the robot's or the specs'),
+/// 1 to [`MAX_SEGMENTS`] segments per cable. A message names the option as
+/// `front_end` spells it (the command's repeatable `--effect`, Python's list `effects`).
+///
+/// ```
+/// use sagcal::error::FrontEnd;
+/// use sagcal::model::Robot;
+/// use sagcal::sim::effects::simulation_truth;
+/// let robot = Robot::builtin("large")?;
+/// let truth = simulation_truth(&robot, 5, &["elastic:ea_n=3e6".into()], 50, FrontEnd::Cli)?;
+/// assert_eq!(truth.effects.axial_stiffness_n, Some(3e6));
+/// let message = simulation_truth(&robot, 0, &[], 50, FrontEnd::Python).unwrap_err().to_string();
+/// assert_eq!(message, "invalid input: poses must be at least 1");
+/// # Ok::<(), sagcal::Error>(())
+/// ```
+pub fn simulation_truth(
+    robot: &Robot,
+    poses: usize,
+    specs: &[String],
+    segments: usize,
+    front_end: FrontEnd,
+) -> Result<Robot> {
+    if poses == 0 {
+        return Err(Error::InvalidInput(format!(
+            "{} must be at least 1",
+            front_end.option("poses")
+        )));
+    }
+    let mut truth = robot.clone();
+    let effect = match front_end {
+        FrontEnd::Cli => "--effect",
+        FrontEnd::Python => "effects",
+    };
+    for spec in specs {
+        truth
+            .effects
+            .apply_spec(spec)
+            .map_err(|e| Error::InvalidInput(format!("{effect} `{spec}`: {e}")))?;
+    }
+    if !truth.effects.is_none() && !(1..=MAX_SEGMENTS).contains(&segments) {
+        return Err(Error::InvalidInput(format!(
+            "{} must be between 1 and {MAX_SEGMENTS}, got {segments}",
+            front_end.option("segments")
+        )));
+    }
+    Ok(truth)
+}
 
 /// The discretised model's settings for `effects` with `segments` segments
 /// per cable, or, for a finite-element cable (`effects.cable_segments`), its
