@@ -19,6 +19,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 use nalgebra::DMatrix;
 
 use super::accumulate::{FactorRuns, SlotBlock};
+use super::dense::zeroed;
 use super::schur::SchurLayout;
 use super::sparse_cholesky::SparseCholesky;
 use crate::graph::{Factor, Values, VariableId};
@@ -431,60 +432,9 @@ impl LinearSystem {
     }
 }
 
-/// `len` zeros, written in 1 kB pieces: one `memset` (or `calloc`) of a
-/// large buffer is a `rep stosb`, which callgrind counts once per byte and
-/// which is slower than vector stores below a few pages.
-pub(super) fn zeroed(len: usize) -> Vec<f64> {
-    let mut zeros = Vec::with_capacity(len);
-    fill_zeros(&mut zeros, len);
-    zeros
-}
-
-/// Make `buffer` `len` zeros, in 1 kB pieces (see [`zeroed`]).
-pub(super) fn fill_zeros(buffer: &mut Vec<f64>, len: usize) {
-    const PIECE: [f64; 128] = [0.0; 128];
-    buffer.truncate(len);
-    for piece in buffer.chunks_mut(PIECE.len()) {
-        piece.copy_from_slice(&PIECE[..piece.len()]);
-    }
-    while buffer.len() < len {
-        let missing = (len - buffer.len()).min(PIECE.len());
-        buffer.extend_from_slice(&PIECE[..missing]);
-    }
-}
-
-/// `a . b` for two columns of `R` entries (`R = 0`: of equal length).
-#[inline(always)]
-pub(super) fn dot<const R: usize>(a: &[f64], b: &[f64]) -> f64 {
-    if R == 0 {
-        return a.iter().zip(b).map(|(x, y)| x * y).sum();
-    }
-    let (a, b) = (&a[..R], &b[..R]);
-    let mut sum = 0.0;
-    for r in 0..R {
-        sum += a[r] * b[r];
-    }
-    sum
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A reused buffer of any length, shorter or longer than asked, comes
-    /// back as exactly `len` zeros (lengths around the 128-entry pieces).
-    #[test]
-    fn fill_zeros_gives_len_zeros_from_any_buffer() {
-        for start in [0usize, 5, 128, 300] {
-            for len in [0usize, 1, 127, 128, 129, 1000] {
-                let mut buffer: Vec<f64> = (0..start).map(|k| k as f64 + 0.5).collect();
-                fill_zeros(&mut buffer, len);
-                assert_eq!(buffer.len(), len, "from {start}");
-                assert!(buffer.iter().all(|&v| v == 0.0), "from {start} to {len}");
-            }
-        }
-        assert_eq!(zeroed(257), vec![0.0; 257]);
-    }
 
     /// A linear residual `r = A [x_v1; x_v2; ...]` on vector variables.
     struct Linear {

@@ -14,9 +14,8 @@
 //! nonlinear elimination (Lanzkron, Rose & Wilkes, 1996). At a minimum of the
 //! full problem the refinement changes nothing.
 
+use super::dense::{backward_substitute, cholesky_in_place, dot, forward_substitute};
 use super::gram_avx2;
-use super::linear_system::dot;
-use super::schur::{backward_substitute, cholesky_in_place, forward_substitute};
 use std::cell::RefCell;
 
 use crate::graph::{FactorGraph, LinearizationBuffers, SlotMask, Values, VariableId, VariableValue};

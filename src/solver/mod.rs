@@ -36,6 +36,7 @@
 
 mod accumulate;
 mod covariance;
+mod dense;
 mod gram_avx2;
 mod linear_system;
 mod local;
@@ -49,7 +50,7 @@ mod system_cache;
 use local::LocalGroups;
 
 pub use covariance::{marginal_covariance, marginal_covariance_cached, Covariance, UnobservableDirection};
-use linear_system::fill_zeros;
+use dense::fill_zeros;
 pub use linear_system::LinearSystem;
 pub use redundancy::redundancy_numbers;
 pub use score::{score_system, score_tests, Direction, ScoreSystem, ScoreTest};

@@ -19,6 +19,8 @@
 //! dense (`g = 16` for anchors and offsets), so each factorisation is a loop
 //! of fixed-size kernels with no symbolic bookkeeping.
 
+use super::dense::{backward_substitute, cholesky_in_place, forward_substitute, zeroed};
+
 /// Where every stored entry of `H` goes, and the dense blocks it fills.
 pub(super) struct SchurLayout {
     /// Tangent dimension of the global (non-eliminated) variables; they come first.
@@ -71,7 +73,7 @@ impl SchurLayout {
             groups,
             group_base,
             group_of,
-            values: super::linear_system::zeroed(size),
+            values: zeroed(size),
             factored: false,
         }
     }
@@ -446,55 +448,6 @@ fn subtract_gram<const M: usize, const G: usize, const AVX2: bool>(w: &[f64], re
             }
             column[i] -= sum;
         }
-    }
-}
-
-/// In-place Cholesky `A = L L^T` of the lower triangle of a column-major
-/// `n x n` matrix; `false` unless every pivot is positive and finite.
-#[inline(always)]
-pub(super) fn cholesky_in_place(a: &mut [f64], n: usize) -> bool {
-    for j in 0..n {
-        let mut pivot = a[j + j * n];
-        for k in 0..j {
-            pivot -= a[j + k * n] * a[j + k * n];
-        }
-        if !(pivot > 0.0 && pivot.is_finite()) {
-            return false;
-        }
-        let pivot = pivot.sqrt();
-        a[j + j * n] = pivot;
-        for i in j + 1..n {
-            let mut sum = a[i + j * n];
-            for k in 0..j {
-                sum -= a[i + k * n] * a[j + k * n];
-            }
-            a[i + j * n] = sum / pivot;
-        }
-    }
-    true
-}
-
-/// `x <- L^-1 x` for the lower-triangular factor in `l` (column-major `n x n`).
-#[inline(always)]
-pub(super) fn forward_substitute(l: &[f64], n: usize, x: &mut [f64]) {
-    for j in 0..n {
-        let xj = x[j] / l[j + j * n];
-        x[j] = xj;
-        for i in j + 1..n {
-            x[i] -= l[i + j * n] * xj;
-        }
-    }
-}
-
-/// `x <- L^-T x` for the lower-triangular factor in `l` (column-major `n x n`).
-#[inline(always)]
-pub(super) fn backward_substitute(l: &[f64], n: usize, x: &mut [f64]) {
-    for j in (0..n).rev() {
-        let mut sum = x[j];
-        for i in j + 1..n {
-            sum -= l[i + j * n] * x[i];
-        }
-        x[j] = sum / l[j + j * n];
     }
 }
 

@@ -3,7 +3,7 @@
 //! factor `L` of the damped block, `W = L^-1 B` and `reduced -= W^T W`.
 //!
 //! Every entry goes through the operations of the portable loops of
-//! `schur.rs` in the same order, each rounded on its own (no fused
+//! `schur.rs` and `dense.rs` in the same order, each rounded on its own (no fused
 //! multiply-add): `L[i][j] = (a[i][j] - a[i][0] a[j][0] - ...) / l_jj` with
 //! the pivot `l_jj^2 = a[j][j] - a[j][0]^2 - ...`, and `W` row by row
 //! (`w_j = w_j / l_jj`, then `w_i -= l_ij w_j` for the rows below), so the
@@ -76,7 +76,7 @@ pub(super) unsafe fn eliminate_group(block: &mut [f64], reduced: &mut [f64]) -> 
 }
 
 /// In-place Cholesky of the lower triangle of an 8 x 8 column-major `a`
-/// (`cholesky_in_place` of `schur.rs`, bit for bit); `false` unless every
+/// (`cholesky_in_place` of `dense.rs`, bit for bit); `false` unless every
 /// pivot is positive and finite. The entries above the diagonal are not written.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
@@ -122,7 +122,7 @@ unsafe fn cholesky(a: &mut [f64]) -> bool {
 
 /// `X <- L^-1 X` for the 16 columns of `rows` (row `r` of `X` in
 /// `rows[r]`), `L` the 8 x 8 column-major factor in `l`: per column the
-/// operations of `forward_substitute` of `schur.rs`, in its order.
+/// operations of `forward_substitute` of `dense.rs`, in its order.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn forward_substitute_rows(l: &[f64], rows: &mut [[f64; G]; M]) {
@@ -151,7 +151,7 @@ unsafe fn forward_substitute_rows(l: &[f64], rows: &mut [[f64; G]; M]) {
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests {
     use super::*;
-    use crate::solver::schur::{cholesky_in_place, forward_substitute};
+    use crate::solver::dense::{cholesky_in_place, forward_substitute};
 
     /// A damped block of a pose (8 x 8, positive definite, many significant
     /// bits) and its 8 x 16 coupling, eliminated by the portable loops and
