@@ -18,8 +18,7 @@ use nalgebra::DMatrix;
 
 use crate::graph::VariableId;
 
-#[cfg(target_arch = "x86_64")]
-use super::gram_avx2;
+use super::simd;
 
 /// Consecutive factor slots `first_slot..end_slot` whose tangent columns are
 /// `offset..offset + width` of the step vector, and `column..column + width`
@@ -218,9 +217,9 @@ impl FactorRuns {
     /// `residual.len()` rows) into `hessian` and `J^T r` into `gradient`;
     /// `rows_buffer` is reused scratch.
     ///
-    /// On x86-64 CPUs with AVX2 the same code runs compiled for it (four
-    /// lanes instead of SSE2's two; no FMA, so every sum is rounded as in the
-    /// SSE2 build and the results are bit for bit the same: unit test).
+    /// On the AVX2 path (`simd::avx2`) the same code runs compiled for it
+    /// (four lanes instead of SSE2's two; no FMA, so every sum is rounded as
+    /// in the SSE2 build and the results are bit for bit the same: unit test).
     pub(super) fn accumulate(
         &self,
         jacobians: &[DMatrix<f64>],
@@ -230,8 +229,8 @@ impl FactorRuns {
         rows_buffer: &mut Vec<f64>,
     ) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `accumulate_avx2` only needs AVX2, which the CPU has (checked just above).
+        if simd::avx2() {
+            // SAFETY: `accumulate_avx2` only needs AVX2, which the CPU has (`simd::avx2`).
             unsafe { self.accumulate_avx2(jacobians, residual, hessian, gradient, rows_buffer) };
             return;
         }
@@ -255,7 +254,7 @@ impl FactorRuns {
 
     /// [`FactorRuns::accumulate`] for the instruction set it is inlined into
     /// (`AVX2`: only from [`FactorRuns::accumulate_avx2`], whose products go
-    /// to the intrinsic kernel of `gram_avx2`).
+    /// to the intrinsic kernel of `simd::gram`).
     #[inline(always)]
     fn accumulate_any<const AVX2: bool>(
         &self,
@@ -383,7 +382,7 @@ fn gather_four_rows_avx2(run: &Run, jacobians: &[DMatrix<f64>], rows: &mut [f64]
         let mut column = 0;
         for jacobian in &jacobians[run.first_slot..run.end_slot] {
             // SAFETY: reached only from `accumulate_avx2`, which runs only where the CPU has AVX2.
-            unsafe { gram_avx2::scatter_four_rows(jacobian.as_slice(), rows, run.width, column) };
+            unsafe { simd::gram::scatter_four_rows(jacobian.as_slice(), rows, run.width, column) };
             column += jacobian.ncols();
         }
         true
@@ -511,7 +510,7 @@ fn add_gram_avx2<const R: usize>(a: RunRows, b: RunRows, same: bool, stride: usi
                 match (a.width, b.width, same) {
                     $(($ca, $cb, $same) => {
                         // SAFETY: reached only from `accumulate_avx2`, which runs only where the CPU has AVX2.
-                        unsafe { gram_avx2::gram_block::<4, $ca, $cb, $same, false>(a.data, b.data, stride, block) };
+                        unsafe { simd::gram::gram_block::<4, $ca, $cb, $same, false>(a.data, b.data, stride, block) };
                         return true;
                     })*
                     _ => {}

@@ -15,7 +15,7 @@
 //! full problem the refinement changes nothing.
 
 use super::dense::{backward_substitute, cholesky_in_place, dot, forward_substitute};
-use super::gram_avx2;
+use super::simd;
 use std::cell::RefCell;
 
 use crate::graph::{FactorGraph, LinearizationBuffers, SlotMask, Values, VariableId, VariableValue};
@@ -189,7 +189,7 @@ fn linearize_group(
         let residual = &linearized.residual;
         match (rows, columns.len()) {
             // A pose's catenary rows on its pose and tension; its pose prior.
-            (4, 8) if contiguous(columns) && gram_avx2::available() => {
+            (4, 8) if contiguous(columns) && simd::avx2() => {
                 add_normal_equations_avx2(columns[0], gathered, residual, dim, out, &mut rows_buffer)
             }
             (4, 8) => add_normal_equations_by_rows::<4, 8>(columns, gathered, residual, dim, out),
@@ -241,11 +241,11 @@ fn add_normal_equations_avx2(
     rows: &mut [f64; 32],
 ) {
     #[cfg(target_arch = "x86_64")]
-    // SAFETY: the caller checked `gram_avx2::available()`.
+    // SAFETY: the caller checked `simd::avx2()`.
     unsafe {
-        gram_avx2::scatter_four_rows(&gathered[..32], rows, 8, 0);
-        gram_avx2::gram_block::<4, 8, 1, false, false>(rows, residual, 0, &mut out.gradient[first..]);
-        gram_avx2::gram_block::<4, 8, 8, true, false>(rows, rows, dim, &mut out.hessian[first + first * dim..]);
+        simd::gram::scatter_four_rows(&gathered[..32], rows, 8, 0);
+        simd::gram::gram_block::<4, 8, 1, false, false>(rows, residual, 0, &mut out.gradient[first..]);
+        simd::gram::gram_block::<4, 8, 8, true, false>(rows, rows, dim, &mut out.hessian[first + first * dim..]);
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = (first, gathered, residual, dim, out, rows);
@@ -455,7 +455,7 @@ mod tests {
             assert_eq!(bits(&by_rows.hessian), bits(&by_dots.hessian), "{R} x {C}");
             assert_eq!(bits(&by_rows.gradient), bits(&by_dots.gradient), "{R} x {C}");
             assert_ne!(bits(&by_rows.hessian), bits(&start().hessian));
-            if R == 4 && C == 8 && contiguous(columns) && gram_avx2::available() {
+            if R == 4 && C == 8 && contiguous(columns) && simd::avx2_under_test() {
                 let mut by_avx2 = start();
                 add_normal_equations_avx2(columns[0], &gathered, &residual, dim, &mut by_avx2, &mut [0.0; 32]);
                 assert_eq!(bits(&by_avx2.hessian), bits(&by_dots.hessian), "AVX2 {R} x {C}");

@@ -37,13 +37,12 @@
 mod accumulate;
 mod covariance;
 mod dense;
-mod gram_avx2;
 mod linear_system;
 mod local;
 mod redundancy;
 mod schur;
-mod schur_avx2;
 mod score;
+mod simd;
 mod sparse_cholesky;
 mod system_cache;
 

@@ -20,6 +20,7 @@
 //! of fixed-size kernels with no symbolic bookkeeping.
 
 use super::dense::{backward_substitute, cholesky_in_place, forward_substitute, zeroed};
+use super::simd;
 
 /// Where every stored entry of `H` goes, and the dense blocks it fills.
 pub(super) struct SchurLayout {
@@ -118,12 +119,12 @@ impl SchurLayout {
     /// buffer ([`SchurLayout::place`]; only lower triangles are read);
     /// `false` if a block or the reduced system is not positive definite.
     ///
-    /// On x86-64 CPUs with AVX2 the same code runs compiled for it (no FMA:
-    /// the values are bit for bit those of the SSE2 build).
+    /// On the AVX2 path (`simd::avx2`) the same code runs compiled for it
+    /// (no FMA: the values are bit for bit those of the SSE2 build).
     pub(super) fn factorize(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `factorize_avx2` only needs AVX2, which the CPU has (checked just above).
+        if simd::avx2() {
+            // SAFETY: `factorize_avx2` only needs AVX2, which the CPU has (`simd::avx2`).
             return unsafe { self.factorize_avx2(hessian, damping) };
         }
         self.factorize_any::<false>(hessian, damping)
@@ -176,12 +177,12 @@ impl SchurLayout {
 
     /// Solve with the last successful factorisation; `None` if there is none.
     ///
-    /// On x86-64 CPUs with AVX2 the same code runs compiled for it (no FMA,
-    /// and every sum keeps its order: bit for bit the SSE2 build's values).
+    /// On the AVX2 path (`simd::avx2`) the same code runs compiled for it
+    /// (no FMA, and every sum keeps its order: bit for bit the SSE2 build's values).
     pub(super) fn solve(&self, rhs: &[f64]) -> Option<Vec<f64>> {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `solve_avx2` only needs AVX2, which the CPU has (checked just above).
+        if simd::avx2() {
+            // SAFETY: `solve_avx2` only needs AVX2, which the CPU has (`simd::avx2`).
             return unsafe { self.solve_avx2(rhs) };
         }
         self.solve_any(rhs)
@@ -389,7 +390,7 @@ fn eliminate_group<const M: usize, const AVX2: bool>(
     #[cfg(target_arch = "x86_64")]
     if AVX2 && M == 8 && g == 16 {
         // SAFETY: `AVX2` only from `factorize_avx2`, which runs only where the CPU has AVX2.
-        return unsafe { super::schur_avx2::eliminate_group(block, reduced) };
+        return unsafe { simd::elimination::eliminate_group(block, reduced) };
     }
     let (d, w) = block.split_at_mut(m * m);
     if !cholesky_in_place(d, m) {
@@ -436,7 +437,7 @@ fn subtract_gram<const M: usize, const G: usize, const AVX2: bool>(w: &[f64], re
     if AVX2 && G == 16 {
         let rows = rows.as_flattened();
         // SAFETY: `AVX2` only from `factorize_avx2`, which runs only where the CPU has AVX2.
-        unsafe { super::gram_avx2::gram_block::<M, 16, 16, true, true>(rows, rows, 16, reduced) };
+        unsafe { simd::gram::gram_block::<M, 16, 16, true, true>(rows, rows, 16, reduced) };
         return;
     }
     for j in 0..G {

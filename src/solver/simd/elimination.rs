@@ -48,7 +48,7 @@ const BELOW: [[f64; M]; M] = {
 /// The CPU must support AVX2. The lengths are checked (a panic if short).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn eliminate_group(block: &mut [f64], reduced: &mut [f64]) -> bool {
+pub(in crate::solver) unsafe fn eliminate_group(block: &mut [f64], reduced: &mut [f64]) -> bool {
     assert!(block.len() >= M * M + M * G && reduced.len() >= G * G);
     let (d, w) = block.split_at_mut(M * M);
     // SAFETY: `d` holds 8 columns of 8 (asserted above).
@@ -71,7 +71,7 @@ pub(super) unsafe fn eliminate_group(block: &mut [f64], reduced: &mut [f64]) -> 
     }
     let rows = rows.as_flattened();
     // SAFETY: the CPU has AVX2 (this function's contract).
-    unsafe { super::gram_avx2::gram_block::<M, G, G, true, true>(rows, rows, G, reduced) };
+    unsafe { super::gram::gram_block::<M, G, G, true, true>(rows, rows, G, reduced) };
     true
 }
 
@@ -159,8 +159,7 @@ mod tests {
     /// indefinite block fails in both and leaves `reduced` alone.
     #[test]
     fn the_kernel_eliminates_exactly_as_the_portable_loops() {
-        if !std::arch::is_x86_feature_detected!("avx2") {
-            eprintln!("skipped: this CPU has no AVX2");
+        if !crate::simd::avx2_under_test() {
             return;
         }
         let value = |k: usize| ((k * 7919 % 1009) as f64 / 1009.0 - 0.5) * 1.7 + 1e-3 * (k as f64).sin();
@@ -189,7 +188,7 @@ mod tests {
         // The kernel.
         let mut block: Vec<f64> = d.iter().chain(&b).copied().collect();
         let mut kernel_reduced = reduced_start.clone();
-        // SAFETY: the CPU has AVX2 (checked above).
+        // SAFETY: the CPU has AVX2 (`avx2_under_test` above).
         assert!(unsafe { eliminate_group(&mut block, &mut kernel_reduced) });
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         for col in 0..M {
