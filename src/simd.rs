@@ -84,8 +84,20 @@ impl std::fmt::Display for SimdPath {
 static CHOICE: OnceLock<(SimdRequest, SimdPath)> = OnceLock::new();
 
 /// The switch's value and the path, read and decided on the first call.
+/// After it, one atomic load: the hot loops call [`avx2`] once per factor.
 #[inline]
 fn choice() -> (SimdRequest, SimdPath) {
+    match CHOICE.get() {
+        Some(&choice) => choice,
+        None => decide(),
+    }
+}
+
+/// [`choice`]'s first call: read the switch, test the CPU (out of line, so
+/// that the callers stay small enough to inline).
+#[cold]
+#[inline(never)]
+fn decide() -> (SimdRequest, SimdPath) {
     *CHOICE.get_or_init(|| {
         let value = std::env::var(SWITCH).ok();
         let request = SimdRequest::parse(value.as_deref()).unwrap_or_else(|error| panic!("{error}"));

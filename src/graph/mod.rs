@@ -267,7 +267,10 @@ impl LinearizationBuffers {
     /// graph whose factors do not change while these buffers are used (the
     /// solver's pass over a graph): the buffers found for `index` the first
     /// time are taken again without comparing shapes. Bit for bit
-    /// [`LinearizationBuffers::linearize`].
+    /// [`LinearizationBuffers::linearize`]. Inlined into the solver's pass
+    /// whatever codegen unit each lands in (its call per factor showed as
+    /// +0.5 % instructions of a solve when a module move separated them).
+    #[inline]
     pub(crate) fn linearize_at(
         &mut self,
         index: usize,

@@ -42,6 +42,7 @@ mod local;
 mod redundancy;
 mod schur;
 mod score;
+mod shapes;
 mod simd;
 mod sparse_cholesky;
 mod system_cache;
@@ -53,6 +54,7 @@ use dense::fill_zeros;
 pub use linear_system::LinearSystem;
 pub use redundancy::redundancy_numbers;
 pub use score::{score_system, score_tests, Direction, ScoreSystem, ScoreTest};
+pub use shapes::Fallbacks;
 pub use system_cache::SystemCache;
 
 use serde::Serialize;

@@ -17,10 +17,14 @@ use std::arch::x86_64::{
     _mm256_sub_pd,
 };
 
-/// Group dimension.
-const M: usize = 8;
-/// Global dimension.
-const G: usize = 16;
+use crate::solver::shapes::{GLOBALS, GROUP};
+
+/// Group dimension (`GROUP` of the table of `shapes`).
+const M: usize = GROUP;
+/// Global dimension (`GLOBALS` of the table of `shapes`).
+const G: usize = GLOBALS;
+// The registers below are laid out for 8 x 16: another shape in the table needs another kernel.
+const _: () = assert!(M == 8 && G == 16);
 
 /// Lane masks per column `j` of the rows below it: entry `j` holds, for the
 /// rows 0..8, a set sign bit where the row is greater than `j`.

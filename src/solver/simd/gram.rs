@@ -189,6 +189,22 @@ mod tests {
         check::<6, 16, 16, true, true>(17);
     }
 
+    /// Every four-row shape of the AVX2 path's table
+    /// (`shapes::avx2_run_shapes!`), with a gap between the columns.
+    #[test]
+    fn every_shape_of_the_table_matches_the_scalar_loop() {
+        use crate::solver::shapes::{avx2_run_shapes, run_shapes, ANCHORS, CABLE_ROWS, GLOBALS, GROUP};
+        if !crate::simd::avx2_under_test() {
+            return;
+        }
+        macro_rules! checks {
+            ($(($ca:tt, $cb:tt, $same:literal)),*) => {
+                $(check::<CABLE_ROWS, $ca, $cb, $same, false>($ca + 1);)*
+            };
+        }
+        avx2_run_shapes!(checks);
+    }
+
     /// The copy puts entry `r` of column `c` at `r * width + first + c`
     /// and leaves the other columns alone.
     #[test]
