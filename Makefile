@@ -54,7 +54,8 @@ test: codegen-check lint
 	cargo test --all-targets
 	cargo test --doc
 	SAGCAL_SIMD=portable cargo test --lib -- simd:: graph:: solver:: calib::
-	SAGCAL_SIMD=portable cargo test --test final_cost --test solver --test calibration
+	SAGCAL_SIMD=portable cargo test --test solver --test final_cost --test calibration --test prepared_calibration \
+		--test extended_model --test gross_errors --test cli_calibrate
 	$(MAKE) python-test
 
 ## What a reviewer runs: formatting, clippy with warnings denied (the crate and the
