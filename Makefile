@@ -46,10 +46,16 @@ codegen-check: $(VENV)/.installed
 	$(PYTHON) codegen/generate.py --check generated
 
 ## The README's test command: generated code up to date, the lint, every test of
-## the crate, then the Python package's tests.
+## the crate, the solver's and the calibration's tests once more on the portable
+## path (the first run takes the AVX2 kernels where the CPU has them;
+## `SAGCAL_SIMD=avx2 make test` fails on a CPU without AVX2: src/simd.rs), then
+## the Python package's tests.
 test: codegen-check lint
 	cargo test --all-targets
 	cargo test --doc
+	SAGCAL_SIMD=portable cargo test --lib -- simd:: graph:: solver:: calib::
+	SAGCAL_SIMD=portable cargo test --test solver --test final_cost --test calibration --test prepared_calibration \
+		--test extended_model --test gross_errors --test cli_calibrate
 	$(MAKE) python-test
 
 ## What a reviewer runs: formatting, clippy with warnings denied (the crate and the

@@ -124,14 +124,14 @@ def classify(function, stack):
     if "/generated/" in path or "sagcal::generated::" in name:
         return "evaluation"
     if "gram_block" in name:
-        return "elimination (L, W = L^-1 B, W^T W)" if "schur" in outer else "J^T J and J^T r"
+        return "elimination (L, W = L^-1 B, W^T W)" if "schur" in outer or "elimination" in outer else "J^T J and J^T r"
     if any(k in name for k in ("run_product", "add_run_product", "add_run_gradient")):
         return "J^T J and J^T r"
-    if "schur_avx2" in path and any(k in name for k in ("cholesky", "forward_substitute_rows")):
+    if "simd/elimination.rs" in path and any(k in name for k in ("cholesky", "forward_substitute_rows")):
         return "elimination (L, W = L^-1 B, W^T W)"
-    if "schur.rs" in path and any(k in name for k in ("cholesky_in_place", "eliminate_group")):
+    if ("schur.rs" in path or "dense.rs" in path) and any(k in name for k in ("cholesky_in_place", "eliminate_group")):
         return "elimination (L, W = L^-1 B, W^T W)"
-    if "schur.rs" in path and any(k in name for k in ("forward_substitute", "backward_substitute",
+    if ("schur.rs" in path or "dense.rs" in path) and any(k in name for k in ("forward_substitute", "backward_substitute",
                                                        "reduce_right_hand_side", "back_substitute_group")):
         return "substitutions (solve)"
     module = re.search(r"sagcal::(\w+)::(\w+)", name)

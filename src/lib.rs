@@ -15,7 +15,7 @@
 //!
 //! | layer | purpose |
 //! |---|---|
-//! | [`error`], [`stats`], [`steps`] | the error type; chi-square quantiles, correlation, BIC; the count of work done (tests bound running time by it) |
+//! | [`error`], [`stats`], [`steps`], [`simd`] | the error type; chi-square quantiles, correlation, BIC; the count of work done (tests bound running time by it); which instruction set the hand-written kernels run (the switch `SAGCAL_SIMD`) |
 //! | [`model`] | cable physics (catenary, elastic, pulley), robot, statics, effects, measurements |
 //! | [`io`] | files (robot TOML; sagcal CSV, RecurDyn logs, the authors' dataset folder) -> `model` types (`model` never sees a file) |
 //! | [`sim`] | closed-form and discretised simulators (the truth of the experiments) |
@@ -64,6 +64,7 @@ pub mod model;
 pub mod plan;
 pub mod plot;
 pub mod sim;
+pub mod simd;
 pub mod solver;
 pub mod stats;
 pub mod steps;

@@ -20,13 +20,18 @@ use std::path::{Path, PathBuf};
 const ALLOWED: &[(&str, &[&str])] = &[
     ("error", &[]),
     ("steps", &[]),
+    // The kernels' instruction set: a leaf, so that `graph` and `solver` follow one switch.
+    ("simd", &[]),
     ("cancel", &["error"]),
     ("stats", &["error"]),
     ("model", &["error", "steps", "stats", "generated"]),
     ("io", &["error", "model"]),
     ("sim", &["error", "steps", "cancel", "stats", "generated", "model"]),
-    ("graph", &["error", "stats", "generated", "model"]),
-    ("solver", &["error", "steps", "cancel", "stats", "model", "graph"]),
+    ("graph", &["error", "stats", "generated", "model", "simd"]),
+    (
+        "solver",
+        &["error", "steps", "cancel", "stats", "model", "graph", "simd"],
+    ),
     ("calib", &["error", "stats", "generated", "model", "graph", "solver"]),
     (
         "diagnose",

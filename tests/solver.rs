@@ -256,3 +256,46 @@ fn a_kept_linear_system_solves_exactly_as_a_new_one() {
     cache.clear();
     assert!(cache.is_empty());
 }
+
+/// A catenary calibration graph (the final stage of `calibrate`, pose priors
+/// with orientation: the benchmark problem's graph, and the same poses with
+/// the tension guards, solved with local refinement) has a fixed-size kernel
+/// for every shape it gives the solver (the table of `solver::shapes`): its
+/// solves take no general loop, on either path (`SAGCAL_SIMD`).
+#[test]
+fn a_calibration_graph_takes_no_general_loop() {
+    use sagcal::calib::{build_graph, CableModel};
+    use sagcal::experiments::benchmark::BenchmarkProblem;
+    use sagcal::solver::{optimize_cached, Fallbacks, SystemCache};
+    let problem = BenchmarkProblem::new(9, 1).unwrap();
+    let with_guards = build_graph(
+        &problem.initial,
+        &problem.measurements,
+        &problem.initial_poses,
+        &problem.initial_tensions,
+        CableModel::Catenary,
+        &problem.options,
+    );
+    assert!(with_guards.graph.factors.iter().any(|f| f.kind() == "tension_guard"));
+    let refined = LmParams {
+        max_iterations: 6,
+        ..LmParams::default()
+    };
+    for (mut built, params) in [(problem.graph(), BenchmarkProblem::stopping()), (with_guards, refined)] {
+        assert!(built.graph.factors.iter().any(|f| f.kind() == "catenary_length"));
+        let mut cache = SystemCache::default();
+        let summary = optimize_cached(&mut built.graph, &params, &mut cache).unwrap();
+        assert!(summary.iterations > 0 && summary.final_cost < summary.initial_cost);
+        let graph = &built.graph;
+        let system = cache
+            .system(&graph.values, &graph.factors, &graph.local_groups)
+            .unwrap();
+        assert!(system.uses_block_elimination());
+        assert_eq!(
+            system.fallbacks(),
+            Fallbacks::default(),
+            "{} factors",
+            graph.factors.len()
+        );
+    }
+}

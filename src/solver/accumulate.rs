@@ -18,8 +18,11 @@ use nalgebra::DMatrix;
 
 use crate::graph::VariableId;
 
-#[cfg(target_arch = "x86_64")]
-use super::gram_avx2;
+use super::shapes::{
+    avx2_run_shapes, portable_run_shapes, run_shapes, FallbackCounter, ANCHORS, CABLE_ROWS, GLOBALS, GROUP, POSE,
+    PRIOR_ROWS, TENSION,
+};
+use super::simd;
 
 /// Consecutive factor slots `first_slot..end_slot` whose tangent columns are
 /// `offset..offset + width` of the step vector, and `column..column + width`
@@ -218,9 +221,9 @@ impl FactorRuns {
     /// `residual.len()` rows) into `hessian` and `J^T r` into `gradient`;
     /// `rows_buffer` is reused scratch.
     ///
-    /// On x86-64 CPUs with AVX2 the same code runs compiled for it (four
-    /// lanes instead of SSE2's two; no FMA, so every sum is rounded as in the
-    /// SSE2 build and the results are bit for bit the same: unit test).
+    /// On the AVX2 path (`simd::avx2`) the same code runs compiled for it
+    /// (four lanes instead of SSE2's two; no FMA, so every sum is rounded as
+    /// in the SSE2 build and the results are bit for bit the same: unit test).
     pub(super) fn accumulate(
         &self,
         jacobians: &[DMatrix<f64>],
@@ -228,14 +231,15 @@ impl FactorRuns {
         hessian: &mut [f64],
         gradient: &mut [f64],
         rows_buffer: &mut Vec<f64>,
+        fallbacks: &FallbackCounter,
     ) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `accumulate_avx2` only needs AVX2, which the CPU has (checked just above).
-            unsafe { self.accumulate_avx2(jacobians, residual, hessian, gradient, rows_buffer) };
+        if simd::avx2() {
+            // SAFETY: `accumulate_avx2` only needs AVX2, which the CPU has (`simd::avx2`).
+            unsafe { self.accumulate_avx2(jacobians, residual, hessian, gradient, rows_buffer, fallbacks) };
             return;
         }
-        self.accumulate_any::<false>(jacobians, residual, hessian, gradient, rows_buffer);
+        self.accumulate_any::<false>(jacobians, residual, hessian, gradient, rows_buffer, fallbacks);
     }
 
     /// [`FactorRuns::accumulate_any`] compiled with AVX2 (a closure-taking
@@ -249,13 +253,14 @@ impl FactorRuns {
         hessian: &mut [f64],
         gradient: &mut [f64],
         rows_buffer: &mut Vec<f64>,
+        fallbacks: &FallbackCounter,
     ) {
-        self.accumulate_any::<true>(jacobians, residual, hessian, gradient, rows_buffer);
+        self.accumulate_any::<true>(jacobians, residual, hessian, gradient, rows_buffer, fallbacks);
     }
 
     /// [`FactorRuns::accumulate`] for the instruction set it is inlined into
     /// (`AVX2`: only from [`FactorRuns::accumulate_avx2`], whose products go
-    /// to the intrinsic kernel of `gram_avx2`).
+    /// to the intrinsic kernel of `simd::gram`).
     #[inline(always)]
     fn accumulate_any<const AVX2: bool>(
         &self,
@@ -264,12 +269,17 @@ impl FactorRuns {
         hessian: &mut [f64],
         gradient: &mut [f64],
         rows_buffer: &mut Vec<f64>,
+        fallbacks: &FallbackCounter,
     ) {
         match residual.len() {
-            1 => self.accumulate_rows::<1, AVX2>(jacobians, residual, hessian, gradient, rows_buffer),
-            4 => self.accumulate_rows::<4, AVX2>(jacobians, residual, hessian, gradient, rows_buffer),
-            6 => self.accumulate_rows::<6, AVX2>(jacobians, residual, hessian, gradient, rows_buffer),
-            _ => self.accumulate_rows::<0, AVX2>(jacobians, residual, hessian, gradient, rows_buffer),
+            1 => self.accumulate_rows::<1, AVX2>(jacobians, residual, hessian, gradient, rows_buffer, fallbacks),
+            CABLE_ROWS => {
+                self.accumulate_rows::<CABLE_ROWS, AVX2>(jacobians, residual, hessian, gradient, rows_buffer, fallbacks)
+            }
+            PRIOR_ROWS => {
+                self.accumulate_rows::<PRIOR_ROWS, AVX2>(jacobians, residual, hessian, gradient, rows_buffer, fallbacks)
+            }
+            _ => self.accumulate_rows::<0, AVX2>(jacobians, residual, hessian, gradient, rows_buffer, fallbacks),
         }
     }
 
@@ -282,6 +292,7 @@ impl FactorRuns {
         hessian: &mut [f64],
         gradient: &mut [f64],
         rows_buffer: &mut Vec<f64>,
+        fallbacks: &FallbackCounter,
     ) {
         let rows = if R == 0 { residual.len() } else { R };
         // (1) Each run's columns, row by row: at `rows * run.column`, `rows x width`.
@@ -290,7 +301,10 @@ impl FactorRuns {
         }
         for run in &self.runs {
             let base = rows * run.column;
-            if AVX2 && R == 4 && gather_four_rows_avx2(run, jacobians, &mut rows_buffer[base..base + 4 * run.width]) {
+            if AVX2
+                && R == CABLE_ROWS
+                && gather_four_rows_avx2(run, jacobians, &mut rows_buffer[base..base + R * run.width])
+            {
                 add_run_gradient::<R, AVX2>(&rows_buffer[base..base + rows * run.width], run, residual, gradient);
                 continue;
             }
@@ -325,6 +339,7 @@ impl FactorRuns {
                 rows,
                 block.stride,
                 &mut hessian[block.start..],
+                fallbacks,
             );
         }
     }
@@ -383,7 +398,7 @@ fn gather_four_rows_avx2(run: &Run, jacobians: &[DMatrix<f64>], rows: &mut [f64]
         let mut column = 0;
         for jacobian in &jacobians[run.first_slot..run.end_slot] {
             // SAFETY: reached only from `accumulate_avx2`, which runs only where the CPU has AVX2.
-            unsafe { gram_avx2::scatter_four_rows(jacobian.as_slice(), rows, run.width, column) };
+            unsafe { simd::gram::scatter_four_rows(jacobian.as_slice(), rows, run.width, column) };
             column += jacobian.ncols();
         }
         true
@@ -436,16 +451,6 @@ fn place_columns(runs: &mut [Run]) {
     }
 }
 
-/// Calls `$kernels!` with the run shapes `(columns of a, columns of b,
-/// diagonal block)` of a calibration graph's catenary factors (a pose with
-/// its tension 8 columns, the anchors and offsets 16, the anchors 12; `1`:
-/// the gradient of a run) and the `$extra` ones.
-macro_rules! run_shapes {
-    ($kernels:ident $(, $extra:tt)*) => {
-        $kernels!((8, 8, true), (8, 16, false), (16, 16, true), (8, 12, false), (12, 12, true), (8, 1, false) $(, $extra)*)
-    };
-}
-
 /// A run's Jacobian columns stored row by row: entry `(r, c)` at `data[r * width + c]`.
 #[derive(Clone, Copy)]
 struct RunRows<'a> {
@@ -457,10 +462,9 @@ struct RunRows<'a> {
 /// runs of `rows` rows to the block at the start of `block`, entry `(i, j)`
 /// at `i + j * stride`, each entry summed over the rows in order.
 ///
-/// The run shapes of a calibration graph (`R` rows; a pose with its tension
-/// 8 columns, the anchors and offsets 16 or the anchors 12, a pose prior 6)
-/// go to kernels whose sizes are known at compile time (unrolled,
-/// vectorised, no bounds checks); the rest to the general loop.
+/// The run shapes of a calibration graph (the table of `shapes`) go to
+/// kernels whose sizes are known at compile time (unrolled, vectorised, no
+/// bounds checks); the rest to the general loop, counted in `fallbacks`.
 #[inline(always)]
 fn add_run_product<const R: usize, const AVX2: bool>(
     a: RunRows,
@@ -469,21 +473,23 @@ fn add_run_product<const R: usize, const AVX2: bool>(
     rows: usize,
     stride: usize,
     block: &mut [f64],
+    fallbacks: &FallbackCounter,
 ) {
     if AVX2 && add_gram_avx2::<R>(a, b, same, stride, block) {
         return;
     }
     if R != 0 {
         macro_rules! kernels {
-            ($(($ca:literal, $cb:literal, $same:literal)),*) => {
+            ($(($ca:tt, $cb:tt, $same:literal)),*) => {
                 match (a.width, b.width, same) {
                     $(($ca, $cb, $same) => return run_product::<R, $ca, $cb, $same>(a.data, b.data, stride, block),)*
                     _ => {}
                 }
             };
         }
-        run_shapes!(kernels, (6, 6, true), (2, 2, true), (1, 1, true));
+        portable_run_shapes!(kernels);
     }
+    fallbacks.product();
     for j in 0..b.width {
         let first = if same { j } else { 0 };
         let column = &mut block[j * stride + first..j * stride + a.width];
@@ -507,19 +513,19 @@ fn add_gram_avx2<const R: usize>(a: RunRows, b: RunRows, same: bool, stride: usi
     #[cfg(target_arch = "x86_64")]
     {
         macro_rules! kernels {
-            ($(($ca:literal, $cb:literal, $same:literal)),*) => {
+            ($(($ca:tt, $cb:tt, $same:literal)),*) => {
                 match (a.width, b.width, same) {
                     $(($ca, $cb, $same) => {
                         // SAFETY: reached only from `accumulate_avx2`, which runs only where the CPU has AVX2.
-                        unsafe { gram_avx2::gram_block::<4, $ca, $cb, $same, false>(a.data, b.data, stride, block) };
+                        unsafe { simd::gram::gram_block::<CABLE_ROWS, $ca, $cb, $same, false>(a.data, b.data, stride, block) };
                         return true;
                     })*
                     _ => {}
                 }
             };
         }
-        if R == 4 {
-            run_shapes!(kernels, (16, 1, false), (12, 1, false));
+        if R == CABLE_ROWS {
+            avx2_run_shapes!(kernels);
         }
     }
     let _ = (a, b, same, stride, block);
@@ -592,14 +598,38 @@ mod tests {
             let residual: Vec<f64> = (0..rows).map(|r| value(1000 + r)).collect();
             let mut run_buffer = Vec::new();
             let (mut h_merged, mut g_merged) = (vec![0.0; n * n], vec![0.0; n]);
-            merged.accumulate(&jacobians, &residual, &mut h_merged, &mut g_merged, &mut run_buffer);
+            let fallbacks = FallbackCounter::default();
+            merged.accumulate(
+                &jacobians,
+                &residual,
+                &mut h_merged,
+                &mut g_merged,
+                &mut run_buffer,
+                &fallbacks,
+            );
+            // The 8 x 8 block has a kernel for 1, 4 and 6 rows; 5 rows take the general loop.
+            assert_eq!(fallbacks.read().products, usize::from(rows == 5), "{rows} rows");
             let (mut h_single, mut g_single) = (vec![0.0; n * n], vec![0.0; n]);
-            single.accumulate(&jacobians, &residual, &mut h_single, &mut g_single, &mut run_buffer);
+            single.accumulate(
+                &jacobians,
+                &residual,
+                &mut h_single,
+                &mut g_single,
+                &mut run_buffer,
+                &fallbacks,
+            );
             assert_eq!(h_merged, h_single, "{rows} rows");
             assert_eq!(g_merged, g_single, "{rows} rows");
             // The build for the CPU's instruction set (AVX2 where it has it) and the portable one agree bit for bit.
             let (mut h_any, mut g_any) = (vec![0.0; n * n], vec![0.0; n]);
-            merged.accumulate_any::<false>(&jacobians, &residual, &mut h_any, &mut g_any, &mut run_buffer);
+            merged.accumulate_any::<false>(
+                &jacobians,
+                &residual,
+                &mut h_any,
+                &mut g_any,
+                &mut run_buffer,
+                &fallbacks,
+            );
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&h_any), bits(&h_merged), "{rows} rows");
             assert_eq!(bits(&g_any), bits(&g_merged), "{rows} rows");

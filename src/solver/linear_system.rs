@@ -1,49 +1,66 @@
 //! The normal equations `H dx = -g` in sparse form.
 //!
-//! The sparsity pattern of `H = J^T W J` (lower triangle) follows from which
-//! variables share a factor. It is built once per problem at the block level
-//! (one dense block per pair of connected free variables), its symbolic
-//! Cholesky (AMD ordering, supernodal) is computed once, and every damping
-//! trial only refactors numerically into buffers allocated once
-//! (`SymbolicCholesky::factorize_numeric_llt`, single-threaded).
+//! A [`LinearSystem`] is built once per graph structure and answers three
+//! questions, one part each:
 //!
-//! `H` is accumulated block by block ([`LinearSystem::accumulate`]) straight
-//! into the storage its factorisation reads: the dense blocks of the block
-//! elimination (`schur`), copied whole before each factorisation, or one
-//! dense column-major block per pair of variables, scattered into faer's
-//! compressed columns.
-
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
+//! - where the free variables sit in the step vector (`offsets`, `dim`: the
+//!   globals first, then each local group's variables together);
+//! - where the entries of `H = J^T W J` (lower triangle) are stored and how
+//!   each factor's `J^T J` and `J^T r` add into them (`HessianStorage`: per
+//!   factor its runs of contiguous columns, see `accumulate`), accumulated
+//!   ([`LinearSystem::accumulate`]) straight into the storage its
+//!   factorisation reads;
+//! - how `H + damping` is factored (`Factorization`): the block elimination
+//!   of the local groups (`schur`; its dense zones read off the tangent
+//!   layout, `block_elimination`), or faer's supernodal sparse Cholesky
+//!   (`sparse_cholesky`; one dense block per pair of connected variables,
+//!   read off the factors' slot pairs and scattered into faer's compressed
+//!   columns, `sparse_pattern`), whose symbolic analysis (AMD ordering) is
+//!   done once while every damping trial only refactors numerically into
+//!   buffers allocated once.
+//!
+//! Beside them, a count of the work done by general loops for shapes outside
+//! the table of `shapes` ([`LinearSystem::fallbacks`]).
 
 use nalgebra::DMatrix;
 
-use super::accumulate::{FactorRuns, SlotBlock};
+use super::accumulate::FactorRuns;
+use super::dense::zeroed;
 use super::schur::SchurLayout;
+use super::shapes::{FallbackCounter, Fallbacks};
 use super::sparse_cholesky::SparseCholesky;
 use crate::graph::{Factor, Values, VariableId};
 
-/// Where the free variables sit in the tangent vector, and the pattern of `H`.
+mod block_elimination;
+mod sparse_pattern;
+
+/// The normal equations of a graph of one structure: where the free
+/// variables sit in the tangent vector, where the entries of `H` are stored
+/// and how each factor adds to them, and how `H + damping` is factored.
 pub struct LinearSystem {
     /// Tangent offset of each variable (`None` when fixed), indexed by `VariableId`.
     pub offsets: Vec<Option<usize>>,
     /// Total tangent dimension of the free variables.
     pub dim: usize,
-    /// Per factor, how its `J^T J` blocks add into the storage of `H`.
+    /// The storage of `H` and how each factor adds into it.
+    storage: HessianStorage,
+    /// How `H + damping` is factored, with what that path alone needs.
+    factorization: Factorization,
+    /// The work done by general loops for shapes outside the table of `shapes`.
+    fallbacks: FallbackCounter,
+}
+
+/// The storage of `H`'s lower triangle, laid out for the factorisation that
+/// reads it, and where each factor's `J^T J` goes in it.
+struct HessianStorage {
+    /// Per factor, how its `J^T J` blocks add into the storage.
     factor_runs: Vec<FactorRuns>,
     /// Per tangent index, the storage position of its diagonal entry.
     diagonal_slots: Vec<usize>,
-    /// Per tangent index, the index in `positions` of its diagonal entry
-    /// (faer's sparse Cholesky only; empty for the block elimination).
-    diagonal_entries: Vec<usize>,
-    /// Length of the storage of `H`.
-    storage_len: usize,
-    /// Storage position of every entry of the lower triangle, in the order
-    /// of the sparse Cholesky's pattern (faer's sparse Cholesky only).
-    positions: Vec<usize>,
+    /// Length of the storage.
+    len: usize,
     /// Every stored block of the lower triangle and where it is stored.
     blocks: Vec<StoredBlock>,
-    factorization: Factorization,
 }
 
 /// One stored block of `H`: rows `row..row + rows`, columns `col..col + cols`
@@ -77,34 +94,9 @@ const MAX_SCHUR_GLOBALS: usize = 400;
 enum Factorization {
     /// Block elimination of the local groups ([`SchurLayout`]).
     Schur(SchurLayout),
-    /// faer's supernodal sparse Cholesky of the whole pattern.
+    /// faer's supernodal sparse Cholesky of the whole pattern (with the
+    /// storage position of each of its entries).
     Sparse(Box<SparseCholesky>),
-}
-
-/// Block starts by `(row variable, column variable)` index.
-type BlockMap = HashMap<(usize, usize), usize, BuildHasherDefault<IndexHasher>>;
-
-/// A multiplicative hasher for small integer keys (variable indices): the
-/// pattern analysis looks up one block per pair of variables of every
-/// factor, and the default SipHash dominated it.
-#[derive(Default)]
-struct IndexHasher(u64);
-
-impl Hasher for IndexHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(u64::from(b));
-        }
-    }
-    fn write_usize(&mut self, i: usize) {
-        self.write_u64(i as u64);
-    }
-    fn write_u64(&mut self, i: u64) {
-        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
 }
 
 /// Where each free variable's tangent block sits in the step vector: the
@@ -158,77 +150,6 @@ impl TangentLayout {
     }
 }
 
-mod block_elimination;
-
-/// The stored blocks of the lower triangle of `H`, in storage order, and
-/// where each factor's slot pairs accumulate.
-struct BlockPattern {
-    blocks: BlockMap,
-    /// `(row variable, column variable, start)` of each block, in storage order.
-    block_order: Vec<(VariableId, VariableId, usize)>,
-    /// Number of stored scalars.
-    entry_count: usize,
-    /// Per factor: the blocks it touches (start in the block-wise storage, stride: rows of the block).
-    factor_blocks: Vec<Vec<SlotBlock>>,
-}
-
-impl BlockPattern {
-    fn new(values: &Values, factors: &[Box<dyn Factor>], offsets: &[Option<usize>]) -> Self {
-        let mut pattern = Self {
-            blocks: BlockMap::default(),
-            block_order: Vec::new(),
-            entry_count: 0,
-            factor_blocks: Vec::with_capacity(factors.len()),
-        };
-        // Every free variable gets its diagonal block, even if no factor touches it
-        // (then H is singular and the solver reports it instead of crashing).
-        for (id, _) in values.iter() {
-            if offsets[id.0].is_some() {
-                pattern.block_for(values, id, id);
-            }
-        }
-        for factor in factors {
-            let vars = factor.variables();
-            let mut list = Vec::with_capacity(vars.len() * (vars.len() + 1) / 2);
-            for (slot_a, &a) in vars.iter().enumerate() {
-                let Some(oa) = offsets[a.0] else {
-                    continue;
-                };
-                let stride = values.tangent_dim(a);
-                for (slot_b, &b) in vars.iter().enumerate() {
-                    let Some(ob) = offsets[b.0] else {
-                        continue;
-                    };
-                    if oa < ob || (a == b && slot_a != slot_b) {
-                        continue;
-                    }
-                    list.push(SlotBlock {
-                        slot_a,
-                        slot_b,
-                        start: pattern.block_for(values, a, b),
-                        stride,
-                    });
-                }
-            }
-            pattern.factor_blocks.push(list);
-        }
-        pattern
-    }
-
-    /// The start of block `(a, b)` (dense, column-major; a diagonal block's
-    /// upper triangle is never written), stored after the others if new.
-    fn block_for(&mut self, values: &Values, a: VariableId, b: VariableId) -> usize {
-        let entry_count = &mut self.entry_count;
-        let block_order = &mut self.block_order;
-        *self.blocks.entry((a.0, b.0)).or_insert_with(|| {
-            let start = *entry_count;
-            *entry_count += values.tangent_dim(a) * values.tangent_dim(b);
-            block_order.push((a, b, start));
-            start
-        })
-    }
-}
-
 impl LinearSystem {
     /// Analyse the pattern of `H` for these factors and free variables.
     ///
@@ -263,72 +184,14 @@ impl LinearSystem {
         Self::with_sparse_cholesky(values, factors, layout)
     }
 
-    /// The pattern for faer's sparse Cholesky: every block a factor touches,
-    /// stored column-major from its start, in the order first touched.
-    fn with_sparse_cholesky(
-        values: &Values,
-        factors: &[Box<dyn Factor>],
-        layout: TangentLayout,
-    ) -> Result<Self, String> {
-        let pattern = BlockPattern::new(values, factors, &layout.offsets);
-        let offset = |v: VariableId| layout.offsets[v.0].unwrap_or(0);
-        let block = |&(a, b, start): &(VariableId, VariableId, usize)| StoredBlock {
-            row: offset(a),
-            col: offset(b),
-            rows: values.tangent_dim(a),
-            cols: values.tangent_dim(b),
-            first: start,
-            stride: values.tangent_dim(a),
-        };
-        let blocks: Vec<StoredBlock> = pattern.block_order.iter().map(block).collect();
-        let entries = blocks.iter().flat_map(StoredBlock::entries);
-        let (indices, positions): (Vec<(usize, usize)>, Vec<usize>) =
-            entries.map(|(row, col, position)| ((row, col), position)).unzip();
-        let mut diagonal_entries = vec![0; layout.dim];
-        for (k, &(row, col)) in indices.iter().enumerate() {
-            if row == col {
-                diagonal_entries[row] = k;
-            }
-        }
-        let sparse = SparseCholesky::new(&indices, layout.dim)?;
-        let mut diagonal_slots = vec![0; layout.dim];
-        for block in blocks.iter().filter(|b| b.row == b.col) {
-            for i in 0..block.rows {
-                diagonal_slots[block.row + i] = block.first + i + i * block.stride;
-            }
-        }
-        let mut dims = Vec::new();
-        let factor_runs = factors
-            .iter()
-            .zip(&pattern.factor_blocks)
-            .map(|(factor, blocks)| {
-                let variables = factor.variables();
-                dims.clear();
-                dims.extend(variables.iter().map(|&v| values.tangent_dim(v)));
-                FactorRuns::new(variables, &layout.offsets, &dims, blocks)
-            })
-            .collect();
-        Ok(Self {
-            offsets: layout.offsets,
-            dim: layout.dim,
-            factor_runs,
-            diagonal_slots,
-            diagonal_entries,
-            storage_len: pattern.entry_count,
-            positions,
-            blocks,
-            factorization: Factorization::Sparse(Box::new(sparse)),
-        })
-    }
-
     /// A zeroed value array for `H`.
     pub fn zero_hessian(&self) -> Vec<f64> {
-        zeroed(self.storage_len)
+        zeroed(self.storage.len)
     }
 
     /// Length of [`LinearSystem::zero_hessian`]'s array.
     pub fn zero_hessian_len(&self) -> usize {
-        self.storage_len
+        self.storage.len
     }
 
     /// Add factor `index`'s weighted `J^T J` blocks (whitened, robust-weighted
@@ -343,32 +206,37 @@ impl LinearSystem {
         gradient: &mut [f64],
         rows_buffer: &mut Vec<f64>,
     ) {
-        self.factor_runs[index].accumulate(jacobians, residual, hessian, gradient, rows_buffer);
+        self.storage.factor_runs[index].accumulate(
+            jacobians,
+            residual,
+            hessian,
+            gradient,
+            rows_buffer,
+            &self.fallbacks,
+        );
     }
 
     /// The diagonal of `H` from its value array.
     pub fn diagonal(&self, hessian: &[f64]) -> Vec<f64> {
-        self.diagonal_slots.iter().map(|&k| hessian[k]).collect()
+        self.storage.diagonal_slots.iter().map(|&k| hessian[k]).collect()
     }
 
     /// Factor `H + diag(damping)` (Cholesky); `false` if it is not
     /// numerically positive definite. Solves with [`LinearSystem::solve_factored`].
     pub fn factorize(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
-        let sparse = match &mut self.factorization {
-            Factorization::Schur(layout) => return layout.factorize(hessian, damping),
-            Factorization::Sparse(sparse) => sparse,
-        };
-        sparse.factorize(hessian, &self.positions, &self.diagonal_entries, damping)
+        match &mut self.factorization {
+            Factorization::Schur(layout) => layout.factorize(hessian, damping, &self.fallbacks),
+            Factorization::Sparse(sparse) => sparse.factorize(hessian, damping),
+        }
     }
 
     /// Solve with the last successful [`LinearSystem::factorize`]; `None` if
     /// there is none or the solution is not finite.
     pub fn solve_factored(&mut self, rhs: &[f64]) -> Option<Vec<f64>> {
-        let sparse = match &mut self.factorization {
-            Factorization::Schur(layout) => return layout.solve(rhs),
-            Factorization::Sparse(sparse) => sparse,
-        };
-        sparse.solve(rhs)
+        match &mut self.factorization {
+            Factorization::Schur(layout) => layout.solve(rhs, &self.fallbacks),
+            Factorization::Sparse(sparse) => sparse.solve(rhs),
+        }
     }
 
     /// The number of leading tangent indices (the globals) that the block
@@ -412,6 +280,16 @@ impl LinearSystem {
         matches!(self.factorization, Factorization::Schur(_))
     }
 
+    /// The products, group eliminations and group substitutions this
+    /// system has done by general loops since it was built, for want of a
+    /// fixed-size kernel for their shape (the table of the `shapes`
+    /// module): zero for the catenary calibration graph, so a new factor
+    /// shape shows here instead of only in the running time. The results do
+    /// not depend on it.
+    pub fn fallbacks(&self) -> Fallbacks {
+        self.fallbacks.read()
+    }
+
     /// Solve `(H + diag(damping)) x = rhs`; `None` if the matrix is not positive definite.
     pub fn solve(&mut self, hessian: &[f64], damping: &[f64], rhs: &[f64]) -> Option<Vec<f64>> {
         if !self.factorize(hessian, damping) {
@@ -423,7 +301,7 @@ impl LinearSystem {
     /// `H` as a dense symmetric matrix (for the rank analysis of small problems).
     pub fn dense(&self, hessian: &[f64]) -> DMatrix<f64> {
         let mut dense = DMatrix::zeros(self.dim, self.dim);
-        for (row, col, position) in self.blocks.iter().flat_map(StoredBlock::entries) {
+        for (row, col, position) in self.storage.blocks.iter().flat_map(StoredBlock::entries) {
             dense[(row, col)] = hessian[position];
             dense[(col, row)] = hessian[position];
         }
@@ -431,60 +309,9 @@ impl LinearSystem {
     }
 }
 
-/// `len` zeros, written in 1 kB pieces: one `memset` (or `calloc`) of a
-/// large buffer is a `rep stosb`, which callgrind counts once per byte and
-/// which is slower than vector stores below a few pages.
-pub(super) fn zeroed(len: usize) -> Vec<f64> {
-    let mut zeros = Vec::with_capacity(len);
-    fill_zeros(&mut zeros, len);
-    zeros
-}
-
-/// Make `buffer` `len` zeros, in 1 kB pieces (see [`zeroed`]).
-pub(super) fn fill_zeros(buffer: &mut Vec<f64>, len: usize) {
-    const PIECE: [f64; 128] = [0.0; 128];
-    buffer.truncate(len);
-    for piece in buffer.chunks_mut(PIECE.len()) {
-        piece.copy_from_slice(&PIECE[..piece.len()]);
-    }
-    while buffer.len() < len {
-        let missing = (len - buffer.len()).min(PIECE.len());
-        buffer.extend_from_slice(&PIECE[..missing]);
-    }
-}
-
-/// `a . b` for two columns of `R` entries (`R = 0`: of equal length).
-#[inline(always)]
-pub(super) fn dot<const R: usize>(a: &[f64], b: &[f64]) -> f64 {
-    if R == 0 {
-        return a.iter().zip(b).map(|(x, y)| x * y).sum();
-    }
-    let (a, b) = (&a[..R], &b[..R]);
-    let mut sum = 0.0;
-    for r in 0..R {
-        sum += a[r] * b[r];
-    }
-    sum
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A reused buffer of any length, shorter or longer than asked, comes
-    /// back as exactly `len` zeros (lengths around the 128-entry pieces).
-    #[test]
-    fn fill_zeros_gives_len_zeros_from_any_buffer() {
-        for start in [0usize, 5, 128, 300] {
-            for len in [0usize, 1, 127, 128, 129, 1000] {
-                let mut buffer: Vec<f64> = (0..start).map(|k| k as f64 + 0.5).collect();
-                fill_zeros(&mut buffer, len);
-                assert_eq!(buffer.len(), len, "from {start}");
-                assert!(buffer.iter().all(|&v| v == 0.0), "from {start} to {len}");
-            }
-        }
-        assert_eq!(zeroed(257), vec![0.0; 257]);
-    }
 
     /// A linear residual `r = A [x_v1; x_v2; ...]` on vector variables.
     struct Linear {
@@ -632,5 +459,81 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A shape outside the table of `shapes` is solved by the general loops
+    /// and counted; the table's shapes are not. Globals of 16 columns (four
+    /// 3-vectors, then four scalars: anchors and offsets) and a group of 8 (a
+    /// 6-vector and a 2-vector: a pose and its tension), counted over one
+    /// linearisation, factorisation and solve.
+    #[test]
+    fn a_shape_outside_the_table_is_counted() {
+        let vector = |n: usize, k: f64| {
+            crate::graph::VariableValue::Vector(nalgebra::DVector::from_fn(n, |i, _| k + 0.1 * i as f64))
+        };
+        let mut values = Values::new();
+        let anchors: Vec<VariableId> = (0..4)
+            .map(|i| values.insert(format!("anchor {i}"), vector(3, i as f64)))
+            .collect();
+        let offsets: Vec<VariableId> = (0..4)
+            .map(|i| values.insert(format!("offset {i}"), vector(1, -(i as f64))))
+            .collect();
+        let pose = values.insert("pose", vector(6, 0.5));
+        let tension = values.insert("tension", vector(2, 1.5));
+        let lever = values.insert("lever", vector(3, 2.5));
+        let factor = |variables: Vec<VariableId>, rows: usize| -> Box<dyn Factor> {
+            let cols = variables.iter().map(|&v| values.tangent_dim(v)).sum();
+            let seed = (rows * 10 + variables.len()) as f64;
+            Box::new(Linear {
+                variables,
+                a: DMatrix::from_fn(rows, cols, |i, j| ((i * 7 + j * 3) as f64 * 0.61 + seed).sin()),
+                sigmas: nalgebra::DVector::from_element(rows, 0.5),
+            })
+        };
+        let globals = [anchors.clone(), offsets].concat();
+        let group_and = |others: &[VariableId]| [vec![pose, tension], others.to_vec()].concat();
+        // A length factor, a height factor, a pose prior, a tension factor.
+        let table = || {
+            vec![
+                factor(group_and(&globals), 4),
+                factor(group_and(&anchors), 4),
+                factor(vec![pose], 6),
+                factor(vec![tension], 1),
+            ]
+        };
+        let count = |factors: Vec<Box<dyn Factor>>, groups: Vec<Vec<VariableId>>| {
+            let mut graph = crate::graph::FactorGraph::new();
+            graph.values = values.clone();
+            // The lever is fixed unless it is a group of its own.
+            graph.values.set_fixed(lever, !groups.contains(&vec![lever]));
+            graph.factors = factors;
+            let values = &graph.values;
+            let mut system = LinearSystem::new(values, &graph.factors, &groups).unwrap();
+            assert!(system.uses_block_elimination());
+            let linearized = crate::solver::linearize(&graph, values, &system).unwrap();
+            let ones = vec![1.0; system.dim];
+            assert!(system.solve(&linearized.hessian, &ones, &ones).is_some());
+            system.fallbacks()
+        };
+        let pose_group = vec![pose, tension];
+        assert_eq!(count(table(), vec![pose_group.clone()]), Fallbacks::default());
+        // Five rows: the three products of the group and the globals.
+        let mut five_rows = table();
+        five_rows.push(factor(group_and(&globals), 5));
+        let expected = Fallbacks {
+            products: 3,
+            eliminations: 0,
+            substitutions: 0,
+        };
+        assert_eq!(count(five_rows, vec![pose_group.clone()]), expected);
+        // A group of 3: its products (3 x 3, 3 x 16), its elimination and its two substitutions.
+        let mut lever_group = table();
+        lever_group.push(factor([vec![lever], globals.clone()].concat(), 4));
+        let expected = Fallbacks {
+            products: 2,
+            eliminations: 1,
+            substitutions: 2,
+        };
+        assert_eq!(count(lever_group, vec![pose_group, vec![lever]]), expected);
     }
 }

@@ -14,9 +14,9 @@
 //! nonlinear elimination (Lanzkron, Rose & Wilkes, 1996). At a minimum of the
 //! full problem the refinement changes nothing.
 
-use super::gram_avx2;
-use super::linear_system::dot;
-use super::schur::{backward_substitute, cholesky_in_place, forward_substitute};
+use super::dense::{backward_substitute, cholesky_in_place, dot, forward_substitute};
+use super::shapes::{CABLE_ROWS, GROUP, POSE, POSITION_PRIOR_ROWS, PRIOR_ROWS};
+use super::simd;
 use std::cell::RefCell;
 
 use crate::graph::{FactorGraph, LinearizationBuffers, SlotMask, Values, VariableId, VariableValue};
@@ -169,7 +169,7 @@ fn linearize_group(
     out.gradient.clear();
     out.gradient.resize(dim, 0.0);
     let mut cost = 0.0;
-    let mut rows_buffer = [0.0; 32];
+    let mut rows_buffer = [0.0; CABLE_ROWS * GROUP];
     for ((&f, slots), &mask) in group.factors.iter().zip(&group.factor_slots).zip(&group.factor_masks) {
         let Ok(linearized) = buffers.linearize_slots(graph.factors[f].as_ref(), values, mask) else {
             return None;
@@ -190,15 +190,21 @@ fn linearize_group(
         let residual = &linearized.residual;
         match (rows, columns.len()) {
             // A pose's catenary rows on its pose and tension; its pose prior.
-            (4, 8) if contiguous(columns) && gram_avx2::available() => {
+            (CABLE_ROWS, GROUP) if contiguous(columns) && simd::avx2() => {
                 add_normal_equations_avx2(columns[0], gathered, residual, dim, out, &mut rows_buffer)
             }
-            (4, 8) => add_normal_equations_by_rows::<4, 8>(columns, gathered, residual, dim, out),
-            (6, 6) => add_normal_equations_by_rows::<6, 6>(columns, gathered, residual, dim, out),
-            (3, 6) => add_normal_equations_by_rows::<3, 6>(columns, gathered, residual, dim, out),
+            (CABLE_ROWS, GROUP) => {
+                add_normal_equations_by_rows::<CABLE_ROWS, GROUP>(columns, gathered, residual, dim, out)
+            }
+            (PRIOR_ROWS, POSE) => {
+                add_normal_equations_by_rows::<PRIOR_ROWS, POSE>(columns, gathered, residual, dim, out)
+            }
+            (POSITION_PRIOR_ROWS, POSE) => {
+                add_normal_equations_by_rows::<POSITION_PRIOR_ROWS, POSE>(columns, gathered, residual, dim, out)
+            }
             (1, _) => add_normal_equations::<1>(columns, gathered, residual, dim, out),
-            (4, _) => add_normal_equations::<4>(columns, gathered, residual, dim, out),
-            (6, _) => add_normal_equations::<6>(columns, gathered, residual, dim, out),
+            (CABLE_ROWS, _) => add_normal_equations::<CABLE_ROWS>(columns, gathered, residual, dim, out),
+            (PRIOR_ROWS, _) => add_normal_equations::<PRIOR_ROWS>(columns, gathered, residual, dim, out),
             _ => add_normal_equations::<0>(columns, gathered, residual, dim, out),
         }
     }
@@ -239,14 +245,19 @@ fn add_normal_equations_avx2(
     residual: &[f64],
     dim: usize,
     out: &mut GroupSystem,
-    rows: &mut [f64; 32],
+    rows: &mut [f64; CABLE_ROWS * GROUP],
 ) {
     #[cfg(target_arch = "x86_64")]
-    // SAFETY: the caller checked `gram_avx2::available()`.
+    // SAFETY: the caller checked `simd::avx2()`.
     unsafe {
-        gram_avx2::scatter_four_rows(&gathered[..32], rows, 8, 0);
-        gram_avx2::gram_block::<4, 8, 1, false, false>(rows, residual, 0, &mut out.gradient[first..]);
-        gram_avx2::gram_block::<4, 8, 8, true, false>(rows, rows, dim, &mut out.hessian[first + first * dim..]);
+        simd::gram::scatter_four_rows(&gathered[..CABLE_ROWS * GROUP], rows, GROUP, 0);
+        simd::gram::gram_block::<CABLE_ROWS, GROUP, 1, false, false>(rows, residual, 0, &mut out.gradient[first..]);
+        simd::gram::gram_block::<CABLE_ROWS, GROUP, GROUP, true, false>(
+            rows,
+            rows,
+            dim,
+            &mut out.hessian[first + first * dim..],
+        );
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = (first, gathered, residual, dim, out, rows);
@@ -417,7 +428,7 @@ fn solve_in_place(a: &mut [f64], dim: usize, x: &mut [f64]) -> bool {
         true
     }
     match dim {
-        8 => solve(a, 8, x),
+        GROUP => solve(a, GROUP, x),
         _ => solve(a, dim, x),
     }
 }
@@ -456,7 +467,7 @@ mod tests {
             assert_eq!(bits(&by_rows.hessian), bits(&by_dots.hessian), "{R} x {C}");
             assert_eq!(bits(&by_rows.gradient), bits(&by_dots.gradient), "{R} x {C}");
             assert_ne!(bits(&by_rows.hessian), bits(&start().hessian));
-            if R == 4 && C == 8 && contiguous(columns) && gram_avx2::available() {
+            if R == CABLE_ROWS && C == GROUP && contiguous(columns) && simd::avx2_under_test() {
                 let mut by_avx2 = start();
                 add_normal_equations_avx2(columns[0], &gathered, &residual, dim, &mut by_avx2, &mut [0.0; 32]);
                 assert_eq!(bits(&by_avx2.hessian), bits(&by_dots.hessian), "AVX2 {R} x {C}");

@@ -36,23 +36,25 @@
 
 mod accumulate;
 mod covariance;
-mod gram_avx2;
+mod dense;
 mod linear_system;
 mod local;
 mod redundancy;
 mod schur;
-mod schur_avx2;
 mod score;
+mod shapes;
+mod simd;
 mod sparse_cholesky;
 mod system_cache;
 
 use local::LocalGroups;
 
 pub use covariance::{marginal_covariance, marginal_covariance_cached, Covariance, UnobservableDirection};
-use linear_system::fill_zeros;
+use dense::fill_zeros;
 pub use linear_system::LinearSystem;
 pub use redundancy::redundancy_numbers;
 pub use score::{score_system, score_tests, Direction, ScoreSystem, ScoreTest};
+pub use shapes::Fallbacks;
 pub use system_cache::SystemCache;
 
 use serde::Serialize;

@@ -17,7 +17,12 @@
 //! fill-reducing order AMD finds for this pattern), written for the structure:
 //! the per-group blocks are small dense (`m <= 8`) and the reduced system is
 //! dense (`g = 16` for anchors and offsets), so each factorisation is a loop
-//! of fixed-size kernels with no symbolic bookkeeping.
+//! of fixed-size kernels with no symbolic bookkeeping (the sizes of the
+//! table of `shapes`; other sizes take general loops, counted).
+
+use super::dense::{backward_substitute, cholesky_in_place, forward_substitute, zeroed};
+use super::shapes::{FallbackCounter, GLOBALS, GROUP, POSE};
+use super::simd;
 
 /// Where every stored entry of `H` goes, and the dense blocks it fills.
 pub(super) struct SchurLayout {
@@ -35,6 +40,10 @@ pub(super) struct SchurLayout {
     /// `D_k` its `L_k` and `B_k` its `W_k`.
     values: Vec<f64>,
     factored: bool,
+    /// The groups whose substitutions in a solve take the general loops
+    /// ([`has_substitution_kernel`]), counted once per solve rather than in
+    /// its loops.
+    groups_without_kernel: usize,
 }
 
 impl SchurLayout {
@@ -66,13 +75,18 @@ impl SchurLayout {
         for (k, &(start, m)) in groups.iter().enumerate() {
             group_of[start - globals..start - globals + m].fill(k);
         }
+        let groups_without_kernel = groups
+            .iter()
+            .filter(|&&(_, m)| !has_substitution_kernel(m, globals))
+            .count();
         Self {
             globals,
             groups,
             group_base,
             group_of,
-            values: super::linear_system::zeroed(size),
+            values: zeroed(size),
             factored: false,
+            groups_without_kernel,
         }
     }
 
@@ -116,28 +130,34 @@ impl SchurLayout {
     /// buffer ([`SchurLayout::place`]; only lower triangles are read);
     /// `false` if a block or the reduced system is not positive definite.
     ///
-    /// On x86-64 CPUs with AVX2 the same code runs compiled for it (no FMA:
-    /// the values are bit for bit those of the SSE2 build).
-    pub(super) fn factorize(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
+    /// On the AVX2 path (`simd::avx2`) the same code runs compiled for it
+    /// (no FMA: the values are bit for bit those of the SSE2 build). A group
+    /// of a shape outside the table of `shapes` is counted in `fallbacks`.
+    pub(super) fn factorize(&mut self, hessian: &[f64], damping: &[f64], fallbacks: &FallbackCounter) -> bool {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `factorize_avx2` only needs AVX2, which the CPU has (checked just above).
-            return unsafe { self.factorize_avx2(hessian, damping) };
+        if simd::avx2() {
+            // SAFETY: `factorize_avx2` only needs AVX2, which the CPU has (`simd::avx2`).
+            return unsafe { self.factorize_avx2(hessian, damping, fallbacks) };
         }
-        self.factorize_any::<false>(hessian, damping)
+        self.factorize_any::<false>(hessian, damping, fallbacks)
     }
 
     /// [`SchurLayout::factorize_any`] compiled with AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn factorize_avx2(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
-        self.factorize_any::<true>(hessian, damping)
+    unsafe fn factorize_avx2(&mut self, hessian: &[f64], damping: &[f64], fallbacks: &FallbackCounter) -> bool {
+        self.factorize_any::<true>(hessian, damping, fallbacks)
     }
 
     /// [`SchurLayout::factorize`] for the instruction set it is inlined into
     /// (`AVX2`: only from [`SchurLayout::factorize_avx2`]).
     #[inline(always)]
-    fn factorize_any<const AVX2: bool>(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
+    fn factorize_any<const AVX2: bool>(
+        &mut self,
+        hessian: &[f64],
+        damping: &[f64],
+        fallbacks: &FallbackCounter,
+    ) -> bool {
         self.factored = false;
         let g = self.globals;
         // Each block is copied from `hessian` just before it is factored
@@ -151,10 +171,11 @@ impl SchurLayout {
             let base = self.group_base[k] - g * g;
             let block = &mut blocks[base..base + m * m + m * g];
             block.copy_from_slice(&hessian[g * g + base..g * g + base + m * m + m * g]);
+            let group_damping = &damping[start..start + m];
             let eliminated = match m {
-                8 => eliminate_group::<8, AVX2>(block, &damping[start..start + m], reduced, g),
-                6 => eliminate_group::<6, AVX2>(block, &damping[start..start + m], reduced, g),
-                _ => eliminate_group::<0, AVX2>(block, &damping[start..start + m], reduced, g),
+                GROUP => eliminate_group::<GROUP, AVX2>(block, group_damping, reduced, g, fallbacks),
+                POSE => eliminate_group::<POSE, AVX2>(block, group_damping, reduced, g, fallbacks),
+                _ => eliminate_group::<0, AVX2>(block, group_damping, reduced, g, fallbacks),
             };
             if !eliminated {
                 return false;
@@ -174,29 +195,35 @@ impl SchurLayout {
 
     /// Solve with the last successful factorisation; `None` if there is none.
     ///
-    /// On x86-64 CPUs with AVX2 the same code runs compiled for it (no FMA,
-    /// and every sum keeps its order: bit for bit the SSE2 build's values).
-    pub(super) fn solve(&self, rhs: &[f64]) -> Option<Vec<f64>> {
+    /// On the AVX2 path (`simd::avx2`) the same code runs compiled for it
+    /// (no FMA, and every sum keeps its order: bit for bit the SSE2 build's
+    /// values). A group of a shape outside the table of `shapes` is counted
+    /// in `fallbacks`.
+    pub(super) fn solve(&self, rhs: &[f64], fallbacks: &FallbackCounter) -> Option<Vec<f64>> {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `solve_avx2` only needs AVX2, which the CPU has (checked just above).
-            return unsafe { self.solve_avx2(rhs) };
+        if simd::avx2() {
+            // SAFETY: `solve_avx2` only needs AVX2, which the CPU has (`simd::avx2`).
+            return unsafe { self.solve_avx2(rhs, fallbacks) };
         }
-        self.solve_any(rhs)
+        self.solve_any(rhs, fallbacks)
     }
 
     /// [`SchurLayout::solve_any`] compiled with AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn solve_avx2(&self, rhs: &[f64]) -> Option<Vec<f64>> {
-        self.solve_any(rhs)
+    unsafe fn solve_avx2(&self, rhs: &[f64], fallbacks: &FallbackCounter) -> Option<Vec<f64>> {
+        self.solve_any(rhs, fallbacks)
     }
 
     /// [`SchurLayout::solve`] for the instruction set it is inlined into.
     #[inline(always)]
-    fn solve_any(&self, rhs: &[f64]) -> Option<Vec<f64>> {
+    fn solve_any(&self, rhs: &[f64], fallbacks: &FallbackCounter) -> Option<Vec<f64>> {
         if !self.factored {
             return None;
+        }
+        if self.groups_without_kernel > 0 {
+            // Two substitutions per group, in the two loops below.
+            fallbacks.substitutions(2 * self.groups_without_kernel);
         }
         let g = self.globals;
         let (reduced, _) = self.values.split_at(g * g);
@@ -207,8 +234,9 @@ impl SchurLayout {
             let (d, w) = self.values[base..base + m * m + m * g].split_at(m * m);
             let (global_part, rest) = x.split_at_mut(g);
             let y = &mut rest[start - g..start - g + m];
+            // The shapes of `has_substitution_kernel`.
             match (m, g) {
-                (8, 16) => reduce_right_hand_side::<8, 16>(d, w, y, global_part),
+                (GROUP, GLOBALS) => reduce_right_hand_side::<GROUP, GLOBALS>(d, w, y, global_part),
                 _ => reduce_right_hand_side::<0, 0>(d, w, y, global_part),
             }
         }
@@ -223,7 +251,7 @@ impl SchurLayout {
             let (global_part, rest) = x.split_at_mut(g);
             let y = &mut rest[start - g..start - g + m];
             match (m, g) {
-                (8, 16) => back_substitute_group::<8, 16>(d, w, global_part, y),
+                (GROUP, GLOBALS) => back_substitute_group::<GROUP, GLOBALS>(d, w, global_part, y),
                 _ => back_substitute_group::<0, 0>(d, w, global_part, y),
             }
         }
@@ -311,6 +339,12 @@ impl SchurLayout {
     }
 }
 
+/// Whether a group of `m` columns against `g` globals has fixed-size
+/// substitutions (the arms of [`SchurLayout::solve_any`]'s matches).
+fn has_substitution_kernel(m: usize, g: usize) -> bool {
+    matches!((m, g), (GROUP, GLOBALS))
+}
+
 /// `y <- L^-1 y` and `b_g -= W^T y` for one group (`L` `m x m`, `W` `m x g`,
 /// column-major); `M`, `G` the sizes when known at compile time (`0`: any).
 #[inline(always)]
@@ -372,22 +406,25 @@ fn back_substitute_group<const M: usize, const G: usize>(l: &[f64], w: &[f64], g
 /// Factor one group's damped `D` in place (`block` = `D`, then `B`, column-major)
 /// into `L`, turn `B` into `W = L^-1 B`, and subtract `W^T W` from the
 /// reduced system's lower triangle. `M` is the group dimension when known at
-/// compile time (the loops then unroll), `0` for any.
+/// compile time (the loops then unroll), `0` for any; a shape `(M, g)`
+/// outside the table of `shapes` takes the general loops and is counted in
+/// `fallbacks`.
 #[inline(always)]
 fn eliminate_group<const M: usize, const AVX2: bool>(
     block: &mut [f64],
     damping: &[f64],
     reduced: &mut [f64],
     g: usize,
+    fallbacks: &FallbackCounter,
 ) -> bool {
     let m = if M == 0 { damping.len() } else { M };
     for i in 0..m {
         block[i + i * m] += damping[i];
     }
     #[cfg(target_arch = "x86_64")]
-    if AVX2 && M == 8 && g == 16 {
+    if AVX2 && M == GROUP && g == GLOBALS {
         // SAFETY: `AVX2` only from `factorize_avx2`, which runs only where the CPU has AVX2.
-        return unsafe { super::schur_avx2::eliminate_group(block, reduced) };
+        return unsafe { simd::elimination::eliminate_group(block, reduced) };
     }
     let (d, w) = block.split_at_mut(m * m);
     if !cholesky_in_place(d, m) {
@@ -397,9 +434,10 @@ fn eliminate_group<const M: usize, const AVX2: bool>(
         forward_substitute(d, m, column);
     }
     match (M, g) {
-        (8, 16) => subtract_gram::<8, 16, AVX2>(w, reduced),
-        (6, 16) => subtract_gram::<6, 16, AVX2>(w, reduced),
+        (GROUP, GLOBALS) => subtract_gram::<GROUP, GLOBALS, AVX2>(w, reduced),
+        (POSE, GLOBALS) => subtract_gram::<POSE, GLOBALS, AVX2>(w, reduced),
         _ => {
+            fallbacks.elimination();
             for j in 0..g {
                 let wj = &w[j * m..(j + 1) * m];
                 for i in j..g {
@@ -431,10 +469,10 @@ fn subtract_gram<const M: usize, const G: usize, const AVX2: bool>(w: &[f64], re
     }
     let reduced = &mut reduced[..G * G];
     #[cfg(target_arch = "x86_64")]
-    if AVX2 && G == 16 {
+    if AVX2 && G == GLOBALS {
         let rows = rows.as_flattened();
         // SAFETY: `AVX2` only from `factorize_avx2`, which runs only where the CPU has AVX2.
-        unsafe { super::gram_avx2::gram_block::<M, 16, 16, true, true>(rows, rows, 16, reduced) };
+        unsafe { simd::gram::gram_block::<M, GLOBALS, GLOBALS, true, true>(rows, rows, GLOBALS, reduced) };
         return;
     }
     for j in 0..G {
@@ -446,55 +484,6 @@ fn subtract_gram<const M: usize, const G: usize, const AVX2: bool>(w: &[f64], re
             }
             column[i] -= sum;
         }
-    }
-}
-
-/// In-place Cholesky `A = L L^T` of the lower triangle of a column-major
-/// `n x n` matrix; `false` unless every pivot is positive and finite.
-#[inline(always)]
-pub(super) fn cholesky_in_place(a: &mut [f64], n: usize) -> bool {
-    for j in 0..n {
-        let mut pivot = a[j + j * n];
-        for k in 0..j {
-            pivot -= a[j + k * n] * a[j + k * n];
-        }
-        if !(pivot > 0.0 && pivot.is_finite()) {
-            return false;
-        }
-        let pivot = pivot.sqrt();
-        a[j + j * n] = pivot;
-        for i in j + 1..n {
-            let mut sum = a[i + j * n];
-            for k in 0..j {
-                sum -= a[i + k * n] * a[j + k * n];
-            }
-            a[i + j * n] = sum / pivot;
-        }
-    }
-    true
-}
-
-/// `x <- L^-1 x` for the lower-triangular factor in `l` (column-major `n x n`).
-#[inline(always)]
-pub(super) fn forward_substitute(l: &[f64], n: usize, x: &mut [f64]) {
-    for j in 0..n {
-        let xj = x[j] / l[j + j * n];
-        x[j] = xj;
-        for i in j + 1..n {
-            x[i] -= l[i + j * n] * xj;
-        }
-    }
-}
-
-/// `x <- L^-T x` for the lower-triangular factor in `l` (column-major `n x n`).
-#[inline(always)]
-pub(super) fn backward_substitute(l: &[f64], n: usize, x: &mut [f64]) {
-    for j in (0..n).rev() {
-        let mut sum = x[j];
-        for i in j + 1..n {
-            sum -= l[i + j * n] * x[i];
-        }
-        x[j] = sum / l[j + j * n];
     }
 }
 
@@ -527,7 +516,7 @@ mod tests {
         for &(r, c) in &indices {
             entries[layout.place(r, c).0] = h[(r, c)];
         }
-        assert!(layout.factorize(&entries, damping));
+        assert!(layout.factorize(&entries, damping, &FallbackCounter::default()));
         layout
     }
 
@@ -564,10 +553,20 @@ mod tests {
         for &(r, c) in &arrowhead_indices(g, m, dim) {
             entries[layout.place(r, c).0] = h[(r, c)];
         }
-        assert!(layout.factorize_any::<false>(&entries, &damping));
+        let fallbacks = FallbackCounter::default();
+        assert!(layout.factorize_any::<false>(&entries, &damping, &fallbacks));
         assert_eq!(layout.values.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), factors);
         let rhs: Vec<f64> = (0..dim).map(|i| (i as f64).sin()).collect();
-        let x = layout.solve(&rhs).expect("solution");
+        let x = layout.solve(&rhs, &fallbacks).expect("solution");
+        // Groups of 2 against 3 globals have no kernel (the table of
+        // `shapes`): each group's elimination and its two substitutions take
+        // the general loops, and are counted.
+        let expected = super::super::shapes::Fallbacks {
+            products: 0,
+            eliminations: n,
+            substitutions: 2 * n,
+        };
+        assert_eq!(fallbacks.read(), expected);
         let damped = &h + nalgebra::DMatrix::from_diagonal(&nalgebra::DVector::from_vec(damping));
         let dense = damped.cholesky().expect("SPD").solve(&nalgebra::DVector::from_vec(rhs));
         let worst = x
@@ -608,7 +607,7 @@ mod tests {
             }
             a[g + group * m] = -1.25;
             a[g + group * m + 1] = 0.5;
-            let x = layout.solve(&a).expect("solution");
+            let x = layout.solve(&a, &FallbackCounter::default()).expect("solution");
             let full: f64 = a.iter().zip(&x).map(|(a, x)| a * x).sum();
             let form = layout.inverse_quadratic_form(&a).expect("form");
             assert_eq!(form.to_bits(), full.to_bits(), "group {group}");
@@ -622,7 +621,7 @@ mod tests {
         for rhs_globals in [vec![0.0, 1.0, 0.0], vec![0.7, -0.0, -2.5]] {
             let mut rhs = vec![0.0; dim];
             rhs[..g].copy_from_slice(&rhs_globals);
-            let full = layout.solve(&rhs).expect("solution");
+            let full = layout.solve(&rhs, &FallbackCounter::default()).expect("solution");
             let globals = layout.solve_globals(&rhs_globals).expect("solution");
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&globals), bits(&full[..g]), "{rhs_globals:?}");
@@ -651,13 +650,16 @@ mod tests {
             entries[layout.place(r, c).0] = if r == c { 10.0 } else { 0.1 + 0.01 * (r + c) as f64 };
         }
         let damping = vec![0.0; dim];
-        assert!(layout.factorize(&entries, &damping));
+        assert!(layout.factorize(&entries, &damping, &FallbackCounter::default()));
         for &(r, c) in &indices {
             for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
                 let mut broken = entries.clone();
                 broken[layout.place(r, c).0] = bad;
-                assert!(!layout.factorize(&broken, &damping), "({r}, {c}) = {bad}");
-                assert!(layout.solve(&vec![1.0; dim]).is_none());
+                assert!(
+                    !layout.factorize(&broken, &damping, &FallbackCounter::default()),
+                    "({r}, {c}) = {bad}"
+                );
+                assert!(layout.solve(&vec![1.0; dim], &FallbackCounter::default()).is_none());
             }
         }
     }
@@ -668,8 +670,8 @@ mod tests {
         let mut layout = SchurLayout::new(&[(0, 0), (1, 1)], 1, vec![(1, 1)]).expect("layout");
         assert_eq!(layout.storage_len(), 3);
         assert_eq!(layout.place(1, 1).0, 1);
-        assert!(!layout.factorize(&[1.0, -1.0, 0.0], &[0.0, 0.0]));
-        assert!(layout.solve(&[1.0, 1.0]).is_none());
+        assert!(!layout.factorize(&[1.0, -1.0, 0.0], &[0.0, 0.0], &FallbackCounter::default()));
+        assert!(layout.solve(&[1.0, 1.0], &FallbackCounter::default()).is_none());
     }
 
     /// The group substitutions for `M = 8, G = 16` (local copies, dot
@@ -683,12 +685,12 @@ mod tests {
         let y: Vec<f64> = (0..8).map(|k| entry(k + 200)).collect();
         let globals: Vec<f64> = (0..16).map(|k| entry(k + 300)).collect();
         let (mut y_fixed, mut y_any, mut g_fixed, mut g_any) = (y.clone(), y.clone(), globals.clone(), globals.clone());
-        reduce_right_hand_side::<8, 16>(&l, &w, &mut y_fixed, &mut g_fixed);
+        reduce_right_hand_side::<GROUP, GLOBALS>(&l, &w, &mut y_fixed, &mut g_fixed);
         reduce_right_hand_side::<0, 0>(&l, &w, &mut y_any, &mut g_any);
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!((bits(&y_fixed), bits(&g_fixed)), (bits(&y_any), bits(&g_any)));
         assert!(g_fixed.iter().zip(&globals).all(|(a, b)| a != b));
-        back_substitute_group::<8, 16>(&l, &w, &globals, &mut y_fixed);
+        back_substitute_group::<GROUP, GLOBALS>(&l, &w, &globals, &mut y_fixed);
         back_substitute_group::<0, 0>(&l, &w, &globals, &mut y_any);
         assert_eq!(bits(&y_fixed), bits(&y_any));
     }

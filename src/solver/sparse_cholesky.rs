@@ -18,6 +18,10 @@ pub(super) struct SparseCholesky {
     pattern: SymbolicSparseColMat<usize>,
     /// Per entry of the lower triangle (in the order given to [`SparseCholesky::new`]), its index in the compressed-column values.
     csc_position: Vec<usize>,
+    /// Per entry of the lower triangle (the same order), its position in the storage of `H`.
+    positions: Vec<usize>,
+    /// Per tangent index, the entry (the same order) of its diagonal element.
+    diagonal_entries: Vec<usize>,
     symbolic: SymbolicCholesky<usize>,
     /// `H + damping` in compressed-column order.
     matrix_values: Vec<f64>,
@@ -33,8 +37,15 @@ pub(super) struct SparseCholesky {
 
 impl SparseCholesky {
     /// The pattern of `H`'s lower triangle (`indices`: `(row, col)` of
-    /// every entry, `row >= col`) analysed for a `dim x dim` system.
-    pub(super) fn new(indices: &[(usize, usize)], dim: usize) -> Result<Self, String> {
+    /// every entry, `row >= col`; `positions`: where each entry is stored in
+    /// `H`'s value array) analysed for a `dim x dim` system.
+    pub(super) fn new(indices: &[(usize, usize)], positions: Vec<usize>, dim: usize) -> Result<Self, String> {
+        let mut diagonal_entries = vec![0; dim];
+        for (k, &(row, col)) in indices.iter().enumerate() {
+            if row == col {
+                diagonal_entries[row] = k;
+            }
+        }
         let entry_count = indices.len();
         // Compressed columns: sort the entries by (column, row).
         let order = column_major_order(indices, dim);
@@ -74,25 +85,20 @@ impl SparseCholesky {
             symbolic,
             pattern,
             csc_position,
+            positions,
+            diagonal_entries,
         })
     }
 
-    /// Factor `H + diag(damping)`, `H` read from `hessian` at `positions`
-    /// (one per entry, in the order given to [`SparseCholesky::new`]),
-    /// `diagonal_entries` the entry of each diagonal element; `false` if it is
-    /// not finite or not numerically positive definite.
-    pub(super) fn factorize(
-        &mut self,
-        hessian: &[f64],
-        positions: &[usize],
-        diagonal_entries: &[usize],
-        damping: &[f64],
-    ) -> bool {
+    /// Factor `H + diag(damping)`, `H` read from `hessian` at the positions
+    /// given to [`SparseCholesky::new`]; `false` if it is not finite or not
+    /// numerically positive definite.
+    pub(super) fn factorize(&mut self, hessian: &[f64], damping: &[f64]) -> bool {
         self.factored = false;
-        for (&csc, &position) in self.csc_position.iter().zip(positions) {
+        for (&csc, &position) in self.csc_position.iter().zip(&self.positions) {
             self.matrix_values[csc] = hessian[position];
         }
-        for (i, &k) in diagonal_entries.iter().enumerate() {
+        for (i, &k) in self.diagonal_entries.iter().enumerate() {
             self.matrix_values[self.csc_position[k]] += damping[i];
         }
         if self.matrix_values.iter().any(|v| !v.is_finite()) {

@@ -8,17 +8,18 @@
 //! and `stride`, so any run of consecutive tangent columns inside one zone
 //! is one dense block: a factor's `J^T J` goes to `H` by the products of its
 //! runs (`FactorRuns::in_zones`) with no per-slot-pair bookkeeping, which
-//! the general pattern ([`super::BlockPattern`]: one hash lookup per slot
+//! the general pattern (`sparse_pattern`'s `BlockPattern`: one hash lookup per slot
 //! pair) spent most of a small solve's setup on. Every entry still receives
 //! the same sum in the same order (the kernels are the same), so a system
 //! built this way solves bit for bit as one built from the slot pairs
 //! (unit test `dense_h_is_j_transpose_j_in_both_storages` and the
 //! calibration outputs).
 
-use super::{Factorization, LinearSystem, StoredBlock, TangentLayout};
+use super::{Factorization, HessianStorage, LinearSystem, StoredBlock, TangentLayout};
 use crate::graph::{Factor, Values};
 use crate::solver::accumulate::FactorRuns;
 use crate::solver::schur::SchurLayout;
+use crate::solver::shapes::FallbackCounter;
 
 /// Whether a factor has free variables in two different local groups (the
 /// elimination then does not apply).
@@ -79,13 +80,14 @@ impl LinearSystem {
         LinearSystem {
             offsets: layout.offsets,
             dim: layout.dim,
-            factor_runs,
-            diagonal_slots,
-            diagonal_entries: Vec::new(),
-            storage_len: schur.storage_len(),
-            positions: Vec::new(),
-            blocks,
+            storage: HessianStorage {
+                factor_runs,
+                diagonal_slots,
+                len: schur.storage_len(),
+                blocks,
+            },
             factorization: Factorization::Schur(schur),
+            fallbacks: FallbackCounter::default(),
         }
     }
 }

@@ -18,15 +18,6 @@ use std::arch::x86_64::{
     _mm256_mul_pd, _mm256_set1_pd, _mm256_storeu_pd, _mm256_sub_pd, _mm_storeh_pd, _mm_storel_pd,
 };
 
-/// Whether this CPU runs the kernels (x86-64 with AVX2; the check is cached by std).
-#[inline]
-pub(super) fn available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    return std::arch::is_x86_feature_detected!("avx2");
-    #[cfg(not(target_arch = "x86_64"))]
-    false
-}
-
 /// Lane masks of the diagonal lane group of a lower triangle: entry `k`
 /// selects lanes `l >= k` (sign bit set) for column `j` with `j % 4 == k`.
 #[cfg(target_arch = "x86_64")]
@@ -48,7 +39,7 @@ const LOWER_LANES: [[f64; 4]; 4] = [
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-pub(super) unsafe fn gram_block<
+pub(in crate::solver) unsafe fn gram_block<
     const R: usize,
     const CA: usize,
     const CB: usize,
@@ -102,7 +93,7 @@ pub(super) unsafe fn gram_block<
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-pub(super) unsafe fn scatter_four_rows(block: &[f64], rows: &mut [f64], width: usize, first: usize) {
+pub(in crate::solver) unsafe fn scatter_four_rows(block: &[f64], rows: &mut [f64], width: usize, first: usize) {
     let n = block.len() / 4;
     assert!(block.len() % 4 == 0 && first + n <= width && rows.len() >= 4 * width);
     let (from, to) = (block.as_ptr(), rows.as_mut_ptr());
@@ -184,8 +175,7 @@ mod tests {
     /// lower triangle, between the columns, past the end) left untouched.
     #[test]
     fn the_kernel_matches_the_scalar_loop_bit_for_bit() {
-        if !std::arch::is_x86_feature_detected!("avx2") {
-            eprintln!("skipped: this CPU has no AVX2");
+        if !crate::simd::avx2_under_test() {
             return;
         }
         check::<4, 8, 8, true, false>(8);
@@ -199,12 +189,27 @@ mod tests {
         check::<6, 16, 16, true, true>(17);
     }
 
+    /// Every four-row shape of the AVX2 path's table
+    /// (`shapes::avx2_run_shapes!`), with a gap between the columns.
+    #[test]
+    fn every_shape_of_the_table_matches_the_scalar_loop() {
+        use crate::solver::shapes::{avx2_run_shapes, run_shapes, ANCHORS, CABLE_ROWS, GLOBALS, GROUP};
+        if !crate::simd::avx2_under_test() {
+            return;
+        }
+        macro_rules! checks {
+            ($(($ca:tt, $cb:tt, $same:literal)),*) => {
+                $(check::<CABLE_ROWS, $ca, $cb, $same, false>($ca + 1);)*
+            };
+        }
+        avx2_run_shapes!(checks);
+    }
+
     /// The copy puts entry `r` of column `c` at `r * width + first + c`
     /// and leaves the other columns alone.
     #[test]
     fn four_row_columns_are_copied_row_by_row() {
-        if !std::arch::is_x86_feature_detected!("avx2") {
-            eprintln!("skipped: this CPU has no AVX2");
+        if !crate::simd::avx2_under_test() {
             return;
         }
         let (width, first) = (13, 5);

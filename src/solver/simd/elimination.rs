@@ -3,7 +3,7 @@
 //! factor `L` of the damped block, `W = L^-1 B` and `reduced -= W^T W`.
 //!
 //! Every entry goes through the operations of the portable loops of
-//! `schur.rs` in the same order, each rounded on its own (no fused
+//! `schur.rs` and `dense.rs` in the same order, each rounded on its own (no fused
 //! multiply-add): `L[i][j] = (a[i][j] - a[i][0] a[j][0] - ...) / l_jj` with
 //! the pivot `l_jj^2 = a[j][j] - a[j][0]^2 - ...`, and `W` row by row
 //! (`w_j = w_j / l_jj`, then `w_i -= l_ij w_j` for the rows below), so the
@@ -17,10 +17,14 @@ use std::arch::x86_64::{
     _mm256_sub_pd,
 };
 
-/// Group dimension.
-const M: usize = 8;
-/// Global dimension.
-const G: usize = 16;
+use crate::solver::shapes::{GLOBALS, GROUP};
+
+/// Group dimension (`GROUP` of the table of `shapes`).
+const M: usize = GROUP;
+/// Global dimension (`GLOBALS` of the table of `shapes`).
+const G: usize = GLOBALS;
+// The registers below are laid out for 8 x 16: another shape in the table needs another kernel.
+const _: () = assert!(M == 8 && G == 16);
 
 /// Lane masks per column `j` of the rows below it: entry `j` holds, for the
 /// rows 0..8, a set sign bit where the row is greater than `j`.
@@ -48,7 +52,7 @@ const BELOW: [[f64; M]; M] = {
 /// The CPU must support AVX2. The lengths are checked (a panic if short).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn eliminate_group(block: &mut [f64], reduced: &mut [f64]) -> bool {
+pub(in crate::solver) unsafe fn eliminate_group(block: &mut [f64], reduced: &mut [f64]) -> bool {
     assert!(block.len() >= M * M + M * G && reduced.len() >= G * G);
     let (d, w) = block.split_at_mut(M * M);
     // SAFETY: `d` holds 8 columns of 8 (asserted above).
@@ -71,12 +75,12 @@ pub(super) unsafe fn eliminate_group(block: &mut [f64], reduced: &mut [f64]) -> 
     }
     let rows = rows.as_flattened();
     // SAFETY: the CPU has AVX2 (this function's contract).
-    unsafe { super::gram_avx2::gram_block::<M, G, G, true, true>(rows, rows, G, reduced) };
+    unsafe { super::gram::gram_block::<M, G, G, true, true>(rows, rows, G, reduced) };
     true
 }
 
 /// In-place Cholesky of the lower triangle of an 8 x 8 column-major `a`
-/// (`cholesky_in_place` of `schur.rs`, bit for bit); `false` unless every
+/// (`cholesky_in_place` of `dense.rs`, bit for bit); `false` unless every
 /// pivot is positive and finite. The entries above the diagonal are not written.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
@@ -122,7 +126,7 @@ unsafe fn cholesky(a: &mut [f64]) -> bool {
 
 /// `X <- L^-1 X` for the 16 columns of `rows` (row `r` of `X` in
 /// `rows[r]`), `L` the 8 x 8 column-major factor in `l`: per column the
-/// operations of `forward_substitute` of `schur.rs`, in its order.
+/// operations of `forward_substitute` of `dense.rs`, in its order.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn forward_substitute_rows(l: &[f64], rows: &mut [[f64; G]; M]) {
@@ -151,7 +155,7 @@ unsafe fn forward_substitute_rows(l: &[f64], rows: &mut [[f64; G]; M]) {
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests {
     use super::*;
-    use crate::solver::schur::{cholesky_in_place, forward_substitute};
+    use crate::solver::dense::{cholesky_in_place, forward_substitute};
 
     /// A damped block of a pose (8 x 8, positive definite, many significant
     /// bits) and its 8 x 16 coupling, eliminated by the portable loops and
@@ -159,8 +163,7 @@ mod tests {
     /// indefinite block fails in both and leaves `reduced` alone.
     #[test]
     fn the_kernel_eliminates_exactly_as_the_portable_loops() {
-        if !std::arch::is_x86_feature_detected!("avx2") {
-            eprintln!("skipped: this CPU has no AVX2");
+        if !crate::simd::avx2_under_test() {
             return;
         }
         let value = |k: usize| ((k * 7919 % 1009) as f64 / 1009.0 - 0.5) * 1.7 + 1e-3 * (k as f64).sin();
@@ -189,7 +192,7 @@ mod tests {
         // The kernel.
         let mut block: Vec<f64> = d.iter().chain(&b).copied().collect();
         let mut kernel_reduced = reduced_start.clone();
-        // SAFETY: the CPU has AVX2 (checked above).
+        // SAFETY: the CPU has AVX2 (`avx2_under_test` above).
         assert!(unsafe { eliminate_group(&mut block, &mut kernel_reduced) });
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         for col in 0..M {
