@@ -511,7 +511,7 @@ const CIRCLES_TO_CUT: &[&str] = &[
     "calib: gross_errors <-> job <-> mistakes <-> mod <-> orientation <-> prepared <-> report <-> result <-> screen <-> settings <-> snooping <-> uncertainty",
     "calib/factors: catenary_call <-> mod <-> tension_guard",
     "graph: masked <-> mod",
-    "solver: accumulate <-> covariance <-> gram_avx2 <-> linear_system <-> local <-> mod <-> redundancy <-> schur <-> schur_avx2 <-> score <-> system_cache",
+    "solver: accumulate <-> covariance <-> linear_system <-> local <-> mod <-> redundancy <-> schur <-> score <-> simd <-> system_cache",
 ];
 
 #[test]
