@@ -17,8 +17,10 @@
 //! | `portable` | portable, whatever the CPU |
 //! | `avx2` | AVX2; on a CPU without it the portable path still runs (an AVX2 instruction there would be undefined behaviour), and the tests of the AVX2 kernels fail instead of skipping |
 //!
-//! Any other value is an error: the first kernel call panics and names the
-//! variable. `make test` runs the solver's and the calibration's tests a
+//! Any other value is an error: the command and the Python package refuse
+//! it before any work ([`check_switch`]: exit 2, or a `ValueError` on
+//! import); a library caller that skips the check gets a panic naming the
+//! variable at the first kernel call. `make test` runs the solver's and the calibration's tests a
 //! second time with `SAGCAL_SIMD=portable`, so both paths are tested on a
 //! machine with AVX2.
 //!
@@ -111,6 +113,13 @@ fn path_for(request: SimdRequest, has_avx2: bool) -> SimdPath {
         SimdRequest::Auto | SimdRequest::Avx2 if has_avx2 => SimdPath::Avx2,
         _ => SimdPath::Portable,
     }
+}
+
+/// The switch as set in this process's environment, checked: the front
+/// ends call it before any work, so that a mistyped value is a clear error
+/// (the kernels themselves could only panic on it).
+pub fn check_switch() -> Result<SimdRequest, String> {
+    SimdRequest::parse(std::env::var(SWITCH).ok().as_deref())
 }
 
 /// Whether this CPU runs AVX2 (std caches the answer).

@@ -1,5 +1,5 @@
-//! The CLI's own surface: `--version`, shell completions, and figures written
-//! as PNG for a `.png` name.
+//! The CLI's own surface: `--version`, shell completions, figures written
+//! as PNG for a `.png` name, and the kernel switch checked before any work.
 
 use std::path::Path;
 
@@ -81,4 +81,24 @@ fn calibrate_plot_with_a_png_name_writes_a_png() {
         u32::from_be_bytes([png[16], png[17], png[18], png[19]]),
         2 * width(&svg)
     );
+}
+
+#[test]
+fn a_mistyped_kernel_switch_is_refused_before_any_work() {
+    let dir = std::env::temp_dir().join(format!("sagcal-simd-switch-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sagcal"))
+        .args(["demo", "--poses", "9"])
+        .current_dir(&dir)
+        .env("SAGCAL_SIMD", "fast")
+        .output()
+        .unwrap();
+    let written = std::fs::read_dir(&dir).unwrap().count();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr).trim(),
+        "error: SAGCAL_SIMD=\"fast\": expected portable, avx2 or auto"
+    );
+    assert_eq!(written, 0, "nothing is written");
 }

@@ -53,6 +53,7 @@ fn _reset_cancel() {
 /// The module `sagcal._sagcal`.
 #[pymodule]
 fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    sagcal::simd::check_switch().map_err(pyo3::exceptions::PyValueError::new_err)?;
     m.add("SagcalError", m.py().get_type::<SagcalError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add(

@@ -138,3 +138,14 @@ def test_messages_name_keywords_not_flags(cli, problem):
     assert message(lambda: sagcal.localize(problem["truth"], problem["measurements"][:, 6:10], pose_prior=True)) == (
         "readings: row 1, field `x_m`: pose_prior=True needs a localiser pose on every row; this file has none"
     )
+
+
+def test_a_mistyped_kernel_switch_is_refused_on_import():
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, SAGCAL_SIMD="fast")
+    run = subprocess.run([sys.executable, "-c", "import sagcal"], env=env, capture_output=True, text=True)
+    assert run.returncode != 0
+    assert 'ValueError: SAGCAL_SIMD="fast": expected portable, avx2 or auto' in run.stderr

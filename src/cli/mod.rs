@@ -549,6 +549,10 @@ pub fn run() -> i32 {
             return code;
         }
     };
+    if let Err(message) = sagcal::simd::check_switch() {
+        eprintln!("error: {message}");
+        return 2;
+    }
     let result = match cli.command {
         None => demo::run(&DemoArgs {
             seed: 1,
