@@ -18,7 +18,12 @@ in and out, the same jobs with the same options, results and error messages.
   RecurDyn logs) as (N, 11) arrays in the columns of :data:`MEASUREMENT_COLUMNS`.
 
 Every error is a :class:`SagcalError` (a ``ValueError``) whose message is what
-the command prints after ``error: ``.
+the command prints after ``error: ``; its subclass names the kind:
+:class:`FileError` (a file, row or field), :class:`RobotError`,
+:class:`InvalidInputError` (an argument), :class:`EquilibriumError`,
+:class:`SolverError`, :class:`CalibrationError` with
+:class:`CalibrationRefused` (a fit that fails its own consistency tests),
+:class:`FigureError` and :class:`CancelledError`.
 
 Example::
 
@@ -37,12 +42,20 @@ from ._boundary import entry as _entry
 from ._sagcal import (
     MEASUREMENT_COLUMNS,
     Calibration,
+    CalibrationError,
+    CalibrationRefused,
+    CancelledError,
     Diagnosis,
+    EquilibriumError,
+    FigureError,
+    FileError,
+    InvalidInputError,
     Localization,
     PosePlan,
     Robot,
     SagcalError,
     Simulation,
+    SolverError,
     __version__,
 )
 
@@ -61,12 +74,20 @@ write_measurements = _entry(_sagcal.write_measurements, lists=("comments",))
 __all__ = [
     "MEASUREMENT_COLUMNS",
     "Calibration",
+    "CalibrationError",
+    "CalibrationRefused",
+    "CancelledError",
     "Diagnosis",
+    "EquilibriumError",
+    "FigureError",
+    "FileError",
+    "InvalidInputError",
     "Localization",
     "PosePlan",
     "Robot",
     "SagcalError",
     "Simulation",
+    "SolverError",
     "__version__",
     "calibrate",
     "diagnose",

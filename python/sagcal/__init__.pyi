@@ -21,6 +21,33 @@ FloatArray = npt.NDArray[np.float64]
 class SagcalError(ValueError):
     """A sagcal error; the message is what the ``sagcal`` command prints after ``error: ``."""
 
+class FileError(SagcalError):
+    """A file cannot be read or written, or one of its rows or fields is wrong."""
+
+class RobotError(SagcalError):
+    """A robot description is invalid."""
+
+class InvalidInputError(SagcalError):
+    """An argument is out of range or not understood (the message names the keyword)."""
+
+class EquilibriumError(SagcalError):
+    """The kineto-statics have no solution with positive cable tensions."""
+
+class SolverError(SagcalError):
+    """The solver failed."""
+
+class CalibrationError(SagcalError):
+    """A calibration gave no result; a failed step's error is the ``__cause__``."""
+
+class CalibrationRefused(CalibrationError):
+    """The fit fails its own consistency tests (``accept_inconsistent=True`` returns it anyway)."""
+
+class FigureError(SagcalError):
+    """A figure could not be rendered."""
+
+class CancelledError(SagcalError):
+    """The job was stopped on request."""
+
 class Robot:
     """A suspended four-cable robot (a robot TOML file). Array attributes
     return new read-only float64 arrays: copy, edit, assign back."""

@@ -21,7 +21,7 @@ import re
 import threading
 
 from . import _sagcal
-from ._sagcal import SagcalError
+from ._sagcal import InvalidInputError, SagcalError
 
 #: Largest seed + 1: seeds are unsigned 64-bit integers.
 SEED_LIMIT = 2**64
@@ -34,7 +34,7 @@ POLL_S = 0.05
 
 
 def _invalid(message):
-    return SagcalError(f"invalid input: {message}")
+    return InvalidInputError(f"invalid input: {message}")
 
 
 def check_int(name, value, low=0, high=SEED_LIMIT):

@@ -4,7 +4,9 @@
 //! A thin layer: numpy arrays and paths in, the library's jobs run exactly as
 //! the `sagcal` command runs them (`src/cli/`), numpy arrays and plain Python
 //! objects out. Every `sagcal::Error` becomes a [`SagcalError`] whose message
-//! is the error's `Display`, the text the command prints after `error: `.
+//! is the error's `Display`, the text the command prints after `error: `; its
+//! class tells the kind ([`to_py`]), and a calibration that failed on a step
+//! carries that step's error as `__cause__`.
 
 mod arrays;
 mod calibrate;
@@ -28,9 +30,91 @@ pyo3::create_exception!(
      The message is exactly what the `sagcal` command prints after `error: `."
 );
 
-/// A Python exception for a sagcal error, with the command's message.
+pyo3::create_exception!(
+    sagcal,
+    FileError,
+    SagcalError,
+    "A file cannot be read or written, or one of its rows or fields is wrong (the message names the file, row and field)."
+);
+pyo3::create_exception!(
+    sagcal,
+    RobotError,
+    SagcalError,
+    "A robot description is invalid (coincident anchors, an unknown reference cable, implausible weights, ...)."
+);
+pyo3::create_exception!(
+    sagcal,
+    InvalidInputError,
+    SagcalError,
+    "An argument is out of range or not understood (the message names the keyword argument)."
+);
+pyo3::create_exception!(
+    sagcal,
+    EquilibriumError,
+    SagcalError,
+    "The kineto-statics have no solution with positive cable tensions."
+);
+pyo3::create_exception!(
+    sagcal,
+    SolverError,
+    SagcalError,
+    "The solver failed (nothing to solve, a factor undefined at the solution, a singular information matrix)."
+);
+pyo3::create_exception!(
+    sagcal,
+    CalibrationError,
+    SagcalError,
+    "A calibration gave no result: readings off by a unit, or a step failed (its error is the `__cause__`)."
+);
+pyo3::create_exception!(
+    sagcal,
+    CalibrationRefused,
+    CalibrationError,
+    "The fit fails its own consistency tests (`accept_inconsistent=True` returns it anyway)."
+);
+pyo3::create_exception!(sagcal, FigureError, SagcalError, "A figure could not be rendered.");
+pyo3::create_exception!(sagcal, CancelledError, SagcalError, "The job was stopped on request.");
+
+/// A Python exception for a sagcal error, with the command's message; its
+/// class names the kind, a subclass of [`SagcalError`], so that a caller can
+/// catch a refused calibration apart from a file error.
 pub(crate) fn to_py(error: sagcal::Error) -> PyErr {
-    SagcalError::new_err(error.to_string())
+    use sagcal::error::CalibrationError as Calibration;
+    use sagcal::Error as E;
+    let message = error.to_string();
+    match error {
+        E::Io { .. } | E::Format { .. } | E::Field { .. } => FileError::new_err(message),
+        E::Robot { .. } => RobotError::new_err(message),
+        E::InvalidInput(_) => InvalidInputError::new_err(message),
+        E::NoEquilibrium(_) => EquilibriumError::new_err(message),
+        E::Solver(_) => SolverError::new_err(message),
+        E::Calibration(Calibration::Refused { .. }) => CalibrationRefused::new_err(message),
+        E::NotWritten { cause, .. } => {
+            let error = CalibrationError::new_err(message);
+            Python::attach(|py| error.set_cause(py, Some(to_py(*cause))));
+            error
+        }
+        E::Calibration(_) => CalibrationError::new_err(message),
+        E::Png(_) => FigureError::new_err(message),
+        E::Cancelled => CancelledError::new_err(message),
+        _ => SagcalError::new_err(message),
+    }
+}
+
+/// The exception classes of [`to_py`], by name.
+fn add_exceptions(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("SagcalError", py.get_type::<SagcalError>())?;
+    m.add("FileError", py.get_type::<FileError>())?;
+    m.add("RobotError", py.get_type::<RobotError>())?;
+    m.add("InvalidInputError", py.get_type::<InvalidInputError>())?;
+    m.add("EquilibriumError", py.get_type::<EquilibriumError>())?;
+    m.add("SolverError", py.get_type::<SolverError>())?;
+    m.add("CalibrationError", py.get_type::<CalibrationError>())?;
+    m.add("CalibrationRefused", py.get_type::<CalibrationRefused>())?;
+    m.add("FigureError", py.get_type::<FigureError>())?;
+    m.add("CancelledError", py.get_type::<CancelledError>())?;
+    Ok(())
 }
 
 /// A [`SagcalError`] for invalid input given through Python (`invalid input: ...`).
@@ -54,7 +138,7 @@ fn _reset_cancel() {
 #[pymodule]
 fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     sagcal::simd::check_switch().map_err(pyo3::exceptions::PyValueError::new_err)?;
-    m.add("SagcalError", m.py().get_type::<SagcalError>())?;
+    add_exceptions(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add(
         "MEASUREMENT_COLUMNS",

@@ -149,3 +149,28 @@ def test_a_mistyped_kernel_switch_is_refused_on_import():
     run = subprocess.run([sys.executable, "-c", "import sagcal"], env=env, capture_output=True, text=True)
     assert run.returncode != 0
     assert 'ValueError: SAGCAL_SIMD="fast": expected portable, avx2 or auto' in run.stderr
+
+
+def test_each_kind_of_error_has_its_class(problem, tmp_path):
+    guess, data = problem["guess"], problem["measurements"]
+
+    def caught(call):
+        with pytest.raises(sagcal.SagcalError) as error:
+            call()
+        return error.value
+
+    missing = caught(lambda: sagcal.calibrate(guess, tmp_path / "missing.csv"))
+    assert type(missing) is sagcal.FileError
+    keyword = caught(lambda: sagcal.calibrate(guess, data, encoder_sigma_m=-1.0))
+    assert type(keyword) is sagcal.InvalidInputError
+    # A refused fit is a CalibrationError, apart from a file error.
+    refused = caught(lambda: sagcal.calibrate(guess, data, model="rigid"))
+    assert type(refused) is sagcal.CalibrationRefused
+    assert isinstance(refused, sagcal.CalibrationError) and not isinstance(refused, sagcal.FileError)
+    # A calibration that failed on a step carries that step's error as its cause.
+    few = caught(lambda: sagcal.calibrate(guess, data[:3]))
+    assert type(few) is sagcal.CalibrationError
+    assert type(few.__cause__) is sagcal.InvalidInputError
+    assert str(few) == f"invalid input: measurements: no robot file is written: {few.__cause__}"
+    for kind in (sagcal.FileError, sagcal.InvalidInputError, sagcal.CalibrationError, sagcal.SolverError):
+        assert issubclass(kind, sagcal.SagcalError) and kind.__module__ == "sagcal"

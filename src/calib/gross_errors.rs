@@ -191,10 +191,10 @@ fn checked_fit(
         .collect();
     if !units.is_empty() {
         // No reading is to blame and no fit can mend it: the data must be fixed.
-        return Err(crate::error::Error::InvalidInput(format!(
-            "{}; fix the data and calibrate again",
-            units.join("; ")
-        )));
+        return Err(crate::error::CalibrationError::UnitMistakes {
+            mistakes: units.iter().map(|m| m.to_string()).collect(),
+        }
+        .into());
     }
     screen::check_kept_rows(initial, measurements, &current, &rows, &options.noise)?;
     let mut plain = None;

@@ -8,7 +8,7 @@ use super::gross_errors::{calibrate_checked, CheckedCalibration, Verdict};
 use super::report::{CalibrationReport, CheckedReport, GrossErrorReport};
 use super::settings::CalibrationSettings;
 use super::CalibrationOptions;
-use crate::error::{Error, FrontEnd, Result};
+use crate::error::{CalibrationError, Error, FrontEnd, Result};
 use crate::model::measurement::PoseMeasurement;
 use crate::model::Robot;
 
@@ -60,8 +60,13 @@ pub fn calibrate_job(
     front_end: FrontEnd,
 ) -> Result<CalibrationJob> {
     let (options, check) = settings.options(nominal, front_end)?;
-    let checked = calibrate_checked(nominal, measurements, &options, &check)
-        .map_err(|e| Error::InvalidInput(format!("{source}: no robot file is written: {e}")))?;
+    let checked = calibrate_checked(nominal, measurements, &options, &check).map_err(|e| match e {
+        Error::Cancelled => e,
+        cause => Error::NotWritten {
+            source_name: source.to_string(),
+            cause: Box::new(cause),
+        },
+    })?;
     let lines: Vec<usize> = checked
         .rows
         .iter()
@@ -103,8 +108,11 @@ pub fn refusal(source: &str, reason: &str, front_end: FrontEnd) -> Error {
         FrontEnd::Cli => "writes it anyway",
         FrontEnd::Python => "returns it anyway",
     };
-    Error::InvalidInput(format!(
-        "{source}: the calibration fails its own consistency tests, so no robot file is written \
-         ({accept} {anyway}): {reason}"
-    ))
+    CalibrationError::Refused {
+        source_name: source.to_string(),
+        accept,
+        anyway,
+        reason: reason.to_string(),
+    }
+    .into()
 }

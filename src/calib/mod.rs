@@ -432,7 +432,7 @@ fn rigid_calibration(
 /// Solve one stage; errors name the stage.
 fn solve_stage(name: &str, built: &mut CalibrationGraph, lm: &LmParams) -> Result<StageSummary> {
     let summary = system_scope::with_system_cache(|cache| optimize_cached(&mut built.graph, lm, cache))
-        .map_err(|e| Error::InvalidInput(format!("{name} stage: {e}")))?;
+        .map_err(|e| e.during(format!("{name} stage")))?;
     Ok(StageSummary {
         name: name.to_string(),
         summary,

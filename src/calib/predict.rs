@@ -65,7 +65,7 @@ pub fn predict_with_effects(robot: &Robot, start: &Equilibrium, load_cell_n: f64
     for id in built.globals.anchors.iter().chain(&built.globals.length_offsets) {
         built.graph.values.set_fixed(*id, true);
     }
-    let summary = optimize(&mut built.graph, &options.lm).map_err(Error::InvalidInput)?;
+    let summary = optimize(&mut built.graph, &options.lm)?;
     if !summary.termination.converged() {
         return Err(Error::NoEquilibrium(format!(
             "the extended model has no equilibrium at {:?} with the load cell at {load_cell_n} N ({:?})",

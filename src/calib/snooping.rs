@@ -148,7 +148,7 @@ pub fn test_fit(
 ) -> Result<ConsistencyTest> {
     let (indices, used) = used_measurements(result, measurements);
     let built = graph_at_solution(result, &used, options);
-    let numbers = redundancy_numbers(&built.graph, &READING_KINDS).map_err(Error::InvalidInput)?;
+    let numbers = redundancy_numbers(&built.graph, &READING_KINDS)?;
     let with_orientation =
         options.as_used_by(result).orientation_prior == OrientationPrior::On || options.model == CableModel::Rigid;
     let owner = pose_owners(&built);

@@ -25,7 +25,7 @@ pub(super) fn effect_estimate(built: &CalibrationGraph, kind: EffectKind) -> Res
     let id = vars.of(kind);
     let raw = built.graph.values.vector(id).clone();
     let values = EffectEstimate::values_from_variable(kind, raw.as_slice());
-    let covariance: Vec<Vec<f64>> = match marginal_covariance(&built.graph, &[id]).map_err(Error::InvalidInput)? {
+    let covariance: Vec<Vec<f64>> = match marginal_covariance(&built.graph, &[id])? {
         Covariance::Full(c) => (0..raw.len())
             .map(|r| (0..raw.len()).map(|k| c[(r, k)]).collect())
             .collect(),
@@ -51,8 +51,7 @@ pub fn parameter_uncertainty(built: &CalibrationGraph) -> Result<ParameterUncert
         .copied()
         .collect();
     let covariance =
-        super::system_scope::with_system_cache(|cache| marginal_covariance_cached(&built.graph, &selected, cache))
-            .map_err(Error::InvalidInput)?;
+        super::system_scope::with_system_cache(|cache| marginal_covariance_cached(&built.graph, &selected, cache))?;
     Ok(match covariance {
         Covariance::Full(c) => uncertainty_from_covariance(&c),
         Covariance::RankDeficient(directions) => ParameterUncertainty::RankDeficient { directions },

@@ -271,7 +271,7 @@ pub(super) fn causes_given_terms(
             .iter()
             .map(|(residual, driver)| direction_of(graph, used, samples, residual, driver).0)
             .collect();
-        let system = score_system(&graph.graph, &directions).map_err(Error::InvalidInput)?;
+        let system = score_system(&graph.graph, &directions)?;
         let (_, drop) = system
             .joint_fit()
             .ok_or_else(|| Error::InvalidInput("the proposed terms' information is singular".into()))?;
@@ -321,7 +321,7 @@ pub(super) fn missing_terms(
             }
         }
     }
-    let system = score_system(&graph.graph, &directions).map_err(Error::InvalidInput)?;
+    let system = score_system(&graph.graph, &directions)?;
     let limit_of = |testable: usize| chi_square_critical(1, false_alarm / testable.max(1) as f64).sqrt();
     let term = |j: usize, given: &[usize]| {
         let (residual, driver, points) = terms[j];

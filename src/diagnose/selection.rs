@@ -347,8 +347,7 @@ fn held_out_terms(
     let (train, test): (Vec<usize>, Vec<usize>) = (0..used.len()).partition(|k| k % folds != fold);
     let subset = |indices: &[usize]| -> CalibrationGraph { subgraph(full, fit, used, indices, options) };
     let mut trained = subset(&train);
-    optimize(&mut trained.graph, &options.lm)
-        .map_err(|e| Error::InvalidInput(format!("cross-validation fold {}: {e}", fold + 1)))?;
+    optimize(&mut trained.graph, &options.lm).map_err(|e| e.during(format!("cross-validation fold {}", fold + 1)))?;
     let mut held_out = subset(&test);
     for id in global_ids(&trained) {
         held_out
@@ -358,7 +357,7 @@ fn held_out_terms(
         held_out.graph.values.set_fixed(id, true);
     }
     optimize(&mut held_out.graph, &options.lm)
-        .map_err(|e| Error::InvalidInput(format!("cross-validation fold {} (held-out poses): {e}", fold + 1)))?;
+        .map_err(|e| e.during(format!("cross-validation fold {} (held-out poses)", fold + 1)))?;
     held_out
         .graph
         .factors

@@ -86,7 +86,7 @@ pub(super) fn fit_with_terms(
         .collect();
     let directions: Vec<Direction> = terms.iter().map(|t| t.direction.clone()).collect();
     let step_at = |graph: &CalibrationGraph| -> Result<(Vec<f64>, f64, f64)> {
-        let system = score_system(&graph.graph, &directions).map_err(Error::InvalidInput)?;
+        let system = score_system(&graph.graph, &directions)?;
         let (step, gain) = system
             .joint_fit()
             .ok_or_else(|| Error::InvalidInput("the proposed terms' information is singular".into()))?;

@@ -114,7 +114,7 @@ pub fn identifiability(
     let mut selected: Vec<_> = built.globals.anchors.to_vec();
     selected.extend(built.globals.length_offsets);
     selected.push(parameter);
-    let joint = match marginal_covariance(&built.graph, &selected).map_err(Error::InvalidInput)? {
+    let joint = match marginal_covariance(&built.graph, &selected)? {
         Covariance::Full(c) => c,
         Covariance::RankDeficient(_) => {
             return Err(Error::InvalidInput(

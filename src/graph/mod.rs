@@ -39,6 +39,7 @@ pub mod robust;
 pub mod shared;
 pub mod values;
 
+pub use crate::error::LinearizeError;
 pub use masked::MaskedFactor;
 pub use robust::RobustKernel;
 pub use shared::SharedEvaluation;
@@ -209,7 +210,7 @@ pub struct WhitenedLinearization {
 
 /// Linearise one factor at `values`; `Err` names what went wrong (the model is
 /// undefined there, or a residual or Jacobian entry is not finite).
-pub fn linearize_factor(factor: &dyn Factor, values: &Values) -> Result<WhitenedLinearization, &'static str> {
+pub fn linearize_factor(factor: &dyn Factor, values: &Values) -> Result<WhitenedLinearization, LinearizeError> {
     let rows = factor.residual_dim();
     let mut linearized = WhitenedLinearization {
         residual: Vec::with_capacity(rows),
@@ -240,7 +241,11 @@ pub struct LinearizationBuffers {
 
 impl LinearizationBuffers {
     /// Linearise `factor` at `values` into the buffers of its shape (see [`linearize_factor`]).
-    pub fn linearize(&mut self, factor: &dyn Factor, values: &Values) -> Result<&WhitenedLinearization, &'static str> {
+    pub fn linearize(
+        &mut self,
+        factor: &dyn Factor,
+        values: &Values,
+    ) -> Result<&WhitenedLinearization, LinearizeError> {
         self.linearize_slots(factor, values, SlotMask::ALL)
     }
 
@@ -256,7 +261,7 @@ impl LinearizationBuffers {
         factor: &dyn Factor,
         values: &Values,
         wanted: SlotMask,
-    ) -> Result<&WhitenedLinearization, &'static str> {
+    ) -> Result<&WhitenedLinearization, LinearizeError> {
         let index = self.shape_index(factor, values, wanted);
         let linearized = &mut self.by_shape[index];
         linearize_into(factor, values, linearized, wanted)?;
@@ -276,7 +281,7 @@ impl LinearizationBuffers {
         index: usize,
         factor: &dyn Factor,
         values: &Values,
-    ) -> Result<&WhitenedLinearization, &'static str> {
+    ) -> Result<&WhitenedLinearization, LinearizeError> {
         if self.shape_of_factor.len() <= index {
             self.shape_of_factor.resize(index + 1, u32::MAX);
         }
@@ -375,20 +380,20 @@ fn linearize_into(
     values: &Values,
     out: &mut WhitenedLinearization,
     wanted: SlotMask,
-) -> Result<(), &'static str> {
+) -> Result<(), LinearizeError> {
     let rows = factor.residual_dim();
     out.raw_residual.clear();
     out.raw_residual.resize(rows, 0.0);
     let defined = factor.evaluate_slots(values, &mut out.raw_residual, Some(&mut out.jacobians), wanted);
     let residual = &out.raw_residual;
     if !defined {
-        return Err("model undefined (slack cable)");
+        return Err(LinearizeError::Undefined);
     }
     let sigmas = factor.sigmas();
     let s = squared_norm_over(residual, sigmas);
     let sigmas = sigmas.as_slice();
     if !s.is_finite() {
-        return Err("non-finite residual");
+        return Err(LinearizeError::NonFiniteResidual);
     }
     let kernel = factor.robust_kernel();
     let scale = kernel.weight(s).sqrt();
@@ -423,7 +428,7 @@ fn linearize_into(
         (_, true) => weigh_columns::<0, true>(wanted_blocks, weights),
     };
     if !finite {
-        return Err("non-finite Jacobian");
+        return Err(LinearizeError::NonFiniteJacobian);
     }
     out.is_zero = residual_zero && zero;
     out.cost = 0.5 * kernel.rho(s);
@@ -617,11 +622,14 @@ mod tests {
     fn only_wanted_blocks_are_checked_for_finite_entries() {
         let (values, factor) = setup(1.0, true);
         let mut buffers = LinearizationBuffers::default();
-        assert_eq!(buffers.linearize(&factor, &values).err(), Some("non-finite Jacobian"));
+        assert_eq!(
+            buffers.linearize(&factor, &values).err(),
+            Some(LinearizeError::NonFiniteJacobian)
+        );
         assert!(buffers.linearize_slots(&factor, &values, SlotMask::of([0])).is_ok());
         assert_eq!(
             buffers.linearize_slots(&factor, &values, SlotMask::of([1])).err(),
-            Some("non-finite Jacobian")
+            Some(LinearizeError::NonFiniteJacobian)
         );
     }
 

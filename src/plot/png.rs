@@ -14,7 +14,7 @@ use std::sync::{Arc, OnceLock};
 
 use resvg::{tiny_skia, usvg};
 
-use crate::error::{Error, Result};
+use crate::error::{PngError, Result};
 
 /// DejaVu Sans 2.37, regular.
 static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
@@ -43,8 +43,8 @@ fn fonts() -> Arc<usvg::fontdb::Database> {
 
 /// Render `svg` to PNG bytes at `scale` device pixels per SVG pixel, on white.
 ///
-/// Errors are [`Error::InvalidInput`] (`what` names the figure) when the SVG
-/// does not parse or the image would be empty or too large.
+/// Errors are [`PngError`]s (`what` names the figure) when the SVG does not
+/// parse, the image would be empty or too large, or the encoder fails.
 ///
 /// ```
 /// let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="40" height="20">
@@ -59,19 +59,19 @@ pub fn svg_to_png(svg: &str, scale: f32, what: &str) -> Result<Vec<u8>> {
         font_family: "DejaVu Sans".into(),
         ..usvg::Options::default()
     };
-    let tree = usvg::Tree::from_str(svg, &options)
-        .map_err(|e| Error::InvalidInput(format!("{what}: the figure's SVG does not parse: {e}")))?;
+    let tree = usvg::Tree::from_str(svg, &options).map_err(|e| PngError::Svg {
+        what: what.to_string(),
+        message: e.to_string(),
+    })?;
     let size = tree
         .size()
         .to_int_size()
         .scale_by(scale)
-        .ok_or_else(|| Error::InvalidInput(format!("{what}: the figure has no area")))?;
-    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height()).ok_or_else(|| {
-        Error::InvalidInput(format!(
-            "{what}: a {} x {} px image is too large",
-            size.width(),
-            size.height()
-        ))
+        .ok_or_else(|| PngError::NoArea { what: what.to_string() })?;
+    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height()).ok_or_else(|| PngError::TooLarge {
+        what: what.to_string(),
+        width: size.width(),
+        height: size.height(),
     })?;
     pixmap.fill(tiny_skia::Color::WHITE);
     resvg::render(
@@ -79,9 +79,10 @@ pub fn svg_to_png(svg: &str, scale: f32, what: &str) -> Result<Vec<u8>> {
         tiny_skia::Transform::from_scale(scale, scale),
         &mut pixmap.as_mut(),
     );
-    pixmap
-        .encode_png()
-        .map_err(|e| Error::InvalidInput(format!("{what}: PNG encoding failed: {e}")))
+    Ok(pixmap.encode_png().map_err(|e| PngError::Encode {
+        what: what.to_string(),
+        message: e.to_string(),
+    })?)
 }
 
 /// Whether `path` names a PNG file (extension `.png`, any case).

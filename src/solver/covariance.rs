@@ -8,6 +8,7 @@
 //! unobservable directions (eigenvectors with eigenvalue below `1e-10` of the
 //! largest) instead of printing a meaningless inverse.
 
+use crate::error::SolverError;
 use nalgebra::{DMatrix, SymmetricEigen};
 use serde::Serialize;
 
@@ -43,7 +44,7 @@ pub enum Covariance {
 ///    `1e14` times the smallest one marks a direction the data do not fix
 ///    (rounding noise made `H` look positive definite), reported with its
 ///    components in the selected variables.
-pub fn marginal_covariance(graph: &FactorGraph, selected: &[VariableId]) -> Result<Covariance, String> {
+pub fn marginal_covariance(graph: &FactorGraph, selected: &[VariableId]) -> Result<Covariance, SolverError> {
     marginal_covariance_cached(graph, selected, &mut SystemCache::default())
 }
 
@@ -54,15 +55,15 @@ pub fn marginal_covariance_cached(
     graph: &FactorGraph,
     selected: &[VariableId],
     cache: &mut SystemCache,
-) -> Result<Covariance, String> {
+) -> Result<Covariance, SolverError> {
     let system = cache.system(&graph.values, &graph.factors, &graph.local_groups)?;
     let hessian = linearize(graph, &graph.values, system)
-        .map_err(|e| format!("covariance at the solution: {e}"))?
+        .map_err(|e| e.during("covariance at the solution"))?
         .hessian;
     let mut columns = Vec::new();
     let mut labels = Vec::new();
     for &id in selected {
-        let offset = system.offsets[id.0].ok_or_else(|| format!("{} is fixed", graph.values.variable(id).name))?;
+        let offset = system.offsets[id.0].ok_or_else(|| SolverError::Fixed(graph.values.variable(id).name.clone()))?;
         for c in 0..graph.values.tangent_dim(id) {
             columns.push(offset + c);
             labels.push((graph.values.variable(id).name.clone(), c));

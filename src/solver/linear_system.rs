@@ -22,6 +22,7 @@
 //! Beside them, a count of the work done by general loops for shapes outside
 //! the table of `shapes` ([`LinearSystem::fallbacks`]).
 
+use crate::error::SolverError;
 use nalgebra::DMatrix;
 
 use super::accumulate::FactorRuns;
@@ -157,21 +158,26 @@ impl LinearSystem {
     /// every factor touches at most one group, the groups are eliminated
     /// block by block (`solver::schur`); otherwise, or without groups,
     /// `H` is factored by faer's supernodal sparse Cholesky.
-    pub fn new(values: &Values, factors: &[Box<dyn Factor>], local_groups: &[Vec<VariableId>]) -> Result<Self, String> {
+    pub fn new(
+        values: &Values,
+        factors: &[Box<dyn Factor>],
+        local_groups: &[Vec<VariableId>],
+    ) -> Result<Self, SolverError> {
         let layout = TangentLayout::new(values, local_groups);
         if layout.dim == 0 {
-            return Err("every variable is fixed: nothing to solve".into());
+            return Err(SolverError::NothingToSolve);
         }
         // `J^T J` is added by variable pairs: a variable named twice by one
         // factor would need the cross products of its two slots.
         for (index, factor) in factors.iter().enumerate() {
             let variables = factor.variables();
             if let Some((k, v)) = variables.iter().enumerate().find(|(k, v)| variables[..*k].contains(v)) {
-                return Err(format!(
-                    "factor {index} ({}) names variable '{}' twice (slot {k}): a factor's variables must be distinct",
-                    factor.kind(),
-                    values.variable(*v).name
-                ));
+                return Err(SolverError::RepeatedVariable {
+                    index,
+                    kind: factor.kind(),
+                    variable: values.variable(*v).name.clone(),
+                    slot: k,
+                });
             }
         }
         // The reduced system of the elimination is dense: worth it while it is small.
@@ -374,7 +380,10 @@ mod tests {
         };
         let factors = vec![factor(vec![x, y]), factor(vec![y, x, y])];
         for groups in [Vec::new(), vec![vec![y]]] {
-            let error = LinearSystem::new(&values, &factors, &groups).err().expect("an error");
+            let error = LinearSystem::new(&values, &factors, &groups)
+                .err()
+                .expect("an error")
+                .to_string();
             assert!(error.contains("factor 1") && error.contains("'y' twice"), "{error}");
         }
         assert!(LinearSystem::new(&values, &factors[..1], &[]).is_ok());

@@ -29,7 +29,7 @@
 //!
 //! let problem = BenchmarkProblem::new(9, 1)?;
 //! let mut built = problem.graph();
-//! let summary = optimize(&mut built.graph, &BenchmarkProblem::stopping()).map_err(sagcal::Error::InvalidInput)?;
+//! let summary = optimize(&mut built.graph, &BenchmarkProblem::stopping()).map_err(sagcal::Error::from)?;
 //! assert!(summary.final_cost < 1e-3 * summary.initial_cost);
 //! # Ok::<(), sagcal::Error>(())
 //! ```
@@ -49,6 +49,7 @@ mod system_cache;
 
 use local::LocalGroups;
 
+pub use crate::error::SolverError;
 pub use covariance::{marginal_covariance, marginal_covariance_cached, Covariance, UnobservableDirection};
 use dense::fill_zeros;
 pub use linear_system::LinearSystem;
@@ -186,7 +187,11 @@ pub(crate) struct Linearization {
 }
 
 /// Linearise every factor at `values`.
-pub(crate) fn linearize(graph: &FactorGraph, values: &Values, system: &LinearSystem) -> Result<Linearization, String> {
+pub(crate) fn linearize(
+    graph: &FactorGraph,
+    values: &Values,
+    system: &LinearSystem,
+) -> Result<Linearization, SolverError> {
     linearize_with(graph, values, system, &mut Workspace::default())
 }
 
@@ -207,7 +212,7 @@ fn linearize_with(
     values: &Values,
     system: &LinearSystem,
     work: &mut Workspace,
-) -> Result<Linearization, String> {
+) -> Result<Linearization, SolverError> {
     let (mut hessian, mut gradient) = match work.spare.take() {
         Some(spare) => (spare.hessian, spare.gradient),
         None => (Vec::new(), Vec::new()),
@@ -223,7 +228,11 @@ fn linearize_with(
         let variables = factor.variables();
         let linearized = buffers.linearize_at(index, factor.as_ref(), values).map_err(|what| {
             let names: Vec<&str> = variables.iter().map(|&v| values.variable(v).name.as_str()).collect();
-            format!("{} factor on [{}]: {what}", factor.kind(), names.join(", "))
+            SolverError::Factor {
+                kind: factor.kind(),
+                variables: names.join(", "),
+                source: what,
+            }
         })?;
         cost += linearized.cost;
         if linearized.is_zero {
@@ -258,7 +267,7 @@ fn retract_all(values: &Values, system: &LinearSystem, step: &[f64], next: &mut 
 }
 
 /// Minimise the graph's cost from its current values; the values are updated in place.
-pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSummary, String> {
+pub fn optimize(graph: &mut FactorGraph, params: &LmParams) -> Result<SolveSummary, SolverError> {
     optimize_cached(graph, params, &mut SystemCache::default())
 }
 
@@ -269,7 +278,7 @@ pub fn optimize_cached(
     graph: &mut FactorGraph,
     params: &LmParams,
     cache: &mut SystemCache,
-) -> Result<SolveSummary, String> {
+) -> Result<SolveSummary, SolverError> {
     let system = cache.system(&graph.values, &graph.factors, &graph.local_groups)?;
     let groups = if params.local_refinement {
         LocalGroups::new(graph)
@@ -301,7 +310,7 @@ pub fn optimize_cached(
     for iteration in 1..=params.max_iterations {
         crate::steps::tick();
         if crate::cancel::requested() {
-            return Err("cancelled".into());
+            return Err(SolverError::Cancelled);
         }
         let cost = linearization.cost;
         let gradient = &linearization.gradient;

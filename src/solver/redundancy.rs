@@ -10,6 +10,7 @@
 //! `w_i = e_i / (sigma_i sqrt(r_i))`, standard normal when the model holds.
 //! The `r_i` sum to the redundancy `n - u` of the adjustment.
 
+use crate::error::SolverError;
 use nalgebra::DMatrix;
 
 use super::{linearize, LinearSystem};
@@ -19,7 +20,7 @@ use crate::graph::{Factor, FactorGraph};
 /// of each residual row (`None` for the other factors), at the graph's values.
 /// Each row costs one solve with the factored information matrix, over the
 /// blocks the row touches.
-pub fn redundancy_numbers(graph: &FactorGraph, kinds: &[&str]) -> Result<Vec<Option<Vec<f64>>>, String> {
+pub fn redundancy_numbers(graph: &FactorGraph, kinds: &[&str]) -> Result<Vec<Option<Vec<f64>>>, SolverError> {
     let mut system = factored_information(graph, "redundancy numbers")?;
     let mut all = Vec::with_capacity(graph.factors.len());
     for factor in &graph.factors {
@@ -30,9 +31,9 @@ pub fn redundancy_numbers(graph: &FactorGraph, kinds: &[&str]) -> Result<Vec<Opt
         let (_, rows) = whitened_rows(graph, factor.as_ref(), &system, "redundancy numbers")?;
         let mut numbers = Vec::with_capacity(rows.len());
         for a in &rows {
-            let leverage = system
-                .inverse_quadratic_form(a)
-                .ok_or("redundancy numbers: the solve with the information matrix failed")?;
+            let leverage = system.inverse_quadratic_form(a).ok_or(SolverError::SolveFailed {
+                what: "redundancy numbers",
+            })?;
             numbers.push((1.0 - leverage).clamp(0.0, 1.0));
         }
         all.push(Some(numbers));
@@ -45,10 +46,10 @@ pub fn redundancy_numbers(graph: &FactorGraph, kinds: &[&str]) -> Result<Vec<Opt
 /// direction the data do not fix) has no inverse: the smallest damping that
 /// factors stands in for it, which leaves every quadratic form of a row the
 /// data do control unchanged to that order.
-pub(super) fn factored_information(graph: &FactorGraph, what: &str) -> Result<LinearSystem, String> {
+pub(super) fn factored_information(graph: &FactorGraph, what: &str) -> Result<LinearSystem, SolverError> {
     let mut system = LinearSystem::new(&graph.values, &graph.factors, &graph.local_groups)?;
     let hessian = linearize(graph, &graph.values, &system)
-        .map_err(|e| format!("{what} at the solution: {e}"))?
+        .map_err(|e| e.during(format!("{what} at the solution")))?
         .hessian;
     let diagonal = system.diagonal(&hessian);
     let factored = [0.0, 1e-12, 1e-9, 1e-6].into_iter().any(|relative| {
@@ -56,7 +57,7 @@ pub(super) fn factored_information(graph: &FactorGraph, what: &str) -> Result<Li
         system.factorize(&hessian, &damping)
     });
     if !factored {
-        return Err(format!("{what}: the information matrix is singular"));
+        return Err(SolverError::Singular { what: what.to_string() });
     }
     Ok(system)
 }
@@ -69,16 +70,20 @@ pub(super) fn whitened_rows(
     factor: &dyn Factor,
     system: &LinearSystem,
     what: &str,
-) -> Result<(Vec<f64>, Vec<Vec<f64>>), String> {
+) -> Result<(Vec<f64>, Vec<Vec<f64>>), SolverError> {
     let rows = factor.residual_dim();
     let mut blocks: Vec<DMatrix<f64>> = factor
         .variables()
         .iter()
         .map(|&id| DMatrix::zeros(rows, graph.values.tangent_dim(id)))
         .collect();
-    let residual = factor
-        .evaluate(&graph.values, Some(&mut blocks))
-        .ok_or_else(|| format!("{what}: a `{}` factor is undefined at the solution", factor.kind()))?;
+    let residual =
+        factor
+            .evaluate(&graph.values, Some(&mut blocks))
+            .ok_or_else(|| SolverError::UndefinedAtSolution {
+                what: what.to_string(),
+                kind: factor.kind(),
+            })?;
     let sigmas = factor.sigmas();
     let whitened = (0..rows).map(|row| residual[row] / sigmas[row]).collect();
     let jacobian = (0..rows)

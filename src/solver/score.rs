@@ -18,6 +18,7 @@
 //! testable and `z` is NaN.
 
 use super::redundancy::{factored_information, whitened_rows};
+use crate::error::SolverError;
 use nalgebra::{DMatrix, DVector};
 
 use crate::graph::FactorGraph;
@@ -131,14 +132,14 @@ impl ScoreSystem {
 
 /// The score test of each of `directions` at the graph's values, which must
 /// be a least-squares solution of the graph (module docs).
-pub fn score_tests(graph: &FactorGraph, directions: &[Direction]) -> Result<Vec<ScoreTest>, String> {
+pub fn score_tests(graph: &FactorGraph, directions: &[Direction]) -> Result<Vec<ScoreTest>, SolverError> {
     let system = score_system(graph, directions)?;
     Ok((0..directions.len()).map(|j| system.test(j, &[])).collect())
 }
 
 /// The [`ScoreSystem`] of `directions` at the graph's values, which must be
 /// a least-squares solution of the graph.
-pub fn score_system(graph: &FactorGraph, directions: &[Direction]) -> Result<ScoreSystem, String> {
+pub fn score_system(graph: &FactorGraph, directions: &[Direction]) -> Result<ScoreSystem, SolverError> {
     const WHAT: &str = "score tests";
     let mut system = factored_information(graph, WHAT)?;
     let touched: Vec<bool> = (0..graph.factors.len())
@@ -161,11 +162,11 @@ pub fn score_system(graph: &FactorGraph, directions: &[Direction]) -> Result<Sco
                 continue;
             };
             if weights.len() != residual.len() {
-                return Err(format!(
-                    "{WHAT}: a direction has {} weights for a factor of {} rows",
-                    weights.len(),
-                    residual.len()
-                ));
+                return Err(SolverError::DirectionShape {
+                    what: WHAT,
+                    weights: weights.len(),
+                    rows: residual.len(),
+                });
             }
             for ((w, r), a) in weights.iter().zip(residual).zip(jacobian) {
                 score[j] -= w * r;
@@ -180,7 +181,7 @@ pub fn score_system(graph: &FactorGraph, directions: &[Direction]) -> Result<Sco
         .iter()
         .map(|g| system.solve_factored(g))
         .collect::<Option<_>>()
-        .ok_or_else(|| format!("{WHAT}: the solve with the information matrix failed"))?;
+        .ok_or(SolverError::SolveFailed { what: WHAT })?;
     let mut information = DMatrix::zeros(count, count);
     for j in 0..count {
         for k in j..count {

@@ -2,6 +2,7 @@
 //! the block elimination (`schur`) does not serve: the symbolic analysis
 //! once, then numerical factorisations and solves into buffers allocated once.
 
+use crate::error::SolverError;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::{LltParams, LltRegularization};
 use faer::sparse::linalg::cholesky::{
@@ -39,7 +40,7 @@ impl SparseCholesky {
     /// The pattern of `H`'s lower triangle (`indices`: `(row, col)` of
     /// every entry, `row >= col`; `positions`: where each entry is stored in
     /// `H`'s value array) analysed for a `dim x dim` system.
-    pub(super) fn new(indices: &[(usize, usize)], positions: Vec<usize>, dim: usize) -> Result<Self, String> {
+    pub(super) fn new(indices: &[(usize, usize)], positions: Vec<usize>, dim: usize) -> Result<Self, SolverError> {
         let mut diagonal_entries = vec![0; dim];
         for (k, &(row, col)) in indices.iter().enumerate() {
             if row == col {
@@ -71,7 +72,7 @@ impl SparseCholesky {
                 ..Default::default()
             },
         )
-        .map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
+        .map_err(|e| SolverError::SymbolicCholesky(format!("{e:?}")))?;
         let scratch = StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Spec::<LltParams, f64>::default()),
             symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
@@ -79,7 +80,7 @@ impl SparseCholesky {
         Ok(Self {
             matrix_values: vec![0.0; entry_count],
             factor_values: vec![0.0; symbolic.len_val()],
-            scratch: MemBuffer::try_new(scratch).map_err(|_| "out of memory for the Cholesky workspace".to_string())?,
+            scratch: MemBuffer::try_new(scratch).map_err(|_| SolverError::OutOfMemory)?,
             factored: false,
             dim,
             symbolic,

@@ -12,6 +12,7 @@
 //! one. Results are bit for bit those of a fresh system (test).
 
 use super::LinearSystem;
+use crate::error::SolverError;
 use crate::graph::{Factor, Values, VariableId};
 
 /// At most one linear system and the structure it was built for.
@@ -28,7 +29,7 @@ impl SystemCache {
         values: &Values,
         factors: &[Box<dyn Factor>],
         local_groups: &[Vec<VariableId>],
-    ) -> Result<&mut LinearSystem, String> {
+    ) -> Result<&mut LinearSystem, SolverError> {
         let key = structure_key(values, factors, local_groups);
         let kept = match self.kept.take() {
             Some((kept_key, system)) if kept_key == key => (kept_key, system),

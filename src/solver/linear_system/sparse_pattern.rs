@@ -7,6 +7,7 @@ use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
 use super::{Factorization, HessianStorage, LinearSystem, StoredBlock, TangentLayout};
+use crate::error::SolverError;
 use crate::graph::{Factor, Values, VariableId};
 use crate::solver::accumulate::{FactorRuns, SlotBlock};
 use crate::solver::shapes::FallbackCounter;
@@ -114,7 +115,7 @@ impl LinearSystem {
         values: &Values,
         factors: &[Box<dyn Factor>],
         layout: TangentLayout,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, SolverError> {
         let pattern = BlockPattern::new(values, factors, &layout.offsets);
         let offset = |v: VariableId| layout.offsets[v.0].unwrap_or(0);
         let block = |&(a, b, start): &(VariableId, VariableId, usize)| StoredBlock {

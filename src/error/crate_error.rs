@@ -1,0 +1,105 @@
+//! [`Error`], the one error type of the crate's API, and its [`Result`].
+//!
+//! ```
+//! let failed = sagcal::Error::InvalidInput("poses must be at least 1".into());
+//! assert_eq!(failed.to_string(), "invalid input: poses must be at least 1");
+//! ```
+
+use super::calibration::CalibrationError;
+use super::png::PngError;
+use super::solver::SolverError;
+use std::path::PathBuf;
+
+/// Everything that can go wrong in sagcal, from reading a file to solving the statics.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A file could not be opened, read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file as a whole is not in a format sagcal understands.
+    #[error("{path}: {message}")]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// One field of one row of a data file is wrong.
+    #[error("{path}: row {row}, field `{field}`: {message}")]
+    Field {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number in the file (the header is line 1).
+        row: usize,
+        /// The column name.
+        field: String,
+        /// What is wrong with the value.
+        message: String,
+    },
+    /// A robot description is invalid (coincident anchors, unknown reference cable, ...).
+    #[error("robot {path}: {message}")]
+    Robot {
+        /// The robot file (or `<built-in>`).
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// The job was stopped on request ([`crate::cancel`]).
+    #[error("cancelled")]
+    Cancelled,
+    /// The kineto-static problem has no solution with positive cable tensions.
+    #[error("no static equilibrium: {0}")]
+    NoEquilibrium(String),
+    /// The solver failed; the message names the stage or computation.
+    #[error("solver: {0}")]
+    Solver(#[source] SolverError),
+    /// A calibration gives no robot file: refused, or one of its steps failed.
+    #[error("invalid input: {0}")]
+    Calibration(#[from] CalibrationError),
+    /// A step of a calibration failed, so no robot file is written.
+    #[error("invalid input: {source_name}: no robot file is written: {cause}")]
+    NotWritten {
+        /// The measurements, as the caller named them.
+        source_name: String,
+        /// What failed.
+        #[source]
+        cause: Box<Error>,
+    },
+    /// A figure could not be rendered to PNG.
+    #[error(transparent)]
+    Png(#[from] PngError),
+    /// An argument given on the command line or through the API is out of range.
+    #[error("invalid input: {0}")]
+    InvalidInput(String),
+}
+
+/// Shorthand for `Result<T, sagcal::Error>`.
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    /// Build an [`Error::Io`] for `path`.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+/// A solver failure; a stop on request is [`Error::Cancelled`] whichever
+/// layer noticed it.
+impl From<SolverError> for Error {
+    fn from(error: SolverError) -> Self {
+        match error {
+            SolverError::Cancelled => Error::Cancelled,
+            other => Error::Solver(other),
+        }
+    }
+}
