@@ -211,6 +211,88 @@ impl RobotFile {
     }
 }
 
+impl RobotFile {
+    /// Each field on its own: four cables, a reference cable among them,
+    /// finite points, positive platform weight, non-negative cable weight.
+    fn check_fields(&self) -> std::result::Result<(), String> {
+        if self.cables.len() != CABLE_COUNT {
+            return Err(format!(
+                "field `cables`: sagcal models a suspended robot with {CABLE_COUNT} cables, the file has {}",
+                self.cables.len()
+            ));
+        }
+        if self.reference_cable < 1 || self.reference_cable > CABLE_COUNT {
+            return Err(format!(
+                "field `reference_cable`: cable {} does not exist (cables are numbered 1..{CABLE_COUNT})",
+                self.reference_cable
+            ));
+        }
+        let finite3 = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
+        for (i, CableEntry { anchor_m, attachment_m }) in self.cables.iter().enumerate() {
+            if !finite3(anchor_m) {
+                return Err(format!("cable {}: field `anchor_m` is not finite", i + 1));
+            }
+            if !finite3(attachment_m) {
+                return Err(format!("cable {}: field `attachment_m` is not finite", i + 1));
+            }
+        }
+        if !finite3(&self.com_offset_m) {
+            return Err("field `com_offset_m` is not finite".into());
+        }
+        if !(self.platform_weight_n.is_finite() && self.platform_weight_n > 0.0) {
+            return Err(format!(
+                "field `platform_weight_n` must be a positive weight in newtons, got {}",
+                self.platform_weight_n
+            ));
+        }
+        if !(self.cable_weight_n_per_m.is_finite() && self.cable_weight_n_per_m >= 0.0) {
+            return Err(format!(
+                "field `cable_weight_n_per_m` must be >= 0, got {}",
+                self.cable_weight_n_per_m
+            ));
+        }
+        Ok(())
+    }
+
+    /// The encoder offsets, zero where the file gives none.
+    fn length_offsets(&self) -> std::result::Result<[f64; CABLE_COUNT], String> {
+        match &self.length_offsets_m {
+            None => Ok([0.0; CABLE_COUNT]),
+            Some(v) if v.len() == CABLE_COUNT && v.iter().all(|x| x.is_finite()) => Ok([v[0], v[1], v[2], v[3]]),
+            Some(v) => Err(format!(
+                "field `length_offsets_m` needs {CABLE_COUNT} finite values, got {v:?}"
+            )),
+        }
+    }
+}
+
+/// Every cable has its own pulley and its own attachment point.
+fn distinct_points(
+    anchors_m: &[Vector3<f64>; CABLE_COUNT],
+    attachments_m: &[Vector3<f64>; CABLE_COUNT],
+) -> std::result::Result<(), String> {
+    for i in 0..CABLE_COUNT {
+        for j in i + 1..CABLE_COUNT {
+            if (anchors_m[i] - anchors_m[j]).norm() < 1e-6 {
+                let anchor: [f64; 3] = anchors_m[i].into();
+                return Err(format!(
+                    "cables {} and {}: coincident anchors at {anchor:?}; every cable needs its own pulley",
+                    i + 1,
+                    j + 1,
+                ));
+            }
+            if (attachments_m[i] - attachments_m[j]).norm() < 1e-9 {
+                return Err(format!(
+                    "cables {} and {}: coincident attachment points; the statics need distinct ones",
+                    i + 1,
+                    j + 1
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Effects in their ranges; what a suspended robot needs and what no real one falls outside (each message says why).
 fn suspended_and_plausible(robot: &Robot) -> std::result::Result<(), String> {
     robot.effects.validate().map_err(|e| format!("table `effects`: {e}"))?;
@@ -234,73 +316,12 @@ impl Robot {
             path: path.to_path_buf(),
             message,
         };
-        if file.cables.len() != CABLE_COUNT {
-            return Err(fail(format!(
-                "field `cables`: sagcal models a suspended robot with {CABLE_COUNT} cables, the file has {}",
-                file.cables.len()
-            )));
-        }
-        if file.reference_cable < 1 || file.reference_cable > CABLE_COUNT {
-            return Err(fail(format!(
-                "field `reference_cable`: cable {} does not exist (cables are numbered 1..{CABLE_COUNT})",
-                file.reference_cable
-            )));
-        }
-        let finite3 = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
-        for (i, CableEntry { anchor_m, attachment_m }) in file.cables.iter().enumerate() {
-            if !finite3(anchor_m) {
-                return Err(fail(format!("cable {}: field `anchor_m` is not finite", i + 1)));
-            }
-            if !finite3(attachment_m) {
-                return Err(fail(format!("cable {}: field `attachment_m` is not finite", i + 1)));
-            }
-        }
-        if !finite3(&file.com_offset_m) {
-            return Err(fail("field `com_offset_m` is not finite".into()));
-        }
-        if !(file.platform_weight_n.is_finite() && file.platform_weight_n > 0.0) {
-            return Err(fail(format!(
-                "field `platform_weight_n` must be a positive weight in newtons, got {}",
-                file.platform_weight_n
-            )));
-        }
-        if !(file.cable_weight_n_per_m.is_finite() && file.cable_weight_n_per_m >= 0.0) {
-            return Err(fail(format!(
-                "field `cable_weight_n_per_m` must be >= 0, got {}",
-                file.cable_weight_n_per_m
-            )));
-        }
+        file.check_fields().map_err(fail)?;
         let anchors_m: [Vector3<f64>; CABLE_COUNT] = std::array::from_fn(|i| Vector3::from(file.cables[i].anchor_m));
         let attachments_m: [Vector3<f64>; CABLE_COUNT] =
             std::array::from_fn(|i| Vector3::from(file.cables[i].attachment_m));
-        for i in 0..CABLE_COUNT {
-            for j in i + 1..CABLE_COUNT {
-                if (anchors_m[i] - anchors_m[j]).norm() < 1e-6 {
-                    return Err(fail(format!(
-                        "cables {} and {}: coincident anchors at {:?}; every cable needs its own pulley",
-                        i + 1,
-                        j + 1,
-                        file.cables[i].anchor_m
-                    )));
-                }
-                if (attachments_m[i] - attachments_m[j]).norm() < 1e-9 {
-                    return Err(fail(format!(
-                        "cables {} and {}: coincident attachment points; the statics need distinct ones",
-                        i + 1,
-                        j + 1
-                    )));
-                }
-            }
-        }
-        let length_offsets_m = match &file.length_offsets_m {
-            None => [0.0; CABLE_COUNT],
-            Some(v) if v.len() == CABLE_COUNT && v.iter().all(|x| x.is_finite()) => [v[0], v[1], v[2], v[3]],
-            Some(v) => {
-                return Err(fail(format!(
-                    "field `length_offsets_m` needs {CABLE_COUNT} finite values, got {v:?}"
-                )))
-            }
-        };
+        distinct_points(&anchors_m, &attachments_m).map_err(fail)?;
+        let length_offsets_m = file.length_offsets().map_err(fail)?;
         let workspace = file
             .workspace
             .map(WorkspaceEntry::validated)
