@@ -508,8 +508,6 @@ fn circles(src: &Path) -> Vec<String> {
 /// shrinks: a new circle fails the test, and so does one listed here that is
 /// gone (take it off the list).
 const CIRCLES_TO_CUT: &[&str] = &[
-    "calib: gross_errors <-> job <-> mistakes <-> mod <-> orientation <-> prepared <-> report <-> result <-> screen <-> settings <-> snooping <-> uncertainty",
-    "calib/factors: catenary_call <-> mod <-> tension_guard",
     "graph: masked <-> mod",
     "solver: accumulate <-> covariance <-> linear_system <-> local <-> mod <-> redundancy <-> schur <-> score <-> simd <-> system_cache",
 ];

@@ -57,48 +57,22 @@ use serde::Serialize;
 
 use std::collections::HashMap;
 
+use super::entry::calibrate;
 use super::mistakes::{self, Mistake};
+use super::options::{CalibrationOptions, RobustKernels};
+use super::result::CalibrationResult;
 use super::screen;
-use super::{calibrate, CalibrationOptions, CalibrationResult, RobustKernels};
 use crate::error::Result;
 use crate::graph::RobustKernel;
 use crate::model::measurement::{PoseMeasurement, Sensor};
 use crate::model::robot::CABLE_COUNT;
 use crate::stats::chi_square_critical;
 
+pub use super::options::GrossErrorOptions;
 pub use super::snooping::{
-    graph_at_solution, residuals_at_fit, row_name, test_fit, used_measurements, ConsistencyTest, ReadingTest,
-    SensorTypeTest,
+    graph_at_solution, residuals_at_fit, row_name, test_fit, used_measurements, ConsistencyTest, ExcludedReading,
+    ReadingTest, SensorTypeTest,
 };
-
-/// Settings of the gross-error tests.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct GrossErrorOptions {
-    /// False-alarm rate of each test (per reading: over all readings, Bonferroni;
-    /// per sensor type: over the types). Default 1e-3.
-    pub false_alarm: f64,
-    /// At most this fraction of the readings is left out as gross errors
-    /// (and at least one); more failing readings mean an inconsistent model. Default 0.05.
-    pub max_excluded_fraction: f64,
-}
-
-impl Default for GrossErrorOptions {
-    fn default() -> Self {
-        Self {
-            false_alarm: 1e-3,
-            max_excluded_fraction: 0.05,
-        }
-    }
-}
-
-/// A reading left out as a gross error.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ExcludedReading {
-    /// Its test when it was left out.
-    pub test: ReadingTest,
-    /// A common mistake that explains it, in words, if one does (two cables swapped, ...).
-    pub explanation: Option<String>,
-}
 
 /// Whether the calibration can be trusted.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -141,7 +141,7 @@ pub(super) fn rigid_start(
 }
 
 /// The options of the relaxed-statics stage: the attachment-height sigma
-/// raised to the encoder sigma (see [`super::calibrate_once`]).
+/// raised to the encoder sigma (see [`super::pipeline::calibrate_once`]).
 pub(super) fn relaxed_statics(options: &CalibrationOptions) -> CalibrationOptions {
     CalibrationOptions {
         height_sigma_m: options.height_sigma_m.max(options.noise.encoder_sigma_m),
@@ -226,7 +226,7 @@ pub(super) fn warm_candidates(
 /// with fewer feasible poses is penalised); a start whose cost cannot be
 /// evaluated, or whose anchors repeat a better-placed one, is dropped. The
 /// score only orders them: a start's cost says little about the basin it lies
-/// in (see [`super::calibrate_once`]), so every start is solved and the
+/// in (see [`super::pipeline::calibrate_once`]), so every start is solved and the
 /// lowest final cost wins.
 pub(super) fn rank_starts<'a>(
     warmed: &'a [CatenaryStart],

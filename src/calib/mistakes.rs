@@ -54,7 +54,7 @@ use serde::Serialize;
 
 use std::collections::HashMap;
 
-use super::gross_errors::{row_name, ExcludedReading};
+use super::snooping::{row_name, ExcludedReading};
 use crate::model::measurement::{PoseMeasurement, Sensor};
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};

@@ -1,5 +1,6 @@
 //! How to calibrate: the cable model, the orientation prior, robust kernels
-//! and the solver settings.
+//! and the solver settings; and how to check a calibration: the settings of
+//! its gross-error tests ([`GrossErrorOptions`]).
 
 use serde::Serialize;
 
@@ -112,6 +113,26 @@ impl CalibrationOptions {
             robust: RobustKernels::default(),
             lm: LmParams::default(),
             free_effects: EffectSet::NONE,
+        }
+    }
+}
+
+/// Settings of the gross-error tests.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GrossErrorOptions {
+    /// False-alarm rate of each test (per reading: over all readings, Bonferroni;
+    /// per sensor type: over the types). Default 1e-3.
+    pub false_alarm: f64,
+    /// At most this fraction of the readings is left out as gross errors
+    /// (and at least one); more failing readings mean an inconsistent model. Default 0.05.
+    pub max_excluded_fraction: f64,
+}
+
+impl Default for GrossErrorOptions {
+    fn default() -> Self {
+        Self {
+            false_alarm: 1e-3,
+            max_excluded_fraction: 0.05,
         }
     }
 }

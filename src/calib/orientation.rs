@@ -2,33 +2,14 @@
 //! chi-square test finds it inconsistent with the fitted statics
 //! ([`OrientationPrior::Auto`], module docs of [`crate::calib`]).
 
-use serde::Serialize;
-
 use super::graph::{build_graph, measured_pose};
 use super::options::{CableModel, CalibrationOptions, OrientationPrior};
-use super::result::CalibrationResult;
-use super::{calibrate_prepared, finish, solve_stage, CatenaryPreparation};
+use super::pipeline::{calibrate_prepared, finish, solve_stage, CatenaryPreparation};
+use super::result::{CalibrationResult, OrientationCheck};
 use crate::error::Result;
 use crate::model::measurement::{PoseMeasurement, Sensor};
 use crate::model::robot::Robot;
 use crate::stats::{chi_square_critical, chi_square_quantile_999};
-
-/// The consistency test of the localiser's orientations with the fitted
-/// statics, and what the calibration did with it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct OrientationCheck {
-    /// Whether the final calibration used the orientation prior.
-    pub prior_used: bool,
-    /// `sum |log(R_measured^T R_fitted)|^2 / sigma^2` over the poses, with the prior on.
-    pub chi_square: f64,
-    /// Number of orientation residual components (3 per pose).
-    pub components: usize,
-    /// The 99.9 % quantile of chi-square with `components` degrees of freedom
-    /// (Wilson-Hilferty); above it the orientations are declared inconsistent.
-    pub limit: f64,
-    /// Mean angle between measured and fitted orientations, degrees.
-    pub mean_angle_deg: f64,
-}
 
 /// Chi-square of the localiser's orientations (less the robot's localiser
 /// mount, [`crate::model::effects::Effects::localiser_mount_deg`]) against the

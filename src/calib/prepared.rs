@@ -12,9 +12,12 @@
 //! [`PreparedCalibration`] is therefore the same, digit for digit, as
 //! [`calibrate`] with the same arguments.
 
+use super::entry::calibrate;
+use super::graph::validate_measurements;
 use super::options::{CableModel, CalibrationOptions, OrientationPrior};
+use super::orientation;
+use super::pipeline::{calibrate_prepared, CatenaryPreparation};
 use super::result::CalibrationResult;
-use super::{calibrate, calibrate_prepared, orientation, validate_measurements, CatenaryPreparation};
 use crate::error::Result;
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::Robot;

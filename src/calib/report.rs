@@ -33,10 +33,9 @@ use serde::Serialize;
 
 use super::gross_errors::{CheckedCalibration, ConsistencyTest, ExcludedReading, Verdict};
 use super::mistakes::Mistake;
-use super::{
-    CableModel, CalibrationError, CalibrationResult, FactorStatistics, OrientationCheck, ParameterUncertainty,
-    StageSummary,
-};
+use super::options::CableModel;
+use super::result::{CalibrationResult, FactorStatistics, OrientationCheck, ParameterUncertainty, StageSummary};
+use super::uncertainty::CalibrationError;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::solver::Termination;
 

@@ -1,9 +1,9 @@
 //! What a calibration returns: the calibrated robot, its uncertainty, the
-//! solver stages, and the residual statistics per factor type.
+//! solver stages, the residual statistics per factor type, and the test of
+//! the localiser's orientations ([`OrientationCheck`]).
 
 use serde::Serialize;
 
-use super::orientation::OrientationCheck;
 use crate::graph::{whitened_squared_norm, FactorGraph};
 use crate::model::effect_kind::EffectKind;
 use crate::model::pose::PlatformPose;
@@ -68,6 +68,23 @@ impl ParameterUncertainty {
             Self::RankDeficient { .. } => None,
         }
     }
+}
+
+/// The consistency test of the localiser's orientations with the fitted
+/// statics, and what the calibration did with it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct OrientationCheck {
+    /// Whether the final calibration used the orientation prior.
+    pub prior_used: bool,
+    /// `sum |log(R_measured^T R_fitted)|^2 / sigma^2` over the poses, with the prior on.
+    pub chi_square: f64,
+    /// Number of orientation residual components (3 per pose).
+    pub components: usize,
+    /// The 99.9 % quantile of chi-square with `components` degrees of freedom
+    /// (Wilson-Hilferty); above it the orientations are declared inconsistent.
+    pub limit: f64,
+    /// Mean angle between measured and fitted orientations, degrees.
+    pub mean_angle_deg: f64,
 }
 
 /// The result of a calibration.

@@ -4,8 +4,7 @@
 //! false-alarm rate are validated, with messages naming the input as the
 //! caller spells it ([`FrontEnd`]).
 
-use super::gross_errors::GrossErrorOptions;
-use super::{CableModel, CalibrationOptions, OrientationPrior, RobustKernels};
+use super::options::{CableModel, CalibrationOptions, GrossErrorOptions, OrientationPrior, RobustKernels};
 use crate::error::{Error, FrontEnd, Result};
 use crate::model::sensors::NoisePreset;
 use crate::model::Robot;

@@ -1,14 +1,16 @@
 //! Data snooping at one fit: each reading's normalised residual with its
 //! redundancy number (Baarda's w-test) and each sensor type's chi-square
-//! against its redundancy ([`super::gross_errors`] for the procedure).
+//! against its redundancy ([`super::gross_errors`] for the procedure); and
+//! a reading left out as a gross error, with its test ([`ExcludedReading`]).
 
 use std::collections::HashMap;
 
 use serde::Serialize;
 
-use super::gross_errors::GrossErrorOptions;
-use super::{build_graph, set_effect_estimates, without_estimated, CableModel, CalibrationGraph};
-use super::{CalibrationOptions, CalibrationResult, OrientationPrior};
+use super::graph::{build_graph, CalibrationGraph};
+use super::options::{CableModel, CalibrationOptions, GrossErrorOptions, OrientationPrior};
+use super::refine::{set_effect_estimates, without_estimated};
+use super::result::CalibrationResult;
 use crate::error::{Error, Result};
 use crate::graph::VariableId;
 use crate::model::measurement::{PoseMeasurement, Sensor};
@@ -105,6 +107,15 @@ impl ConsistencyTest {
     pub fn consistent(&self) -> bool {
         self.flagged.is_empty() && self.sensor_types.iter().all(|t| t.consistent)
     }
+}
+
+/// A reading left out as a gross error.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ExcludedReading {
+    /// Its test when it was left out.
+    pub test: ReadingTest,
+    /// A common mistake that explains it, in words, if one does (two cables swapped, ...).
+    pub explanation: Option<String>,
 }
 
 /// The graph of a fit at its solution: the options as the fit used them

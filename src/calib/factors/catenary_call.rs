@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, Matrix3x4, SMatrix, SVector, Vector2, Vector3, Vector4};
 
-use super::{
+use super::slots::{
     gather_anchors, gather_offsets, pose_arguments, tension_argument, CalibrationVariables, PoseVariables, SlotOrder,
     EPSILON,
 };

@@ -5,9 +5,10 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector4};
 
-use super::{
+use super::catenary_call::CatenaryCall;
+use super::slots::{
     gather_anchors, pose_arguments, rows_to_cables, tension_argument, variable_list, CalibrationVariables,
-    CatenaryCall, PoseVariables, SlotOrder, EPSILON,
+    PoseVariables, SlotOrder, EPSILON,
 };
 use crate::generated;
 use crate::graph::{evaluate_through_into, Factor, Values, VariableId};
