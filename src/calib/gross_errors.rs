@@ -142,7 +142,9 @@ pub fn calibrate_checked(
 }
 
 /// [`calibrate_checked`] after its check of the noise, without its check of
-/// what the data determined.
+/// what the data determined: the data checked for mistakes, one plain fit
+/// (all for data that pass), the robust screen, test-and-remove, and the fit
+/// with every reading back if the search gave up.
 fn checked_fit(
     initial: &crate::model::Robot,
     measurements: &[PoseMeasurement],
@@ -151,45 +153,95 @@ fn checked_fit(
 ) -> Result<CheckedCalibration> {
     let found = mistakes::before_calibration(initial, measurements);
     let (mut current, rows) = mistakes::without_rows_outside(measurements, &found);
-    let total_readings = current.len() * (CABLE_COUNT + 1);
-    let mut state = Exclusions {
-        excluded: Vec::new(),
-        stepped: 0,
-        limit: ((check.max_excluded_fraction * total_readings as f64).floor() as usize).max(1),
-        step_cable: None,
+    let mut state = Exclusions::new(check.max_excluded_fraction, current.len());
+    refuse_unit_mistakes(&found)?;
+    screen::check_kept_rows(initial, measurements, &current, &rows, &options.noise)?;
+    let mut plain = None;
+    // Clean data pass at the cost of one fit and its test.
+    if let Ok(result) = calibrate(initial, &current, options) {
+        let test = test_fit(&result, &current, options, check)?;
+        if test.consistent() {
+            let at_fit = residuals_at_fit(&result, &current, options);
+            return Ok(finish(result, current, rows, state, found, test, &at_fit));
+        }
+        plain = Some(PlainFit {
+            result,
+            test,
+            all: current.clone(),
+        });
+    }
+    robust_screen(initial, &mut current, options, check, &mut state);
+    let search = Search {
+        initial,
+        options,
+        check,
     };
+    let checked = test_and_remove(&search, current, &rows, &found, state, plain.as_ref())?;
+    // An inconsistent fit is a model (or noise) error, not blunders: the
+    // readings left out go back (kept in `set_aside`, with the mistakes named,
+    // as hints), and the fit with every reading is the answer, with its verdict.
+    Ok(match plain {
+        Some(plain) if checked.verdict != Verdict::Consistent => gave_up(checked, plain, rows, options),
+        _ => checked,
+    })
+}
+
+/// What every fit of the search shares: the initial guess, the options and the tests.
+#[derive(Clone, Copy)]
+struct Search<'a> {
+    initial: &'a crate::model::Robot,
+    options: &'a CalibrationOptions,
+    check: &'a GrossErrorOptions,
+}
+
+/// The first fit, with every reading the checks before it kept, and its tests.
+struct PlainFit {
+    result: CalibrationResult,
+    test: ConsistencyTest,
+    /// The measurements it used.
+    all: Vec<PoseMeasurement>,
+}
+
+/// Readings logged in the wrong unit: no reading is to blame and no fit can
+/// mend it, the data must be fixed.
+fn refuse_unit_mistakes(found: &[Mistake]) -> Result<()> {
     let units: Vec<&str> = found
         .iter()
         .filter(|m| m.is_unit_mistake())
         .map(|m| m.message.as_str())
         .collect();
-    if !units.is_empty() {
-        // No reading is to blame and no fit can mend it: the data must be fixed.
-        return Err(crate::error::CalibrationError::UnitMistakes {
-            mistakes: units.iter().map(|m| m.to_string()).collect(),
-        }
-        .into());
+    if units.is_empty() {
+        return Ok(());
     }
-    screen::check_kept_rows(initial, measurements, &current, &rows, &options.noise)?;
-    let mut plain = None;
-    {
-        // Clean data pass at the cost of one fit and its test.
-        if let Ok(result) = calibrate(initial, &current, options) {
-            let test = test_fit(&result, &current, options, check)?;
-            if test.consistent() {
-                let at_fit = residuals_at_fit(&result, &current, options);
-                return Ok(finish(result, current, rows, state, found, test, &at_fit));
-            }
-            plain = Some((result, test, current.clone()));
-        }
-        robust_screen(initial, &mut current, options, check, &mut state);
+    Err(crate::error::CalibrationError::UnitMistakes {
+        mistakes: units.iter().map(|m| m.to_string()).collect(),
     }
+    .into())
+}
+
+/// Test-and-remove (module docs): calibrate, test, leave out an offset step
+/// or the most significant flagged reading, and again until nothing is
+/// flagged or more are flagged than a few blunders explain; then take back,
+/// up to three rounds, what the final fit does not reject.
+fn test_and_remove(
+    search: &Search,
+    mut current: Vec<PoseMeasurement>,
+    rows: &[usize],
+    found: &[Mistake],
+    mut state: Exclusions,
+    plain: Option<&PlainFit>,
+) -> Result<CheckedCalibration> {
+    let Search {
+        initial,
+        options,
+        check,
+    } = *search;
     let mut rounds = 0;
-    let checked = loop {
+    Ok(loop {
         // With every reading back in (the robust screen left nothing out, or
         // all were taken back) the fit is the plain one, already tested.
-        let (result, test) = match &plain {
-            Some((result, test, all)) if *all == current => (result.clone(), test.clone()),
+        let (result, test) = match plain {
+            Some(PlainFit { result, test, all }) if *all == current => (result.clone(), test.clone()),
             _ => {
                 let result = calibrate(initial, &current, options)?;
                 let test = test_fit(&result, &current, options, check)?;
@@ -209,37 +261,41 @@ fn checked_fit(
             // may still be left out reject that assumption, and the loop stops.
             Some(worst) if test.flagged.len() <= room => state.leave_out(&mut current, worst),
             _ if rounds < 3 && take_back(&result, &mut current, options, &test, &mut state) => rounds += 1,
-            _ => break finish(result, current, rows.clone(), state, found.clone(), test, &at_fit),
+            _ => break finish(result, current, rows.to_vec(), state, found.to_vec(), test, &at_fit),
         }
+    })
+}
+
+/// The search for gross errors gave up on an inconsistent fit: the plain fit
+/// with every reading, its verdict saying so, the readings the search had
+/// left out listed as set aside.
+fn gave_up(
+    checked: CheckedCalibration,
+    plain: PlainFit,
+    rows: Vec<usize>,
+    options: &CalibrationOptions,
+) -> CheckedCalibration {
+    let PlainFit { result, test, all } = plain;
+    let at_fit = residuals_at_fit(&result, &all, options);
+    let none = Exclusions {
+        excluded: Vec::new(),
+        stepped: 0,
+        limit: 1,
+        step_cable: None,
     };
-    // An inconsistent fit is a model (or noise) error, not blunders: the
-    // readings left out go back (kept in `set_aside`, with the mistakes named,
-    // as hints), and the fit with every reading is the answer, with its verdict.
-    if checked.verdict != Verdict::Consistent {
-        if let Some((result, test, all)) = plain {
-            let at_fit = residuals_at_fit(&result, &all, options);
-            let none = Exclusions {
-                excluded: Vec::new(),
-                stepped: 0,
-                limit: 1,
-                step_cable: None,
-            };
-            let mut reverted = finish(result, all, rows, none, checked.mistakes.clone(), test, &at_fit);
-            reverted.verdict = match checked.verdict {
-                Verdict::Inconsistent { reason } if !checked.excluded.is_empty() => Verdict::Inconsistent {
-                    reason: format!(
-                        "{reason}. The search for gross errors gave up, so the fit reported leaves no reading out \
-                         (the {} it had left out are listed as set aside)",
-                        checked.excluded.len()
-                    ),
-                },
-                verdict => verdict,
-            };
-            reverted.set_aside = checked.excluded;
-            return Ok(reverted);
-        }
-    }
-    Ok(checked)
+    let mut reverted = finish(result, all, rows, none, checked.mistakes.clone(), test, &at_fit);
+    reverted.verdict = match checked.verdict {
+        Verdict::Inconsistent { reason } if !checked.excluded.is_empty() => Verdict::Inconsistent {
+            reason: format!(
+                "{reason}. The search for gross errors gave up, so the fit reported leaves no reading out \
+                 (the {} it had left out are listed as set aside)",
+                checked.excluded.len()
+            ),
+        },
+        verdict => verdict,
+    };
+    reverted.set_aside = checked.excluded;
+    reverted
 }
 
 /// The readings left out so far.
@@ -254,6 +310,18 @@ struct Exclusions {
 }
 
 impl Exclusions {
+    /// None left out yet; at most the fraction `max_excluded_fraction` (at
+    /// least one) of the `poses`' readings may be.
+    fn new(max_excluded_fraction: f64, poses: usize) -> Self {
+        let total_readings = poses * (CABLE_COUNT + 1);
+        Exclusions {
+            excluded: Vec::new(),
+            stepped: 0,
+            limit: ((max_excluded_fraction * total_readings as f64).floor() as usize).max(1),
+            step_cable: None,
+        }
+    }
+
     /// Single readings left out (an offset step's rows not counted).
     fn counted(&self) -> usize {
         self.excluded.len() - self.stepped
