@@ -510,7 +510,6 @@ fn circles(src: &Path) -> Vec<String> {
 const CIRCLES_TO_CUT: &[&str] = &[
     "calib: gross_errors <-> job <-> mistakes <-> mod <-> orientation <-> prepared <-> report <-> result <-> screen <-> settings <-> snooping <-> uncertainty",
     "calib/factors: catenary_call <-> mod <-> tension_guard",
-    "solver: accumulate <-> covariance <-> linear_system <-> local <-> mod <-> redundancy <-> schur <-> score <-> simd <-> system_cache",
 ];
 
 #[test]
