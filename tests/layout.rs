@@ -10,8 +10,7 @@
 //! rustfmt-formatted code. Inside a folder, no files name each other in a
 //! ring (a folder's `mod.rs` only declares, documents and re-exports, so a
 //! child that uses an item the parent file defines while the parent uses
-//! the child is a ring too); the rings not yet cut are listed and the list
-//! only shrinks.
+//! the child is a ring too).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -504,25 +503,15 @@ fn circles(src: &Path) -> Vec<String> {
     found
 }
 
-/// The circles still to cut, each as [`circles`] prints it. The list only
-/// shrinks: a new circle fails the test, and so does one listed here that is
-/// gone (take it off the list).
-const CIRCLES_TO_CUT: &[&str] = &[
-    "graph: masked <-> mod",
-    "solver: accumulate <-> covariance <-> linear_system <-> local <-> mod <-> redundancy <-> schur <-> score <-> simd <-> system_cache",
-];
-
 #[test]
-fn no_new_circle_inside_a_folder() {
+fn no_circle_inside_a_folder() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let found = circles(&src);
-    let new: Vec<&String> = found.iter().filter(|c| !CIRCLES_TO_CUT.contains(&c.as_str())).collect();
-    let cut: Vec<&&str> = CIRCLES_TO_CUT
-        .iter()
-        .filter(|c| !found.contains(&c.to_string()))
-        .collect();
-    assert!(new.is_empty(), "circles inside folders (files that name each other in a ring; a folder's mod.rs only declares, documents and re-exports):\n{}", new.iter().map(|c| c.as_str()).collect::<Vec<_>>().join("\n"));
-    assert!(cut.is_empty(), "cut, take them off CIRCLES_TO_CUT: {cut:?}");
+    assert!(
+        found.is_empty(),
+        "circles inside folders (files that name each other in a ring; a folder's mod.rs only declares, documents and re-exports):\n{}",
+        found.join("\n")
+    );
 }
 
 #[test]

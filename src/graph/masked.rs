@@ -29,7 +29,9 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{Factor, RobustKernel, Values, VariableId};
+use super::factor::Factor;
+use super::robust::RobustKernel;
+use super::values::{Values, VariableId};
 
 /// `inner` without the residual rows `dropped` (indices into its residual).
 pub struct MaskedFactor {

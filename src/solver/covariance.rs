@@ -12,7 +12,9 @@ use crate::error::SolverError;
 use nalgebra::{DMatrix, SymmetricEigen};
 use serde::Serialize;
 
-use super::{linearize, LinearSystem, SystemCache};
+use super::linear_system::LinearSystem;
+use super::linearization::linearize;
+use super::system_cache::SystemCache;
 use crate::graph::{FactorGraph, VariableId};
 
 /// A direction in parameter space the data cannot determine.

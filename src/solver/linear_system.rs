@@ -433,7 +433,7 @@ mod tests {
         for (local_groups, schur) in [(vec![vec![l1, l2], vec![l3]], true), (Vec::new(), false)] {
             let system = LinearSystem::new(&values, &graph.factors, &local_groups).unwrap();
             assert_eq!(system.uses_block_elimination(), schur);
-            let linearized = crate::solver::linearize(&graph, &values, &system).unwrap();
+            let linearized = crate::solver::linearization::linearize(&graph, &values, &system).unwrap();
             let dense = system.dense(&linearized.hessian);
             // The whitened dense Jacobian in the system's column order.
             let rows: usize = specs.iter().map(|(_, a)| a.nrows()).sum();
@@ -519,7 +519,7 @@ mod tests {
             let values = &graph.values;
             let mut system = LinearSystem::new(values, &graph.factors, &groups).unwrap();
             assert!(system.uses_block_elimination());
-            let linearized = crate::solver::linearize(&graph, values, &system).unwrap();
+            let linearized = crate::solver::linearization::linearize(&graph, values, &system).unwrap();
             let ones = vec![1.0; system.dim];
             assert!(system.solve(&linearized.hessian, &ones, &ones).is_some());
             system.fallbacks()

@@ -13,7 +13,8 @@
 use crate::error::SolverError;
 use nalgebra::DMatrix;
 
-use super::{linearize, LinearSystem};
+use super::linear_system::LinearSystem;
+use super::linearization::linearize;
 use crate::graph::{Factor, FactorGraph};
 
 /// Per factor (graph order) whose kind is in `kinds`, the redundancy number

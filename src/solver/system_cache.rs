@@ -11,7 +11,7 @@
 //! every solve, so nothing numeric carries over); any other graph gets a new
 //! one. Results are bit for bit those of a fresh system (test).
 
-use super::LinearSystem;
+use super::linear_system::LinearSystem;
 use crate::error::SolverError;
 use crate::graph::{Factor, Values, VariableId};
 

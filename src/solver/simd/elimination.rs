@@ -52,7 +52,7 @@ const BELOW: [[f64; M]; M] = {
 /// The CPU must support AVX2. The lengths are checked (a panic if short).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-pub(in crate::solver) unsafe fn eliminate_group(block: &mut [f64], reduced: &mut [f64]) -> bool {
+pub(crate) unsafe fn eliminate_group(block: &mut [f64], reduced: &mut [f64]) -> bool {
     assert!(block.len() >= M * M + M * G && reduced.len() >= G * G);
     let (d, w) = block.split_at_mut(M * M);
     // SAFETY: `d` holds 8 columns of 8 (asserted above).

@@ -39,7 +39,7 @@ const LOWER_LANES: [[f64; 4]; 4] = [
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-pub(in crate::solver) unsafe fn gram_block<
+pub(crate) unsafe fn gram_block<
     const R: usize,
     const CA: usize,
     const CB: usize,
@@ -93,7 +93,7 @@ pub(in crate::solver) unsafe fn gram_block<
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-pub(in crate::solver) unsafe fn scatter_four_rows(block: &[f64], rows: &mut [f64], width: usize, first: usize) {
+pub(crate) unsafe fn scatter_four_rows(block: &[f64], rows: &mut [f64], width: usize, first: usize) {
     let n = block.len() / 4;
     assert!(block.len() % 4 == 0 && first + n <= width && rows.len() >= 4 * width);
     let (from, to) = (block.as_ptr(), rows.as_mut_ptr());
