@@ -1,7 +1,7 @@
 //! The sparse Levenberg-Marquardt on small problems with known answers.
 
 use nalgebra::{DMatrix, DVector, Vector3};
-use sagcal::graph::{Factor, FactorGraph, RobustKernel, VariableId, VariableValue};
+use sagcal::graph::{Factor, FactorGraph, Noise, RobustKernel, VariableId, VariableValue};
 use sagcal::solver::{marginal_covariance, optimize, Covariance, LmParams};
 
 /// Range from a point variable to a known beacon: `|p - b| - d`.
@@ -9,8 +9,7 @@ struct Range {
     variables: [VariableId; 1],
     beacon: Vector3<f64>,
     measured_m: f64,
-    sigmas: DVector<f64>,
-    kernel: RobustKernel,
+    noise: Noise,
 }
 
 impl Factor for Range {
@@ -29,11 +28,8 @@ impl Factor for Range {
         }
         Some(DVector::from_element(1, d.norm() - self.measured_m))
     }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.kernel
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         "range"
@@ -66,8 +62,7 @@ fn graph_with(
             variables: [point],
             beacon: *b,
             measured_m: (truth - b).norm(),
-            sigmas: DVector::from_element(1, 0.01),
-            kernel,
+            noise: Noise::new(DVector::from_element(1, 0.01), kernel),
         });
     }
     (graph, point)
@@ -142,8 +137,7 @@ fn a_robust_kernel_resists_an_outlier() {
             variables: [point],
             beacon: all[0],
             measured_m: (truth - all[0]).norm() + 2.0,
-            sigmas: DVector::from_element(1, 0.01),
-            kernel,
+            noise: Noise::new(DVector::from_element(1, 0.01), kernel),
         };
         factors[0] = Box::new(outlier);
         graph.factors = factors;

@@ -40,7 +40,7 @@ use super::factors::{
     tension_argument, variable_list, CalibrationVariables, PoseVariables, SlotOrder, EPSILON,
 };
 use crate::generated;
-use crate::graph::{Factor, RobustKernel, SharedEvaluation, Values, VariableId};
+use crate::graph::{Factor, Noise, RobustKernel, SharedEvaluation, Values, VariableId};
 use crate::model::effect_kind::EffectKind;
 use crate::model::measurement::ReadingOrder;
 use crate::model::robot::CABLE_COUNT;
@@ -424,8 +424,7 @@ pub struct ExtendedLengthFactor {
     /// The pose's row (0: order unknown), and each cable's direction of last motion, slot order.
     row: f64,
     direction: Vector4<f64>,
-    sigmas: DVector<f64>,
-    kernel: RobustKernel,
+    noise: Noise,
     memo: Arc<ExtendedMemo>,
 }
 
@@ -476,8 +475,7 @@ impl ExtendedLengthFactor {
             globals,
             pose,
             effects,
-            sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
-            kernel,
+            noise: Noise::new(DVector::from_element(CABLE_COUNT, sigma_m), kernel),
             memo,
         }
     }
@@ -498,11 +496,8 @@ impl Factor for ExtendedLengthFactor {
         let read = |cables: &ExtendedCables| self.rows(cables, &e, &offsets, jacobians);
         shared_extended_cables(&self.memo, values, s, &self.globals, &self.pose, &e, want, read)
     }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.kernel
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         "catenary_length"
@@ -565,7 +560,7 @@ pub struct ExtendedHeightFactor {
     globals: CalibrationVariables,
     pose: PoseVariables,
     effects: EffectVariables,
-    sigmas: DVector<f64>,
+    noise: Noise,
     memo: Arc<ExtendedMemo>,
 }
 
@@ -596,7 +591,7 @@ impl ExtendedHeightFactor {
             globals,
             pose,
             effects,
-            sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
+            noise: Noise::gaussian(DVector::from_element(CABLE_COUNT, sigma_m)),
             memo,
         }
     }
@@ -631,8 +626,8 @@ impl Factor for ExtendedHeightFactor {
         };
         shared_extended_cables(&self.memo, values, s, &self.globals, &self.pose, &e, want, read)
     }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         "attachment_height"

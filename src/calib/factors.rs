@@ -55,7 +55,7 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, DVector, SMatrix, Vector3, Vector4};
 
 use crate::generated;
-use crate::graph::{evaluate_through_into, Factor, RobustKernel, SlotMask, Values, VariableId};
+use crate::graph::{evaluate_through_into, Factor, Noise, RobustKernel, SlotMask, Values, VariableId};
 use crate::model::robot::CABLE_COUNT;
 
 mod catenary_call;
@@ -101,8 +101,7 @@ macro_rules! four_rows_evaluation {
 pub struct CatenaryLengthFactor {
     variables: Vec<VariableId>,
     call: CatenaryCall,
-    sigmas: DVector<f64>,
-    kernel: RobustKernel,
+    noise: Noise,
 }
 
 impl CatenaryLengthFactor {
@@ -111,8 +110,7 @@ impl CatenaryLengthFactor {
         Self {
             variables: variable_list(&call.pose, &call.globals, true, true),
             call,
-            sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
-            kernel,
+            noise: Noise::new(DVector::from_element(CABLE_COUNT, sigma_m), kernel),
         }
     }
 }
@@ -125,11 +123,8 @@ impl Factor for CatenaryLengthFactor {
         CABLE_COUNT
     }
     four_rows_evaluation!(0);
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.kernel
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         "catenary_length"
@@ -146,7 +141,7 @@ impl Factor for CatenaryLengthFactor {
 pub struct AttachmentHeightFactor {
     variables: Vec<VariableId>,
     call: CatenaryCall,
-    sigmas: DVector<f64>,
+    noise: Noise,
 }
 
 impl AttachmentHeightFactor {
@@ -155,7 +150,7 @@ impl AttachmentHeightFactor {
         Self {
             variables: variable_list(&call.pose, &call.globals, true, false),
             call,
-            sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
+            noise: Noise::gaussian(DVector::from_element(CABLE_COUNT, sigma_m)),
         }
     }
 }
@@ -168,8 +163,8 @@ impl Factor for AttachmentHeightFactor {
         CABLE_COUNT
     }
     four_rows_evaluation!(4);
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         "attachment_height"
@@ -184,8 +179,7 @@ impl Factor for AttachmentHeightFactor {
 pub struct ReferenceTensionFactor {
     variables: [VariableId; 1],
     measured_tension_n: f64,
-    sigmas: DVector<f64>,
-    kernel: RobustKernel,
+    noise: Noise,
 }
 
 impl ReferenceTensionFactor {
@@ -194,8 +188,7 @@ impl ReferenceTensionFactor {
         Self {
             variables: [tension],
             measured_tension_n,
-            sigmas: DVector::from_element(1, sigma_n),
-            kernel,
+            noise: Noise::new(DVector::from_element(1, sigma_n), kernel),
         }
     }
 }
@@ -222,11 +215,8 @@ impl Factor for ReferenceTensionFactor {
         residual[0] = r[0];
         true
     }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.kernel
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         "reference_tension"
@@ -245,8 +235,7 @@ pub struct PosePriorFactor {
     prior_position_m: Vector3<f64>,
     prior_rotation_xyzw: Vector4<f64>,
     with_orientation: bool,
-    sigmas: DVector<f64>,
-    kernel: RobustKernel,
+    noise: Noise,
 }
 
 impl PosePriorFactor {
@@ -269,8 +258,7 @@ impl PosePriorFactor {
             prior_position_m: prior.position_m,
             prior_rotation_xyzw: prior.rotation_xyzw(),
             with_orientation: orientation_sigma_rad.is_some(),
-            sigmas,
-            kernel,
+            noise: Noise::new(sigmas, kernel),
         }
     }
 }
@@ -280,7 +268,7 @@ impl Factor for PosePriorFactor {
         &self.variables
     }
     fn residual_dim(&self) -> usize {
-        self.sigmas.len()
+        self.noise.sigmas.len()
     }
     fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
         evaluate_through_into(self, values, jacobians)
@@ -309,11 +297,8 @@ impl Factor for PosePriorFactor {
         residual.copy_from_slice(&r.as_slice()[first..]);
         true
     }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.kernel
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         "pose_prior"
@@ -332,8 +317,7 @@ pub struct RigidLengthFactor {
     globals: CalibrationVariables,
     pose: PoseVariables,
     encoder_lengths_m: Vector4<f64>,
-    sigmas: DVector<f64>,
-    kernel: RobustKernel,
+    noise: Noise,
 }
 
 impl RigidLengthFactor {
@@ -352,8 +336,7 @@ impl RigidLengthFactor {
             slots,
             globals,
             pose,
-            sigmas: DVector::from_element(CABLE_COUNT, sigma_m),
-            kernel,
+            noise: Noise::new(DVector::from_element(CABLE_COUNT, sigma_m), kernel),
         }
     }
 }
@@ -394,11 +377,8 @@ impl Factor for RigidLengthFactor {
         }
         Some(slots_to_cables(s, &r))
     }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.kernel
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         "rigid_length"

@@ -38,7 +38,7 @@ use nalgebra::{DMatrix, DVector, SMatrix};
 
 use super::factors::{tension_argument, EPSILON};
 use crate::generated;
-use crate::graph::{evaluate_through_into, Factor, RobustKernel, Values, VariableId};
+use crate::graph::{evaluate_through_into, Factor, Noise, RobustKernel, Values, VariableId};
 use crate::model::measurement::ReadingOrder;
 
 /// Force factor with a load-cell model: `bias + (1 + gain_error) |(f_h, f_v)| - f_m`,
@@ -50,8 +50,7 @@ pub struct LoadCellFactor {
     /// The pose's row (0: order unknown) and the reference cable's direction of last motion.
     row: f64,
     direction: f64,
-    sigmas: DVector<f64>,
-    kernel: RobustKernel,
+    noise: Noise,
 }
 
 impl LoadCellFactor {
@@ -69,8 +68,7 @@ impl LoadCellFactor {
             measured_tension_n,
             row: 0.0,
             direction: 0.0,
-            sigmas: DVector::from_element(1, sigma_n),
-            kernel,
+            noise: Noise::new(DVector::from_element(1, sigma_n), kernel),
         }
     }
 
@@ -143,11 +141,8 @@ impl Factor for LoadCellFactor {
         residual[0] = r[0];
         true
     }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.kernel
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         "reference_tension"

@@ -23,7 +23,7 @@ use nalgebra::{DMatrix, DVector, SMatrix, Vector3, Vector4};
 
 use super::factors::{pose_arguments, EPSILON};
 use crate::generated;
-use crate::graph::{Factor, RobustKernel, Values, VariableId};
+use crate::graph::{Factor, Noise, RobustKernel, Values, VariableId};
 
 /// Pose prior factor of a localiser mounted with a rotation (the
 /// `localiser-mount` effect): `[Log(M R_prior^-1 R); p - p_prior]` with
@@ -34,8 +34,7 @@ pub struct MountedPosePriorFactor {
     variables: [VariableId; 2],
     prior_position_m: Vector3<f64>,
     prior_rotation_xyzw: Vector4<f64>,
-    sigmas: DVector<f64>,
-    kernel: RobustKernel,
+    noise: Noise,
 }
 
 impl MountedPosePriorFactor {
@@ -54,8 +53,7 @@ impl MountedPosePriorFactor {
             variables: [pose, mount],
             prior_position_m: prior.position_m,
             prior_rotation_xyzw: prior.rotation_xyzw(),
-            sigmas: DVector::from_row_slice(&[rot, rot, rot, pos, pos, pos]),
-            kernel,
+            noise: Noise::new(DVector::from_row_slice(&[rot, rot, rot, pos, pos, pos]), kernel),
         }
     }
 }
@@ -90,11 +88,8 @@ impl Factor for MountedPosePriorFactor {
         }
         Some(DVector::from_column_slice(r.as_slice()))
     }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.kernel
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         "pose_prior"

@@ -4,6 +4,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::noise::Noise;
 use super::robust::RobustKernel;
 use super::slot_mask::SlotMask;
 use super::values::{Values, VariableId};
@@ -58,11 +59,19 @@ pub trait Factor: Send + Sync {
         let _ = wanted;
         self.evaluate_into(values, residual, jacobians)
     }
-    /// Standard deviation of every residual component (same units as the residual).
-    fn sigmas(&self) -> &DVector<f64>;
-    /// The robust kernel applied to the whitened squared norm.
+    /// The noise model: the standard deviation of every residual component
+    /// (same units as the residual) and the robust kernel on the whitened
+    /// squared norm.
+    fn noise(&self) -> &Noise;
+    /// Standard deviation of every residual component (of [`Factor::noise`];
+    /// not to be overridden).
+    fn sigmas(&self) -> &DVector<f64> {
+        &self.noise().sigmas
+    }
+    /// The robust kernel applied to the whitened squared norm (of
+    /// [`Factor::noise`]; not to be overridden).
     fn robust_kernel(&self) -> RobustKernel {
-        RobustKernel::None
+        self.noise().kernel
     }
     /// A short name of the factor type, for per-type statistics (`"catenary_length"`, ...).
     fn kind(&self) -> &'static str;

@@ -239,14 +239,14 @@ fn linearize_into(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::graph::{VariableId, VariableValue};
+    use crate::graph::{Noise, VariableId, VariableValue};
     use nalgebra::DVector;
 
     /// `r = [x0 y0 - 1, x1 + y0^2] * k` on `x` (2) and `y` (1); with
     /// `nan_in_y`, `y`'s Jacobian block is NaN (a block no reader wants).
     struct Product {
         variables: [VariableId; 2],
-        sigmas: DVector<f64>,
+        noise: Noise,
         k: f64,
         nan_in_y: bool,
     }
@@ -271,8 +271,8 @@ mod tests {
                 self.k * (x[1] + y * y),
             ]))
         }
-        fn sigmas(&self) -> &DVector<f64> {
-            &self.sigmas
+        fn noise(&self) -> &Noise {
+            &self.noise
         }
         fn kind(&self) -> &'static str {
             "product"
@@ -285,7 +285,7 @@ mod tests {
         let y = values.insert("y", VariableValue::Vector(DVector::from_vec(vec![1.9])));
         let factor = Product {
             variables: [x, y],
-            sigmas: DVector::from_vec(vec![0.1, 0.3]),
+            noise: Noise::gaussian(DVector::from_vec(vec![0.1, 0.3])),
             k,
             nan_in_y,
         };

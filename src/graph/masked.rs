@@ -4,9 +4,9 @@
 //!
 //! ```
 //! use nalgebra::{DMatrix, DVector};
-//! use sagcal::graph::{Factor, FactorGraph, MaskedFactor, Values, VariableId, VariableValue};
+//! use sagcal::graph::{Factor, FactorGraph, MaskedFactor, Noise, Values, VariableId, VariableValue};
 //! /// Two readings of a 2-vector, `z`, with sigma 1 each.
-//! struct Readings { variable: [VariableId; 1], z: [f64; 2], sigma: DVector<f64> }
+//! struct Readings { variable: [VariableId; 1], z: [f64; 2], noise: Noise }
 //! impl Factor for Readings {
 //!     fn variables(&self) -> &[VariableId] { &self.variable }
 //!     fn residual_dim(&self) -> usize { 2 }
@@ -14,12 +14,12 @@
 //!         let x = values.vector(self.variable[0]);
 //!         Some(DVector::from_vec(vec![x[0] - self.z[0], x[1] - self.z[1]]))
 //!     }
-//!     fn sigmas(&self) -> &DVector<f64> { &self.sigma }
+//!     fn noise(&self) -> &Noise { &self.noise }
 //!     fn kind(&self) -> &'static str { "readings" }
 //! }
 //! let mut values = Values::new();
 //! let x = values.insert("x", VariableValue::Vector(DVector::zeros(2)));
-//! let readings = || Box::new(Readings { variable: [x], z: [1.0, 40.0], sigma: DVector::from_element(2, 1.0) });
+//! let readings = || Box::new(Readings { variable: [x], z: [1.0, 40.0], noise: Noise::gaussian(DVector::from_element(2, 1.0)) });
 //! // The second reading is a gross error: drop its row, keep the first.
 //! let masked = MaskedFactor::new(readings(), &[1]).unwrap();
 //! assert_eq!(masked.residual_dim(), 1);
@@ -30,7 +30,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::factor::Factor;
-use super::robust::RobustKernel;
+use super::noise::Noise;
 use super::values::{Values, VariableId};
 
 /// `inner` without the residual rows `dropped` (indices into its residual).
@@ -38,7 +38,8 @@ pub struct MaskedFactor {
     inner: Box<dyn Factor>,
     /// The rows of `inner` that are kept, in order.
     kept: Vec<usize>,
-    sigmas: DVector<f64>,
+    /// The kept rows' sigmas, under `inner`'s kernel.
+    noise: Noise,
 }
 
 impl MaskedFactor {
@@ -50,7 +51,8 @@ impl MaskedFactor {
             return None;
         }
         let sigmas = DVector::from_iterator(kept.len(), kept.iter().map(|&r| inner.sigmas()[r]));
-        Some(Self { inner, kept, sigmas })
+        let noise = Noise::new(sigmas, inner.robust_kernel());
+        Some(Self { inner, kept, noise })
     }
 }
 
@@ -81,11 +83,8 @@ impl Factor for MaskedFactor {
             self.kept.iter().map(|&r| residual[r]),
         ))
     }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
-    }
-    fn robust_kernel(&self) -> RobustKernel {
-        self.inner.robust_kernel()
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         self.inner.kind()
@@ -100,7 +99,7 @@ mod tests {
     /// `r = [x0, 2 x0, 3 x0]` on one scalar variable.
     struct Three {
         variables: [VariableId; 1],
-        sigmas: DVector<f64>,
+        noise: Noise,
     }
 
     impl Factor for Three {
@@ -117,8 +116,8 @@ mod tests {
             }
             Some(DVector::from_column_slice(&[x, 2.0 * x, 3.0 * x]))
         }
-        fn sigmas(&self) -> &DVector<f64> {
-            &self.sigmas
+        fn noise(&self) -> &Noise {
+            &self.noise
         }
         fn kind(&self) -> &'static str {
             "three"
@@ -131,7 +130,7 @@ mod tests {
         let x = values.insert("x", VariableValue::Vector(DVector::from_element(1, 2.0)));
         let inner = Box::new(Three {
             variables: [x],
-            sigmas: DVector::from_column_slice(&[0.1, 0.2, 0.3]),
+            noise: Noise::gaussian(DVector::from_column_slice(&[0.1, 0.2, 0.3])),
         });
         let masked = MaskedFactor::new(inner, &[1]).unwrap();
         assert_eq!(masked.residual_dim(), 2);
@@ -142,7 +141,7 @@ mod tests {
         assert_eq!(blocks[0].as_slice(), &[1.0, 3.0]);
         let all = Box::new(Three {
             variables: [x],
-            sigmas: DVector::from_element(3, 1.0),
+            noise: Noise::gaussian(DVector::from_element(3, 1.0)),
         });
         assert!(MaskedFactor::new(all, &[0, 1, 2]).is_none());
     }

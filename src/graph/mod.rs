@@ -10,9 +10,9 @@
 //!
 //! ```
 //! use nalgebra::{DMatrix, DVector};
-//! use sagcal::graph::{linearize_factor, Factor, FactorGraph, Values, VariableId, VariableValue};
+//! use sagcal::graph::{linearize_factor, Factor, FactorGraph, Noise, Values, VariableId, VariableValue};
 //! /// A direct reading `z` of a scalar variable, standard deviation `sigma`.
-//! struct Reading { variable: [VariableId; 1], z: f64, sigma: DVector<f64> }
+//! struct Reading { variable: [VariableId; 1], z: f64, noise: Noise }
 //! impl Factor for Reading {
 //!     fn variables(&self) -> &[VariableId] { &self.variable }
 //!     fn residual_dim(&self) -> usize { 1 }
@@ -20,13 +20,13 @@
 //!         if let Some(blocks) = jacobians { blocks[0][(0, 0)] = 1.0; }
 //!         Some(DVector::from_element(1, values.vector(self.variable[0])[0] - self.z))
 //!     }
-//!     fn sigmas(&self) -> &DVector<f64> { &self.sigma }
+//!     fn noise(&self) -> &Noise { &self.noise }
 //!     fn kind(&self) -> &'static str { "reading" }
 //! }
 //! let mut graph = FactorGraph::new();
 //! let x = graph.values.insert("x", VariableValue::Vector(DVector::from_element(1, 0.0)));
-//! graph.add(Reading { variable: [x], z: 3.0, sigma: DVector::from_element(1, 1.0) });
-//! graph.add(Reading { variable: [x], z: 5.0, sigma: DVector::from_element(1, 2.0) });
+//! graph.add(Reading { variable: [x], z: 3.0, noise: Noise::gaussian(DVector::from_element(1, 1.0)) });
+//! graph.add(Reading { variable: [x], z: 5.0, noise: Noise::gaussian(DVector::from_element(1, 2.0)) });
 //! // At x = 0: 1/2 ((0 - 3) / 1)^2 + 1/2 ((0 - 5) / 2)^2.
 //! assert_eq!(graph.cost(&graph.values), Some(0.5 * 9.0 + 0.5 * 6.25));
 //! // The solver sees each factor whitened: residual r / sigma, Jacobian J / sigma.
@@ -42,6 +42,7 @@ pub mod values;
 mod factor;
 mod factor_graph;
 mod linearization;
+mod noise;
 mod slot_mask;
 mod weighing;
 
@@ -50,6 +51,7 @@ pub use factor::{evaluate_through_into, Factor};
 pub use factor_graph::FactorGraph;
 pub use linearization::{linearize_factor, LinearizationBuffers, WhitenedLinearization};
 pub use masked::MaskedFactor;
+pub use noise::Noise;
 pub use robust::RobustKernel;
 pub use shared::SharedEvaluation;
 pub use slot_mask::SlotMask;

@@ -323,7 +323,7 @@ mod tests {
     struct Linear {
         variables: Vec<VariableId>,
         a: DMatrix<f64>,
-        sigmas: nalgebra::DVector<f64>,
+        noise: crate::graph::Noise,
     }
 
     impl Factor for Linear {
@@ -349,8 +349,8 @@ mod tests {
             }
             Some(&self.a * nalgebra::DVector::from_vec(x))
         }
-        fn sigmas(&self) -> &nalgebra::DVector<f64> {
-            &self.sigmas
+        fn noise(&self) -> &crate::graph::Noise {
+            &self.noise
         }
         fn kind(&self) -> &'static str {
             "linear"
@@ -375,7 +375,7 @@ mod tests {
             Box::new(Linear {
                 variables,
                 a: DMatrix::from_element(2, cols, 1.0),
-                sigmas: nalgebra::DVector::from_element(2, 1.0),
+                noise: crate::graph::Noise::gaussian(nalgebra::DVector::from_element(2, 1.0)),
             })
         };
         let factors = vec![factor(vec![x, y]), factor(vec![y, x, y])];
@@ -426,7 +426,7 @@ mod tests {
             graph.factors.push(Box::new(Linear {
                 variables: variables.clone(),
                 a: a.clone(),
-                sigmas: nalgebra::DVector::from_element(a.nrows(), 0.5),
+                noise: crate::graph::Noise::gaussian(nalgebra::DVector::from_element(a.nrows(), 0.5)),
             }));
         }
         let mut by_storage = Vec::new();
@@ -496,7 +496,7 @@ mod tests {
             Box::new(Linear {
                 variables,
                 a: DMatrix::from_fn(rows, cols, |i, j| ((i * 7 + j * 3) as f64 * 0.61 + seed).sin()),
-                sigmas: nalgebra::DVector::from_element(rows, 0.5),
+                noise: crate::graph::Noise::gaussian(nalgebra::DVector::from_element(rows, 0.5)),
             })
         };
         let globals = [anchors.clone(), offsets].concat();

@@ -114,7 +114,7 @@ mod tests {
     struct Reading {
         variables: [VariableId; 1],
         value: f64,
-        sigmas: DVector<f64>,
+        noise: crate::graph::Noise,
     }
 
     impl Factor for Reading {
@@ -133,8 +133,8 @@ mod tests {
                 values.vector(self.variables[0])[0] - self.value,
             ))
         }
-        fn sigmas(&self) -> &DVector<f64> {
-            &self.sigmas
+        fn noise(&self) -> &crate::graph::Noise {
+            &self.noise
         }
         fn kind(&self) -> &'static str {
             "reading"
@@ -155,7 +155,7 @@ mod tests {
             graph.add(Reading {
                 variables: [x],
                 value: k as f64,
-                sigmas: DVector::from_element(1, *s),
+                noise: crate::graph::Noise::gaussian(DVector::from_element(1, *s)),
             });
         }
         let numbers = redundancy_numbers(&graph, &["reading"]).unwrap();

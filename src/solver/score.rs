@@ -217,7 +217,7 @@ mod tests {
         variables: [VariableId; 1],
         x: f64,
         y: f64,
-        sigmas: DVector<f64>,
+        noise: crate::graph::Noise,
     }
 
     impl Factor for LinePoint {
@@ -235,8 +235,8 @@ mod tests {
             }
             Some(DVector::from_element(1, p[0] + p[1] * self.x - self.y))
         }
-        fn sigmas(&self) -> &DVector<f64> {
-            &self.sigmas
+        fn noise(&self) -> &crate::graph::Noise {
+            &self.noise
         }
         fn kind(&self) -> &'static str {
             "line"
@@ -264,7 +264,7 @@ mod tests {
                 variables: [p],
                 x,
                 y,
-                sigmas: DVector::from_element(1, sigma),
+                noise: crate::graph::Noise::gaussian(DVector::from_element(1, sigma)),
             });
         }
         optimize(&mut graph, &LmParams::default()).unwrap();

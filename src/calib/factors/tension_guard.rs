@@ -11,7 +11,7 @@ use super::slots::{
     PoseVariables, SlotOrder, EPSILON,
 };
 use crate::generated;
-use crate::graph::{evaluate_through_into, Factor, Values, VariableId};
+use crate::graph::{evaluate_through_into, Factor, Noise, Values, VariableId};
 use crate::model::robot::CABLE_COUNT;
 
 /// Where a tension guard takes the tensions of eq. (11) from.
@@ -112,7 +112,7 @@ pub struct TensionGuardFactor {
     variables: Vec<VariableId>,
     source: TensionSource,
     minimum_horizontal_tension_n: f64,
-    sigmas: DVector<f64>,
+    noise: Noise,
 }
 
 impl TensionGuardFactor {
@@ -123,7 +123,7 @@ impl TensionGuardFactor {
             variables: variable_list(pose, globals, true, false),
             source,
             minimum_horizontal_tension_n,
-            sigmas: DVector::from_element(CABLE_COUNT, sigma_n),
+            noise: Noise::gaussian(DVector::from_element(CABLE_COUNT, sigma_n)),
         }
     }
 }
@@ -185,8 +185,8 @@ impl Factor for TensionGuardFactor {
         rows_to_cables(s, blocks);
         true
     }
-    fn sigmas(&self) -> &DVector<f64> {
-        &self.sigmas
+    fn noise(&self) -> &Noise {
+        &self.noise
     }
     fn kind(&self) -> &'static str {
         "tension_guard"
