@@ -7,10 +7,11 @@
 //! anywhere: only code lines are checked. And the source stays readable: no
 //! file under `src/` past 700 lines (but the discretised simulator and the
 //! hand-drawn figures) and no function past 100 lines, counted on
-//! rustfmt-formatted code. Inside a folder, no files name each other in a
-//! ring (a folder's `mod.rs` only declares, documents and re-exports, so a
-//! child that uses an item the parent file defines while the parent uses
-//! the child is a ring too).
+//! rustfmt-formatted code. A folder's `mod.rs` holds only its doc comment,
+//! `mod` declarations and `use`/`pub use` re-exports (and attributes on
+//! those): every definition lives in a file named for it. Inside a folder,
+//! no files name each other in a ring (an item the folder's `mod.rs`
+//! re-exports counts as its defining child's).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -530,5 +531,144 @@ fn the_circle_finder_sees_a_ring_through_a_re_export() {
     assert_eq!(
         expand_use_tree("x::{y, z::{self, w as v}}"),
         vec!["x::y", "x::z", "x::z::w"]
+    );
+}
+
+/// The first line of each folder module file (`mod.rs`) under `root` whose
+/// code ([`production_code`]: comments and the tests at the end dropped) is
+/// not a `mod` declaration, a `use` item (over one line or several) or an
+/// attribute on one of them: (the file relative to `root`, line number, line).
+fn mod_file_offences(root: &Path) -> Vec<(String, usize, String)> {
+    let mut files = Vec::new();
+    rust_files(root, &mut files);
+    files.retain(|f| f.file_name().is_some_and(|n| n == "mod.rs"));
+    files.sort();
+    let mut found = Vec::new();
+    for file in files {
+        let text = std::fs::read_to_string(&file).unwrap();
+        if let Some(line) = first_definition(&production_code(&text)) {
+            let relative = file.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/");
+            found.push((
+                relative,
+                line + 1,
+                text.lines().nth(line).unwrap_or("").trim().to_string(),
+            ));
+        }
+    }
+    found
+}
+
+/// The index of the first line of `code` that starts anything but a `mod`
+/// declaration, a `use` item or an attribute on one of them (a dangling
+/// attribute counts from its own line).
+fn first_definition(code: &str) -> Option<usize> {
+    let lines: Vec<&str> = code.lines().collect();
+    let mut k = 0;
+    let mut attribute_from = None;
+    while k < lines.len() {
+        let mut rest = lines[k].trim();
+        // Attributes, each `#[...]` possibly over several lines.
+        while rest.starts_with("#[") {
+            attribute_from.get_or_insert(k);
+            let mut depth = 0;
+            let mut end = None;
+            while end.is_none() {
+                for (i, c) in rest.char_indices() {
+                    match c {
+                        '[' => depth += 1,
+                        ']' => depth -= 1,
+                        _ => continue,
+                    }
+                    if depth == 0 {
+                        end = Some(i);
+                        break;
+                    }
+                }
+                if end.is_none() {
+                    k += 1;
+                    rest = match lines.get(k) {
+                        Some(line) => line.trim(),
+                        None => return attribute_from,
+                    };
+                }
+            }
+            rest = rest[end.unwrap() + 1..].trim();
+        }
+        if rest.is_empty() {
+            k += 1;
+            continue;
+        }
+        let item = without_visibility(rest);
+        if let Some(name) = item.strip_prefix("mod ").and_then(|m| m.strip_suffix(';')) {
+            if name.trim().chars().any(|c| !(c.is_alphanumeric() || c == '_')) {
+                return Some(attribute_from.unwrap_or(k));
+            }
+        } else if item.starts_with("use ") {
+            while !lines[k].contains(';') {
+                k += 1;
+                if k == lines.len() {
+                    return Some(attribute_from.unwrap_or(k - 1));
+                }
+            }
+        } else {
+            return Some(attribute_from.unwrap_or(k));
+        }
+        attribute_from = None;
+        k += 1;
+    }
+    attribute_from
+}
+
+/// `item` without a leading `pub`, `pub(crate)`, `pub(super)` or `pub(in path)`.
+fn without_visibility(item: &str) -> &str {
+    if let Some(rest) = item.strip_prefix("pub(") {
+        return rest.split_once(')').map_or(item, |(_, after)| after.trim_start());
+    }
+    item.strip_prefix("pub ").unwrap_or(item)
+}
+
+#[test]
+fn mod_files_only_declare_document_and_re_export() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let found: Vec<String> = mod_file_offences(&src)
+        .into_iter()
+        .map(|(file, line, text)| format!("src/{file}:{line}: {text}"))
+        .collect();
+    assert!(
+        found.is_empty(),
+        "a mod.rs holds only its doc comment, `mod` declarations and `use`/`pub use` re-exports; \
+         move each definition into a file named for it:\n{}",
+        found.join("\n")
+    );
+}
+
+#[test]
+fn the_checker_sees_a_definition_in_a_mod_file() {
+    let dir = std::env::temp_dir().join(format!("sagcal-layout-mod-files-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("top/inner")).unwrap();
+    std::fs::create_dir_all(dir.join("clean")).unwrap();
+    std::fs::write(
+        dir.join("top/mod.rs"),
+        "//! Top: `fn` in a doc comment.\nmod a;\npub(super) mod inner;\n\npub use a::{\n    A,\n    B,\n};\n#[cfg(test)]\npub(crate) use a::C;\n\n/// A helper.\nfn helper() {}\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("top/inner/mod.rs"),
+        "//! Inner.\nmod b;\n#[derive(Debug)]\npub struct Defined;\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("clean/mod.rs"),
+        "//! Clean.\npub mod a; // a comment: fn here\n#[cfg(any(\n    test,\n    feature = \"x\"\n))]\nuse a::A;\n\n#[cfg(test)]\nmod tests {\n    fn check() {}\n}\n",
+    )
+    .unwrap();
+    let found = mod_file_offences(&dir);
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(
+        found,
+        vec![
+            ("top/inner/mod.rs".to_string(), 3, "#[derive(Debug)]".to_string()),
+            ("top/mod.rs".to_string(), 13, "fn helper() {}".to_string()),
+        ]
     );
 }

@@ -1,4 +1,7 @@
-//! `sagcal calibrate`: anchors and offsets from a measurement file.
+//! `sagcal calibrate`: anchors and offsets from a measurement file; its
+//! flags ([`CalibrateArgs`]) and the run.
+
+use std::path::PathBuf;
 
 use sagcal::calib::gross_errors::Verdict;
 use sagcal::calib::report::CalibrationReport;
@@ -14,7 +17,37 @@ use sagcal::plot::{anchor_plot_svg, figure_bytes, AnchorPlot, AnchorPlotEntry};
 
 use super::gross_errors;
 use super::output::{print_json, Table};
-use super::CalibrateArgs;
+use super::solver_args::SolverArgs;
+
+#[derive(Debug, clap::Args)]
+pub(super) struct CalibrateArgs {
+    /// Nominal robot description (TOML): the initial guess of anchors and offsets.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Measurements: sagcal CSV (see docs/measurements.md), a RecurDyn log, or the authors' dataset folder
+    /// (`pos_i_cpp_test.csv`, `R_i_cpp_test.csv`, `lc_meas_cpp_test.csv`, `forces_cpp_test.csv`).
+    #[arg(long)]
+    data: PathBuf,
+    /// Write the calibrated robot (TOML) here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Write a plot of nominal and calibrated anchors with error ellipses here (PNG if the name ends in `.png`, SVG otherwise).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+    /// Write the calibrated robot even when the fit fails its own consistency
+    /// tests (the verdict is recorded in the file's header comment).
+    #[arg(long)]
+    accept_inconsistent: bool,
+    /// False-alarm rate of the gross-error tests (per reading, over all
+    /// readings; per sensor type, over the types).
+    #[arg(long, default_value_t = 1e-3)]
+    false_alarm: f64,
+    #[command(flatten)]
+    solver: SolverArgs,
+}
 
 pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
     let nominal = Robot::from_file(&args.robot)?;

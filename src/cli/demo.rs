@@ -1,4 +1,5 @@
-//! `sagcal demo` (and `sagcal` with no arguments): the main job on built-in data.
+//! `sagcal demo` (and `sagcal` with no arguments): the main job on built-in
+//! data; its flags ([`DemoArgs`]) and the run.
 //!
 //! The truth is the built-in large robot with random encoder offsets; the
 //! calibration starts, as in the paper, from anchors moved 10 m and offsets
@@ -20,7 +21,22 @@ use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
 
 use super::calibrate::{plot_svg, render, robot_text};
 use super::output::print_json;
-use super::DemoArgs;
+
+#[derive(Debug, Clone, clap::Args)]
+pub(super) struct DemoArgs {
+    /// Random seed of the simulation and of the perturbed initial guess.
+    #[arg(long, default_value_t = 1)]
+    pub(super) seed: u64,
+    /// Number of static poses.
+    #[arg(long, default_value_t = 35)]
+    pub(super) poses: usize,
+    /// Folder for the demo's files (data.csv, truth.toml, calibrated.toml, anchors.svg).
+    #[arg(long, default_value = "sagcal-demo")]
+    pub(super) out_dir: PathBuf,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub(super) json: bool,
+}
 
 pub fn run(args: &DemoArgs) -> sagcal::Result<()> {
     if args.poses < sagcal::calib::MIN_POSES {

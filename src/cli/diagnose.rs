@@ -1,7 +1,9 @@
-//! `sagcal diagnose`: what the calibration model gets wrong, and what an extension gains.
+//! `sagcal diagnose`: what the calibration model gets wrong, and what an extension gains;
+//! its flags ([`DiagnoseArgs`], [`PlotFormat`]) and the run.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
+use clap::ValueEnum;
 use sagcal::diagnose::{diagnose, DiagnoseOptions, DiagnoseSettings, Diagnosis};
 use sagcal::error::FrontEnd;
 use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
@@ -10,7 +12,68 @@ use sagcal::model::Robot;
 use sagcal::plot::residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
 
 use super::output::{opt, print_json, progress_bar, Table};
-use super::DiagnoseArgs;
+use super::solver_args::SolverArgs;
+
+#[derive(Debug, clap::Args)]
+pub(super) struct DiagnoseArgs {
+    /// Nominal robot description (TOML): the initial guess; its `[effects]` are known inputs.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Measurements: sagcal CSV, a RecurDyn log, or the authors' dataset folder.
+    #[arg(long)]
+    data: PathBuf,
+    /// The true robot (TOML, e.g. from `sagcal simulate --truth`): report anchor and offset errors.
+    #[arg(long)]
+    truth: Option<PathBuf>,
+    /// Write the plot of the residual against the winning driver (before and after) into this folder.
+    #[arg(long)]
+    plots: Option<PathBuf>,
+    /// Format of the `--plots` figures: svg or png.
+    #[arg(long, value_enum, default_value = "svg")]
+    plot_format: PlotFormat,
+    /// Candidate effects, comma separated (default: the whole catalogue: elastic, pulley, encoder-scale, loadcell,
+    /// com, encoder-gain, segments, localiser-mount, platform-weight, cable-weight, and, for rows in the order
+    /// taken (a sagcal file), encoder-drift, encoder-backlash, loadcell-drift, loadcell-friction).
+    #[arg(long)]
+    candidates: Option<String>,
+    /// Leave out the hypothesis "the localiser's orientations are unreliable".
+    #[arg(long)]
+    no_orientation_hypothesis: bool,
+    /// Folds of the cross-validation over poses.
+    #[arg(long, default_value_t = 5)]
+    folds: usize,
+    /// False-alarm rate of the whole search: the probability of declaring an
+    /// effect on data the baseline model describes.
+    #[arg(long, default_value_t = 1e-3)]
+    false_alarm: f64,
+    /// Write the selected model's calibrated robot (anchors, offsets, effects) here (TOML).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Print the diagnosis as JSON.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    solver: SolverArgs,
+}
+
+/// The file format of figures written into a folder.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum PlotFormat {
+    /// Scalable vector graphics (the figure as drawn).
+    Svg,
+    /// The same figure rendered to a PNG image (2x pixel density, bundled font).
+    Png,
+}
+
+impl PlotFormat {
+    /// The file-name extension.
+    fn extension(self) -> &'static str {
+        match self {
+            PlotFormat::Svg => "svg",
+            PlotFormat::Png => "png",
+        }
+    }
+}
 
 /// Diagnose the data against the nominal robot, write the requested files, print the report (or JSON).
 pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {

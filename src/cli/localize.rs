@@ -1,4 +1,7 @@
-//! `sagcal localize`: the calibrated robot's pose and tensions from its cable readings.
+//! `sagcal localize`: the calibrated robot's pose and tensions from its cable readings;
+//! its flags ([`LocalizeArgs`]) and the run.
+
+use std::path::PathBuf;
 
 use serde::Serialize;
 
@@ -11,7 +14,44 @@ use sagcal::model::Robot;
 use sagcal::plot::localize::{localize_plot_svg, LocalizePlot, PlottedPose};
 
 use super::output::{opt, print_json, Table};
-use super::LocalizeArgs;
+
+#[derive(Debug, clap::Args)]
+pub(super) struct LocalizeArgs {
+    /// The calibrated robot (TOML): anchors, length offsets, `[effects]`.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Readings: `l1_m,l2_m,l3_m,l4_m[,f_ref_n]`, a sagcal measurement file, a RecurDyn log or
+    /// the authors' dataset folder.
+    #[arg(long)]
+    data: PathBuf,
+    /// Use the input's localiser pose as a prior (by default it is only compared with).
+    #[arg(long)]
+    pose_prior: bool,
+    /// Sensor sigmas of the readings: paper or authors.
+    #[arg(long, default_value = "paper", value_parser = sagcal::model::sensors::NoisePreset::parse)]
+    noise: sagcal::model::sensors::NoisePreset,
+    /// False-alarm rate of each row's chi-square consistency test.
+    #[arg(long, default_value_t = 1e-3)]
+    false_alarm: f64,
+    /// Leave the robot file's recorded calibration covariance out of the sigmas.
+    #[arg(long)]
+    no_calibration_uncertainty: bool,
+    /// Skip the multistart search for every equilibrium of each row (about
+    /// 1000 starts per row): for long trajectories, each row warm-started
+    /// from the previous one.
+    #[arg(long)]
+    fast: bool,
+    /// Write the poses as CSV (atomically).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Draw the localised poses with their 1-sigma ellipses (top and side
+    /// views), beside the input's poses when it has them (PNG if the name ends in `.png`, SVG otherwise).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Print JSON instead of the table.
+    #[arg(long)]
+    json: bool,
+}
 
 /// What the position sigmas hold, by whether the robot records its calibration's covariance.
 fn covariance_note(robot: &Robot, used: bool) -> &'static str {

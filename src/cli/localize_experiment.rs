@@ -1,5 +1,8 @@
 //! `sagcal experiment localize`: calibrate by the Table II protocol, then
-//! localise the held-out poses (`experiments::localize_after_calibration`).
+//! localise the held-out poses (`experiments::localize_after_calibration`);
+//! its flags ([`LocalizeExperimentArgs`]) and the run.
+
+use std::path::PathBuf;
 
 use serde::Serialize;
 
@@ -12,7 +15,35 @@ use sagcal::model::sensors::NoisePreset;
 use sagcal::model::Robot;
 
 use super::output::{print_json, progress_bar, Table};
-use super::LocalizeExperimentArgs;
+use super::parse::{parse_noises, parse_sources};
+
+#[derive(Debug, clap::Args)]
+pub(super) struct LocalizeExperimentArgs {
+    /// The robot the data were logged on (truth: its anchors, zero offsets).
+    #[arg(long)]
+    robot: PathBuf,
+    /// A RecurDyn log or sagcal measurement file: the pool of poses.
+    #[arg(long)]
+    data: PathBuf,
+    /// Calibration poses per trial; the rest of the pool is localised.
+    #[arg(long, default_value_t = 35)]
+    poses: usize,
+    /// Trials per case.
+    #[arg(long, default_value_t = 50)]
+    trials: usize,
+    /// Base random seed (printed; each trial's streams derive from it).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Noise: paper, authors, or both.
+    #[arg(long, default_value = "both", value_parser = parse_noises)]
+    noise: std::vec::Vec<sagcal::model::sensors::NoisePreset>,
+    /// Data: log, model, or both (`model`: the closed-form equilibria at the logged poses).
+    #[arg(long, default_value = "both", value_parser = parse_sources)]
+    source: std::vec::Vec<sagcal::experiments::table2::Source>,
+    /// Print JSON instead of the table.
+    #[arg(long)]
+    json: bool,
+}
 
 #[derive(Debug, Serialize)]
 struct Case {

@@ -1,7 +1,8 @@
 //! `sagcal plan`: choose the calibration poses that make the anchors
-//! observable, order them into a short path, and compare with random poses.
+//! observable, order them into a short path, and compare with random poses;
+//! its flags ([`PlanArgs`]) and the run.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use sagcal::error::FrontEnd;
 use sagcal::experiments::pose_plan::{plan_calibration, CandidateSource, PlanProgress, PlanReport, PlanSettings};
@@ -16,7 +17,49 @@ use sagcal::plot::figure_bytes;
 use sagcal::plot::plan::{plan_plot_svg, PlanPlot};
 
 use super::output::{print_json, progress_bar, Table};
-use super::PlanArgs;
+
+#[derive(Debug, clap::Args)]
+pub(super) struct PlanArgs {
+    /// The nominal robot (TOML): the plan is computed at its anchors.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Poses to choose.
+    #[arg(long)]
+    poses: usize,
+    /// Sensor noise the bound assumes: paper or authors.
+    #[arg(long, default_value = "paper", value_parser = sagcal::model::sensors::NoisePreset::parse)]
+    noise: sagcal::model::sensors::NoisePreset,
+    /// The box candidates are drawn in, `x0,x1,y0,y1,z0,z1` metres (default: the
+    /// robot file's `[workspace]`, else the frame below the anchors with a 10 % margin).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_workspace)]
+    workspace: Option<sagcal::model::robot::Workspace>,
+    /// Candidate poses from a file (sagcal CSV or RecurDyn log, e.g. poses already logged) instead of drawing them.
+    #[arg(long)]
+    from: Option<PathBuf>,
+    /// Candidates to draw (without `--from`; each a level equilibrium, ~30 ms of CPU).
+    #[arg(long, default_value_t = 1000)]
+    candidates: usize,
+    /// Random seed of the candidates and of the random sets compared with.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Design criterion: a (trace of the anchors' covariance) or d (log-determinant of the information).
+    #[arg(long, default_value = "a", value_parser = sagcal::plan::Criterion::parse)]
+    criterion: sagcal::plan::Criterion,
+    /// The localiser's orientation as a prior in the bound: `on`, or `off`/`auto`
+    /// (the statics alone decide the orientation, as `cramer_rao_bound` reads `auto`).
+    #[arg(long, default_value = "off", value_parser = sagcal::calib::OrientationPrior::parse)]
+    orientation_prior: sagcal::calib::OrientationPrior,
+    /// Write the plan (visiting order) as a sagcal measurement CSV (atomically).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Write the figure (PNG if the name ends in `.png`, SVG otherwise): frame, anchors, candidates,
+    /// path, error ellipses plan vs random.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Print JSON instead of the tables.
+    #[arg(long)]
+    json: bool,
+}
 
 /// `x0,x1,y0,y1,z0,z1` in metres (see `sagcal::experiments::pose_plan::parse_workspace`).
 pub fn parse_workspace(text: &str) -> Result<Workspace, String> {

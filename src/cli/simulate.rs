@@ -1,6 +1,9 @@
 //! `sagcal simulate`: measurements of a robot from the closed-form model, or,
 //! with `--effect` (or a robot file with `[effects]`), from the discretised
-//! simulator with those effects acting.
+//! simulator with those effects acting; its flags ([`SimulateArgs`]) and the
+//! run.
+
+use std::path::PathBuf;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -12,7 +15,47 @@ use sagcal::model::{PoseMeasurement, Robot};
 use sagcal::sim::closed_form::{measure, sample_equilibria_with, Closure, Workspace};
 use sagcal::sim::effects::{measure_with_effects, simulation_truth};
 
-use super::SimulateArgs;
+#[derive(Debug, clap::Args)]
+pub(super) struct SimulateArgs {
+    /// The true robot (TOML): anchors and length offsets of the simulation.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Number of static poses.
+    #[arg(long)]
+    poses: usize,
+    /// Random seed (the same seed gives the same file).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Sensor noise: paper, authors or none.
+    #[arg(long, default_value = "paper", value_parser = sagcal::model::sensors::NoisePreset::parse)]
+    noise: sagcal::model::sensors::NoisePreset,
+    /// Output measurement file (CSV).
+    #[arg(long)]
+    out: PathBuf,
+    /// Also write the truth (robot TOML with offsets, and `[effects]` with `--effect`) here.
+    #[arg(long)]
+    truth: Option<PathBuf>,
+    /// A physical effect the closed-form model lacks, `NAME:PARAM=VALUE[,PARAM=VALUE...]`
+    /// (repeatable). The data then come from the discretised simulator.
+    #[arg(long = "effect", value_name = "SPEC", long_help = effect_help())]
+    effects: Vec<String>,
+    /// Segments per cable of the discretised simulator (only used with effects).
+    #[arg(long, default_value_t = 100)]
+    segments: usize,
+    /// How each pose closes its family of equilibria: level (the most level member),
+    /// yaw (a random yaw within +-1 degree) or mixed (about half each).
+    #[arg(long, default_value = "level", value_parser = sagcal::sim::closed_form::Closure::parse)]
+    closure: sagcal::sim::closed_form::Closure,
+}
+
+/// `simulate --effect`'s long help: every effect with its parameters.
+fn effect_help() -> String {
+    format!(
+        "A physical effect the closed-form model lacks, `NAME:PARAM=VALUE[,PARAM=VALUE...]` \
+         (repeatable): {}. The data then come from the discretised simulator.",
+        sagcal::model::effect_specs::EFFECT_NAMES
+    )
+}
 
 /// Simulate measurements of the robot, write them (and the truth), report what was drawn.
 pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {

@@ -1,5 +1,9 @@
-//! `sagcal verify`: the model against measured data.
+//! `sagcal verify`: the model against measured data; its flags
+//! ([`VerifyArgs`], [`ClosureArg`]) and the run.
 
+use std::path::PathBuf;
+
+use clap::ValueEnum;
 use sagcal::diagnose::verify::{nothing_verified, verify, Closure, LengthKind, MeasuredData, VerifyReport};
 use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
 use sagcal::io::recurdyn::{read_recurdyn, LoadOptions};
@@ -7,7 +11,34 @@ use sagcal::model::statics::StaticsOptions;
 use sagcal::model::Robot;
 
 use super::output::{opt, print_json, Table};
-use super::{ClosureArg, VerifyArgs};
+
+/// Which measurement closes the statics in `verify`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ClosureArg {
+    /// Position + the reference cable's load-cell tension (default).
+    ReferenceTension,
+    /// Position + the four measured cable lengths (least squares).
+    CableLengths,
+}
+
+#[derive(Debug, clap::Args)]
+pub(super) struct VerifyArgs {
+    /// Robot description (TOML), e.g. robots/large.toml.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Measurement log: RecurDyn CSV, sagcal CSV or the authors' dataset folder.
+    #[arg(long)]
+    data: PathBuf,
+    /// The measurement that closes the one-parameter family of equilibria.
+    #[arg(long, value_enum, default_value = "reference-tension")]
+    close_with: ClosureArg,
+    /// Keep rows whose pose was transcribed rounded to 0.01 m (rejected by default).
+    #[arg(long)]
+    keep_rounded: bool,
+    /// Print the full report as JSON instead of tables.
+    #[arg(long)]
+    json: bool,
+}
 
 /// Verify the model against the data and print the report (or JSON).
 pub fn run(args: &VerifyArgs) -> sagcal::Result<()> {

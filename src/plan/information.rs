@@ -24,6 +24,8 @@
 //! eigenvalues above `1e-13` of the largest): a pose adds at most
 //! `rows - 8` independent equations (4 with position priors only, 7 with the
 //! orientation prior), which is what makes the design's rank-k updates cheap.
+//! [`candidate_information`] computes the terms of every candidate, in
+//! parallel.
 //!
 //! ```
 //! use nalgebra::Vector3;
@@ -54,6 +56,7 @@
 //! ```
 
 use nalgebra::{DMatrix, SymmetricEigen};
+use rayon::prelude::*;
 
 use crate::calib::{build_graph, CalibrationOptions, RobustKernels};
 use crate::error::{Error, Result};
@@ -179,6 +182,18 @@ pub fn pose_information(
     Ok(PoseInformation {
         factor: low_rank_factor(&information),
     })
+}
+
+/// The information of every candidate (in parallel), at the nominal robot.
+pub fn candidate_information(
+    nominal: &Robot,
+    candidates: &[Equilibrium],
+    options: &CalibrationOptions,
+) -> Result<Vec<PoseInformation>> {
+    candidates
+        .par_iter()
+        .map(|eq| pose_information(nominal, eq, options))
+        .collect()
 }
 
 /// `J_g^T (1 - P_l) J_g` by the QR factorisation of `J_l` (module docs).
