@@ -16,7 +16,7 @@
 //! max_m = [30.0, 30.0, 28.0]
 //!
 //! [effects]                        # optional: effects beyond the closed-form model
-//! axial_stiffness_n = 3e6          # (written by `simulate --truth`; the calibration ignores it)
+//! axial_stiffness_n = 3e6          # (written by `simulate --truth`, `diagnose --out`; calibrate, localize and verify apply them as known)
 //!
 //! [calibration]                    # optional: written by `calibrate --out`
 //! covariance_m2 = [[...], ...]     # 16 x 16: a1x, a1y, a1z, ..., a4z, l1^0, ..., l4^0
@@ -95,7 +95,9 @@ pub struct RobotFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub workspace: Option<WorkspaceEntry>,
     /// Effects known to act on this robot beyond the closed-form model
-    /// (optional; written by `simulate --truth`; the calibration ignores it).
+    /// (optional; written by `simulate --truth` and `diagnose --out`). The
+    /// calibration models them with their values held fixed (unless
+    /// estimated: `calib::build_graph`), as the localisation and `verify` do.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub effects: Option<Effects>,
     /// What the calibration that produced the anchors and offsets knows of

@@ -6,7 +6,9 @@
 //! describes what a real robot may add; `sagcal simulate --effect` generates
 //! data with them through the discretised simulator
 //! ([`crate::sim::effects::measure_with_effects`]) so the calibration's
-//! sensitivity to model mismatch can be studied. The calibration ignores them.
+//! sensitivity to model mismatch can be studied. A robot file's `[effects]`
+//! are known inputs of the extended model: the calibration holds them fixed
+//! (unless it estimates them), the localisation and `verify` apply them.
 //!
 //! Each effect is given on the command line as `NAME:PARAM=VALUE[,PARAM=VALUE...]`
 //! ([`Effects::apply_spec`]):

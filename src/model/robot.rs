@@ -52,8 +52,9 @@ pub struct Robot {
     /// robot file gives one.
     pub workspace: Option<Workspace>,
     /// Effects known to act on this robot beyond the closed-form model (the
-    /// robot file's optional `[effects]`, written by `simulate --truth`; the
-    /// calibration ignores it). Default: none.
+    /// robot file's optional `[effects]`, written by `simulate --truth` and
+    /// `diagnose --out`; the calibration holds them fixed unless it estimates
+    /// them). Default: none.
     pub effects: Effects,
     /// Which of the paper's robots this is, if the robot file says so (its
     /// optional `paper_robot`); only used to print the paper's numbers beside sagcal's.
