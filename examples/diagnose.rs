@@ -27,10 +27,7 @@ fn main() -> sagcal::Result<()> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let nominal = Robot::builtin("large")?;
     let mut truth = nominal.clone();
-    truth
-        .effects
-        .apply_spec("encoder-scale:gain=1.002")
-        .map_err(sagcal::Error::InvalidInput)?;
+    truth.effects.apply_spec("encoder-scale:gain=1.002")?;
     let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
     let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), 35, &mut rng)?;
     let measurements = measure_with_effects(&truth, &truth.effects, &equilibria, &noise, 50, &mut rng)?;

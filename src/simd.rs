@@ -37,6 +37,8 @@
 
 use std::sync::OnceLock;
 
+use crate::error::ParseError;
+
 /// The environment variable that chooses the path.
 pub const SWITCH: &str = "SAGCAL_SIMD";
 
@@ -54,12 +56,16 @@ pub enum SimdRequest {
 impl SimdRequest {
     /// The request of a value of [`SWITCH`] (`None`: unset); an error names
     /// the variable and the accepted values.
-    pub fn parse(value: Option<&str>) -> Result<Self, String> {
+    pub fn parse(value: Option<&str>) -> Result<Self, ParseError> {
         match value.map(str::trim) {
             None | Some("") | Some("auto") => Ok(Self::Auto),
             Some("portable") => Ok(Self::Portable),
             Some("avx2") => Ok(Self::Avx2),
-            Some(other) => Err(format!("{SWITCH}={other:?}: expected portable, avx2 or auto")),
+            Some(other) => Err(ParseError::UnknownVariable {
+                variable: SWITCH,
+                given: other.to_string(),
+                choices: "portable, avx2 or auto",
+            }),
         }
     }
 }
@@ -118,7 +124,7 @@ fn path_for(request: SimdRequest, has_avx2: bool) -> SimdPath {
 /// The switch as set in this process's environment, checked: the front
 /// ends call it before any work, so that a mistyped value is a clear error
 /// (the kernels themselves could only panic on it).
-pub fn check_switch() -> Result<SimdRequest, String> {
+pub fn check_switch() -> Result<SimdRequest, ParseError> {
     SimdRequest::parse(std::env::var(SWITCH).ok().as_deref())
 }
 
@@ -181,9 +187,9 @@ mod tests {
         assert_eq!(SimdRequest::parse(Some("portable")), Ok(SimdRequest::Portable));
         assert_eq!(SimdRequest::parse(Some(" avx2\n")), Ok(SimdRequest::Avx2));
         let error = SimdRequest::parse(Some("sse2")).unwrap_err();
-        assert!(
-            error.contains(SWITCH) && error.contains("portable, avx2 or auto"),
-            "{error}"
+        assert_eq!(
+            error.to_string(),
+            "SAGCAL_SIMD=\"sse2\": expected portable, avx2 or auto"
         );
     }
 

@@ -20,8 +20,8 @@ use std::path::{Path, PathBuf};
 const ALLOWED: &[(&str, &[&str])] = &[
     ("error", &[]),
     ("steps", &[]),
-    // The kernels' instruction set: a leaf, so that `graph` and `solver` follow one switch.
-    ("simd", &[]),
+    // The kernels' instruction set: below `graph` and `solver`, so that both follow one switch.
+    ("simd", &["error"]),
     ("cancel", &["error"]),
     ("stats", &["error"]),
     ("model", &["error", "steps", "stats", "generated"]),

@@ -68,7 +68,7 @@ fn parser_errors_name_the_effect_and_parameter() {
         ("pulley:radius_m=-1", "must be >= 0"),
         ("encoder-scale:gain2=-1", "must be > 0"),
     ] {
-        let message = Effects::default().apply_spec(spec).unwrap_err();
+        let message = Effects::default().apply_spec(spec).unwrap_err().to_string();
         assert!(message.contains(needle), "{spec}: {message}");
     }
 }

@@ -180,7 +180,10 @@ fn yaw_and_mixed_closures_leave_the_level_member() {
 fn closures_parse_and_reject_bad_settings() {
     assert_eq!(Closure::parse("level").unwrap(), Closure::Level);
     assert!(matches!(Closure::parse("yaw").unwrap(), Closure::Yaw { .. }));
-    assert!(Closure::parse("tilt").unwrap_err().contains("level, yaw or mixed"));
+    assert!(Closure::parse("tilt")
+        .unwrap_err()
+        .to_string()
+        .contains("level, yaw or mixed"));
     let robot = Robot::builtin("small").unwrap();
     let workspace = Workspace::default_for(&robot);
     let bad = Closure::Mixed {

@@ -85,7 +85,7 @@ pub(crate) fn to_py(error: sagcal::Error) -> PyErr {
     match error {
         E::Io { .. } | E::Format { .. } | E::Field { .. } => FileError::new_err(message),
         E::Robot { .. } => RobotError::new_err(message),
-        E::InvalidInput(_) => InvalidInputError::new_err(message),
+        E::InvalidInput(_) | E::Parse(_) | E::EffectSpec(_) => InvalidInputError::new_err(message),
         E::NoEquilibrium(_) => EquilibriumError::new_err(message),
         E::Solver(_) => SolverError::new_err(message),
         E::Calibration(Calibration::Refused { .. }) => CalibrationRefused::new_err(message),
@@ -137,7 +137,7 @@ fn _reset_cancel() {
 /// The module `sagcal._sagcal`.
 #[pymodule]
 fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    sagcal::simd::check_switch().map_err(pyo3::exceptions::PyValueError::new_err)?;
+    sagcal::simd::check_switch().map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
     add_exceptions(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add(

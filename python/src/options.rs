@@ -32,7 +32,7 @@ pub struct SolverArgs<'a> {
 }
 
 /// Parse a keyword's value; the error names the keyword.
-pub fn parse<T>(keyword: &str, value: &str, parser: fn(&str) -> Result<T, String>) -> PyResult<T> {
+pub fn parse<T, E: std::fmt::Display>(keyword: &str, value: &str, parser: fn(&str) -> Result<T, E>) -> PyResult<T> {
     parser(value).map_err(|e| invalid(format!("{keyword}: {e}")))
 }
 

@@ -4,6 +4,8 @@
 
 use serde::Serialize;
 
+use crate::error::ParseError;
+
 use crate::graph::RobustKernel;
 use crate::model::effect_kind::EffectSet;
 use crate::model::sensors::SensorNoise;
@@ -21,11 +23,15 @@ pub enum CableModel {
 
 impl CableModel {
     /// Parse `catenary` or `rigid`.
-    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+    pub fn parse(text: &str) -> std::result::Result<Self, ParseError> {
         match text {
             "catenary" => Ok(CableModel::Catenary),
             "rigid" => Ok(CableModel::Rigid),
-            other => Err(format!("unknown cable model `{other}` (catenary, rigid)")),
+            other => Err(ParseError::UnknownChoice {
+                what: "cable model",
+                given: other.to_string(),
+                choices: " (catenary, rigid)".to_string(),
+            }),
         }
     }
 }
@@ -48,12 +54,16 @@ pub enum OrientationPrior {
 
 impl OrientationPrior {
     /// Parse `auto`, `on` or `off`.
-    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+    pub fn parse(text: &str) -> std::result::Result<Self, ParseError> {
         match text {
             "auto" => Ok(OrientationPrior::Auto),
             "on" => Ok(OrientationPrior::On),
             "off" => Ok(OrientationPrior::Off),
-            other => Err(format!("unknown orientation prior `{other}` (auto, on, off)")),
+            other => Err(ParseError::UnknownChoice {
+                what: "orientation prior",
+                given: other.to_string(),
+                choices: " (auto, on, off)".to_string(),
+            }),
         }
     }
 }

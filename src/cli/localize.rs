@@ -211,7 +211,7 @@ fn localize_file(
                 });
                 report
             }
-            Err(why) => flagged(row.line, why.clone()),
+            Err(why) => flagged(row.line, why.to_string()),
         };
         rows.push(report);
     }

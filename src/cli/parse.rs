@@ -2,7 +2,9 @@
 //! (`paper`, `authors`, `both`), the data sources of the experiments (`log`,
 //! `model`, `both`) and comma-separated pose counts.
 
-pub(super) fn parse_sources(text: &str) -> Result<Vec<sagcal::experiments::table2::Source>, String> {
+use sagcal::error::ParseError;
+
+pub(super) fn parse_sources(text: &str) -> Result<Vec<sagcal::experiments::table2::Source>, ParseError> {
     match text {
         "both" => Ok(vec![
             sagcal::experiments::table2::Source::Log,
@@ -13,30 +15,39 @@ pub(super) fn parse_sources(text: &str) -> Result<Vec<sagcal::experiments::table
 }
 
 /// `paper`, `authors` or `both`.
-pub(super) fn parse_noises(text: &str) -> Result<Vec<sagcal::model::sensors::NoisePreset>, String> {
+pub(super) fn parse_noises(text: &str) -> Result<Vec<sagcal::model::sensors::NoisePreset>, ParseError> {
     use sagcal::model::sensors::NoisePreset;
     match text {
         "both" => Ok(vec![NoisePreset::Paper, NoisePreset::Authors]),
         other => NoisePreset::parse(other)
             .map(|n| vec![n])
-            .map_err(|e| format!("{e}, or `both` (paper and authors)")),
+            .map_err(|_| ParseError::UnknownChoice {
+                what: "noise setting",
+                given: other.to_string(),
+                choices: " (paper, authors, none), or `both` (paper and authors)".to_string(),
+            }),
     }
 }
 
-pub(super) fn parse_pose_counts(text: &str) -> Result<Vec<usize>, String> {
+pub(super) fn parse_pose_counts(text: &str) -> Result<Vec<usize>, ParseError> {
     text.split(',')
         .map(|p| {
-            p.trim()
-                .parse::<usize>()
-                .map_err(|_| format!("`{p}` is not a pose count"))
+            p.trim().parse::<usize>().map_err(|_| ParseError::NotANumber {
+                what: "pose count",
+                given: p.to_string(),
+            })
         })
         .collect()
 }
 
-pub(super) fn parse_source(text: &str) -> Result<sagcal::experiments::table2::Source, String> {
+pub(super) fn parse_source(text: &str) -> Result<sagcal::experiments::table2::Source, ParseError> {
     match text {
         "log" => Ok(sagcal::experiments::table2::Source::Log),
         "model" => Ok(sagcal::experiments::table2::Source::Model),
-        other => Err(format!("unknown source `{other}` (log, model)")),
+        other => Err(ParseError::UnknownChoice {
+            what: "source",
+            given: other.to_string(),
+            choices: " (log, model)".to_string(),
+        }),
     }
 }

@@ -62,7 +62,7 @@ pub(super) struct PlanArgs {
 }
 
 /// `x0,x1,y0,y1,z0,z1` in metres (see `sagcal::experiments::pose_plan::parse_workspace`).
-pub fn parse_workspace(text: &str) -> Result<Workspace, String> {
+pub fn parse_workspace(text: &str) -> Result<Workspace, sagcal::error::ParseError> {
     sagcal::experiments::pose_plan::parse_workspace(text)
 }
 

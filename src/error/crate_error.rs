@@ -6,6 +6,8 @@
 //! ```
 
 use super::calibration::CalibrationError;
+use super::effect_spec::EffectSpecError;
+use super::parse::ParseError;
 use super::png::PngError;
 use super::solver::SolverError;
 use std::path::PathBuf;
@@ -78,6 +80,12 @@ pub enum Error {
     /// An argument given on the command line or through the API is out of range.
     #[error("invalid input: {0}")]
     InvalidInput(String),
+    /// A setting given as text is not one sagcal takes.
+    #[error("invalid input: {0}")]
+    Parse(#[from] ParseError),
+    /// An effect specification is not one sagcal takes.
+    #[error("invalid input: {0}")]
+    EffectSpec(#[from] EffectSpecError),
 }
 
 /// Shorthand for `Result<T, sagcal::Error>`.

@@ -18,14 +18,18 @@
 
 mod calibration;
 mod crate_error;
+mod effect_spec;
 mod front_end;
 mod linearize;
+mod parse;
 mod png;
 mod solver;
 
 pub use calibration::CalibrationError;
 pub use crate_error::{Error, Result};
+pub use effect_spec::EffectSpecError;
 pub use front_end::FrontEnd;
 pub use linearize::LinearizeError;
+pub use parse::ParseError;
 pub use png::PngError;
 pub use solver::SolverError;

@@ -14,6 +14,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::error::ParseError;
+
 use crate::diagnose::WEIGHT_SCALING;
 use crate::model::effect_kind::EffectKind;
 
@@ -30,11 +32,15 @@ pub enum Catalogue {
 
 impl Catalogue {
     /// Parse `full` or `leave-one-out`.
-    pub fn parse(text: &str) -> Result<Self, String> {
+    pub fn parse(text: &str) -> std::result::Result<Self, ParseError> {
         match text.trim() {
             "full" => Ok(Catalogue::Full),
             "leave-one-out" => Ok(Catalogue::LeaveOneOut),
-            other => Err(format!("unknown catalogue `{other}` (full or leave-one-out)")),
+            other => Err(ParseError::UnknownChoice {
+                what: "catalogue",
+                given: other.to_string(),
+                choices: " (full or leave-one-out)".to_string(),
+            }),
         }
     }
 }

@@ -29,7 +29,7 @@ use serde::Serialize;
 use super::plan_candidates::{draw_candidates_with_progress, filter_candidates, frame_workspace, CandidateSet};
 use super::table2::{pose_pool, Source};
 use crate::calib::{CalibrationOptions, OrientationPrior, MIN_POSES};
-use crate::error::{Error, FrontEnd, Result};
+use crate::error::{Error, FrontEnd, ParseError, Result};
 use crate::model::geometry::check_workspace;
 use crate::model::robot::{Robot, Workspace};
 use crate::model::sensors::NoisePreset;
@@ -187,12 +187,12 @@ pub struct PlannedCalibration {
 }
 
 /// A workspace from `x0,x1,y0,y1,z0,z1` (metres); `text` names the input in the message.
-pub fn workspace_from_bounds(bounds: &[f64], text: &str) -> std::result::Result<Workspace, String> {
+pub fn workspace_from_bounds(bounds: &[f64], text: &str) -> std::result::Result<Workspace, ParseError> {
     let v = bounds;
     if v.len() != 6 || v.iter().any(|x| !x.is_finite()) || v[0] >= v[1] || v[2] >= v[3] || v[4] >= v[5] {
-        return Err(format!(
-            "`{text}`: a workspace is six finite numbers x0,x1,y0,y1,z0,z1 (metres) with x0 < x1, y0 < y1, z0 < z1"
-        ));
+        return Err(ParseError::NotABox {
+            given: text.to_string(),
+        });
     }
     Ok(Workspace {
         min_m: [v[0], v[2], v[4]],
@@ -201,10 +201,15 @@ pub fn workspace_from_bounds(bounds: &[f64], text: &str) -> std::result::Result<
 }
 
 /// `x0,x1,y0,y1,z0,z1` in metres (`sagcal plan --workspace`).
-pub fn parse_workspace(text: &str) -> std::result::Result<Workspace, String> {
+pub fn parse_workspace(text: &str) -> std::result::Result<Workspace, ParseError> {
     let v: Vec<f64> = text
         .split(',')
-        .map(|p| p.trim().parse::<f64>().map_err(|_| format!("`{p}` is not a number")))
+        .map(|p| {
+            p.trim().parse::<f64>().map_err(|_| ParseError::NotANumber {
+                what: "number",
+                given: p.to_string(),
+            })
+        })
         .collect::<std::result::Result<_, _>>()?;
     workspace_from_bounds(&v, text)
 }

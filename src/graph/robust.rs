@@ -12,7 +12,7 @@
 //!
 //! ```
 //! use sagcal::graph::RobustKernel;
-//! let huber = RobustKernel::parse("huber").map_err(sagcal::Error::InvalidInput)?;
+//! let huber = RobustKernel::parse("huber")?;
 //! assert_eq!(huber, RobustKernel::Huber(1.345)); // the 95 %-efficiency default
 //! // Least squares inside k sigmas, linear tails outside, continuous at s = k^2.
 //! assert_eq!(huber.rho(1.0), 1.0);
@@ -29,6 +29,8 @@
 //! ```
 
 use serde::{Deserialize, Serialize};
+
+use crate::error::ParseError;
 
 /// A robust kernel.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -75,17 +77,21 @@ impl RobustKernel {
     }
 
     /// Parse `none`, `huber:K` or `cauchy:C` (K, C in sigmas; defaults 1.345 and 2.3849).
-    pub fn parse(text: &str) -> Result<Self, String> {
+    pub fn parse(text: &str) -> Result<Self, ParseError> {
         let (name, scale) = match text.split_once(':') {
             Some((n, s)) => (n, Some(s)),
             None => (text, None),
         };
-        let scale = |default: f64| -> Result<f64, String> {
+        let scale = |default: f64| -> Result<f64, ParseError> {
             match scale {
                 None => Ok(default),
                 Some(s) => match s.parse::<f64>() {
                     Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-                    _ => Err(format!("robust kernel scale must be a positive number, got `{s}`")),
+                    _ => Err(ParseError::OutOfRange {
+                        what: "robust kernel scale",
+                        expected: "a positive number",
+                        given: s.to_string(),
+                    }),
                 },
             }
         };
@@ -93,7 +99,11 @@ impl RobustKernel {
             "none" => Ok(RobustKernel::None),
             "huber" => Ok(RobustKernel::Huber(scale(1.345)?)),
             "cauchy" => Ok(RobustKernel::Cauchy(scale(2.3849)?)),
-            other => Err(format!("unknown robust kernel `{other}` (none, huber[:k], cauchy[:c])")),
+            other => Err(ParseError::UnknownChoice {
+                what: "robust kernel",
+                given: other.to_string(),
+                choices: " (none, huber[:k], cauchy[:c])".to_string(),
+            }),
         }
     }
 }

@@ -9,10 +9,10 @@ use crate::error::Result;
 use crate::model::pose::PlatformPose;
 
 /// One row of a sequence, localised.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct SequenceRow {
-    /// The equilibrium chosen, or why there is none (the error in words).
-    pub found: std::result::Result<Localized, String>,
+    /// The equilibrium chosen, or why there is none.
+    pub found: Result<Localized>,
     /// Why the row is not a trusted localisation ([`Localizer::flag`], or
     /// the error); `None` for a good row.
     pub flag: Option<String>,
@@ -92,8 +92,8 @@ impl Localizer {
                     }
                 }
                 Err(e) => SequenceRow {
-                    found: Err(e.to_string()),
                     flag: Some(e.to_string()),
+                    found: Err(e),
                     search: None,
                 },
             };

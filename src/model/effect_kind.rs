@@ -7,8 +7,8 @@
 //! use sagcal::model::effect_kind::{EffectKind, EffectSet};
 //! use sagcal::model::effects::Effects;
 //! let mut effects = Effects::default();
-//! effects.apply_spec("platform-weight:scale=1.1").map_err(sagcal::Error::InvalidInput)?;
-//! let kind = EffectKind::parse("platform-weight").map_err(sagcal::Error::InvalidInput)?;
+//! effects.apply_spec("platform-weight:scale=1.1")?;
+//! let kind = EffectKind::parse("platform-weight")?;
 //! // Reported as the scale, fitted as its error.
 //! assert_eq!(kind.parameters(&effects), vec![1.1]);
 //! assert!((kind.variable_values(&effects)[0] - 0.1).abs() < 1e-12);
@@ -20,6 +20,8 @@
 //! ```
 
 use serde::{Deserialize, Serialize};
+
+use crate::error::ParseError;
 
 use crate::model::effects::Effects;
 use crate::model::robot::CABLE_COUNT;
@@ -113,10 +115,14 @@ impl EffectKind {
     }
 
     /// Parse [`EffectKind::name`].
-    pub fn parse(text: &str) -> Result<Self, String> {
+    pub fn parse(text: &str) -> Result<Self, ParseError> {
         Self::ALL.into_iter().find(|k| k.name() == text.trim()).ok_or_else(|| {
             let names: Vec<&str> = Self::ALL.iter().map(|k| k.name()).collect();
-            format!("unknown effect `{text}` (effects: {})", names.join(", "))
+            ParseError::UnknownChoice {
+                what: "effect",
+                given: text.to_string(),
+                choices: format!(" (effects: {})", names.join(", ")),
+            }
         })
     }
 

@@ -5,13 +5,14 @@
 //! ```
 //! use sagcal::model::effects::Effects;
 //! let mut effects = Effects::default();
-//! effects.apply_spec("encoder-drift:rate2_m=2e-4").map_err(sagcal::Error::InvalidInput)?;
+//! effects.apply_spec("encoder-drift:rate2_m=2e-4")?;
 //! assert_eq!(effects.encoder_drift_m_per_row, [0.0, 2e-4, 0.0, 0.0]);
 //! assert_eq!(effects.to_string(), "encoder-drift:rate1_m=0,rate2_m=0.0002,rate3_m=0,rate4_m=0");
 //! assert!(Effects::default().apply_spec("attachments:dz1_m=0.01").is_err());
 //! # Ok::<(), sagcal::Error>(())
 //! ```
 
+use crate::error::EffectSpecError;
 use crate::model::effects::Effects;
 use crate::model::robot::CABLE_COUNT;
 
@@ -44,41 +45,49 @@ impl Effects {
     /// `elastic:ea_n=3e6`, `encoder-scale:gain1=1.001,gain3=0.999` or
     /// `com:dx_m=0.02,dz_m=-0.05`. Parameters not given keep their values.
     /// On error `self` is unchanged and the message names the effect and parameter.
-    pub fn apply_spec(&mut self, spec: &str) -> Result<(), String> {
+    pub fn apply_spec(&mut self, spec: &str) -> Result<(), EffectSpecError> {
         let spec = spec.trim();
-        let (name, params) = spec.split_once(':').ok_or_else(|| {
-            format!("effect `{spec}`: expected NAME:PARAM=VALUE[,PARAM=VALUE...] (effects: {EFFECT_NAMES})")
+        let (name, params) = spec.split_once(':').ok_or_else(|| EffectSpecError::Malformed {
+            spec: spec.to_string(),
+            effects: EFFECT_NAMES,
         })?;
         let name = name.trim();
-        let known =
-            spec_parameters(name).ok_or_else(|| format!("unknown effect `{name}` (effects: {EFFECT_NAMES})"))?;
+        let known = spec_parameters(name).ok_or_else(|| EffectSpecError::UnknownEffect {
+            name: name.to_string(),
+            effects: EFFECT_NAMES.to_string(),
+        })?;
         if params.trim().is_empty() {
-            return Err(format!(
-                "effect `{name}`: no parameters given (parameters: {})",
-                known.join(", ")
-            ));
+            return Err(EffectSpecError::NoParameters {
+                name: name.to_string(),
+                parameters: known.join(", "),
+            });
         }
         let mut next = *self;
         for param in params.split(',') {
             let param = param.trim();
-            let (key, value) = param
-                .split_once('=')
-                .ok_or_else(|| format!("effect `{name}`: parameter `{param}` has no `=VALUE`"))?;
+            let (key, value) = param.split_once('=').ok_or_else(|| EffectSpecError::NoValue {
+                name: name.to_string(),
+                param: param.to_string(),
+            })?;
             let key = key.trim();
             if !known.contains(&key) {
-                return Err(format!(
-                    "effect `{name}`: unknown parameter `{key}` (parameters: {})",
-                    known.join(", ")
-                ));
+                return Err(EffectSpecError::UnknownParameter {
+                    name: name.to_string(),
+                    key: key.to_string(),
+                    parameters: known.join(", "),
+                });
             }
-            let value: f64 = value
-                .trim()
-                .parse()
-                .map_err(|_| format!("effect `{name}`: parameter `{key}`: `{}` is not a number", value.trim()))?;
+            let value: f64 = value.trim().parse().map_err(|_| EffectSpecError::NotANumber {
+                name: name.to_string(),
+                key: key.to_string(),
+                value: value.trim().to_string(),
+            })?;
             if !value.is_finite() {
-                return Err(format!(
-                    "effect `{name}`: parameter `{key}` must be finite, got {value}"
-                ));
+                return Err(EffectSpecError::NotFinite {
+                    name: name.to_string(),
+                    key: key.to_string(),
+                    value,
+                });
             }
             set(&mut next, name, key, value)?;
         }
@@ -87,7 +96,7 @@ impl Effects {
     }
 
     /// The effects of `specs`, each applied in turn to no effect ([`Effects::apply_spec`]).
-    pub fn from_specs(specs: &[&str]) -> Result<Effects, String> {
+    pub fn from_specs(specs: &[&str]) -> Result<Effects, EffectSpecError> {
         let mut effects = Effects::default();
         for spec in specs {
             effects.apply_spec(spec)?;
@@ -175,23 +184,26 @@ impl Effects {
 
 /// Set parameter `key` of effect `name` to `value` (finite) in `next`; the
 /// error names the effect, the parameter and the range it must lie in.
-fn set(next: &mut Effects, name: &str, key: &str, value: f64) -> Result<(), String> {
-    let positive = |what: &str| {
+fn set(next: &mut Effects, name: &str, key: &str, value: f64) -> Result<(), EffectSpecError> {
+    let out_of_range = |meaning: &'static str, range: &'static str| EffectSpecError::OutOfRange {
+        name: name.to_string(),
+        key: key.to_string(),
+        meaning,
+        range,
+        value,
+    };
+    let positive = |meaning: &'static str| {
         if value > 0.0 {
             Ok(value)
         } else {
-            Err(format!(
-                "effect `{name}`: parameter `{key}` ({what}) must be > 0, got {value}"
-            ))
+            Err(out_of_range(meaning, "> 0"))
         }
     };
     match (name, key) {
         ("elastic", _) => next.axial_stiffness_n = Some(positive("axial stiffness EA, N")?),
         ("pulley", _) => {
             if value < 0.0 {
-                return Err(format!(
-                    "effect `{name}`: parameter `{key}` (pulley radius, m) must be >= 0, got {value}"
-                ));
+                return Err(out_of_range("pulley radius, m", ">= 0"));
             }
             next.pulley_radius_m = value;
         }
@@ -211,9 +223,7 @@ fn set(next: &mut Effects, name: &str, key: &str, value: f64) -> Result<(), Stri
         }
         ("segments", _) => {
             if value < 1.0 {
-                return Err(format!(
-                    "effect `{name}`: parameter `{key}` (number of cable elements) must be >= 1, got {value}"
-                ));
+                return Err(out_of_range("number of cable elements", ">= 1"));
             }
             next.cable_segments = Some(value);
         }
@@ -231,7 +241,12 @@ fn set(next: &mut Effects, name: &str, key: &str, value: f64) -> Result<(), Stri
         ("encoder-backlash", "b_m") => next.encoder_backlash_m = [value; CABLE_COUNT],
         ("encoder-backlash", k) => next.encoder_backlash_m[drum(k, "b")] = value,
         ("loadcell-drift", _) => next.load_cell_drift_n_per_row = value,
-        ("loadcell-friction", _) => next.load_cell_friction = friction(name, key, value)?,
+        ("loadcell-friction", _) => {
+            if !(0.0..1.0).contains(&value) {
+                return Err(out_of_range("friction mu theta", ">= 0 and < 1"));
+            }
+            next.load_cell_friction = value;
+        }
         ("attachments", k) => {
             let cable = drum(k, "dx");
             next.attachment_shift_m[cable][usize::from(k.starts_with("dy"))] = value;
@@ -239,17 +254,6 @@ fn set(next: &mut Effects, name: &str, key: &str, value: f64) -> Result<(), Stri
         _ => unreachable!("parameter names are checked above"),
     }
     Ok(())
-}
-
-/// A pulley friction `mu theta` given as `value`: in `[0, 1)`.
-fn friction(name: &str, key: &str, value: f64) -> Result<f64, String> {
-    if (0.0..1.0).contains(&value) {
-        Ok(value)
-    } else {
-        Err(format!(
-            "effect `{name}`: parameter `{key}` (friction mu theta) must be >= 0 and < 1, got {value}"
-        ))
-    }
 }
 
 /// The drum (or cable) of a per-drum parameter `rate1_m` .. `rate4_m`,
@@ -280,7 +284,7 @@ mod tests {
     use super::*;
     use crate::model::measurement::ReadingOrder;
 
-    fn parsed(specs: &[&str]) -> Result<Effects, String> {
+    fn parsed(specs: &[&str]) -> Result<Effects, EffectSpecError> {
         Effects::from_specs(specs)
     }
 
@@ -376,7 +380,7 @@ mod tests {
         ];
         for (spec, needles) in cases {
             let mut effects = Effects::default();
-            let message = effects.apply_spec(spec).expect_err(spec);
+            let message = effects.apply_spec(spec).expect_err(spec).to_string();
             for needle in needles {
                 assert!(message.contains(needle), "{spec}: `{message}` lacks `{needle}`");
             }

@@ -38,8 +38,8 @@
 //! use sagcal::model::effect_kind::EffectKind;
 //! use sagcal::model::effects::Effects;
 //! let mut effects = Effects::default();
-//! effects.apply_spec("elastic:ea_n=2e6").map_err(sagcal::Error::InvalidInput)?;
-//! effects.apply_spec("encoder-scale:gain1=1.002,gain3=0.999").map_err(sagcal::Error::InvalidInput)?;
+//! effects.apply_spec("elastic:ea_n=2e6")?;
+//! effects.apply_spec("encoder-scale:gain1=1.002,gain3=0.999")?;
 //! // EA = 2 MN is a compliance 1e6 / EA of 0.5 per MN, the parameter diagnose fits.
 //! assert_eq!(effects.axial_compliance_per_mn(), 0.5);
 //! assert!(EffectKind::Elastic.present_in(&effects) && EffectKind::EncoderScale.present_in(&effects));
@@ -47,7 +47,7 @@
 //! // `specs` writes what `apply_spec` reads.
 //! let mut again = Effects::default();
 //! for spec in effects.specs() {
-//!     again.apply_spec(&spec).map_err(sagcal::Error::InvalidInput)?;
+//!     again.apply_spec(&spec)?;
 //! }
 //! assert_eq!(again, effects);
 //! assert!(Effects::default().apply_spec("elastic:ea_n=-1").is_err());
@@ -356,7 +356,7 @@ impl Effects {
 mod tests {
     use super::*;
 
-    fn parsed(specs: &[&str]) -> Result<Effects, String> {
+    fn parsed(specs: &[&str]) -> Result<Effects, crate::error::EffectSpecError> {
         Effects::from_specs(specs)
     }
 

@@ -7,7 +7,7 @@
 //!
 //! ```
 //! use sagcal::model::sensors::NoisePreset;
-//! let paper = NoisePreset::parse("paper").map_err(sagcal::Error::InvalidInput)?;
+//! let paper = NoisePreset::parse("paper")?;
 //! // The paper's Sec. V-B: 10 mm encoders, 5 mm / 0.01 rad localiser, a 5 N load cell
 //! // on the large robot (334 N) and 1 N on the small one (43 N).
 //! let large = paper.sigmas(333.54);
@@ -21,6 +21,8 @@
 //! ```
 
 use serde::{Deserialize, Serialize};
+
+use crate::error::ParseError;
 
 /// Standard deviations of the sensors.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -50,12 +52,16 @@ pub enum NoisePreset {
 
 impl NoisePreset {
     /// Parse `paper`, `authors` or `none`.
-    pub fn parse(text: &str) -> Result<Self, String> {
+    pub fn parse(text: &str) -> Result<Self, ParseError> {
         match text {
             "paper" => Ok(NoisePreset::Paper),
             "authors" => Ok(NoisePreset::Authors),
             "none" => Ok(NoisePreset::None),
-            other => Err(format!("unknown noise setting `{other}` (paper, authors, none)")),
+            other => Err(ParseError::UnknownChoice {
+                what: "noise setting",
+                given: other.to_string(),
+                choices: " (paper, authors, none)".to_string(),
+            }),
         }
     }
 

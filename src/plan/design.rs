@@ -53,7 +53,7 @@ use serde::Serialize;
 
 use super::bound::{covariance_of, information_sum};
 use super::information::{PoseInformation, ANCHOR_PARAMETERS};
-use crate::error::{Error, Result};
+use crate::error::{Error, ParseError, Result};
 
 /// The ridge of the search, relative to the mean diagonal of one pose's information.
 pub const RIDGE_FRACTION: f64 = 1e-9;
@@ -72,11 +72,15 @@ pub enum Criterion {
 
 impl Criterion {
     /// Parse `a` or `d`.
-    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+    pub fn parse(text: &str) -> std::result::Result<Self, ParseError> {
         match text.to_ascii_lowercase().as_str() {
             "a" => Ok(Self::A),
             "d" => Ok(Self::D),
-            other => Err(format!("unknown design criterion `{other}` (a, d)")),
+            other => Err(ParseError::UnknownChoice {
+                what: "design criterion",
+                given: other.to_string(),
+                choices: " (a, d)".to_string(),
+            }),
         }
     }
 }

@@ -18,7 +18,7 @@
 //! let workspace = Workspace::around_anchors(&robot);
 //! assert!((workspace.max_m[0] - 30.0).abs() < 1e-12 && (workspace.max_m[2] - 27.84).abs() < 1e-12);
 //! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
-//! let closure = Closure::parse("yaw").map_err(sagcal::Error::InvalidInput)?;
+//! let closure = Closure::parse("yaw")?;
 //! let poses = sample_equilibria_with(&robot, &workspace, 4, closure, &mut rng)?;
 //! for eq in &poses {
 //!     let p = eq.pose.position_m;
@@ -34,7 +34,7 @@ use rand::Rng;
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, ParseError, Result};
 use crate::model::geometry;
 use crate::model::measurement::{mark_time_order, PoseMeasurement};
 use crate::model::pose::PlatformPose;
@@ -116,7 +116,7 @@ pub enum Closure {
 
 impl Closure {
     /// `level`, `yaw` or `mixed` (half the poses by yaw), with [`DEFAULT_MAX_YAW_DEG`].
-    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+    pub fn parse(text: &str) -> std::result::Result<Self, ParseError> {
         match text {
             "level" => Ok(Self::Level),
             "yaw" => Ok(Self::Yaw {
@@ -126,7 +126,11 @@ impl Closure {
                 yaw_fraction: 0.5,
                 max_yaw_deg: DEFAULT_MAX_YAW_DEG,
             }),
-            other => Err(format!("unknown closure `{other}`: level, yaw or mixed")),
+            other => Err(ParseError::UnknownChoice {
+                what: "closure",
+                given: other.to_string(),
+                choices: ": level, yaw or mixed".to_string(),
+            }),
         }
     }
 

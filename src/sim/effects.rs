@@ -23,8 +23,8 @@
 //! let robot = Robot::builtin("large")?;
 //! let commanded = solve_level(&robot, Vector3::new(4.0, -2.0, 15.0), &StaticsOptions::default())?;
 //! let mut effects = Effects::default();
-//! effects.apply_spec("encoder-scale:gain=1.002").map_err(sagcal::Error::InvalidInput)?;
-//! effects.apply_spec("loadcell:bias_n=12").map_err(sagcal::Error::InvalidInput)?;
+//! effects.apply_spec("encoder-scale:gain=1.002")?;
+//! effects.apply_spec("loadcell:bias_n=12")?;
 //! let noise = NoisePreset::None.sigmas(robot.platform_weight_n);
 //! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
 //! let read = measure_with_effects(&robot, &effects, &[commanded.clone()], &noise, 20, &mut rng)?;
@@ -36,7 +36,7 @@
 //! let tension = commanded.tensions[robot.reference_cable].magnitude_n();
 //! assert!((read[0].reference_tension_n - 12.0 - tension).abs() < 1e-3 * tension);
 //! // A localiser mounted turned by m reports R Exp(m): |m| away from the platform.
-//! effects.apply_spec("localiser-mount:rx_deg=3,ry_deg=4").map_err(sagcal::Error::InvalidInput)?;
+//! effects.apply_spec("localiser-mount:rx_deg=3,ry_deg=4")?;
 //! assert!((localiser_reading(&commanded.pose, &effects).angle_to_deg(&commanded.pose) - 5.0).abs() < 1e-9);
 //! # Ok::<(), sagcal::Error>(())
 //! ```
