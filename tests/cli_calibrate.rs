@@ -256,4 +256,25 @@ fn demo_runs_with_a_seed_and_writes_its_files() {
     for f in ["data.csv", "truth.toml", "guess.toml", "calibrated.toml", "anchors.svg"] {
         assert!(dir.path().join("d").join(f).exists(), "{f}");
     }
+    // Each robot file's header says what it is: only the calibrated one was estimated from measurements.
+    let first_line = |f: &str| {
+        let text = std::fs::read_to_string(dir.path().join("d").join(f)).unwrap();
+        text.lines().next().unwrap_or_default().to_string()
+    };
+    for (f, header) in [
+        (
+            "truth.toml",
+            "# The truth of sagcal demo (seed 3, 12 poses): the simulated robot's true parameters",
+        ),
+        (
+            "guess.toml",
+            "# The initial guess of sagcal demo (seed 3): the nominal robot the calibration starts from",
+        ),
+        (
+            "calibrated.toml",
+            "# Calibrated by sagcal: anchors and encoder length offsets estimated from measurements.",
+        ),
+    ] {
+        assert!(first_line(f).starts_with(header), "{f}: {}", first_line(f));
+    }
 }

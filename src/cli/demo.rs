@@ -30,7 +30,7 @@ pub(super) struct DemoArgs {
     /// Number of static poses.
     #[arg(long, default_value_t = 35)]
     pub(super) poses: usize,
-    /// Folder for the demo's files (data.csv, truth.toml, calibrated.toml, anchors.svg).
+    /// Folder for the demo's files (data.csv, truth.toml, guess.toml, calibrated.toml, anchors.svg).
     #[arg(long, default_value = "sagcal-demo")]
     pub(super) out_dir: PathBuf,
     /// Print the report as JSON.
@@ -134,16 +134,19 @@ fn write_files(
         &data_path,
         measurements_text(&data_path, &comments, data)?,
     );
-    for (name, robot) in [
-        ("truth.toml", truth),
-        ("guess.toml", guess),
-        ("calibrated.toml", &result.robot),
+    let (truth_header, guess_header) = robot_headers(args);
+    for (name, text) in [
+        (
+            "truth.toml",
+            format!("{truth_header}{}", truth.to_file_contents().to_toml()?),
+        ),
+        (
+            "guess.toml",
+            format!("{guess_header}{}", guess.to_file_contents().to_toml()?),
+        ),
+        ("calibrated.toml", robot_text(&result.robot, &Verdict::Consistent)?),
     ] {
-        outputs.file(
-            "--out-dir",
-            &args.out_dir.join(name),
-            robot_text(robot, &Verdict::Consistent)?,
-        );
+        outputs.file("--out-dir", &args.out_dir.join(name), text);
     }
     outputs.file(
         "--out-dir",
@@ -152,4 +155,19 @@ fn write_files(
     );
     outputs.write()?;
     Ok(data_path)
+}
+
+/// The header comments of `truth.toml` and `guess.toml`: what each file is
+/// (neither was estimated from measurements; `calibrated.toml` was).
+fn robot_headers(args: &DemoArgs) -> (String, String) {
+    (
+        format!(
+            "# The truth of sagcal demo (seed {}, {} poses): the simulated robot's true parameters; data.csv was simulated from it.\n",
+            args.seed, args.poses
+        ),
+        format!(
+            "# The initial guess of sagcal demo (seed {}): the nominal robot the calibration starts from, the truth's anchors moved 10 m and its encoder length offsets moved 80 m.\n",
+            args.seed
+        ),
+    )
 }
