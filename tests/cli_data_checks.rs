@@ -299,7 +299,7 @@ fn one_mistyped_roll_in_range_is_that_rows_blunder() {
     assert!(out.status.success(), "{}{stdout}", String::from_utf8_lossy(&out.stderr));
     assert!(stdout.contains("rad prior, kept"), "{stdout}");
     assert!(
-        stdout.contains("1 readings left out as gross errors:\n  row 12 (line 14), localiser orientation about x"),
+        stdout.contains("1 reading left out as gross errors:\n  row 12 (line 14), localiser orientation about x"),
         "{stdout}"
     );
 }

@@ -156,7 +156,7 @@ fn a_box_the_robot_cannot_reach_is_named_before_drawing() {
     };
     let above = fails_with(
         &plan("-2,2,-0.8,0.8,30,40"),
-        "--workspace [-2.0, -0.8, 30.0] .. [2.0, 0.8, 40.0] m cannot give candidate poses for robot `small`",
+        "--workspace [-2, -0.8, 30] .. [2, 0.8, 40] m cannot give candidate poses for robot `small`",
     );
     assert!(
         above.contains("the box's top z = 40 m is not below the anchor of cable 1 (z = 28.5 m)"),

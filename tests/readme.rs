@@ -87,7 +87,7 @@ fn args(words: &[String]) -> Vec<&str> {
 fn the_diagnose_example_says_what_diagnose_prints() {
     let readme = readme();
     let dir = tempfile::tempdir().unwrap();
-    let simulate = command_with(&readme, "simulate", &["elastic:ea_n=3e6"]);
+    let simulate = command_with(&readme, "simulate", &["elastic:axial_stiffness_n=3e6"]);
     stdout(&sagcal(dir.path(), &args(&simulate)));
     let mut diagnose = command_with(&readme, "diagnose", &["el.csv"]);
     diagnose.push("--json".into());

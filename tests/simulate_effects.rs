@@ -97,11 +97,12 @@ fn cli_writes_effect_data_and_truth_and_rejects_bad_effects() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(
-        stdout.contains("elastic:ea_n=3e6") && stdout.contains("seed 5"),
+        // The older spelling is read; the output names the robot file's key.
+        stdout.contains("elastic:axial_stiffness_n=3e6") && stdout.contains("seed 5"),
         "{stdout}"
     );
     let csv = std::fs::read_to_string(dir.path().join("m.csv")).unwrap();
-    assert!(csv.contains("# effects elastic:ea_n=3e6"), "{csv}");
+    assert!(csv.contains("# effects elastic:axial_stiffness_n=3e6"), "{csv}");
     let data = sagcal::io::measurements::read_measurements(&dir.path().join("m.csv"), &Default::default()).unwrap();
     assert_eq!(data.poses.len(), 2);
     let truth = Robot::from_file(&dir.path().join("t.toml")).unwrap();

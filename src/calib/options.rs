@@ -21,6 +21,16 @@ pub enum CableModel {
     Rigid,
 }
 
+impl std::fmt::Display for CableModel {
+    /// `catenary` or `rigid`: what [`CableModel::parse`] reads.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            CableModel::Catenary => "catenary",
+            CableModel::Rigid => "rigid",
+        })
+    }
+}
+
 impl CableModel {
     /// Parse `catenary` or `rigid`.
     pub fn parse(text: &str) -> std::result::Result<Self, ParseError> {

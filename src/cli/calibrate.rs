@@ -178,7 +178,7 @@ pub fn render(report: &CalibrationReport, options: &CalibrationOptions) -> Strin
     let mut out = String::new();
     let n = &options.noise;
     out += &format!(
-        "sagcal calibrate: robot `{}`, {:?} cable model, {} poses\nnoise: encoders {:.4} m, load cell {:.2} N, position {:.4} m, orientation {}\n\n",
+        "sagcal calibrate: robot `{}`, {} cable model, {} poses\nnoise: encoders {:.4} m, load cell {:.2} N, position {:.4} m, orientation {}\n\n",
         report.robot,
         report.model,
         report.poses_used,

@@ -8,10 +8,11 @@ use sagcal::diagnose::{diagnose, DiagnoseOptions, DiagnoseSettings, Diagnosis};
 use sagcal::error::FrontEnd;
 use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
 use sagcal::io::OutputSet;
+use sagcal::model::effect_kind::EffectKind;
 use sagcal::model::Robot;
 use sagcal::plot::residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
 
-use super::output::{opt, print_json, progress_bar, Table};
+use super::output::{counted, opt, print_json, progress_bar, Table};
 use super::solver_args::SolverArgs;
 
 #[derive(Debug, clap::Args)]
@@ -31,10 +32,8 @@ pub(super) struct DiagnoseArgs {
     /// Format of the `--plots` figures: svg or png.
     #[arg(long, value_enum, default_value = "svg")]
     plot_format: PlotFormat,
-    /// Candidate effects, comma separated (default: the whole catalogue: elastic, pulley, encoder-scale, loadcell,
-    /// com, encoder-gain, segments, localiser-mount, platform-weight, cable-weight, and, for rows in the order
-    /// taken (a sagcal file), encoder-drift, encoder-backlash, loadcell-drift, loadcell-friction).
-    #[arg(long)]
+    /// Candidate effects, comma separated (default: the whole catalogue).
+    #[arg(long, long_help = candidates_help())]
     candidates: Option<String>,
     /// Leave out the hypothesis "the localiser's orientations are unreliable".
     #[arg(long)]
@@ -239,13 +238,32 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
     out
 }
 
+/// `--candidates`' long help: the catalogue, from the library's list of effects.
+fn candidates_help() -> String {
+    let names = |in_time_order: bool| -> String {
+        let kinds = EffectKind::ALL
+            .into_iter()
+            .filter(|k| k.needs_time_order() == in_time_order);
+        kinds.map(EffectKind::name).collect::<Vec<_>>().join(", ")
+    };
+    format!(
+        "Candidate effects, comma separated (default: the whole catalogue: {}, and, for rows in the order \
+         taken (a sagcal file), {}).",
+        names(false),
+        names(true)
+    )
+}
+
 /// Step 0: readings left out as gross errors, and mistakes named.
 fn render_gross_errors(d: &Diagnosis) -> String {
     let mut out = String::from("0. gross errors (the tests of `sagcal calibrate`): ");
     if d.excluded_readings.is_empty() && d.mistakes.is_empty() {
         return out + "no reading left out\n\n";
     }
-    out += &format!("{} readings left out\n", d.excluded_readings.len());
+    out += &format!(
+        "{} left out\n",
+        counted(d.excluded_readings.len(), "reading", "readings")
+    );
     for x in &d.excluded_readings {
         out += &format!("   {}\n", x.test.describe());
     }
@@ -356,6 +374,17 @@ fn render_candidates(d: &Diagnosis) -> String {
     out
 }
 
+/// For the elastic effect's fitted compliance (1/MN), the axial stiffness
+/// it gives in the robot file's name and unit: ` (axial_stiffness_n 3.1e6)`.
+fn stiffness_note(parameter: &str, value: f64) -> String {
+    let compliance = EffectKind::Elastic.parameter_names()[0];
+    if parameter == compliance && value > 0.0 {
+        format!(" (axial_stiffness_n {:.2e})", 1e6 / value)
+    } else {
+        String::new()
+    }
+}
+
 /// Step 4: the verdict, the final model's effects, what it leaves, the gain
 /// and the structure left.
 fn render_verdict(d: &Diagnosis) -> String {
@@ -364,7 +393,15 @@ fn render_verdict(d: &Diagnosis) -> String {
         let params: Vec<String> = e
             .params
             .iter()
-            .map(|p| format!("{} {:.5e} +- {:.1e}", p.name, p.value, p.sigma))
+            .map(|p| {
+                format!(
+                    "{} {:.5e} +- {:.1e}{}",
+                    p.name,
+                    p.value,
+                    p.sigma,
+                    stiffness_note(&p.name, p.value)
+                )
+            })
             .collect();
         let stand_in = d.explanation.stand_ins.iter().any(|s| s.hypothesis == e.effect);
         let proxy = d.explanation.explained_away.contains(&e.effect);

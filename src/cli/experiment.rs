@@ -199,10 +199,10 @@ fn run_trials(
     let bar = progress_bar(total, "{msg} [{bar:40}] {pos}/{len} trials, {elapsed} (eta {eta})");
     bar.set_message(format!("table2 seed {}", args.seed));
     eprintln!(
-        "sagcal experiment table2: seed {}, {} trials x {:?} poses, {} noise, {:?} model, {} data ({} usable poses)",
+        "sagcal experiment table2: seed {}, {} trials x {} poses, {} noise, {} model, {} data ({} usable poses)",
         args.seed,
         args.trials,
-        args.poses,
+        args.poses.iter().map(usize::to_string).collect::<Vec<_>>().join(","),
         args.noise,
         args.model,
         match args.source {
@@ -214,7 +214,7 @@ fn run_trials(
     let selection = selection(args)?;
     if selection != Selection::Random {
         eprintln!(
-            "poses chosen: {} ({:?}-optimal on the bound, planner's anchors {} m off the truth)",
+            "poses chosen: {} ({}-optimal on the bound, planner's anchors {} m off the truth)",
             args.select, args.plan_criterion, args.plan_anchor_error_m
         );
     }
@@ -263,12 +263,12 @@ fn selection(args: &Table2Args) -> sagcal::Result<Selection> {
 fn print_table(args: &Table2Args, truth: &Robot, report: &Table2Report) {
     if args.select != "random" {
         println!(
-            "poses: {} ({:?}-optimal; planner's anchors {} m off the truth)",
+            "poses: {} ({}-optimal; planner's anchors {} m off the truth)",
             args.select, args.plan_criterion, args.plan_anchor_error_m
         );
     }
     println!(
-        "Table II protocol: robot `{}`, {} data, {} noise, {:?} cable model, orientation prior {}, seed {}, initial guess {} m / {} m off",
+        "Table II protocol: robot `{}`, {} data, {} noise, {} cable model, orientation prior {}, seed {}, initial guess {} m / {} m off",
         report.robot,
         match args.source {
             Source::Log => "logged (RecurDyn)",

@@ -3,7 +3,7 @@
 use sagcal::calib::gross_errors::Verdict;
 use sagcal::calib::report::GrossErrorReport;
 
-use super::output::Table;
+use super::output::{counted, Table};
 
 /// The section in words and tables.
 pub fn render(report: &GrossErrorReport) -> String {
@@ -39,8 +39,8 @@ pub fn render(report: &GrossErrorReport) -> String {
         out += "no reading left out\n";
     } else {
         out += &format!(
-            "{} readings left out as gross errors:\n",
-            report.excluded_readings.len()
+            "{} left out as gross errors:\n",
+            counted(report.excluded_readings.len(), "reading", "readings")
         );
         for x in &report.excluded_readings {
             out += &format!("  {}\n", x.test.describe());

@@ -215,7 +215,7 @@ fn hidden_sets() -> Vec<String> {
 fn sweep(args: &HiddenEffectsArgs, robots: &[Robot], options: &HiddenEffectOptions) -> sagcal::Result<SweepCases> {
     let total = robots.len() * args.noise.len() * hidden_sets().len() * args.seeds;
     eprintln!(
-        "sagcal experiment hidden-effects: seed {}, {} closure, {} seeds x {} hidden sets (none, {} effects, {} pairs) x {} robot(s) x {:?} noise, {} poses",
+        "sagcal experiment hidden-effects: seed {}, {} closure, {} seeds x {} hidden sets (none, {} effects, {} pairs) x {} robot(s) x {} noise, {} poses",
         args.seed,
         args.closure,
         args.seeds,
@@ -223,7 +223,7 @@ fn sweep(args: &HiddenEffectsArgs, robots: &[Robot], options: &HiddenEffectOptio
         EffectKind::ALL.len(),
         PAIRS.len(),
         robots.len(),
-        args.noise,
+        noise_names(&args.noise),
         args.poses
     );
     let bar = progress_bar(
@@ -343,14 +343,29 @@ fn summaries(robots: &[Robot], noises: &[NoisePreset], scores: &[EffectScore], c
     out
 }
 
+/// The noise readings of a sweep, as a person reads them: `paper and authors`.
+fn noise_names(noises: &[NoisePreset]) -> String {
+    let names: Vec<String> = noises.iter().map(NoisePreset::to_string).collect();
+    names.join(" and ")
+}
+
+/// `--noise`'s value that runs `noises` again: `both` for paper and authors.
+fn noise_flag(noises: &[NoisePreset]) -> String {
+    if noises == [NoisePreset::Paper, NoisePreset::Authors] {
+        "both".to_string()
+    } else {
+        noise_names(noises)
+    }
+}
+
 /// The readable report.
 fn print_report(args: &HiddenEffectsArgs, report: &Report) {
     println!(
-        "sagcal experiment hidden-effects --seeds {} --seed {} --poses {} --noise {:?} --closure {}\n",
+        "sagcal experiment hidden-effects --seeds {} --seed {} --poses {} --noise {} --closure {}\n",
         args.seeds,
         args.seed,
         args.poses,
-        report.noises,
+        noise_flag(&report.noises),
         args.closure.name()
     );
     for (robot, ranges) in &report.ranges {
@@ -386,7 +401,7 @@ fn print_dishonest(cases: &[HiddenCase]) {
             count += 1;
             t.row([
                 c.robot.clone(),
-                format!("{:?}", c.noise).to_lowercase(),
+                c.noise.to_string(),
                 c.hidden.clone(),
                 c.seed.to_string(),
                 x.left_out.clone(),
@@ -414,7 +429,7 @@ fn print_unmeasurable(cases: &[UnmeasurableCase]) {
     for c in cases {
         t.row([
             c.robot.clone(),
-            format!("{:?}", c.noise).to_lowercase(),
+            c.noise.to_string(),
             c.hidden.clone(),
             c.seed.to_string(),
             c.reason.clone(),
@@ -441,7 +456,7 @@ fn print_scores(scores: &[EffectScore]) {
         let verdicts: Vec<String> = s.verdicts.iter().map(|(k, v)| format!("{k} {v}")).collect();
         t.row([
             s.robot.clone(),
-            format!("{:?}", s.noise).to_lowercase(),
+            s.noise.to_string(),
             s.hidden.clone(),
             format!("{}/{}", s.right, s.cases),
             s.detectable.to_string(),
@@ -482,7 +497,7 @@ fn print_summaries(summaries: &[Summary]) {
     for s in summaries {
         t.row([
             s.robot.clone(),
-            format!("{:?}", s.noise).to_lowercase(),
+            s.noise.to_string(),
             pct(s.single_right_rate),
             pct(s.pair_right_rate),
             pct(s.none_false_rejection_rate),

@@ -293,7 +293,7 @@ fn flagged(line: usize, reason: String) -> RowReport {
 
 fn render(report: &Report) -> String {
     let mut out = format!(
-        "sagcal localize: robot {}, data {} ({:?}){}\nsigmas: {}\n\n",
+        "sagcal localize: robot {}, data {} ({}){}\nsigmas: {}\n\n",
         report.robot,
         report.data,
         report.format,

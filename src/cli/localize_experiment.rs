@@ -173,8 +173,8 @@ fn print_report(report: &Report) {
     for case in &report.cases {
         let s = &case.summary;
         table.row(vec![
-            format!("{:?}", case.source).to_lowercase(),
-            format!("{:?}", case.noise).to_lowercase(),
+            case.source.to_string(),
+            case.noise.to_string(),
             format!("{}/{}", s.calibrated, s.trials),
             format!("{:.3}", s.anchor_error_m),
             format!("{:.1}", s.position_rms_error_m * 1e3),

@@ -3,6 +3,11 @@
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
+/// `n` things in words: `1 reading`, `2 readings` (`plural` for every count but one).
+pub fn counted(n: usize, singular: &str, plural: &str) -> String {
+    format!("{n} {}", if n == 1 { singular } else { plural })
+}
+
 /// A left-aligned first column, right-aligned others, columns sized to fit.
 pub struct Table {
     header: Vec<String>,

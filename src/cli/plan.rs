@@ -46,7 +46,7 @@ pub(super) struct PlanArgs {
     #[arg(long, default_value = "a", value_parser = sagcal::plan::Criterion::parse)]
     criterion: sagcal::plan::Criterion,
     /// The localiser's orientation as a prior in the bound: `on`, or `off`/`auto`
-    /// (the statics alone decide the orientation, as `cramer_rao_bound` reads `auto`).
+    /// (the statics alone decide the orientation; the bound reads `auto` as `off`).
     #[arg(long, default_value = "off", value_parser = sagcal::calib::OrientationPrior::parse)]
     orientation_prior: sagcal::calib::OrientationPrior,
     /// Write the plan (visiting order) as a sagcal measurement CSV (atomically).
@@ -101,7 +101,7 @@ fn settings(args: &PlanArgs, robot: &Robot) -> sagcal::Result<PlanSettings> {
 pub fn run(args: &PlanArgs) -> sagcal::Result<()> {
     let robot = Robot::from_file(&args.robot)?;
     eprintln!(
-        "sagcal plan: seed {}, {} poses, {:?}-optimal",
+        "sagcal plan: seed {}, {} poses, {}-optimal",
         args.seed, args.poses, args.criterion
     );
     let settings = settings(args, &robot)?;
@@ -161,11 +161,11 @@ fn plan_csv(
         .collect();
     let comments = vec![
         format!(
-            "sagcal plan: {} poses in visiting order ({:?}-optimal, seed {}, {} noise); path {:.1} m",
+            "sagcal plan: {} poses in visiting order ({}-optimal, seed {}, {} noise); path {:.1} m",
             plan.order.len(),
             args.criterion,
             args.seed,
-            format!("{:?}", args.noise).to_lowercase(),
+            args.noise,
             plan.path_length_m
         ),
         format!(
@@ -179,7 +179,7 @@ fn plan_csv(
 
 fn print_report(report: &PlanReport, plan: &Plan) {
     println!(
-        "{} candidates ({}; {} outside the margins, {} unstable left out), {} chosen, {:?}-optimal, seed {}",
+        "{} candidates ({}; {} outside the margins, {} unstable left out), {} chosen, {}-optimal, seed {}",
         report.candidates.equilibria.len(),
         report.candidates_from,
         report.candidates.outside_margins,
@@ -231,11 +231,11 @@ fn plot_svg(
 ) -> String {
     let plot = PlanPlot {
         title: format!(
-            "sagcal plan: {} poses for robot {} ({:?}-optimal, {} noise)",
+            "sagcal plan: {} poses for robot {} ({}-optimal, {} noise)",
             plan.order.len(),
             robot.name,
             args.criterion,
-            format!("{:?}", args.noise).to_lowercase()
+            args.noise
         ),
         caption: format!(
             "seed {}; {} candidates; bound (RMS per anchor) {:.3} m planned vs {:.3} m random {} (mean of {}){}; path {:.1} m",

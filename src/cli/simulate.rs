@@ -10,10 +10,13 @@ use rand_chacha::ChaCha8Rng;
 use sagcal::error::FrontEnd;
 use sagcal::io::measurements::measurements_text;
 use sagcal::io::OutputSet;
+use sagcal::model::sensors::NoisePreset;
 use sagcal::model::statics::Equilibrium;
 use sagcal::model::{PoseMeasurement, Robot};
 use sagcal::sim::closed_form::{measure, sample_equilibria_with, Closure, Workspace};
 use sagcal::sim::effects::{measure_with_effects, simulation_truth};
+
+use super::output::counted;
 
 #[derive(Debug, clap::Args)]
 pub(super) struct SimulateArgs {
@@ -75,11 +78,14 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
     outputs.write()?;
     print_ranges(&workspace, &equilibria);
     println!(
-        "seed {}: {} poses of robot `{}` with {} noise{} written to {}",
+        "seed {}: {} of robot `{}` {}{} written to {}",
         args.seed,
-        args.poses,
+        counted(args.poses, "pose", "poses"),
         truth.name,
-        args.noise,
+        match args.noise {
+            NoisePreset::None => "without noise".to_string(),
+            noise => format!("with {noise} noise"),
+        },
         closure_note(args.closure),
         args.out.display()
     );
@@ -146,7 +152,7 @@ fn comments(args: &SimulateArgs, truth: &Robot, workspace: &Workspace) -> Vec<St
             args.noise,
             closure_note(args.closure)
         ),
-        format!("workspace {:?} .. {:?} m", workspace.min_m, workspace.max_m),
+        format!("workspace {workspace}"),
     ];
     if !effects.is_none() {
         comments.push(format!("effects {effects}"));
@@ -194,7 +200,6 @@ fn print_ranges(workspace: &Workspace, equilibria: &[Equilibrium]) {
             .flat_map(|eq| eq.tensions.iter().map(|t| t.magnitude_n())),
     );
     println!(
-        "workspace {:?} .. {:?} m: cable lengths {length_min:.1} .. {length_max:.1} m, tensions {tension_min:.1} .. {tension_max:.1} N",
-        workspace.min_m, workspace.max_m
+        "workspace {workspace}: cable lengths {length_min:.1} .. {length_max:.1} m, tensions {tension_min:.1} .. {tension_max:.1} N"
     );
 }

@@ -264,11 +264,9 @@ fn gave_up(robot: &Robot, workspace: &Workspace, count: usize, k: usize, drawn: 
         ),
     };
     Error::InvalidInput(format!(
-        "no candidate pose for robot `{}` in the box {:?} .. {:?} m: candidate {} of {count} found none ({why}), \
+        "no candidate pose for robot `{}` in the box {workspace}: candidate {} of {count} found none ({why}), \
          so the drawing stopped there: check the box against the anchors",
         robot.name,
-        workspace.min_m,
-        workspace.max_m,
         k + 1
     ))
 }

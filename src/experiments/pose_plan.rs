@@ -253,8 +253,8 @@ fn candidates(
             from.to_string()
         };
         Error::InvalidInput(format!(
-            "{named} {:?} .. {:?} m cannot give candidate poses for robot `{}`: {e}",
-            workspace.min_m, workspace.max_m, robot.name
+            "{named} {workspace} cannot give candidate poses for robot `{}`: {e}",
+            robot.name
         ))
     })?;
     progress(PlanProgress::Drawing(&format!(

@@ -29,6 +29,16 @@ pub enum Source {
     Model,
 }
 
+impl std::fmt::Display for Source {
+    /// `log` or `model`, as the command line names them.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Source::Log => "log",
+            Source::Model => "model",
+        })
+    }
+}
+
 /// One pose of the experiment's pool: what the sensors would read without noise, and the truth.
 #[derive(Debug, Clone)]
 pub struct PoolPose {

@@ -119,8 +119,9 @@ const RECURDYN_HEADER: &str = "x,y,z,pitch,roll,yaw,L1,L2,L3,L4,fc1,fz1,fh1,fc2,
 /// At most this many rejection reasons are quoted when every row is rejected.
 const MAX_QUOTED_REASONS: usize = 3;
 
-/// The format a measurement file was read from.
+/// The format a measurement file was read from (JSON: `sagcal`, `recurdyn`, `authors`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum MeasurementFormat {
     /// sagcal's own measurement file (this module).
     Sagcal,
@@ -128,6 +129,17 @@ pub enum MeasurementFormat {
     RecurDyn,
     /// The dataset folder of the paper's published program ([`crate::io::authors`]).
     Authors,
+}
+
+impl std::fmt::Display for MeasurementFormat {
+    /// The format as a person names it: `sagcal CSV`, `RecurDyn log`, `authors' folder`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            MeasurementFormat::Sagcal => "sagcal CSV",
+            MeasurementFormat::RecurDyn => "RecurDyn log",
+            MeasurementFormat::Authors => "authors' folder",
+        })
+    }
 }
 
 /// The measurements of one file.

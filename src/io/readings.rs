@@ -64,7 +64,10 @@ pub struct ReadingRow {
     pub localiser_pose: Option<PlatformPose>,
 }
 
-/// The format a readings file was in.
+/// The format a readings file was in (JSON: `readings-only`, `sagcal`,
+/// `recurdyn`, `authors`, as [`MeasurementFormat`] names the same formats).
+///
+/// [`MeasurementFormat`]: crate::io::measurements::MeasurementFormat
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ReadingsFormat {
@@ -73,9 +76,22 @@ pub enum ReadingsFormat {
     /// sagcal's measurement file.
     Sagcal,
     /// A RecurDyn log.
+    #[serde(rename = "recurdyn")]
     RecurDyn,
     /// The authors' dataset folder.
     Authors,
+}
+
+impl std::fmt::Display for ReadingsFormat {
+    /// The format as a person names it: `readings-only CSV`, `sagcal CSV`, ...
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ReadingsFormat::ReadingsOnly => "readings-only CSV",
+            ReadingsFormat::Sagcal => "sagcal CSV",
+            ReadingsFormat::RecurDyn => "RecurDyn log",
+            ReadingsFormat::Authors => "authors' folder",
+        })
+    }
 }
 
 /// The rows of one file.

@@ -18,12 +18,13 @@ use crate::model::robot::CABLE_COUNT;
 
 /// The effect names accepted by [`Effects::apply_spec`], with their parameters.
 pub const EFFECT_NAMES: &str =
-    "elastic:ea_n, pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m, segments:n, localiser-mount:rx_deg,ry_deg,rz_deg, platform-weight:scale, cable-weight:scale, encoder-drift:rate_m|rate1_m..rate4_m, encoder-backlash:b_m|b1_m..b4_m, loadcell-drift:rate_n, loadcell-friction:k, attachments:dx1_m,dy1_m..dx4_m,dy4_m";
+    "elastic:axial_stiffness_n (or ea_n), pulley:radius_m, encoder-scale:gain|gain1..gain4, loadcell:bias_n,gain, com:dx_m,dy_m,dz_m, segments:n, localiser-mount:rx_deg,ry_deg,rz_deg, platform-weight:scale, cable-weight:scale, encoder-drift:rate_m|rate1_m..rate4_m, encoder-backlash:b_m|b1_m..b4_m, loadcell-drift:rate_n, loadcell-friction:k, attachments:dx1_m,dy1_m..dx4_m,dy4_m";
 
 /// The parameters [`Effects::apply_spec`] accepts for the effect `name`; `None` for no effect.
 fn spec_parameters(name: &str) -> Option<&'static [&'static str]> {
     Some(match name {
-        "elastic" => &["ea_n"],
+        // `ea_n`: the name files and scripts written before use.
+        "elastic" => &["axial_stiffness_n", "ea_n"],
         "pulley" => &["radius_m"],
         "encoder-scale" => &["gain", "gain1", "gain2", "gain3", "gain4"],
         "loadcell" => &["bias_n", "gain"],
@@ -42,7 +43,7 @@ fn spec_parameters(name: &str) -> Option<&'static [&'static str]> {
 
 impl Effects {
     /// Apply one `NAME:PARAM=VALUE[,PARAM=VALUE...]` specification, e.g.
-    /// `elastic:ea_n=3e6`, `encoder-scale:gain1=1.001,gain3=0.999` or
+    /// `elastic:axial_stiffness_n=3e6`, `encoder-scale:gain1=1.001,gain3=0.999` or
     /// `com:dx_m=0.02,dz_m=-0.05`. Parameters not given keep their values.
     /// On error `self` is unchanged and the message names the effect and parameter.
     pub fn apply_spec(&mut self, spec: &str) -> Result<(), EffectSpecError> {
@@ -109,7 +110,7 @@ impl Effects {
         let none = Self::default();
         let mut specs = Vec::new();
         if let Some(ea) = self.axial_stiffness_n {
-            specs.push(format!("elastic:ea_n={ea:e}"));
+            specs.push(format!("elastic:axial_stiffness_n={ea:e}"));
         }
         if self.pulley_radius_m != none.pulley_radius_m {
             specs.push(format!("pulley:radius_m={}", self.pulley_radius_m));
@@ -286,6 +287,14 @@ mod tests {
 
     fn parsed(specs: &[&str]) -> Result<Effects, EffectSpecError> {
         Effects::from_specs(specs)
+    }
+
+    #[test]
+    fn the_axial_stiffness_has_the_robot_files_name_and_reads_its_older_spelling() {
+        let named = parsed(&["elastic:axial_stiffness_n=3e6"]).unwrap();
+        assert_eq!(named.axial_stiffness_n, Some(3e6));
+        assert_eq!(parsed(&["elastic:ea_n=3e6"]).unwrap(), named);
+        assert_eq!(named.specs(), ["elastic:axial_stiffness_n=3e6"]);
     }
 
     #[test]

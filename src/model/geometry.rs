@@ -225,7 +225,7 @@ pub fn check_workspace(robot: &Robot, workspace: &Workspace) -> Result<(), Strin
     let Workspace { min_m, max_m } = *workspace;
     if !(0..3).all(|k| min_m[k].is_finite() && max_m[k].is_finite() && min_m[k] <= max_m[k]) {
         return Err(format!(
-            "the box {min_m:?} .. {max_m:?} m needs finite corners with the lower <= the upper on every axis"
+            "the box {workspace} needs finite corners with the lower <= the upper on every axis"
         ));
     }
     let (lowest, z) = lowest_anchor(robot);

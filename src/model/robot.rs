@@ -96,6 +96,28 @@ pub struct Workspace {
     pub max_m: [f64; 3],
 }
 
+impl std::fmt::Display for Workspace {
+    /// `[-6, -4, 2] .. [6, 4, 9] m`: the corners, each coordinate to 0.1 mm
+    /// (without the binary noise of a computed bound, `29.700000000000003`).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let corner = |p: &[f64; 3]| -> String {
+            let parts: Vec<String> = p.iter().map(|x| short_metres(*x)).collect();
+            format!("[{}]", parts.join(", "))
+        };
+        write!(f, "{} .. {} m", corner(&self.min_m), corner(&self.max_m))
+    }
+}
+
+/// `x` metres to 0.1 mm, without trailing zeros: `-29.7`, `0.96`, `6`.
+fn short_metres(x: f64) -> String {
+    let text = format!("{x:.4}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    match text {
+        "-0" => "0".to_string(),
+        other => other.to_string(),
+    }
+}
+
 /// `robot` with its attachment points where `effects` puts them: each moved
 /// horizontally by `effects.attachment_shift_m` (`attachments`), platform frame.
 pub fn with_true_attachments(robot: &Robot, effects: &Effects) -> Robot {
@@ -115,4 +137,23 @@ pub fn with_true_weights(robot: &Robot, effects: &Effects) -> Robot {
     true_robot.platform_weight_n *= effects.platform_weight_scale;
     true_robot.cable_weight_n_per_m *= effects.cable_weight_scale;
     true_robot
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_workspace_prints_its_corners_without_binary_noise() {
+        let computed = Workspace {
+            min_m: [-30.0, -0.3 * 99.0, 0.96],
+            max_m: [30.0, 29.700000000000003, 27.839999999999996],
+        };
+        assert_eq!(computed.to_string(), "[-30, -29.7, 0.96] .. [30, 29.7, 27.84] m");
+        let small = Workspace {
+            min_m: [-0.00001, 0.00005, 1.23456],
+            max_m: [f64::NAN, f64::INFINITY, 2.0],
+        };
+        assert_eq!(small.to_string(), "[0, 0.0001, 1.2346] .. [NaN, inf, 2] m");
+    }
 }

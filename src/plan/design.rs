@@ -85,6 +85,16 @@ impl Criterion {
     }
 }
 
+impl std::fmt::Display for Criterion {
+    /// `A` or `D`, as in `A-optimal`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::A => "A",
+            Self::D => "D",
+        })
+    }
+}
+
 /// Settings of the search.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DesignOptions {

@@ -239,12 +239,10 @@ pub fn sample_equilibria_counted(
             if attempts > limit || (poses.is_empty() && attempts > first_draws) {
                 let drawn = attempts - 1;
                 return Err(Error::InvalidInput(format!(
-                    "robot `{}`: only {} of {count} reachable static poses ({closure} closure) found in the box {:?} .. {:?} m \
+                    "robot `{}`: only {} of {count} reachable static poses ({closure} closure) found in the box {workspace} \
                      after {drawn} draws: {:.1} % of the positions drawn had no equilibrium with every cable taut",
                     robot.name,
                     poses.len(),
-                    workspace.min_m,
-                    workspace.max_m,
                     100.0 * (drawn - poses.len()) as f64 / drawn as f64
                 )));
             }
