@@ -369,10 +369,7 @@ fn the_default_workspace_is_what_simulate_draws_from() {
         dir.path(),
         "sagcal simulate --robot hall.toml --poses 1 --seed 1 --out m.csv",
     );
-    assert!(
-        printed.starts_with(&format!("workspace {:?} .. {:?} m", w.min_m, w.max_m)),
-        "{printed}"
-    );
+    assert!(printed.starts_with(&format!("workspace {w}:")), "{printed}");
     let axis = |k: usize| format!("{:.2} .. {:.2} m", w.min_m[k], w.max_m[k]);
     says("robot-file.md", &format!("x {}, y {}, z {}", axis(0), axis(1), axis(2)));
 }

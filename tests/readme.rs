@@ -204,21 +204,21 @@ fn the_calibrate_table_says_what_calibrate_prints() {
     let dir = tempfile::tempdir().unwrap();
     stdout(&sagcal(dir.path(), &["demo"]));
     let truth = dir.path().join("sagcal-demo/truth.toml");
-    let calibrate = |data: &Path| {
+    let calibrate_with = |data: &Path, more: &[&str]| {
         let data = data.to_string_lossy().into_owned();
-        sagcal(
-            dir.path(),
-            &[
-                "calibrate",
-                "--robot",
-                "sagcal-demo/guess.toml",
-                "--data",
-                &data,
-                "--out",
-                "c.toml",
-            ],
-        )
+        let mut words = vec![
+            "calibrate",
+            "--robot",
+            "sagcal-demo/guess.toml",
+            "--data",
+            &data,
+            "--out",
+            "c.toml",
+        ];
+        words.extend_from_slice(more);
+        sagcal(dir.path(), &words)
     };
+    let calibrate = |data: &Path| calibrate_with(data, &[]);
     let range = |(low, high): (f64, f64)| format!("{low:.2}-{high:.2} m");
 
     // None.
@@ -282,6 +282,11 @@ fn the_calibrate_table_says_what_calibrate_prints() {
         &readme,
         &format!("`{sentence}: they look like mN, not N`; exit 1, nothing written"),
     );
+    // No switch accepts a unit mistake.
+    let out = calibrate_with(&millinewtons, &["--accept-inconsistent"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!dir.path().join("c.toml").exists());
+    says(&readme, "| (refused, with `--accept-inconsistent` too) |");
 }
 
 #[test]
