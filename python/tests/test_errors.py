@@ -48,14 +48,14 @@ def test_nan_in_a_file_and_in_an_array(cli, problem, tmp_path):
     path.write_text("\n".join(lines) + "\n")
     guess = problem["folder"] / "guess.toml"
     expected = cli_error(cli("calibrate", "--robot", guess, "--data", path, check=False))
-    line = header + 4  # 1-based line of the fourth data row
-    assert expected == f"{path}: row {line}, field `x_m`: not a finite number: `NaN`"
+    line = header + 4  # 1-based line of the third data row
+    assert expected == f"{path}: row 3 (line {line}), field `x_m`: not a finite number: `NaN`"
     assert message(lambda: sagcal.calibrate(problem["guess"], path)) == expected
-    # The same value in an array: the same check and words; the row is the array's (1-based).
+    # The same value in an array: the same check and words, the same row 3 (1-based), no line.
     data = problem["measurements"].copy()
-    data[3, 0] = np.nan
+    data[2, 0] = np.nan
     assert message(lambda: sagcal.calibrate(problem["guess"], data)) == (
-        "measurements: row 4, field `x_m`: not a finite number: `NaN`"
+        "measurements: row 3, field `x_m`: not a finite number: `NaN`"
     )
 
 
