@@ -190,9 +190,10 @@ fn field_error(dir: &Path, edit: (&str, &str)) -> (String, usize, String, String
         Err(Error::Field {
             path,
             row,
+            line,
             field,
             message,
-        }) => (
+        }) if line == Some(row) => (
             path.file_name().unwrap().to_string_lossy().into_owned(),
             row,
             field,
@@ -286,7 +287,7 @@ fn folder_level_errors_name_the_files() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(
-        stderr.contains(&format!("{POSITION_FILE}: row 2, field `z_m`")),
+        stderr.contains(&format!("{POSITION_FILE}: row 2 (line 2), field `z_m`")),
         "{stderr}"
     );
     assert!(!d.join("cal.toml").exists());

@@ -177,7 +177,7 @@ fn bad_calibration_input_is_a_clear_error_and_writes_nothing() {
             "--out",
             "c.toml",
         ],
-        &["cols.csv", "row 2", "expected 11"],
+        &["cols.csv", "row 1 (line 2)", "expected 11"],
         &["c.toml"],
     );
     std::fs::write(
@@ -196,7 +196,7 @@ fn bad_calibration_input_is_a_clear_error_and_writes_nothing() {
             "--out",
             "c.toml",
         ],
-        &["neg.csv", "row 2", "f_ref_n", "negative tension"],
+        &["neg.csv", "row 1 (line 2)", "f_ref_n", "negative tension"],
         &["c.toml"],
     );
     let bad_ref = std::fs::read_to_string(robot("large"))

@@ -573,7 +573,7 @@ fn every_readings_example_reads_as_the_page_says() {
             ),
         );
     }
-    // `localize` labels its rows by their lines.
+    // `localize` labels its rows by their data rows.
     std::fs::write(dir.path().join("hall.toml"), example_text()).unwrap();
     written(dir.path(), "readings.csv", csv_blocks(&all, "readings", false)[0]);
     let printed = run_ok(dir.path(), "sagcal localize --robot hall.toml --data readings.csv");

@@ -120,8 +120,11 @@ fn check_recurdyn(bytes: &[u8]) -> Result<Vec<sagcal::Error>, TestCaseError> {
 /// A row error must point at line `line`, and at column `field` when given.
 fn points_at(errors: &[sagcal::Error], line: usize, field: Option<&str>) -> Result<(), TestCaseError> {
     for error in errors {
-        if let sagcal::Error::Field { row, field: named, .. } = error {
-            prop_assert_eq!(*row, line, "{}", error);
+        if let sagcal::Error::Field {
+            line: at, field: named, ..
+        } = error
+        {
+            prop_assert_eq!(*at, Some(line), "{}", error);
             if let Some(field) = field {
                 prop_assert_eq!(named, field, "{}", error);
             }

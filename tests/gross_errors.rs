@@ -153,7 +153,7 @@ fn a_rehomed_encoder_is_found_as_an_offset_step() {
         step[0].message.contains("cable 3") && (jump - 2.0).abs() < 0.02,
         "{jump}"
     );
-    assert_eq!(step[0].rows, (22..35).collect::<Vec<_>>());
+    assert_eq!(step[0].indices(), (22..35).collect::<Vec<_>>());
     assert!(anchor_error(&checked, &truth) < 1.0);
 }
 
@@ -301,7 +301,7 @@ fn diagnose_leaves_out_the_same_blunders_and_reports_them() {
     assert!(d
         .mistakes
         .iter()
-        .any(|m| m.kind == MistakeKind::SwappedCables && m.rows == [12]));
+        .any(|m| m.kind == MistakeKind::SwappedCables && m.indices() == [12]));
     // The blunder is not mistaken for a model error.
     assert_eq!(d.verdict, "none");
 }
@@ -319,7 +319,8 @@ fn a_pose_outside_the_frame_is_named_and_its_row_left_out() {
         .collect();
     assert_eq!(outside.len(), 1, "{:#?}", checked.mistakes);
     println!("{}", outside[0].message);
-    assert_eq!(outside[0].rows, [7]);
+    // Row 8 (from 1), no line: in-memory data.
+    assert_eq!(outside[0].rows, [sagcal::model::DataRow { row: 8, line: None }]);
     assert!(outside[0].message.starts_with("row 8") && outside[0].message.contains("outside the robot's frame"));
     assert_eq!(checked.measurements.len(), 34);
     assert!(!checked.rows.contains(&7));

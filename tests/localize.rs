@@ -348,6 +348,7 @@ fn cli_localizes_a_simulated_file() {
     for row in rows {
         for key in [
             "row",
+            "line",
             "position_m",
             "roll_pitch_yaw_deg",
             "tensions_n",
@@ -390,7 +391,7 @@ fn cli_localizes_a_simulated_file() {
     let run = sagcal(&["localize", "--robot", &s(&truth), "--data", &s(&readings)]);
     assert!(!run.status.success());
     let stderr = String::from_utf8_lossy(&run.stderr);
-    assert!(stderr.contains("row 2") && stderr.contains("l3_m"), "{stderr}");
+    assert!(stderr.contains("row 1 (line 2), field `l3_m`"), "{stderr}");
 }
 
 /// Accuracy on the RecurDyn log (finite-element cables, the paper's large

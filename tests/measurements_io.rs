@@ -64,19 +64,20 @@ fn assert_field_error(result: sagcal::Result<MeasurementSet>, path: &Path, line:
     match &err {
         Error::Field {
             path: p,
-            row,
+            line: at,
             field: f,
             message,
+            ..
         } => {
             assert_eq!(p, path, "{text}");
-            assert_eq!(*row, line, "{text}");
+            assert_eq!(*at, Some(line), "{text}");
             assert_eq!(f, field, "{text}");
             assert!(message.contains(contains), "message `{message}` lacks `{contains}`");
         }
         other => panic!("expected Error::Field, got {other:?}"),
     }
     assert!(text.contains(&path.display().to_string()), "{text}");
-    assert!(text.contains(&format!("row {line}")), "{text}");
+    assert!(text.contains(&format!(" (line {line}), field")), "{text}");
     assert!(text.contains(&format!("`{field}`")), "{text}");
 }
 

@@ -85,19 +85,20 @@ fn assert_field_error(result: sagcal::Result<RecurDynLog>, path: &Path, line: us
     match &err {
         Error::Field {
             path: p,
-            row,
+            line: at,
             field: f,
             message,
+            ..
         } => {
             assert_eq!(p, path, "{text}");
-            assert_eq!(*row, line, "{text}");
+            assert_eq!(*at, Some(line), "{text}");
             assert_eq!(f, field, "{text}");
             assert!(message.contains(contains), "message `{message}` lacks `{contains}`");
         }
         other => panic!("expected Error::Field, got {other:?}"),
     }
     assert!(text.contains(&path.display().to_string()), "{text}");
-    assert!(text.contains(&format!("row {line}")), "{text}");
+    assert!(text.contains(&format!(" (line {line}), field")), "{text}");
     assert!(text.contains(&format!("`{field}`")), "{text}");
 }
 
@@ -153,10 +154,11 @@ fn shared_file_reasons() {
         r18.starts_with("cable 1: fc1 = 578.648 N but sqrt(fz1^2 + fh1^2) = 684.583 N (difference 105.935 N"),
         "{r18}"
     );
-    assert_eq!(reason(&log, 71), "duplicate of row 34");
-    assert_eq!(reason(&log, 33), "duplicate of row 17");
-    assert_eq!(reason(&log, 61), "duplicate of row 17");
-    assert_eq!(reason(&log, 93), "duplicate of row 29");
+    // The first is named by its row among the rows kept and its line.
+    assert_eq!(reason(&log, 71), "duplicate of row 29 (line 34)");
+    assert_eq!(reason(&log, 33), "duplicate of row 14 (line 17)");
+    assert_eq!(reason(&log, 61), "duplicate of row 14 (line 17)");
+    assert_eq!(reason(&log, 93), "duplicate of row 25 (line 29)");
 
     // Line 34 has line 18's pose with corrected tensions: kept, since 18 was rejected.
     let row34 = log.rows.iter().find(|r| r.line == 34).expect("line 34 kept");
@@ -292,11 +294,11 @@ fn quality_rejections() {
             },
             RejectedRow {
                 line: 5,
-                reason: "same pose as row 3 with different tensions".to_string(),
+                reason: "same pose as row 2 (line 3) with different tensions".to_string(),
             },
             RejectedRow {
                 line: 6,
-                reason: "duplicate of row 3".to_string(),
+                reason: "duplicate of row 2 (line 3)".to_string(),
             },
             RejectedRow {
                 line: 7,

@@ -152,8 +152,8 @@ class Calibration:
     def poses_used(self) -> int:
         """Poses in the final solve."""
     @property
-    def excluded_poses(self) -> list[int]:
-        """Poses without an equilibrium near them (file lines or 1-based rows)."""
+    def excluded_poses(self) -> list[dict[str, Any]]:
+        """Poses without an equilibrium near them: ``row`` (1-based) and ``line`` (``None`` for an array)."""
     @property
     def excluded_readings(self) -> list[dict[str, Any]]:
         """Readings left out as gross errors."""
@@ -168,7 +168,10 @@ class Calibration:
         """Why the fit fails its consistency tests, or ``None``."""
     @property
     def rows(self) -> list[int]:
-        """0-based row of each pose the fit used."""
+        """1-based row of each pose the fit used."""
+    @property
+    def lines(self) -> list[Optional[int]]:
+        """File line of each pose the fit used (``None`` for an array)."""
     @property
     def positions_m(self) -> FloatArray:
         """Estimated platform positions, metres: (M, 3)."""
@@ -218,7 +221,10 @@ class Localization:
 
     @property
     def rows(self) -> list[int]:
-        """File lines, or 1-based rows of an array."""
+        """1-based row of each row of readings."""
+    @property
+    def lines(self) -> list[Optional[int]]:
+        """File line of each row (``None`` for an array)."""
     @property
     def positions_m(self) -> FloatArray:
         """Platform positions, metres: (N, 3)."""

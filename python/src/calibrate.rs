@@ -8,6 +8,7 @@ use sagcal::calib::gross_errors::Verdict;
 use sagcal::calib::report::CalibrationReport;
 use sagcal::calib::{calibrate_job, CalibrationResult, CalibrationSettings, ParameterUncertainty};
 use sagcal::error::FrontEnd;
+use sagcal::model::DataRow;
 
 use crate::arrays::{out1, out2, out3};
 use crate::json::to_python;
@@ -29,7 +30,7 @@ pub struct Calibration {
     report: CalibrationReport,
     json: serde_json::Value,
     verdict: Verdict,
-    rows: Vec<usize>,
+    rows: Vec<DataRow>,
 }
 
 #[pymethods]
@@ -123,16 +124,19 @@ impl Calibration {
     }
 
     /// Poses left out because no positive-tension equilibrium is near them:
-    /// their file lines, or 1-based rows of an array.
+    /// a list of dicts with ``row`` (1-based) and ``line`` (the file's line,
+    /// ``None`` for an array).
     #[getter]
-    fn excluded_poses(&self) -> Vec<usize> {
-        self.report.excluded_poses.clone()
+    fn excluded_poses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.report.excluded_poses)
     }
 
     /// Readings left out as gross errors, in the order found: a list of dicts
-    /// with the reading's ``test`` (``pose`` 0-based, ``line``, ``sensor``,
-    /// ``residual``, ``sigma``, ``redundancy``, ``w``, ``estimated_error``)
-    /// and an ``explanation`` (a common mistake that explains it, or ``None``).
+    /// with the reading's ``test`` (``row`` 1-based, ``line`` (``None`` for
+    /// an array), ``sensor``, ``cable`` (1-based, encoders), ``axis``
+    /// (localiser), ``residual``, ``sigma``, ``redundancy``, ``w``,
+    /// ``estimated_error``) and an ``explanation`` (a common mistake that
+    /// explains it, or ``None``).
     #[getter]
     fn excluded_readings<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &self.json["gross_errors"]["excluded_readings"])
@@ -140,7 +144,7 @@ impl Calibration {
 
     /// Common mistakes recognised in the data (units, swapped cables,
     /// re-homing, poses outside the frame): a list of dicts with ``kind``,
-    /// ``message`` and ``rows`` (0-based).
+    /// ``message`` and ``rows`` (dicts with ``row``, 1-based, and ``line``).
     #[getter]
     fn mistakes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &self.json["gross_errors"]["mistakes"])
@@ -162,10 +166,17 @@ impl Calibration {
         }
     }
 
-    /// Row (0-based, in the measurements given) of each pose the fit used (rows outside the frame left out).
+    /// Row (1-based, in the measurements given) of each pose the fit used
+    /// (rows outside the frame left out); ``measurements[rows - 1]`` are their readings.
     #[getter]
     fn rows(&self) -> Vec<usize> {
-        self.rows.clone()
+        self.rows.iter().map(|r| r.row).collect()
+    }
+
+    /// File line of each pose the fit used (as :attr:`rows`); ``None`` each for an array.
+    #[getter]
+    fn lines(&self) -> Vec<Option<usize>> {
+        self.rows.iter().map(|r| r.line).collect()
     }
 
     /// Estimated platform positions, world frame, metres: an (M, 3) array, one row per pose in :attr:`rows`.
@@ -297,12 +308,19 @@ pub fn calibrate(
     }
     let json = serde_json::to_value(&job.report)
         .map_err(|e| crate::invalid(format!("cannot serialise the report as JSON: {e}")))?;
+    // Every attribute is read off the one report the command prints.
+    let rows = job
+        .checked
+        .rows
+        .iter()
+        .map(|&row| DataRow::at(row, data.poses[row].line))
+        .collect();
     Ok(Calibration {
         robot: job.checked.result.robot.clone(),
         result: job.checked.result,
         report: job.report.report,
         json,
-        verdict: job.checked.verdict,
-        rows: job.checked.rows,
+        verdict: job.report.gross_errors.verdict,
+        rows,
     })
 }

@@ -42,10 +42,16 @@ impl Localization {
 
 #[pymethods]
 impl Localization {
-    /// Per row, the number that names it: its file line, or its 1-based row in an array.
+    /// Per row, its number counted from 1 (the data rows of a file, the rows of an array).
     #[getter]
     fn rows(&self) -> Vec<usize> {
-        self.lines.clone()
+        (1..=self.lines.len()).collect()
+    }
+
+    /// Per row, its line in the file; ``None`` each for an array.
+    #[getter]
+    fn lines(&self) -> Vec<Option<usize>> {
+        self.lines.iter().map(|&line| (line > 0).then_some(line)).collect()
     }
 
     /// Platform positions, world frame, metres: an (N, 3) array.
@@ -259,6 +265,7 @@ fn rows_from_arrays(
         to_py(sagcal::Error::Field {
             path: PathBuf::from(source),
             row,
+            line: None,
             field: field.into(),
             message,
         })
@@ -297,7 +304,7 @@ fn rows_from_arrays(
             }
         };
         out.push(ReadingRow {
-            line: i + 1,
+            line: 0,
             encoder_lengths_m: *l,
             load_cell_n: f,
             localiser_pose: pose,

@@ -67,7 +67,7 @@ def test_result_shapes_dtypes_and_contents(problem):
         assert value.shape == shape, name
         assert value.dtype == np.float64, name
         assert not value.flags.writeable, name
-    assert n == 30 and result.rows == list(range(30))
+    assert n == 30 and result.rows == list(range(1, 31)) and result.lines == [None] * 30
     kinds = {s["kind"] for s in result.factor_statistics}
     assert {"catenary_length", "reference_tension", "pose_prior"} <= kinds, kinds
     for s in result.factor_statistics:
@@ -90,7 +90,10 @@ def test_a_blunder_is_left_out_and_named(problem):
     result = sagcal.calibrate(problem["guess"], data)
     assert len(result.excluded_readings) == 1
     test = result.excluded_readings[0]["test"]
-    assert test["pose"] == 7 and test["sensor"] == {"encoder": 0}
+    # Named as the text names it: row 8, cable 1; an array has no lines.
+    assert (test["row"], test["line"], test["sensor"], test["cable"]) == (8, None, "encoder", 1)
+    largest = result.report["gross_errors"]["tests"]["largest"]
+    assert largest is not None and largest["line"] is None
     # Its estimated error is the blunder, to within the encoder noise (10 mm).
     assert test["estimated_error"] == pytest.approx(5.0, abs=0.05)
 

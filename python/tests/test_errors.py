@@ -48,14 +48,14 @@ def test_nan_in_a_file_and_in_an_array(cli, problem, tmp_path):
     path.write_text("\n".join(lines) + "\n")
     guess = problem["folder"] / "guess.toml"
     expected = cli_error(cli("calibrate", "--robot", guess, "--data", path, check=False))
-    line = header + 4  # 1-based line of the fourth data row
-    assert expected == f"{path}: row {line}, field `x_m`: not a finite number: `NaN`"
+    line = header + 4  # 1-based line of the third data row
+    assert expected == f"{path}: row 3 (line {line}), field `x_m`: not a finite number: `NaN`"
     assert message(lambda: sagcal.calibrate(problem["guess"], path)) == expected
-    # The same value in an array: the same check and words; the row is the array's (1-based).
+    # The same value in an array: the same check and words, the same row 3 (1-based), no line.
     data = problem["measurements"].copy()
-    data[3, 0] = np.nan
+    data[2, 0] = np.nan
     assert message(lambda: sagcal.calibrate(problem["guess"], data)) == (
-        "measurements: row 4, field `x_m`: not a finite number: `NaN`"
+        "measurements: row 3, field `x_m`: not a finite number: `NaN`"
     )
 
 
@@ -67,8 +67,11 @@ def test_a_negative_tension_in_a_file_and_in_an_array(cli, problem, tmp_path):
     header = ",".join(sagcal.MEASUREMENT_COLUMNS)
     path.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in r) for r in data) + "\n")
     expected = cli_error(cli("calibrate", "--robot", problem["folder"] / "guess.toml", "--data", path, check=False))
-    assert expected == f"{path}: row 2, field `f_ref_n`: negative tension: the reference tension must be positive, got -5 N"
-    assert message(lambda: sagcal.calibrate(problem["guess"], data)) == expected.replace(f"{path}: row 2", "measurements: row 1")
+    assert expected == f"{path}: row 1 (line 2), field `f_ref_n`: negative tension: the reference tension must be positive, got -5 N"
+    # The same row 1, without a line: an array is no file.
+    assert message(lambda: sagcal.calibrate(problem["guess"], data)) == expected.replace(
+        f"{path}: row 1 (line 2)", "measurements: row 1"
+    )
 
 
 def test_bad_shapes_and_values_name_the_argument(problem):
@@ -171,6 +174,8 @@ def test_each_kind_of_error_has_its_class(problem, tmp_path):
     few = caught(lambda: sagcal.calibrate(guess, data[:3]))
     assert type(few) is sagcal.CalibrationError
     assert type(few.__cause__) is sagcal.InvalidInputError
-    assert str(few) == f"invalid input: measurements: no robot file is written: {few.__cause__}"
+    # One "invalid input: " only, the cause's own.
+    assert str(few) == f"measurements: no robot file is written: {few.__cause__}"
+    assert str(few.__cause__).startswith("invalid input: ")
     for kind in (sagcal.FileError, sagcal.InvalidInputError, sagcal.CalibrationError, sagcal.SolverError):
         assert issubclass(kind, sagcal.SagcalError) and kind.__module__ == "sagcal"

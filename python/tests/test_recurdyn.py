@@ -37,7 +37,7 @@ def test_localize_the_recurdyn_log_as_the_command_does(cli, log):
     command = cli_json(cli("localize", "--robot", ROBOT, "--data", log, "--json"))
     found = sagcal.localize(sagcal.Robot.from_toml(ROBOT), log)
     rows = command["rows"]
-    assert found.rows == [r["row"] for r in rows]
+    assert found.rows == [r["row"] for r in rows] and found.lines == [r["line"] for r in rows]
     assert found.flags == [r["flag"] for r in rows]
     solved = [i for i, r in enumerate(rows) if r["position_m"] is not None]
     np.testing.assert_array_equal(found.positions_m[solved], [rows[i]["position_m"] for i in solved])

@@ -54,7 +54,7 @@ def test_localize_without_noise_finds_the_simulated_poses(problem):
     assert found.covariance.shape == (8, 6, 6) and found.position_sigma_m.shape == (8, 3)
     assert found.chi_square.shape == (8,) and np.all(found.chi_square < 1e-6)
     assert found.degrees_of_freedom == [1] * 8 and all(found.consistent) and all(found.stable)
-    assert found.flags == [None] * 8 and found.rows == list(range(1, 9))
+    assert found.flags == [None] * 8 and found.rows == list(range(1, 9)) and found.lines == [None] * 8
     assert np.max(found.position_error_m) < 1e-6
     # The reference cable's tension is the load cell's reading.
     np.testing.assert_allclose(found.tensions_n[:, truth.reference_cable - 1], data[:, 10], rtol=1e-9)
@@ -71,7 +71,7 @@ def test_localize_equals_the_command(cli, problem):
     command = cli_json(cli("localize", "--robot", folder / "truth.toml", "--data", folder / "data.csv", "--json"))
     found = sagcal.localize(problem["truth"], folder / "data.csv")
     rows = command["rows"]
-    assert found.rows == [r["row"] for r in rows]
+    assert found.rows == [r["row"] for r in rows] and found.lines == [r["line"] for r in rows]
     np.testing.assert_array_equal(found.positions_m, [r["position_m"] for r in rows])
     np.testing.assert_array_equal(found.tensions_n, [r["tensions_n"] for r in rows])
     np.testing.assert_array_equal(found.chi_square, [r["chi_square"] for r in rows])

@@ -47,7 +47,7 @@ pub fn validate_measurements(measurements: &[PoseMeasurement]) -> Result<()> {
             measurements[0].position_m
         )));
     }
-    for m in measurements {
+    for (k, m) in measurements.iter().enumerate() {
         let fields = m
             .position_m
             .iter()
@@ -57,8 +57,8 @@ pub fn validate_measurements(measurements: &[PoseMeasurement]) -> Result<()> {
             || !(m.reference_tension_n.is_finite() && m.reference_tension_n > 0.0)
         {
             return Err(Error::InvalidInput(format!(
-                "pose at line {}: values must be finite and the tension positive",
-                m.line
+                "{}: values must be finite and the tension positive",
+                crate::model::DataRow::at(k, m.line)
             )));
         }
     }

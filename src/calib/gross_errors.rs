@@ -181,7 +181,7 @@ fn checked_fit(
     // readings left out go back (kept in `set_aside`, with the mistakes named,
     // as hints), and the fit with every reading is the answer, with its verdict.
     Ok(match plain {
-        Some(plain) if checked.verdict != Verdict::Consistent => gave_up(checked, plain, rows, options),
+        Some(plain) if checked.verdict != Verdict::Consistent => gave_up(checked, plain, rows, options, check),
         _ => checked,
     })
 }
@@ -267,33 +267,29 @@ fn test_and_remove(
 }
 
 /// The search for gross errors gave up on an inconsistent fit: the plain fit
-/// with every reading, its verdict saying so, the readings the search had
-/// left out listed as set aside.
+/// with every reading, its verdict on its own tests (the numbers the report
+/// prints beside it) saying so, the readings the search had left out listed
+/// as set aside.
 fn gave_up(
     checked: CheckedCalibration,
     plain: PlainFit,
     rows: Vec<usize>,
     options: &CalibrationOptions,
+    check: &GrossErrorOptions,
 ) -> CheckedCalibration {
     let PlainFit { result, test, all } = plain;
     let at_fit = residuals_at_fit(&result, &all, options);
-    let none = Exclusions {
-        excluded: Vec::new(),
-        stepped: 0,
-        limit: 1,
-        step_cable: None,
-    };
+    let none = Exclusions::new(check.max_excluded_fraction, all.len());
     let mut reverted = finish(result, all, rows, none, checked.mistakes.clone(), test, &at_fit);
-    reverted.verdict = match checked.verdict {
-        Verdict::Inconsistent { reason } if !checked.excluded.is_empty() => Verdict::Inconsistent {
-            reason: format!(
-                "{reason}. The search for gross errors gave up, so the fit reported leaves no reading out \
-                 (the {} it had left out are listed as set aside)",
+    if let Verdict::Inconsistent { reason } = &mut reverted.verdict {
+        if !checked.excluded.is_empty() {
+            reason.push_str(&format!(
+                ". The search for gross errors gave up after leaving out {} readings, so the fit reported \
+                 leaves none out (they are listed as set aside)",
                 checked.excluded.len()
-            ),
-        },
-        verdict => verdict,
-    };
+            ));
+        }
+    }
     reverted.set_aside = checked.excluded;
     reverted
 }
@@ -570,10 +566,15 @@ fn verdict(test: &ConsistencyTest, excluded: usize, limit: usize, found: &[Mista
     let mut reasons = Vec::new();
     if !test.flagged.is_empty() {
         let names: Vec<String> = test.flagged.iter().take(3).map(ReadingTest::describe).collect();
+        let fail = match excluded {
+            0 => format!("{} readings fail the w-test", test.flagged.len()),
+            _ => format!(
+                "{} readings still fail the w-test after {excluded} were left out (at most {limit} may be)",
+                test.flagged.len()
+            ),
+        };
         reasons.push(format!(
-            "{} readings still fail the w-test after {} were left out (at most {limit} may be): {}{}",
-            test.flagged.len(),
-            excluded,
+            "{fail}: {}{}",
             names.join("; "),
             if test.flagged.len() > 3 { "; ..." } else { "" }
         ));

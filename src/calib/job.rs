@@ -10,6 +10,7 @@ use super::settings::CalibrationSettings;
 use super::CalibrationOptions;
 use crate::error::{CalibrationError, Error, FrontEnd, Result};
 use crate::model::measurement::PoseMeasurement;
+use crate::model::DataRow;
 use crate::model::Robot;
 
 /// A checked calibration, its report, and whether it is refused.
@@ -30,8 +31,8 @@ pub struct CalibrationJob {
 /// Calibrate `nominal` from `measurements` under `settings`, as `sagcal
 /// calibrate` does: check the settings ([`CalibrationSettings::options`]),
 /// calibrate with the gross-error tests ([`calibrate_checked`]), build the
-/// report (each pose named by its file line; in-memory data, line 0, by its
-/// 1-based row) and, for an inconsistent fit not accepted, the refusal.
+/// report (each pose named by its row and its file line,
+/// [`crate::model::DataRow`]) and, for an inconsistent fit not accepted, the refusal.
 /// `source` names the measurements in messages (the file as given); an error
 /// of the calibration says that no robot file is written.
 ///
@@ -67,16 +68,13 @@ pub fn calibrate_job(
             cause: Box::new(cause),
         },
     })?;
-    let lines: Vec<usize> = checked
+    let rows: Vec<DataRow> = checked
         .rows
         .iter()
-        .map(|&row| match measurements[row].line {
-            0 => row + 1,
-            line => line,
-        })
+        .map(|&row| DataRow::at(row, measurements[row].line))
         .collect();
     let report = CheckedReport {
-        report: CalibrationReport::new(&checked.result, nominal, options.model, &lines, None),
+        report: CalibrationReport::new(&checked.result, nominal, options.model, &rows, None),
         gross_errors: GrossErrorReport::new(&checked),
     };
     let refusal = match &checked.verdict {

@@ -42,7 +42,7 @@
 //! assert_eq!(found.len(), 2, "{found:#?}");
 //! assert_eq!(found[0].kind, MistakeKind::WrongUnit);
 //! assert!(found[0].message.contains("they look like kN, not N"), "{}", found[0].message);
-//! assert_eq!((found[1].kind, found[1].rows.clone()), (MistakeKind::OutsideFrame, vec![2]));
+//! assert_eq!((found[1].kind, found[1].indices()), (MistakeKind::OutsideFrame, vec![2]));
 //! assert!(found[1].message.starts_with("row 3"), "{}", found[1].message);
 //! let (kept, rows) = without_rows_outside(&data, &found);
 //! assert_eq!((kept.len(), rows), (7, vec![0, 1, 3, 4, 5, 6, 7]));
@@ -54,11 +54,12 @@ use serde::Serialize;
 
 use std::collections::HashMap;
 
-use super::snooping::{row_name, ExcludedReading};
+use super::snooping::{row_name, ExcludedReading, ReadingTest};
 use crate::model::measurement::{PoseMeasurement, Sensor};
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::statics::{cable_geometry, reference_tension_magnitude_guess};
+use crate::model::DataRow;
 
 /// What kind of mistake.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -83,11 +84,17 @@ pub struct Mistake {
     pub kind: MistakeKind,
     /// What it is, naming rows, sensors and cables.
     pub message: String,
-    /// The rows concerned (0-based indices into the measurements given).
-    pub rows: Vec<usize>,
+    /// The rows concerned, as reports name them (`row` from 1, in the
+    /// measurements given, and `line`).
+    pub rows: Vec<DataRow>,
 }
 
 impl Mistake {
+    /// The 0-based indices of [`Mistake::rows`] in the measurements given.
+    pub fn indices(&self) -> Vec<usize> {
+        self.rows.iter().map(|r| r.row - 1).collect()
+    }
+
     /// Whether the mistake is a whole sensor in the wrong unit (no single
     /// reading is to blame; the data must be fixed).
     pub fn is_unit_mistake(&self) -> bool {
@@ -113,7 +120,7 @@ pub fn without_rows_outside(measurements: &[PoseMeasurement], found: &[Mistake])
     let outside: Vec<usize> = found
         .iter()
         .filter(|m| m.kind == MistakeKind::OutsideFrame)
-        .flat_map(|m| m.rows.iter().copied())
+        .flat_map(Mistake::indices)
         .collect();
     (0..measurements.len())
         .filter(|k| !outside.contains(k))
@@ -206,7 +213,7 @@ fn outside_frame(initial: &Robot, measurements: &[PoseMeasurement]) -> Vec<Mista
         })
         .map(|(k, m)| Mistake {
             kind: MistakeKind::OutsideFrame,
-            rows: vec![k],
+            rows: vec![DataRow::at(k, m.line)],
             message: format!(
                 "{}: the localiser's position [{:.3}, {:.3}, {:.3}] m is outside the robot's frame \
                  (x {:.2} .. {:.2}, y {:.2} .. {:.2}, below z = {:.2} m): no cable can hold the platform there; the row is left out",
@@ -289,7 +296,7 @@ fn swapped_cables(
                     found.push(Mistake {
                         kind: MistakeKind::SwappedCables,
                         message,
-                        rows: vec![rows[k]],
+                        rows: vec![DataRow::at(rows[k], measurements[k].line)],
                     });
                 }
             }
@@ -327,7 +334,7 @@ fn failing_poses(measurements: &[PoseMeasurement], rows: &[usize], excluded: &mu
         found.push(Mistake {
             kind: MistakeKind::FailingPose,
             message,
-            rows: vec![rows[k]],
+            rows: vec![DataRow::at(rows[k], measurements[k].line)],
         });
     }
     found
@@ -395,8 +402,13 @@ pub fn name_step(cable: usize, rows: &[usize], excluded: &mut [ExcludedReading])
     Some(Mistake {
         kind: MistakeKind::Rehoming,
         message,
-        rows: mine.iter().map(|&x| rows[excluded[x].test.pose]).collect(),
+        rows: mine.iter().map(|&x| step_row(rows, &excluded[x].test)).collect(),
     })
+}
+
+/// The row of a reading left out, `rows[k]` being the row of the fit's pose `k`.
+fn step_row(rows: &[usize], test: &ReadingTest) -> DataRow {
+    DataRow::at(rows[test.pose], test.line)
 }
 
 fn rehoming(excluded: &mut [ExcludedReading], rows: &[usize]) -> Vec<Mistake> {
@@ -434,7 +446,7 @@ fn rehoming(excluded: &mut [ExcludedReading], rows: &[usize]) -> Vec<Mistake> {
         found.push(Mistake {
             kind: MistakeKind::Rehoming,
             message,
-            rows: mine.iter().map(|&x| rows[excluded[x].test.pose]).collect(),
+            rows: mine.iter().map(|&x| step_row(rows, &excluded[x].test)).collect(),
         });
     }
     found

@@ -37,6 +37,7 @@ use super::options::CableModel;
 use super::result::{CalibrationResult, FactorStatistics, OrientationCheck, ParameterUncertainty, StageSummary};
 use super::uncertainty::CalibrationError;
 use crate::model::robot::{Robot, CABLE_COUNT};
+use crate::model::DataRow;
 use crate::solver::Termination;
 
 /// Everything a user needs from one calibration.
@@ -48,8 +49,9 @@ pub struct CalibrationReport {
     pub model: CableModel,
     /// Number of poses in the final solve.
     pub poses_used: usize,
-    /// File lines (or 1-based indices for in-memory data) of poses left out: no equilibrium near them.
-    pub excluded_poses: Vec<usize>,
+    /// Poses left out, no equilibrium being near them: each its `row` (from
+    /// 1, in the data given) and `line` (`null` for in-memory data).
+    pub excluded_poses: Vec<DataRow>,
     /// Calibrated anchors, world frame, metres (4 x 3).
     pub anchors_m: Vec<[f64; 3]>,
     /// 1-sigma of each anchor coordinate, metres (`null` where not observable).
@@ -81,12 +83,13 @@ pub struct CalibrationReport {
 }
 
 impl CalibrationReport {
-    /// Build the report; `lines[k]` names pose `k` in messages.
+    /// Build the report; `rows[k]` names the fit's pose `k` (without it:
+    /// its 1-based index, no line).
     pub fn new(
         result: &CalibrationResult,
         nominal: &Robot,
         model: CableModel,
-        lines: &[usize],
+        rows: &[DataRow],
         truth: Option<&Robot>,
     ) -> Self {
         let (anchor_sigma_m, offset_sigma_m) = match &result.uncertainty {
@@ -105,7 +108,7 @@ impl CalibrationReport {
             excluded_poses: result
                 .excluded_poses
                 .iter()
-                .map(|&k| lines.get(k).copied().unwrap_or(k + 1))
+                .map(|&k| rows.get(k).copied().unwrap_or(DataRow::at(k, 0)))
                 .collect(),
             anchors_m: result.robot.anchors_m.iter().map(|a| [a.x, a.y, a.z]).collect(),
             anchor_sigma_m,

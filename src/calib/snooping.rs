@@ -15,6 +15,7 @@ use crate::error::{Error, Result};
 use crate::graph::VariableId;
 use crate::model::measurement::{PoseMeasurement, Sensor};
 use crate::model::robot::CABLE_COUNT;
+use crate::model::DataRow;
 use crate::solver::redundancy_numbers;
 use crate::stats::{chi_square_critical, chi_square_survival};
 
@@ -22,11 +23,17 @@ use crate::stats::{chi_square_critical, chi_square_survival};
 const READING_KINDS: [&str; 4] = ["catenary_length", "rigid_length", "reference_tension", "pose_prior"];
 
 /// The data-snooping test of one reading.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+///
+/// Its JSON names the reading as every report does
+/// ([`crate::model::DataRow`]): `row` (from 1), `line` (`null` without a
+/// file), `sensor` (`encoder`, `load_cell`, `position`, `orientation`),
+/// `cable` (from 1, for an encoder) and `axis` (`x`, `y`, `z`, for the
+/// localiser), then the numbers.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReadingTest {
-    /// Index of the pose in the measurements given (0-based).
+    /// Index of the pose in the measurements given (0-based; `row` - 1 in JSON).
     pub pose: usize,
-    /// Line of the pose in its file (0: in-memory data).
+    /// Line of the pose in its file (0: in-memory data, `null` in JSON).
     pub line: usize,
     /// The reading.
     pub sensor: Sensor,
@@ -45,7 +52,7 @@ pub struct ReadingTest {
 }
 
 impl ReadingTest {
-    /// `row 10 (line 11), encoder of cable 1: 5.000 m off, w = 49.2`.
+    /// `row 10 (line 12), encoder of cable 1: +5.0000 m off, w = 49.2`.
     pub fn describe(&self) -> String {
         let (value, unit) = match self.sensor {
             Sensor::Encoder(_) | Sensor::Position(_) => (format!("{:+.4}", self.estimated_error), "m"),
@@ -61,13 +68,48 @@ impl ReadingTest {
     }
 }
 
-/// `row 10 (line 11)` or `row 10` for in-memory data.
-pub fn row_name(pose: usize, line: usize) -> String {
-    if line > 0 {
-        format!("row {} (line {line})", pose + 1)
-    } else {
-        format!("row {}", pose + 1)
+impl Serialize for ReadingTest {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> std::result::Result<S::Ok, S::Error> {
+        /// The JSON of a [`ReadingTest`].
+        #[derive(Serialize)]
+        struct Json {
+            #[serde(flatten)]
+            at: DataRow,
+            sensor: &'static str,
+            cable: Option<usize>,
+            axis: Option<&'static str>,
+            residual: f64,
+            sigma: f64,
+            redundancy: f64,
+            w: f64,
+            estimated_error: f64,
+        }
+        const AXES: [&str; 3] = ["x", "y", "z"];
+        let (sensor, cable, axis) = match self.sensor {
+            Sensor::Encoder(i) => ("encoder", Some(i + 1), None),
+            Sensor::LoadCell => ("load_cell", None, None),
+            Sensor::Position(a) => ("position", None, AXES.get(a).copied()),
+            Sensor::Orientation(a) => ("orientation", None, AXES.get(a).copied()),
+        };
+        Json {
+            at: DataRow::at(self.pose, self.line),
+            sensor,
+            cable,
+            axis,
+            residual: self.residual,
+            sigma: self.sigma,
+            redundancy: self.redundancy,
+            w: self.w,
+            estimated_error: self.estimated_error,
+        }
+        .serialize(serializer)
     }
+}
+
+/// `row 10 (line 12)` or `row 10` for in-memory data (line 0): the pose of
+/// 0-based index `pose` as [`DataRow`] names it.
+pub fn row_name(pose: usize, line: usize) -> String {
+    DataRow::at(pose, line).to_string()
 }
 
 /// The chi-square test of one sensor type.

@@ -66,8 +66,10 @@ pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
     let source = args.data.display().to_string();
     let mut job = calibrate_job(&nominal, &data.poses, &source, &settings, FrontEnd::Cli)?;
     if let Some(refusal) = job.refusal.take() {
-        // Nothing is written: the report goes out, then the error names the sensors.
-        if !args.json {
+        // Nothing is written: the report goes out (as text or JSON), then the error names the sensors.
+        if args.json {
+            print_json(&job.report)?;
+        } else {
             print!("{}", render(&job.report.report, &job.options));
             print!("{}", gross_errors::render(&job.report.gross_errors));
         }
@@ -92,8 +94,9 @@ pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
     } else {
         print!("{}", render(&job.report.report, &job.options));
         print!("{}", gross_errors::render(&job.report.gross_errors));
-        if let Some(out) = &args.out {
-            println!("calibrated robot written to {}", out.display());
+        match &args.out {
+            Some(out) => println!("calibrated robot written to {}", out.display()),
+            None => println!("the calibrated robot was not saved: no --out given (--out calibrated.toml writes it)"),
         }
         if let Some(plot) = &args.plot {
             println!("plot written to {}", plot.display());
@@ -254,10 +257,11 @@ pub fn render(report: &CalibrationReport, options: &CalibrationOptions) -> Strin
     }
     out += &stages.to_string();
     if !report.excluded_poses.is_empty() {
+        let rows: Vec<String> = report.excluded_poses.iter().map(ToString::to_string).collect();
         out += &format!(
-            "\nWARNING: {} poses left out (no positive-tension equilibrium near them): lines {:?}\n",
+            "\nWARNING: {} poses left out (no positive-tension equilibrium near them): {}\n",
             report.excluded_poses.len(),
-            report.excluded_poses
+            rows.join(", ")
         );
     }
     if !report.converged {

@@ -74,8 +74,7 @@ pub fn run(args: &DemoArgs) -> sagcal::Result<()> {
     let result = calibrate(&guess, &data, &options)?;
     let elapsed_ms = started.elapsed().as_secs_f64() * 1e3;
     let bound = cramer_rao_bound(&truth, &equilibria, &options.as_used_by(&result))?;
-    let lines: Vec<usize> = (1..=data.len()).collect();
-    let report = CalibrationReport::new(&result, &guess, options.model, &lines, Some(&truth));
+    let report = CalibrationReport::new(&result, &guess, options.model, &[], Some(&truth));
 
     let data_path = write_files(args, &data, &truth, &guess, &result)?;
     if args.json {

@@ -10,6 +10,7 @@ use sagcal::io::readings::{read_readings, ReadingsFile, ReadingsFormat};
 use sagcal::io::recurdyn::RejectedRow;
 use sagcal::localize::{require_pose_priors, LocalizeSettings, Localized, Localizer, Readings};
 use sagcal::model::pose::PlatformPose;
+use sagcal::model::DataRow;
 use sagcal::model::Robot;
 use sagcal::plot::localize::{localize_plot_svg, LocalizePlot, PlottedPose};
 
@@ -65,8 +66,9 @@ fn covariance_note(robot: &Robot, used: bool) -> &'static str {
 /// One row of the report.
 #[derive(Debug, Clone, Serialize)]
 struct RowReport {
-    /// 1-based line of the input.
-    row: usize,
+    /// The row (from 1) and its line in the input (`null` without a file).
+    #[serde(flatten)]
+    at: DataRow,
     position_m: Option<[f64; 3]>,
     roll_pitch_yaw_deg: Option<[f64; 3]>,
     tensions_n: Option<[f64; 4]>,
@@ -192,10 +194,11 @@ fn localize_file(
     let solved = localizer.localize_sequence(&readings, search, &mut || false)?;
     let mut rows = Vec::with_capacity(file.rows.len());
     let mut plotted = Vec::new();
-    for (row, solved) in file.rows.iter().zip(solved) {
+    for (k, (row, solved)) in file.rows.iter().zip(solved).enumerate() {
+        let at = DataRow::at(k, row.line);
         let report = match &solved.found {
             Ok(found) => {
-                let mut report = row_report(row.line, found, solved.flag, row.localiser_pose.as_ref());
+                let mut report = row_report(at, found, solved.flag, row.localiser_pose.as_ref());
                 if let Some(search) = solved.search {
                     report.equilibria = Some(search.equilibria);
                     report.stable_equilibria = Some(search.stable);
@@ -203,7 +206,7 @@ fn localize_file(
                 }
                 let total = found.covariance + found.calibration_covariance.unwrap_or_default();
                 plotted.push(PlottedPose {
-                    row: row.line,
+                    row: at.row,
                     position_m: found.pose.position_m.into(),
                     covariance_m2: Some(std::array::from_fn(|r| std::array::from_fn(|c| total[(3 + r, 3 + c)]))),
                     reference_m: row.localiser_pose.map(|p| p.position_m.into()),
@@ -211,7 +214,7 @@ fn localize_file(
                 });
                 report
             }
-            Err(why) => flagged(row.line, why.to_string()),
+            Err(why) => flagged(at, why.to_string()),
         };
         rows.push(report);
     }
@@ -246,10 +249,10 @@ fn rms_of(values: impl Iterator<Item = f64>) -> Option<f64> {
     (n > 0).then(|| (sum / n as f64).sqrt())
 }
 
-fn row_report(line: usize, found: &Localized, flag: Option<String>, localiser: Option<&PlatformPose>) -> RowReport {
+fn row_report(at: DataRow, found: &Localized, flag: Option<String>, localiser: Option<&PlatformPose>) -> RowReport {
     let (roll, pitch, yaw) = found.pose.roll_pitch_yaw_deg();
     RowReport {
-        row: line,
+        at,
         position_m: Some(found.pose.position_m.into()),
         roll_pitch_yaw_deg: Some([roll, pitch, yaw]),
         tensions_n: Some(found.tension_magnitudes_n()),
@@ -270,9 +273,9 @@ fn row_report(line: usize, found: &Localized, flag: Option<String>, localiser: O
     }
 }
 
-fn flagged(line: usize, reason: String) -> RowReport {
+fn flagged(at: DataRow, reason: String) -> RowReport {
     RowReport {
-        row: line,
+        at,
         position_m: None,
         roll_pitch_yaw_deg: None,
         tensions_n: None,
@@ -306,6 +309,7 @@ fn render(report: &Report) -> String {
     );
     let mut table = Table::new([
         "row",
+        "line",
         "x m",
         "y m",
         "z m",
@@ -332,7 +336,7 @@ fn render(report: &Report) -> String {
         let a = r.roll_pitch_yaw_deg.unwrap_or_default();
         let t = r.tensions_n.unwrap_or_default();
         let s = r.position_sigma_m.unwrap_or_default();
-        let mut cells = vec![r.row.to_string()];
+        let mut cells = vec![r.at.row.to_string(), r.at.line.map_or("-".into(), |l| l.to_string())];
         cells.extend(p.iter().map(|v| format!("{v:.4}")));
         cells.extend(a.iter().map(|v| format!("{v:.3}")));
         cells.extend(t.iter().map(|v| format!("{v:.2}")));
@@ -350,10 +354,10 @@ fn render(report: &Report) -> String {
     }
     out += &table.to_string();
     for r in report.rows.iter().filter(|r| r.flag.is_some()) {
-        out += &format!("row {}: {}\n", r.row, r.flag.as_deref().unwrap_or(""));
+        out += &format!("{}: {}\n", r.at, r.flag.as_deref().unwrap_or(""));
     }
     for r in &report.rejected {
-        out += &format!("row {} left out by the loader: {}\n", r.line, r.reason);
+        out += &format!("line {} left out by the loader: {}\n", r.line, r.reason);
     }
     out += &format!(
         "\nrows localised: {}, flagged: {}\n",
@@ -376,10 +380,11 @@ fn render(report: &Report) -> String {
     out
 }
 
-/// The poses as CSV (one line per input row; a flagged row's values empty).
+/// The poses as CSV (one line per input row, named by its row and its
+/// line in the input, empty without a file; a flagged row's values empty).
 fn render_csv(report: &Report) -> String {
     let mut out = String::from(
-        "row,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,t1_n,t2_n,t3_n,t4_n,sigma_x_m,sigma_y_m,sigma_z_m,chi_square,dof,consistent,stable,position_error_m,flag\n",
+        "row,line,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,t1_n,t2_n,t3_n,t4_n,sigma_x_m,sigma_y_m,sigma_z_m,chi_square,dof,consistent,stable,position_error_m,flag\n",
     );
     let join = |v: Option<&[f64]>, n: usize| -> String {
         v.map_or_else(
@@ -389,8 +394,9 @@ fn render_csv(report: &Report) -> String {
     };
     for r in &report.rows {
         out += &format!(
-            "{},{},{},{},{},{},{},{},{},{},{}\n",
-            r.row,
+            "{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            r.at.row,
+            r.at.line.map_or(String::new(), |l| l.to_string()),
             join(r.position_m.as_ref().map(|v| &v[..]), 3),
             join(r.roll_pitch_yaw_deg.as_ref().map(|v| &v[..]), 3),
             join(r.tensions_n.as_ref().map(|v| &v[..]), 4),

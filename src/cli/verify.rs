@@ -99,6 +99,7 @@ fn render(report: &VerifyReport) -> String {
     );
     let mut table = Table::new([
         "row",
+        "line",
         "x m",
         "y m",
         "z m",
@@ -117,7 +118,8 @@ fn render(report: &VerifyReport) -> String {
     ]);
     for r in &report.rows {
         let mut cells = vec![
-            r.line.to_string(),
+            r.at.row.to_string(),
+            r.at.line.map_or("-".into(), |l| l.to_string()),
             format!("{:.3}", r.position_m[0]),
             format!("{:.3}", r.position_m[1]),
             format!("{:.3}", r.position_m[2]),
@@ -140,9 +142,12 @@ fn render(report: &VerifyReport) -> String {
 fn render_left_out(report: &VerifyReport) -> String {
     let mut out = String::new();
     if !report.rows_rejected.is_empty() {
-        out += &format!("rejected rows ({}):\n", report.rows_rejected.len());
+        out += &format!(
+            "rejected rows ({}, named by their line and not counted as rows):\n",
+            report.rows_rejected.len()
+        );
         for r in &report.rows_rejected {
-            out += &format!("  row {:>3}: {}\n", r.line, r.reason);
+            out += &format!("  line {:>3}: {}\n", r.line, r.reason);
         }
         out += "\n";
     }
@@ -152,7 +157,7 @@ fn render_left_out(report: &VerifyReport) -> String {
             report.rows_unsolved.len()
         );
         for r in &report.rows_unsolved {
-            out += &format!("  row {:>3}: {}\n", r.line, r.reason);
+            out += &format!("  {}: {}\n", r.at, r.reason);
         }
         out += "\n";
     }
@@ -178,8 +183,8 @@ fn render_orientation(report: &VerifyReport) -> String {
         out += "rows whose angles fit far better with permuted columns:\n";
         for s in &report.suspect_orientation_rows {
             out += &format!(
-                "  row {:>3}: {:.2} deg as documented, {:.2} deg as {}\n",
-                s.line, s.documented_error_deg, s.best_error_deg, s.best_convention
+                "  {}: {:.2} deg as documented, {:.2} deg as {}\n",
+                s.at, s.documented_error_deg, s.best_error_deg, s.best_convention
             );
         }
     }

@@ -85,6 +85,7 @@ mod explanation;
 mod fitted_graph;
 mod missing_terms;
 mod options;
+mod paper_table1;
 mod pipeline;
 mod prediction;
 mod progress;

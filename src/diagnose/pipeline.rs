@@ -222,8 +222,10 @@ fn screen_gross_errors(
         free_effects: EffectSet::NONE,
         ..options.calibration
     };
-    let checked = calibrate_checked(robot, measurements, &base_options, &check)
-        .map_err(|e| Error::InvalidInput(format!("diagnose: {e}")))?;
+    let checked = calibrate_checked(robot, measurements, &base_options, &check).map_err(|e| match e {
+        Error::InvalidInput(why) => Error::InvalidInput(format!("diagnose: {why}")),
+        other => other,
+    })?;
     let consistent = checked.verdict == Verdict::Consistent;
     let specific = |x: &ExcludedReading| {
         checked.mistakes.iter().any(|m| {
@@ -251,7 +253,7 @@ fn screen_gross_errors(
         .mistakes
         .iter()
         .filter(|m| m.kind == MistakeKind::OutsideFrame)
-        .flat_map(|m| m.rows.iter().copied())
+        .flat_map(Mistake::indices)
         .collect();
     let cleaned = (0..cleaned.len())
         .filter(|k| !outside.contains(k))

@@ -32,7 +32,7 @@
 //! use sagcal::diagnose::verify::{paper_table1, verify, Closure, LengthKind, MeasuredData, MeasuredRow};
 //! use sagcal::model::robot::PaperRobot;
 //! use sagcal::model::statics::StaticsOptions;
-//! use sagcal::model::Robot;
+//! use sagcal::model::{DataRow, Robot};
 //! use sagcal::sim::closed_form::{sample_equilibria, Workspace};
 //! let robot = Robot::builtin("large")?;
 //! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
@@ -44,7 +44,7 @@
 //!     .map(|(k, eq)| {
 //!         let (roll, pitch, yaw) = eq.pose.roll_pitch_yaw_deg();
 //!         MeasuredRow {
-//!             line: k + 2,
+//!             at: DataRow::at(k, k + 2),
 //!             position_m: eq.pose.position_m.into(),
 //!             roll_pitch_yaw_deg: [roll, pitch, yaw],
 //!             cable_lengths_m: eq.cable_lengths_m,
@@ -75,42 +75,17 @@ use crate::calib::predict_with_effects;
 use crate::error::Error;
 use crate::io::measurements::MeasurementSet;
 use crate::io::recurdyn::{RecurDynLog, RejectedRow};
-use crate::model::pose::PlatformPose;
-use crate::model::robot::{PaperRobot, Robot, CABLE_COUNT};
+use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::statics::{self, Equilibrium, StaticsOptions};
+use crate::model::{DataRow, PlatformPose};
 
-/// One robot's column of the paper's Table I (model verification).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct PaperTable1 {
-    /// The paper's robot the column is for.
-    pub robot: PaperRobot,
-    /// Static poses the paper verified on.
-    pub poses: usize,
-    /// Mean percentage error of the predicted cable lengths (MPE-L), %.
-    pub mpe_length_pct: f64,
-    /// Mean percentage error of the predicted cable forces (MPE-F), %.
-    pub mpe_force_pct: f64,
-}
-
-/// The paper's Table I column for `robot` (both columns over 5 random poses).
-pub fn paper_table1(robot: PaperRobot) -> PaperTable1 {
-    let (mpe_length_pct, mpe_force_pct) = match robot {
-        PaperRobot::Large => (8.8947e-3, 0.9154),
-        PaperRobot::Small => (7.3595e-3, 0.9046),
-    };
-    PaperTable1 {
-        robot,
-        poses: 5,
-        mpe_length_pct,
-        mpe_force_pct,
-    }
-}
+pub use super::paper_table1::{paper_table1, PaperTable1};
 
 /// What one row of the data measured at a static pose.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeasuredRow {
-    /// Line number in the data file.
-    pub line: usize,
+    /// The row (from 1, among the rows kept) and its line in the data file.
+    pub at: DataRow,
     /// Platform position, metres.
     pub position_m: [f64; 3],
     /// Angles as the file gives them, degrees: `[pitch, roll, yaw]` columns read as roll, pitch, yaw.
@@ -151,8 +126,9 @@ impl MeasuredData {
         let rows = log
             .rows
             .iter()
-            .map(|row| MeasuredRow {
-                line: row.line,
+            .enumerate()
+            .map(|(k, row)| MeasuredRow {
+                at: DataRow::at(k, row.line),
                 position_m: row.position_m,
                 roll_pitch_yaw_deg: [row.roll_deg, row.pitch_deg, row.yaw_deg],
                 cable_lengths_m: row.cable_lengths_m,
@@ -173,8 +149,9 @@ impl MeasuredData {
         let rows = set
             .poses
             .iter()
-            .map(|m| MeasuredRow {
-                line: m.line,
+            .enumerate()
+            .map(|(k, m)| MeasuredRow {
+                at: DataRow::at(k, m.line),
                 position_m: m.position_m,
                 roll_pitch_yaw_deg: [m.roll_deg, m.pitch_deg, m.yaw_deg],
                 cable_lengths_m: m.encoder_lengths_m,
@@ -203,8 +180,9 @@ pub enum Closure {
 /// Prediction against measurement for one row.
 #[derive(Debug, Clone, Serialize)]
 pub struct RowVerification {
-    /// Line number in the data file.
-    pub line: usize,
+    /// The row and its line in the data file (`row`, `line` in JSON).
+    #[serde(flatten)]
+    pub at: DataRow,
     /// Measured position, metres.
     pub position_m: [f64; 3],
     /// Measured cable lengths (or encoder readings), metres.
@@ -233,8 +211,9 @@ pub struct RowVerification {
 /// A row the statics could not solve (no equilibrium with positive tensions).
 #[derive(Debug, Clone, Serialize)]
 pub struct UnsolvedRow {
-    /// Line number in the data file.
-    pub line: usize,
+    /// The row and its line in the data file (`row`, `line` in JSON).
+    #[serde(flatten)]
+    pub at: DataRow,
     /// Why.
     pub reason: String,
 }
@@ -253,8 +232,9 @@ pub struct OrientationConventionFit {
 /// A row whose angles match the model far better with their columns permuted.
 #[derive(Debug, Clone, Serialize)]
 pub struct SuspectOrientationRow {
-    /// Line number in the data file.
-    pub line: usize,
+    /// The row and its line in the data file (`row`, `line` in JSON).
+    #[serde(flatten)]
+    pub at: DataRow,
     /// Error with the documented convention, degrees.
     pub documented_error_deg: f64,
     /// The best alternative reading.
@@ -322,8 +302,8 @@ fn solve_row(
         Closure::ReferenceTension => {
             let measured = row.tensions_n[robot.reference_cable].ok_or_else(|| {
                 crate::Error::InvalidInput(format!(
-                    "row {}: no tension for the reference cable {}",
-                    row.line,
+                    "{}: no tension for the reference cable {}",
+                    row.at,
                     robot.reference_cable + 1
                 ))
             })?;
@@ -337,8 +317,8 @@ fn solve_row(
             }
         }
         Closure::CableLengths if !robot.effects.is_none() => Err(crate::Error::InvalidInput(format!(
-            "row {}: the cable-lengths closure does not apply the robot file's [effects] ({}); use the reference-tension closure",
-            row.line, robot.effects
+            "{}: the cable-lengths closure does not apply the robot file's [effects] ({}); use the reference-tension closure",
+            row.at, robot.effects
         ))),
         Closure::CableLengths => {
             let cable_lengths = std::array::from_fn(|i| row.cable_lengths_m[i] - offset(robot, lengths, i));
@@ -533,7 +513,7 @@ fn compare_row(
     });
     let (r, p, y) = equilibrium.pose.roll_pitch_yaw_deg();
     RowVerification {
-        line: row.line,
+        at: row.at,
         position_m: row.position_m,
         measured_length_m: row.cable_lengths_m,
         predicted_length_m,
@@ -553,7 +533,7 @@ fn compare_row(
 /// Each reading of the angle columns against the model's orientations, best
 /// first, and the rows that a permuted reading explains far better.
 fn orientation_analysis(
-    solved: &[(usize, [f64; 3], UnitQuaternion<f64>)],
+    solved: &[(DataRow, [f64; 3], UnitQuaternion<f64>)],
 ) -> (Vec<OrientationConventionFit>, Vec<SuspectOrientationRow>) {
     let readings = AngleReading::all();
     let errors_per_reading: Vec<Vec<f64>> = readings
@@ -582,7 +562,7 @@ fn orientation_analysis(
     let suspects = solved
         .iter()
         .enumerate()
-        .filter_map(|(k, (line, _, _))| {
+        .filter_map(|(k, (at, _, _))| {
             let documented = errors_per_reading[0][k];
             let (best, best_error) = readings
                 .iter()
@@ -593,7 +573,7 @@ fn orientation_analysis(
             // A different reading of the columns explains the row at least twice as well,
             // and the documented one is off by more than the typical 2 degrees.
             (best_error < 0.5 * documented && documented > 2.0).then(|| SuspectOrientationRow {
-                line: *line,
+                at: *at,
                 documented_error_deg: documented,
                 best_convention: best.name(),
                 best_error_deg: best_error,
@@ -627,9 +607,9 @@ pub fn nothing_verified(report: &VerifyReport) -> Option<Error> {
     }
     let why = match report.rows_unsolved.first() {
         Some(first) => format!(
-            "the statics solved none of its {} kept rows with this robot (line {}: {}{})",
+            "the statics solved none of its {} kept rows with this robot ({}: {}{})",
             report.rows_kept,
-            first.line,
+            first.at,
             first.reason,
             if report.rows_unsolved.len() > 1 {
                 "; the others alike or listed above"
@@ -658,10 +638,10 @@ pub fn verify(robot: &Robot, data: &MeasuredData, closure: Closure, options: &St
             Ok(equilibrium) => {
                 rows.push(compare_row(robot, row, data.lengths, closure, &equilibrium));
                 let [roll, pitch, yaw] = row.roll_pitch_yaw_deg;
-                solved_orientations.push((row.line, [pitch, roll, yaw], equilibrium.pose.rotation));
+                solved_orientations.push((row.at, [pitch, roll, yaw], equilibrium.pose.rotation));
             }
             Err(e) => unsolved.push(UnsolvedRow {
-                line: row.line,
+                at: row.at,
                 reason: e.to_string(),
             }),
         }

@@ -14,7 +14,8 @@
 //! use sagcal::error::{CalibrationError, FrontEnd};
 //! let refused = refusal("m.csv", "the load cell fails", FrontEnd::Cli);
 //! assert!(matches!(refused, sagcal::Error::Calibration(CalibrationError::Refused { .. })));
-//! assert!(refused.to_string().starts_with("invalid input: m.csv: the calibration fails its own consistency tests"));
+//! // A refusal, not an input error: the message says so and nothing else.
+//! assert!(refused.to_string().starts_with("m.csv: the calibration fails its own consistency tests"));
 //! ```
 
 /// A calibration that gives no robot file.

@@ -33,13 +33,17 @@ pub enum Error {
         /// What is wrong with it.
         message: String,
     },
-    /// One field of one row of a data file is wrong.
-    #[error("{path}: row {row}, field `{field}`: {message}")]
+    /// One field of one row of a data file is wrong: `m.csv: row 10 (line
+    /// 12), field `f_ref_n`: ...` (rows as [`crate::model::DataRow`] counts them).
+    #[error("{path}: {}, field `{field}`: {message}", row_and_line(.row, .line))]
     Field {
-        /// The file.
+        /// The file (or what holds the data, `measurements` for an array).
         path: PathBuf,
-        /// 1-based line number in the file (the header is line 1).
+        /// The row, counted from 1 among the file's data rows (an array's rows).
         row: usize,
+        /// Its line in the file (from 1, the header and comments counted);
+        /// `None` for data that were not read from a file.
+        line: Option<usize>,
         /// The column name.
         field: String,
         /// What is wrong with the value.
@@ -62,11 +66,13 @@ pub enum Error {
     /// The solver failed; the message names the stage or computation.
     #[error("solver: {0}")]
     Solver(#[source] SolverError),
-    /// A calibration gives no robot file: refused, or one of its steps failed.
-    #[error("invalid input: {0}")]
+    /// A calibration gives no robot file: refused, or readings off by a unit.
+    #[error(transparent)]
     Calibration(#[from] CalibrationError),
-    /// A step of a calibration failed, so no robot file is written.
-    #[error("invalid input: {source_name}: no robot file is written: {cause}")]
+    /// A step of a calibration failed, so no robot file is written (the
+    /// message is the step's own after the source's name: `m.csv: no robot
+    /// file is written: invalid input: ...`).
+    #[error("{source_name}: no robot file is written: {cause}")]
     NotWritten {
         /// The measurements, as the caller named them.
         source_name: String,
@@ -86,6 +92,14 @@ pub enum Error {
     /// An effect specification is not one sagcal takes.
     #[error("invalid input: {0}")]
     EffectSpec(#[from] EffectSpecError),
+}
+
+/// `row 10 (line 12)`, or `row 10` without a file.
+fn row_and_line(row: &usize, line: &Option<usize>) -> String {
+    match line {
+        Some(line) => format!("row {row} (line {line})"),
+        None => format!("row {row}"),
+    }
 }
 
 /// Shorthand for `Result<T, sagcal::Error>`.

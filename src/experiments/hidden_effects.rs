@@ -580,7 +580,7 @@ pub fn run_sweep(
                     };
                     let case = simulated
                         .as_ref()
-                        .map_err(|e| Error::InvalidInput(e.to_string()))
+                        .map_err(|e| input_error("", e))
                         .and_then(|truth| {
                             let held_out = truth.held_out(*noise, options.segments)?;
                             Ok((truth.measure(*noise, options.segments)?, held_out))
@@ -596,9 +596,7 @@ pub fn run_sweep(
                             None => diagnose_case(&robots[*r], (set, seed), &case_options, data, &held_out)
                                 .map(|case| SweepCase::Diagnosed(Box::new(case))),
                         })
-                        .map_err(|e| {
-                            Error::InvalidInput(format!("{}: {e}", name(*r, set, format!("{noise:?}"), seed)))
-                        });
+                        .map_err(|e| input_error(&format!("{}: ", name(*r, set, format!("{noise:?}"), seed)), &e));
                     progress();
                     case
                 })
@@ -622,6 +620,15 @@ pub fn run_sweep(
         }
     }
     Ok(cases)
+}
+
+/// `error` as an input error with `context` before its message, without a
+/// second `invalid input: ` when it is one already.
+fn input_error(context: &str, error: &Error) -> Error {
+    match error {
+        Error::InvalidInput(why) => Error::InvalidInput(format!("{context}{why}")),
+        other => Error::InvalidInput(format!("{context}{other}")),
+    }
 }
 
 #[cfg(test)]

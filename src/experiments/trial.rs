@@ -58,7 +58,7 @@ pub struct PoolPose {
 pub fn pose_pool(robot: &Robot, measurements: &[PoseMeasurement], source: Source) -> Result<Vec<PoolPose>> {
     let options = StaticsOptions::default();
     let mut pool = Vec::with_capacity(measurements.len());
-    for m in measurements {
+    for (k, m) in measurements.iter().enumerate() {
         let logged = m.localiser_pose();
         let equilibrium = statics::solve_with_reference_tension(
             robot,
@@ -67,7 +67,7 @@ pub fn pose_pool(robot: &Robot, measurements: &[PoseMeasurement], source: Source
             Some(logged.rotation),
             &options,
         )
-        .map_err(|e| Error::InvalidInput(format!("line {}: {e}", m.line)))?;
+        .map_err(|e| Error::InvalidInput(format!("{}: {e}", crate::model::DataRow::at(k, m.line))))?;
         let pose = match source {
             Source::Log => PoolPose {
                 line: m.line,

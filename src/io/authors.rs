@@ -45,8 +45,8 @@
 //! * Every value is a finite number; the four files have the same number of
 //!   lines (rows are paired by line number), at least one.
 //!
-//! Errors name the file, the line (1-based, every line counted) and the
-//! column; files that disagree on the number of rows are an error naming
+//! Errors name the file, the row and its line (the same number: the files
+//! have no header) and the column; files that disagree on the number of rows are an error naming
 //! both; a folder without the four files is an error listing the missing ones.
 //!
 //! ```
@@ -152,6 +152,7 @@ pub fn read_authors_folder(dir: &Path) -> Result<Vec<PoseMeasurement>> {
                 return Err(Error::Field {
                     path: forces_path.clone(),
                     row: k + 1,
+                    line: Some(k + 1),
                     field: "f_h_n".into(),
                     message: format!(
                         "the reference cable's force ({}, {}) N has norm {tension} N: the tension must be positive",
@@ -206,9 +207,11 @@ fn parse_line(path: &Path, row: usize, line: &str, columns: &[&str]) -> Result<V
     if fields.len() == columns.len() + 1 && fields.last().is_some_and(|f| f.is_empty()) {
         fields.pop();
     }
+    // The files have no header: row `row` is line `row`.
     let field_error = |index: usize, message: String| Error::Field {
         path: path.to_path_buf(),
         row,
+        line: Some(row),
         field: columns[index.min(columns.len() - 1)].to_string(),
         message,
     };

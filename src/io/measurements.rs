@@ -39,8 +39,8 @@
 //! 9.94283158474076,9.93145571155357,15.9060269359906,-1.06322173025346,-0.19122393512445,0.971850603803798,183.324069126233,169.162981532604,155.642263929178,170.927219368362,698.722056942942
 //! ```
 //!
-//! Errors name the file, the line (1-based, comments and blank lines counted)
-//! and the column. [`write_measurements`] writes numbers with full
+//! Errors name the file, the row (the data rows counted from 1), its line
+//! (from 1, the header, comments and blank lines counted) and the column. [`write_measurements`] writes numbers with full
 //! round-trip precision, so writing and reading back gives bit-identical values.
 //!
 //! # RecurDyn logs
@@ -77,7 +77,7 @@
 //! std::fs::write(&bad, "x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,l1_m,l2_m,l3_m,l4_m,f_ref_n\n\
 //!     9.94,9.93,15.9,-1.06,-0.19,0.97,183.32,169.16,155.64,170.93,-698.72\n").unwrap();
 //! let message = read_measurements(&bad, &ReadOptions::default()).unwrap_err().to_string();
-//! assert!(message.contains("bad.csv: row 2, field `f_ref_n`"), "{message}");
+//! assert!(message.contains("bad.csv: row 1 (line 2), field `f_ref_n`"), "{message}");
 //! # std::fs::remove_dir_all(&dir).unwrap();
 //! # Ok::<(), sagcal::Error>(())
 //! ```
@@ -252,7 +252,7 @@ pub fn read_measurements(path: &Path, options: &ReadOptions) -> Result<Measureme
         if is_blank(text) || is_comment(text) {
             continue;
         }
-        poses.push(parse_row(text, line, path)?);
+        poses.push(parse_row(text, (poses.len() + 1, line), path)?);
     }
     if poses.is_empty() {
         return Err(format_error(
@@ -475,8 +475,8 @@ fn sagcal_header_mismatch(fields: &[&str]) -> Option<String> {
     (fields.len() != N_COLUMNS).then(|| format!("{} columns, expected {N_COLUMNS}", fields.len()))
 }
 
-/// Parse one data row (line `line`, without its line ending).
-fn parse_row(text: &[u8], line: usize, path: &Path) -> Result<PoseMeasurement> {
+/// Parse one data row (the `row`-th, on line `line`, without its line ending).
+fn parse_row(text: &[u8], (row, line): (usize, usize), path: &Path) -> Result<PoseMeasurement> {
     let fields: Vec<&[u8]> = text.split(|b| *b == b',').collect();
     let n = fields.len();
     if n != N_COLUMNS {
@@ -493,7 +493,8 @@ fn parse_row(text: &[u8], line: usize, path: &Path) -> Result<PoseMeasurement> {
         };
         return Err(Error::Field {
             path: path.to_path_buf(),
-            row: line,
+            row,
+            line: Some(line),
             field,
             message: format!("wrong number of fields: expected {N_COLUMNS}, found {n} ({what})"),
         });
@@ -502,7 +503,8 @@ fn parse_row(text: &[u8], line: usize, path: &Path) -> Result<PoseMeasurement> {
     for (index, (raw, slot)) in fields.iter().zip(values.iter_mut()).enumerate() {
         let err = |message: String| Error::Field {
             path: path.to_path_buf(),
-            row: line,
+            row,
+            line: Some(line),
             field: MEASUREMENT_HEADER[index].to_string(),
             message,
         };
@@ -577,6 +579,7 @@ pub fn measurement_from_values(source: &Path, row: usize, values: &[f64; N_COLUM
             return Err(Error::Field {
                 path: source.to_path_buf(),
                 row,
+                line: None,
                 field: MEASUREMENT_HEADER[index].to_string(),
                 message,
             });
@@ -630,7 +633,7 @@ mod tests {
             let message = read_measurements(&path, &ReadOptions::default())
                 .unwrap_err()
                 .to_string();
-            assert!(message.contains("row 2, field `x_m`"), "{message}");
+            assert!(message.contains("row 1 (line 2), field `x_m`"), "{message}");
         }
     }
 

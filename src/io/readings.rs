@@ -16,7 +16,7 @@
 //! row). Encoder readings are any finite numbers (cable length plus the
 //! calibrated offset). Comments (`#`) and blank lines are ignored, as in the
 //! measurement file ([`crate::io::measurements`]). Errors name the file, the
-//! line and the column.
+//! row (the data rows counted from 1), its line and the column.
 //!
 //! Measurement files and RecurDyn logs are read by
 //! [`read_measurements`]: their localiser pose is kept (for comparison, or a
@@ -54,7 +54,8 @@ pub const READINGS_HEADER: [&str; 5] = ["l1_m", "l2_m", "l3_m", "l4_m", "f_ref_n
 /// One row of readings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReadingRow {
-    /// 1-based line in the file.
+    /// 1-based line in the file; 0 for readings that were not read from a
+    /// file (reports name a row as [`crate::model::DataRow`] does).
     pub line: usize,
     /// Encoder readings of cables 1..4, metres.
     pub encoder_lengths_m: [f64; CABLE_COUNT],
@@ -107,10 +108,12 @@ pub struct ReadingsFile {
     pub rejected: Vec<RejectedRow>,
 }
 
-fn field_error(path: &Path, row: usize, field: &str, message: String) -> Error {
+/// An [`Error::Field`] for the data row `row` on line `line`.
+fn field_error(path: &Path, (row, line): (usize, usize), field: &str, message: String) -> Error {
     Error::Field {
         path: path.to_path_buf(),
         row,
+        line: Some(line),
         field: field.into(),
         message,
     }
@@ -137,6 +140,7 @@ pub fn read_readings(path: &Path, reference_cable: usize) -> Result<ReadingsFile
     }
     let mut rows = Vec::new();
     for (line, text) in lines {
+        let at = (rows.len() + 1, line);
         let values: Vec<&str> = text
             .split(',')
             .map(|v| crate::io::measurements::unquote(v.trim()))
@@ -144,17 +148,18 @@ pub fn read_readings(path: &Path, reference_cable: usize) -> Result<ReadingsFile
         if values.len() != fields.len() {
             return Err(field_error(
                 path,
-                line,
+                at,
                 fields.last().copied().unwrap_or(""),
                 format!("expected {} fields, found {}", fields.len(), values.len()),
             ));
         }
-        let number =
-            |k: usize| -> Result<f64> {
-                values[k].parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
-                    field_error(path, line, fields[k], format!("`{}` is not a finite number", values[k]))
-                })
-            };
+        let number = |k: usize| -> Result<f64> {
+            values[k]
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| field_error(path, at, fields[k], format!("`{}` is not a finite number", values[k])))
+        };
         let mut encoder_lengths_m = [0.0; CABLE_COUNT];
         for (k, value) in encoder_lengths_m.iter_mut().enumerate() {
             *value = number(k)?;
@@ -165,7 +170,7 @@ pub fn read_readings(path: &Path, reference_cable: usize) -> Result<ReadingsFile
                 if f <= 0.0 {
                     return Err(field_error(
                         path,
-                        line,
+                        at,
                         "f_ref_n",
                         format!("tension {f} N must be positive"),
                     ));
@@ -247,6 +252,6 @@ mod tests {
         // Quotes around something that is not a number are still an error naming the field.
         std::fs::write(&path, "l1_m,l2_m,l3_m,l4_m\n1,\"x\",3,4\n").unwrap();
         let message = read_readings(&path, 0).unwrap_err().to_string();
-        assert!(message.contains("row 2, field `l2_m`"), "{message}");
+        assert!(message.contains("row 1 (line 2), field `l2_m`"), "{message}");
     }
 }

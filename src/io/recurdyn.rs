@@ -122,11 +122,11 @@ pub struct RecurDynRow {
     pub tensions: [Option<CableTensionReading>; 4],
 }
 
-/// A row left out for a data-quality reason.
+/// A row left out for a data-quality reason: named by its line alone, it is
+/// not counted among the rows read ([`crate::model::DataRow`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RejectedRow {
-    /// 1-based line number in the file (the header is line 1); `row` in JSON.
-    #[serde(rename = "row")]
+    /// 1-based line number in the file (the header is line 1).
     pub line: usize,
     /// Why the row was left out.
     pub reason: String,
@@ -229,13 +229,15 @@ pub fn read_recurdyn(path: &Path, options: &LoadOptions) -> Result<RecurDynLog> 
         rows: Vec::new(),
         rejected: Vec::new(),
     };
-    let mut kept_values: HashMap<[Option<u64>; N_DATA], usize> = HashMap::new();
-    let mut kept_poses: HashMap<[u64; N_POSE], usize> = HashMap::new();
+    // The first kept row (row, line) of each value and pose.
+    let mut kept_values: HashMap<[Option<u64>; N_DATA], (usize, usize)> = HashMap::new();
+    let mut kept_poses: HashMap<[u64; N_POSE], (usize, usize)> = HashMap::new();
 
     while read_filled_record(&mut reader, &mut record, path)? {
         let line = lines.line_of(&record);
-        let values = parse_record(&record, n_fields, line, path)?;
-        let row = build_row(&values, line, path)?;
+        let at = (log.rows.len() + 1, line);
+        let values = parse_record(&record, n_fields, at, path)?;
+        let row = build_row(&values, at, path)?;
 
         let value_key: [Option<u64>; N_DATA] = std::array::from_fn(|i| values[i].map(|v| float_key(v.value)));
         let pose_key: [u64; N_POSE] = std::array::from_fn(|i| value_key[i].unwrap_or(0));
@@ -249,19 +251,19 @@ pub fn read_recurdyn(path: &Path, options: &LoadOptions) -> Result<RecurDynLog> 
         .or_else(|| {
             kept_values
                 .get(&value_key)
-                .map(|first| format!("duplicate of row {first}"))
+                .map(|(row, first)| format!("duplicate of row {row} (line {first})"))
         })
         .or_else(|| {
             kept_poses
                 .get(&pose_key)
-                .map(|first| format!("same pose as row {first} with different tensions"))
+                .map(|(row, first)| format!("same pose as row {row} (line {first}) with different tensions"))
         });
 
         match reason {
             Some(reason) => log.rejected.push(RejectedRow { line, reason }),
             None => {
-                kept_values.insert(value_key, line);
-                kept_poses.insert(pose_key, line);
+                kept_values.insert(value_key, at);
+                kept_poses.insert(pose_key, at);
                 log.rows.push(row);
             }
         }
@@ -331,11 +333,13 @@ fn format_error(path: &Path, message: String) -> Error {
     }
 }
 
-/// An [`Error::Field`] for column `index` of `line`.
-fn field_error(path: &Path, line: usize, index: usize, message: String) -> Error {
+/// An [`Error::Field`] for column `index` of the data row `row` on line `line`
+/// (the rows kept before it counted, as reports count them).
+fn field_error(path: &Path, (row, line): (usize, usize), index: usize, message: String) -> Error {
     Error::Field {
         path: path.to_path_buf(),
-        row: line,
+        row,
+        line: Some(line),
         field: column_name(index),
         message,
     }
@@ -393,7 +397,7 @@ impl<'a> LineCounter<'a> {
 fn parse_record(
     record: &csv::ByteRecord,
     n_fields: usize,
-    line: usize,
+    at: (usize, usize),
     path: &Path,
 ) -> Result<[Option<Value>; N_DATA]> {
     let n = record.len();
@@ -405,7 +409,7 @@ fn parse_record(
         };
         return Err(field_error(
             path,
-            line,
+            at,
             index,
             format!(
                 "row has {n} field{}, the header {n_fields}: {what}",
@@ -417,19 +421,19 @@ fn parse_record(
     for (index, slot) in values.iter_mut().enumerate() {
         let raw = record.get(index).unwrap_or_default();
         let text = std::str::from_utf8(raw)
-            .map_err(|_| field_error(path, line, index, "not valid UTF-8 text".to_string()))?
+            .map_err(|_| field_error(path, at, index, "not valid UTF-8 text".to_string()))?
             .trim();
         if text.is_empty() {
             if index < N_REQUIRED {
-                return Err(field_error(path, line, index, "required value is empty".to_string()));
+                return Err(field_error(path, at, index, "required value is empty".to_string()));
             }
             continue;
         }
         let value: f64 = text
             .parse()
-            .map_err(|_| field_error(path, line, index, format!("not a number: `{text}`")))?;
+            .map_err(|_| field_error(path, at, index, format!("not a number: `{text}`")))?;
         if !value.is_finite() {
-            return Err(field_error(path, line, index, format!("not a finite number: `{text}`")));
+            return Err(field_error(path, at, index, format!("not a finite number: `{text}`")));
         }
         *slot = Some(Value {
             value,
@@ -454,7 +458,7 @@ fn written_decimals(text: &str) -> i32 {
 }
 
 /// Validate the values that must hold whatever the row's quality, and build the row.
-fn build_row(values: &[Option<Value>; N_DATA], line: usize, path: &Path) -> Result<RecurDynRow> {
+fn build_row(values: &[Option<Value>; N_DATA], at: (usize, usize), path: &Path) -> Result<RecurDynRow> {
     let req = |i: usize| values[i].map(|v| v.value).unwrap_or_default();
     let mut cable_lengths_m = [0.0; 4];
     for (c, length) in cable_lengths_m.iter_mut().enumerate() {
@@ -462,7 +466,7 @@ fn build_row(values: &[Option<Value>; N_DATA], line: usize, path: &Path) -> Resu
         if *length <= 0.0 {
             return Err(field_error(
                 path,
-                line,
+                at,
                 LEN + c,
                 format!("cable length must be positive, got {length}"),
             ));
@@ -470,10 +474,10 @@ fn build_row(values: &[Option<Value>; N_DATA], line: usize, path: &Path) -> Resu
     }
     let mut tensions = [None; 4];
     for (c, slot) in tensions.iter_mut().enumerate() {
-        *slot = cable_tension(values, c, line, path)?;
+        *slot = cable_tension(values, c, at, path)?;
     }
     Ok(RecurDynRow {
-        line,
+        line: at.1,
         position_m: [req(POS), req(POS + 1), req(POS + 2)],
         roll_deg: req(ROLL),
         pitch_deg: req(PITCH),
@@ -487,7 +491,7 @@ fn build_row(values: &[Option<Value>; N_DATA], line: usize, path: &Path) -> Resu
 fn cable_tension(
     values: &[Option<Value>; N_DATA],
     c: usize,
-    line: usize,
+    at: (usize, usize),
     path: &Path,
 ) -> Result<Option<CableTensionReading>> {
     let (ic, iz, ih) = (FORCE + 3 * c, FORCE + 3 * c + 1, FORCE + 3 * c + 2);
@@ -498,32 +502,22 @@ fn cable_tension(
         (_, _, Some(_)) => {
             return Err(field_error(
                 path,
-                line,
+                at,
                 ih,
                 format!("fh{k} is given but fc{k} and fz{k} are not both given"),
             ));
         }
         (Some(_), None, None) => {
-            return Err(field_error(
-                path,
-                line,
-                iz,
-                format!("fc{k} is given but fz{k} is empty"),
-            ));
+            return Err(field_error(path, at, iz, format!("fc{k} is given but fz{k} is empty")));
         }
         (None, Some(_), None) => {
-            return Err(field_error(
-                path,
-                line,
-                ic,
-                format!("fz{k} is given but fc{k} is empty"),
-            ));
+            return Err(field_error(path, at, ic, format!("fz{k} is given but fc{k} is empty")));
         }
     };
     if fc <= 0.0 {
         return Err(field_error(
             path,
-            line,
+            at,
             ic,
             format!("total tension must be positive, got {fc} N"),
         ));
@@ -531,7 +525,7 @@ fn cable_tension(
     if let Some(fh) = fh.filter(|fh| *fh < 0.0) {
         return Err(field_error(
             path,
-            line,
+            at,
             ih,
             format!("horizontal tension is a magnitude and cannot be negative, got {fh} N"),
         ));

@@ -61,8 +61,9 @@ impl LocalizeSettings {
 }
 
 /// With the localiser pose as a prior every row needs one: the error naming
-/// the first of `rows` (each its line in `path` and its localiser pose)
-/// without, and the option `pose_prior` as `front_end` spells it.
+/// the first of `rows` (each its line in `path`, 0 for data not read from a
+/// file, and its localiser pose) without, and the option `pose_prior` as
+/// `front_end` spells it.
 ///
 /// ```
 /// use std::path::Path;
@@ -72,7 +73,7 @@ impl LocalizeSettings {
 /// let message = require_pose_priors(Path::new("r.csv"), rows, FrontEnd::Python).unwrap_err().to_string();
 /// assert_eq!(
 ///     message,
-///     "r.csv: row 2, field `x_m`: pose_prior=True needs a localiser pose on every row; this file has none"
+///     "r.csv: row 1 (line 2), field `x_m`: pose_prior=True needs a localiser pose on every row; this file has none"
 /// );
 /// ```
 pub fn require_pose_priors(
@@ -80,10 +81,11 @@ pub fn require_pose_priors(
     rows: impl IntoIterator<Item = (usize, Option<PlatformPose>)>,
     front_end: FrontEnd,
 ) -> Result<()> {
-    match rows.into_iter().find(|(_, pose)| pose.is_none()) {
-        Some((line, _)) => Err(Error::Field {
+    match rows.into_iter().enumerate().find(|(_, (_, pose))| pose.is_none()) {
+        Some((k, (line, _))) => Err(Error::Field {
             path: path.to_path_buf(),
-            row: line,
+            row: k + 1,
+            line: (line > 0).then_some(line),
             field: "x_m".into(),
             message: format!(
                 "{} needs a localiser pose on every row; this file has none",

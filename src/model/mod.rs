@@ -3,7 +3,8 @@
 //! parameters ([`robot`]), the statics that balance the four cables against
 //! gravity (eq. 5-11, [`statics`]), the effects the paper's model lacks
 //! ([`effects`]), the sensors and their noise ([`sensors`]) and one pose's
-//! measurements ([`measurement`]); the geometry a suspended robot needs
+//! measurements ([`measurement`]) and how reports name a row of data
+//! ([`data_row`]); the geometry a suspended robot needs
 //! ([`geometry`]) and the magnitudes no real robot falls outside
 //! ([`plausibility`]); the typical magnitudes of each effect
 //! ([`effect_ranges`]) and the largest any real robot could show
@@ -29,6 +30,7 @@
 
 mod cables;
 pub mod catenary;
+pub mod data_row;
 pub mod effect_kind;
 pub mod effect_limits;
 pub mod effect_ranges;
@@ -43,6 +45,7 @@ pub mod sensors;
 pub mod statics;
 
 pub use catenary::Catenary;
+pub use data_row::DataRow;
 pub use effects::Effects;
 pub use measurement::PoseMeasurement;
 pub use pose::PlatformPose;

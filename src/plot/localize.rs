@@ -40,7 +40,7 @@ use super::svg::{esc, halo_text, n2, C_FRAME, C_GRID, C_MUTED, C_TEXT, FONT};
 /// One localised row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlottedPose {
-    /// 1-based line of the input.
+    /// The row, counted from 1 in the input (`DataRow::row`).
     pub row: usize,
     /// Localised position, world frame, metres.
     pub position_m: [f64; 3],
