@@ -22,6 +22,7 @@
 //! | [`graph`] | variables, the factor trait, noise, robust kernels ([`calib`]'s factors wrap [`generated`]) |
 //! | [`solver`] | sparse Levenberg-Marquardt: pattern, Schur / Cholesky, covariance |
 //! | [`calib`], [`diagnose`], [`localize`], [`plan`] | the jobs: staged calibration; residual tests, candidate effects, verdict; pose and tensions from the cable readings; the poses to visit (optimal design on the Cramer-Rao bound) |
+//! | [`check`] | what sagcal understood from a user's robot and data files, before any fit, and their likely mistakes |
 //! | [`experiments`] | Table II protocol, hidden effects, the benchmark problem |
 //! | [`plot`] | figures, SVG or PNG (rendered with a bundled font) |
 //! | the `sagcal` binary | a thin clap layer, one file per command |
@@ -51,6 +52,7 @@
 
 pub mod calib;
 pub mod cancel;
+pub mod check;
 pub mod diagnose;
 pub mod error;
 pub mod experiments;

@@ -63,6 +63,8 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "calib",
         ],
     ),
+    // What sagcal understood from a user's files: read with `io`, checked as `calib` checks them.
+    ("check", &["error", "stats", "model", "io", "sim", "calib"]),
     (
         "experiments",
         &[

@@ -14,6 +14,10 @@ in and out, the same jobs with the same options, results and error messages.
 - :func:`localize`: pose and tensions from the cable readings (``sagcal localize``).
 - :func:`plan`: the calibration poses that best determine the anchors, in a
   short visiting order (``sagcal plan``).
+- :func:`init_robot`: a new, commented robot file from your robot's
+  anchors, attachments and weights (``sagcal init``).
+- :func:`check`: what sagcal understood from a robot file and a data file,
+  before any fit, and their likely mistakes (``sagcal check``).
 - :func:`read_measurements`, :func:`write_measurements`: sagcal's CSV (and
   RecurDyn logs) as (N, 11) arrays in the columns of :data:`MEASUREMENT_COLUMNS`.
 
@@ -65,7 +69,9 @@ from ._sagcal import (
 # anything but a SagcalError, and Ctrl-C raising KeyboardInterrupt.
 _COUNT = (0, _SEED_LIMIT)
 calibrate = _entry(_sagcal.calibrate)
+check = _entry(_sagcal.check)
 diagnose = _entry(_sagcal.diagnose, ints={"folds": _COUNT}, lists=("candidates",))
+init_robot = _entry(_sagcal.init_robot)
 localize = _entry(_sagcal.localize)
 plan = _entry(_sagcal.plan, ints={"poses": _COUNT, "seed": _COUNT})
 read_measurements = _entry(_sagcal.read_measurements, ints={"reference_cable": (1, 5)})
@@ -92,7 +98,9 @@ __all__ = [
     "SolverError",
     "__version__",
     "calibrate",
+    "check",
     "diagnose",
+    "init_robot",
     "localize",
     "plan",
     "read_measurements",

@@ -401,6 +401,28 @@ def simulate(
 ) -> Simulation:
     """Simulated measurements, as ``sagcal simulate`` draws them."""
 
+def init_robot(
+    anchors_m: Optional[ArrayLike] = None,
+    attachments_m: Optional[ArrayLike] = None,
+    *,
+    platform_mass_kg: Optional[float] = None,
+    platform_weight_n: Optional[float] = None,
+    cable_mass_per_m_kg: Optional[float] = None,
+    cable_weight_n_per_m: Optional[float] = None,
+    axial_stiffness_n: Optional[float] = None,
+    com_offset_m: Optional[ArrayLike] = None,
+    reference_cable: Optional[int] = None,
+    workspace: Optional[Sequence[float]] = None,
+    name: Optional[str] = None,
+    from_template: Optional[str] = None,
+    out: Optional[PathLike] = None,
+    force: bool = False,
+) -> str:
+    """A new robot file's text (TOML, every key commented), as ``sagcal init`` writes it; with ``out``, written there."""
+
+def check(robot: Union[Robot, PathLike], data: Optional[PathLike] = None) -> dict[str, Any]:
+    """What sagcal understood from a robot file and a data file, as ``sagcal check --json`` prints it."""
+
 def read_measurements(path: PathLike, reference_cable: int = 1) -> FloatArray:
     """A measurement file (sagcal CSV or RecurDyn log) as an (N, 11) array."""
 

@@ -10,8 +10,10 @@
 
 mod arrays;
 mod calibrate;
+mod check;
 mod data;
 mod diagnose;
+mod init;
 mod json;
 mod localize;
 mod options;
@@ -157,6 +159,8 @@ fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(data::read_measurements, m)?)?;
     m.add_function(wrap_pyfunction!(data::write_measurements, m)?)?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
+    m.add_function(wrap_pyfunction!(init::init_robot, m)?)?;
+    m.add_function(wrap_pyfunction!(check::check, m)?)?;
     m.add_function(wrap_pyfunction!(_cancel, m)?)?;
     m.add_function(wrap_pyfunction!(_reset_cancel, m)?)?;
     Ok(())

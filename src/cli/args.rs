@@ -6,10 +6,12 @@
 use clap::{Parser, Subcommand};
 
 use super::calibrate::CalibrateArgs;
+use super::check::CheckArgs;
 use super::demo::DemoArgs;
 use super::diagnose::DiagnoseArgs;
 use super::experiment::Table2Args;
 use super::hidden::HiddenEffectsArgs;
+use super::init::InitArgs;
 use super::localize::LocalizeArgs;
 use super::localize_experiment::LocalizeExperimentArgs;
 use super::plan::PlanArgs;
@@ -28,6 +30,10 @@ pub(super) struct Cli {
 pub(super) enum Command {
     /// Simulate the built-in large robot, calibrate it from a perturbed guess, plot the anchors (the default).
     Demo(DemoArgs),
+    /// Write a new robot file (TOML, every key commented) from your robot's anchors, attachments and weights.
+    Init(InitArgs),
+    /// Say what sagcal understood from a robot file and a data file, before any fit, and what looks wrong.
+    Check(CheckArgs),
     /// Estimate anchors and encoder length offsets from measurements.
     Calibrate(CalibrateArgs),
     /// Write simulated measurements of a robot (sagcal's CSV format).

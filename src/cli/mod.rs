@@ -8,11 +8,13 @@
 
 mod args;
 mod calibrate;
+mod check;
 mod demo;
 mod diagnose;
 mod experiment;
 mod gross_errors;
 mod hidden;
+mod init;
 mod localize;
 mod localize_experiment;
 mod output;

@@ -7,10 +7,12 @@ use clap::{CommandFactory, Parser};
 
 use super::args::{Cli, Command, ExperimentCommand};
 use super::calibrate;
+use super::check;
 use super::demo::{self, DemoArgs};
 use super::diagnose;
 use super::experiment;
 use super::hidden;
+use super::init;
 use super::localize;
 use super::localize_experiment;
 use super::plan;
@@ -39,6 +41,8 @@ pub fn run() -> i32 {
             json: false,
         }),
         Some(Command::Demo(args)) => demo::run(&args),
+        Some(Command::Init(args)) => init::run(&args),
+        Some(Command::Check(args)) => check::run(&args),
         Some(Command::Calibrate(args)) => calibrate::run(&args),
         Some(Command::Simulate(args)) => simulate::run(&args),
         Some(Command::Verify(args)) => verify::run(&args),

@@ -2,6 +2,7 @@
 //! formats and validation of single values, no physics.
 //!
 //! - [`robot_file`]: the robot description (TOML);
+//! - [`robot_init`]: a new, commented robot file from a few numbers (`sagcal init`);
 //! - [`measurements`]: what `calibrate`, `diagnose` and `verify` read: sagcal's
 //!   CSV, a RecurDyn log ([`recurdyn`]) or the authors' dataset folder
 //!   ([`authors`]), told apart by the header or by being a folder;
@@ -42,6 +43,8 @@ pub mod outputs;
 pub mod readings;
 pub mod recurdyn;
 pub mod robot_file;
+pub mod robot_init;
+mod robot_text;
 
 pub use atomic::write_atomically;
 pub use outputs::OutputSet;
