@@ -21,6 +21,7 @@ use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::sensors::NoisePreset;
 use crate::model::statics::reference_tension_magnitude_guess;
+use crate::model::DataRow;
 use crate::sim::closed_form::Workspace;
 
 /// At most this many rows are named in one warning.
@@ -114,7 +115,7 @@ fn pose_findings(robot: &Robot, poses: &[PoseMeasurement]) -> Vec<CheckWarning> 
         let others: Vec<String> = outside[1..]
             .iter()
             .take(NAMED_ROWS)
-            .map(|m| row_label(m.rows[0] + 1, poses[m.rows[0]].line))
+            .map(|m| m.rows[0].to_string())
             .collect();
         let message = match others.len() {
             0 => first.message.clone(),
@@ -129,7 +130,7 @@ fn pose_findings(robot: &Robot, poses: &[PoseMeasurement]) -> Vec<CheckWarning> 
         found.push(CheckWarning {
             kind: WarningKind::OutsideFrame,
             message,
-            rows: outside.iter().map(|m| m.rows[0] + 1).collect(),
+            rows: outside.iter().map(|m| m.rows[0]).collect(),
         });
     }
     // As calibrate: the row checks once the units are right, or when too few
@@ -184,7 +185,7 @@ fn outside_workspace(robot: &Robot, poses: &[PoseMeasurement]) -> Option<CheckWa
             p[1],
             p[2]
         ),
-        rows: rows.iter().map(|k| k + 1).collect(),
+        rows: rows.iter().map(|&k| DataRow::at(k, poses[k].line)).collect(),
     })
 }
 

@@ -4,11 +4,11 @@ use serde::Serialize;
 
 /// `row 3 (line 5)`: a data row counted from 1 and its file line (`row 3` without one).
 pub fn row_label(row: usize, line: usize) -> String {
-    if line > 0 {
-        format!("row {row} (line {line})")
-    } else {
-        format!("row {row}")
+    crate::model::DataRow {
+        row,
+        line: (line > 0).then_some(line),
     }
+    .to_string()
 }
 
 /// What sagcal understood from a robot file and, optionally, a data file.
@@ -237,8 +237,8 @@ pub struct CheckWarning {
     pub kind: WarningKind,
     /// What it is, naming rows (`row 3 (line 5)`), cables and columns.
     pub message: String,
-    /// The data rows concerned, counted from 1 (empty: the whole column or file).
-    pub rows: Vec<usize>,
+    /// The data rows concerned (empty: the whole column or file).
+    pub rows: Vec<crate::model::DataRow>,
 }
 
 /// The kind of a [`CheckWarning`].
