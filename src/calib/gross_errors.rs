@@ -284,9 +284,17 @@ fn gave_up(
     if let Verdict::Inconsistent { reason } = &mut reverted.verdict {
         if !checked.excluded.is_empty() {
             reason.push_str(&format!(
-                ". The search for gross errors gave up after leaving out {} readings, so the fit reported \
-                 leaves none out (they are listed as set aside)",
-                checked.excluded.len()
+                ". The search for gross errors gave up after leaving out {}, so the fit reported \
+                 leaves none out ({} listed as set aside)",
+                match checked.excluded.len() {
+                    1 => "1 reading".to_string(),
+                    n => format!("{n} readings"),
+                },
+                if checked.excluded.len() == 1 {
+                    "it is"
+                } else {
+                    "they are"
+                }
             ));
         }
     }
