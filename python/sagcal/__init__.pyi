@@ -339,6 +339,7 @@ def calibrate(
     robust_pose: str = "none",
     false_alarm: float = 1e-3,
     accept_inconsistent: bool = False,
+    progress: Optional[Callable[[int, int, str], Any]] = None,
 ) -> Calibration:
     """Calibrate anchors and encoder offsets, as ``sagcal calibrate`` does."""
 
@@ -373,6 +374,7 @@ def localize(
     pose_prior: bool = False,
     noise: str = "paper",
     false_alarm: float = 1e-3,
+    progress: Optional[Callable[[int, int, str], Any]] = None,
 ) -> Localization:
     """Pose and tensions from the cable readings, as ``sagcal localize`` does."""
 
@@ -386,6 +388,7 @@ def plan(
     criterion: str = "a",
     seed: int = 1,
     orientation_prior: str = "off",
+    progress: Optional[Callable[[int, int, str], Any]] = None,
 ) -> PosePlan:
     """The calibration poses that best determine the anchors, as ``sagcal plan`` chooses them."""
 

@@ -6,13 +6,14 @@
 use pyo3::prelude::*;
 use sagcal::calib::gross_errors::Verdict;
 use sagcal::calib::report::CalibrationReport;
-use sagcal::calib::{calibrate_job, CalibrationResult, CalibrationSettings, ParameterUncertainty};
+use sagcal::calib::{calibrate_job_with_progress, CalibrationResult, CalibrationSettings, ParameterUncertainty};
 use sagcal::error::FrontEnd;
 use sagcal::model::DataRow;
 
 use crate::arrays::{out1, out2, out3};
 use crate::json::to_python;
 use crate::options::SolverArgs;
+use crate::progress::Progress;
 use crate::robot::Robot;
 use crate::to_py;
 
@@ -244,7 +245,11 @@ impl Calibration {
 /// ``"on"``, ``"off"``), robust kernels (``"none"``, ``"huber[:k]"``,
 /// ``"cauchy[:c]"``), ``false_alarm`` of the gross-error tests. A fit that
 /// fails its own consistency tests raises, as the command refuses to write
-/// it, unless ``accept_inconsistent=True``.
+/// it, unless ``accept_inconsistent=True``. ``progress`` is an optional
+/// ``callable(done, total, what)`` called before each stage of each fit
+/// (``done`` fits made of the ``total`` expected so far, which grows while
+/// the gross-error search finds readings to leave out; ``what`` the fit and
+/// its stage, ``"calibration: rigid"``), last with ``(fits, fits, "done")``.
 ///
 /// Raises :class:`SagcalError` with the message the command prints.
 #[pyfunction]
@@ -263,6 +268,7 @@ impl Calibration {
     robust_pose = "none",
     false_alarm = 1e-3,
     accept_inconsistent = false,
+    progress = None,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
@@ -280,6 +286,7 @@ pub fn calibrate(
     robust_pose: &str,
     false_alarm: f64,
     accept_inconsistent: bool,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Calibration> {
     let nominal = robot.inner.clone();
     let data = crate::data::measurements(measurements, nominal.reference_cable)?;
@@ -300,12 +307,23 @@ pub fn calibrate(
         accept_inconsistent,
     };
     let source = data.label.display().to_string();
+    let progress = Progress::new(progress);
     let mut job = py
-        .detach(|| calibrate_job(&nominal, &data.poses, &source, &settings, FrontEnd::Python))
+        .detach(|| {
+            calibrate_job_with_progress(
+                &nominal,
+                &data.poses,
+                &source,
+                &settings,
+                FrontEnd::Python,
+                &mut |done, total, what| progress.report(done, total, what),
+            )
+        })
         .map_err(to_py)?;
     if let Some(refusal) = job.refusal.take() {
         return Err(to_py(refusal));
     }
+    progress.finish()?;
     let json = serde_json::to_value(&job.report)
         .map_err(|e| crate::invalid(format!("cannot serialise the report as JSON: {e}")))?;
     // Every attribute is read off the one report the command prints.

@@ -2,8 +2,6 @@
 //! diagnose`), with the same options, checked by the library
 //! (`sagcal::diagnose::DiagnoseSettings`), and the same report.
 
-use std::sync::Mutex;
-
 use pyo3::prelude::*;
 use sagcal::diagnose::DiagnoseSettings;
 use sagcal::error::FrontEnd;
@@ -11,6 +9,7 @@ use sagcal::error::FrontEnd;
 use crate::arrays::out2;
 use crate::json::to_python;
 use crate::options::SolverArgs;
+use crate::progress::Progress;
 use crate::robot::Robot;
 use crate::{invalid, to_py};
 
@@ -189,8 +188,7 @@ pub fn diagnose(
     }
     .options(&nominal, FrontEnd::Python)
     .map_err(to_py)?;
-    // The first exception the progress callback raised, re-raised after the run.
-    let callback_error: Mutex<Option<PyErr>> = Mutex::new(None);
+    let progress = Progress::new(progress);
     let diagnosis = py
         .detach(|| {
             sagcal::diagnose::diagnose(
@@ -198,21 +196,11 @@ pub fn diagnose(
                 &data.poses,
                 truth.as_ref(),
                 &options,
-                &mut |done, total, what| {
-                    if let Some(callback) = &progress {
-                        Python::attach(|py| {
-                            if let Err(e) = callback.call1(py, (done, total, what)) {
-                                callback_error.lock().expect("not poisoned").get_or_insert(e);
-                            }
-                        });
-                    }
-                },
+                &mut |done, total, what| progress.report(done, total, what),
             )
         })
         .map_err(to_py)?;
-    if let Some(e) = callback_error.into_inner().expect("not poisoned") {
-        return Err(e);
-    }
+    progress.finish()?;
     let json =
         serde_json::to_value(&diagnosis).map_err(|e| invalid(format!("cannot serialise the report as JSON: {e}")))?;
     Ok(Diagnosis { inner: diagnosis, json })

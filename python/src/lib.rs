@@ -18,6 +18,7 @@ mod json;
 mod localize;
 mod options;
 mod plan;
+mod progress;
 mod robot;
 mod simulate;
 

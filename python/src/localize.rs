@@ -15,6 +15,7 @@ use sagcal::model::pose::PlatformPose;
 use crate::arrays::{exact_rows, out1, out2, out3, rows, vector};
 use crate::data::as_path;
 use crate::options::noise_preset;
+use crate::progress::Progress;
 use crate::robot::Robot;
 use crate::{invalid, to_py};
 
@@ -167,12 +168,15 @@ impl Localization {
 /// optional (N, 6) array ``x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg``,
 /// compared with (or, with ``pose_prior=True``, used as a prior). ``noise``
 /// (``"paper"``, ``"authors"``) gives the reading sigmas; ``false_alarm`` the
-/// rate of each row's chi-square test.
+/// rate of each row's chi-square test; ``progress`` an optional
+/// ``callable(done, total, what)`` called as the rows go (``done`` rows
+/// localised of ``total``; at most about a hundred calls), last with
+/// ``(total, total, "done")``.
 ///
 /// A row no stable equilibrium explains is flagged, not an error; bad input
 /// raises :class:`SagcalError` with the command's message.
 #[pyfunction]
-#[pyo3(signature = (robot, readings, load_cell = None, localiser_poses = None, *, pose_prior = false, noise = "paper", false_alarm = 1e-3))]
+#[pyo3(signature = (robot, readings, load_cell = None, localiser_poses = None, *, pose_prior = false, noise = "paper", false_alarm = 1e-3, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn localize(
     py: Python<'_>,
@@ -183,6 +187,7 @@ pub fn localize(
     pose_prior: bool,
     noise: &str,
     false_alarm: f64,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Localization> {
     let robot = &robot.inner;
     let (label, input) = match as_path(readings) {
@@ -213,13 +218,16 @@ pub fn localize(
     }
     .localizer(robot)
     .map_err(to_py)?;
-    py.detach(|| localize_rows(&localizer, &input))
+    let progress = Progress::new(progress);
+    let localization = py.detach(|| localize_rows(&localizer, &input, &progress))?;
+    progress.finish()?;
+    Ok(localization)
 }
 
 /// Every row in order, as the command localises them
 /// (`sagcal::localize::Localizer::localize_sequence`, without the
-/// multistart search), stopping at a stop request.
-fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> PyResult<Localization> {
+/// multistart search), stopping at a stop request, telling `progress`.
+fn localize_rows(localizer: &Localizer, input: &[ReadingRow], progress: &Progress) -> PyResult<Localization> {
     let readings: Vec<Readings> = input
         .iter()
         .map(|row| Readings {
@@ -229,7 +237,12 @@ fn localize_rows(localizer: &Localizer, input: &[ReadingRow]) -> PyResult<Locali
         })
         .collect();
     let solved = localizer
-        .localize_sequence(&readings, false, &mut sagcal::cancel::requested)
+        .localize_sequence_with_progress(
+            &readings,
+            false,
+            &mut sagcal::cancel::requested,
+            &mut |done, total, what| progress.report(done, total, what),
+        )
         .map_err(to_py)?;
     let (found, flags): (Vec<Option<Localized>>, Vec<Option<String>>) =
         solved.into_iter().map(|row| (row.found.ok(), row.flag)).unzip();

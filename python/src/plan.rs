@@ -18,6 +18,7 @@ use crate::arrays::{any_vector, out1, out2, out3};
 use crate::data::{as_path, to_array};
 use crate::json::to_python;
 use crate::options::{noise_preset, parse};
+use crate::progress::Progress;
 use crate::robot::Robot;
 use crate::{invalid, to_py};
 
@@ -181,7 +182,10 @@ impl PosePlan {
 /// ``"authors"``) is the noise the bound assumes; ``criterion`` ``"a"``
 /// (trace of the anchors' covariance) or ``"d"`` (log-determinant of the
 /// information); ``orientation_prior`` ``"on"`` or ``"off"``/``"auto"``;
-/// ``seed`` draws the candidates and the random sets (same seed, same plan).
+/// ``seed`` draws the candidates and the random sets (same seed, same plan);
+/// ``progress`` an optional ``callable(done, total, what)`` called as the
+/// plan goes (the candidates drawn so far, the poses chosen; ``what`` names
+/// the stage, ``done`` counts within it), last with ``(1, 1, "done")``.
 ///
 /// Raises :class:`SagcalError` with the command's message.
 #[pyfunction]
@@ -195,7 +199,8 @@ impl PosePlan {
     criterion = "a",
     seed = 1,
     orientation_prior = "off",
-), text_signature = "(robot, poses, *, candidates=1000, workspace=None, noise='paper', criterion='a', seed=1, orientation_prior='off')")]
+    progress = None,
+), text_signature = "(robot, poses, *, candidates=1000, workspace=None, noise='paper', criterion='a', seed=1, orientation_prior='off', progress=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn plan(
     py: Python<'_>,
@@ -207,6 +212,7 @@ pub fn plan(
     criterion: &str,
     seed: u64,
     orientation_prior: &str,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<PosePlan> {
     let robot = robot.inner.clone();
     let workspace = workspace.map(workspace_argument).transpose()?;
@@ -219,9 +225,16 @@ pub fn plan(
         orientation_prior: parse("orientation_prior", orientation_prior, OrientationPrior::parse)?,
         front_end: FrontEnd::Python,
     };
+    let progress = Progress::new(progress);
     let planned = py
-        .detach(|| plan_calibration(&robot, &settings, &mut |_| {}))
+        .detach(|| {
+            plan_calibration(&robot, &settings, &mut |step| {
+                let (done, total, what) = step.counts();
+                progress.report(done, total, &what)
+            })
+        })
         .map_err(to_py)?;
+    progress.finish()?;
     let candidates = &planned.report.candidates.equilibria;
     let readings = planned
         .plan

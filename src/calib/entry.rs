@@ -26,10 +26,22 @@ pub fn calibrate(
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
 ) -> Result<CalibrationResult> {
+    calibrate_with_stages(initial, measurements, options, &mut |_| {})
+}
+
+/// [`calibrate`], telling `stage` the name of each stage before it is
+/// solved (`rigid`, `catenary (relaxed statics)`, `catenary`, once per start
+/// and per fit of the orientation test); it changes nothing computed.
+pub(super) fn calibrate_with_stages(
+    initial: &Robot,
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+    stage: &mut dyn FnMut(&str),
+) -> Result<CalibrationResult> {
     let _shared_system = system_scope::Scope::enter();
     validate_measurements(measurements)?;
     if options.orientation_prior == OrientationPrior::Auto && options.model == CableModel::Catenary {
-        return orientation::calibrate_testing_orientation(initial, measurements, options);
+        return orientation::calibrate_testing_orientation(initial, measurements, options, stage);
     }
-    calibrate_once(initial, measurements, options)
+    calibrate_once(initial, measurements, options, stage)
 }

@@ -57,7 +57,7 @@ use serde::Serialize;
 
 use std::collections::HashMap;
 
-use super::entry::calibrate;
+use super::fit_progress::{search_fit, FitProgress};
 use super::mistakes::{self, Mistake};
 use super::options::{CalibrationOptions, RobustKernels};
 use super::result::CalibrationResult;
@@ -128,8 +128,48 @@ pub fn calibrate_checked(
     options: &CalibrationOptions,
     check: &GrossErrorOptions,
 ) -> Result<CheckedCalibration> {
+    calibrate_checked_with_progress(initial, measurements, options, check, &mut |_, _, _| {})
+}
+
+/// [`calibrate_checked`], telling `progress(done, total, what)` before each
+/// stage of each fit: `done` fits made of the `total` expected so far (one
+/// for data that pass, one more per reading the search still flags), `what`
+/// the fit and its stage; the last report is `(fits, fits, "done")`. It
+/// changes nothing computed.
+///
+/// ```
+/// use rand::SeedableRng;
+/// use sagcal::calib::gross_errors::{calibrate_checked_with_progress, GrossErrorOptions};
+/// use sagcal::calib::CalibrationOptions;
+/// use sagcal::model::sensors::NoisePreset;
+/// use sagcal::model::Robot;
+/// use sagcal::sim::closed_form::{measure, sample_equilibria, Workspace};
+/// let truth = Robot::builtin("large")?;
+/// let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(63);
+/// let equilibria = sample_equilibria(&truth, &Workspace::default_for(&truth), 15, &mut rng)?;
+/// let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
+/// let data = measure(&truth, &equilibria, &noise, &mut rng);
+/// let options = CalibrationOptions::new(noise);
+/// let mut reports = Vec::new();
+/// calibrate_checked_with_progress(&truth, &data, &options, &GrossErrorOptions::default(), &mut |done, total, what| {
+///     reports.push((done, total, what.to_string()))
+/// })?;
+/// // Clean data: one fit, its stages named, then the end.
+/// assert_eq!(reports[0], (0, 1, "calibration: rigid".to_string()));
+/// assert_eq!(reports.last(), Some(&(1, 1, "done".to_string())));
+/// # Ok::<(), sagcal::Error>(())
+/// ```
+pub fn calibrate_checked_with_progress(
+    initial: &crate::model::Robot,
+    measurements: &[PoseMeasurement],
+    options: &CalibrationOptions,
+    check: &GrossErrorOptions,
+    progress: &mut dyn FnMut(usize, usize, &str),
+) -> Result<CheckedCalibration> {
     screen::check_noise(&options.noise, initial)?;
-    let mut checked = checked_fit(initial, measurements, options, check)?;
+    let mut fits = FitProgress::new(progress);
+    let mut checked = checked_fit(initial, measurements, options, check, &mut fits)?;
+    fits.finish();
     if let Some(why) = screen::undetermined(&checked.result, screen::robot_size_m(initial)) {
         checked.verdict = match checked.verdict {
             Verdict::Consistent => Verdict::Inconsistent { reason: why },
@@ -150,6 +190,7 @@ fn checked_fit(
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
     check: &GrossErrorOptions,
+    fits: &mut FitProgress<'_>,
 ) -> Result<CheckedCalibration> {
     let found = mistakes::before_calibration(initial, measurements);
     let (mut current, rows) = mistakes::without_rows_outside(measurements, &found);
@@ -158,7 +199,7 @@ fn checked_fit(
     screen::check_kept_rows(initial, measurements, &current, &rows, &options.noise)?;
     let mut plain = None;
     // Clean data pass at the cost of one fit and its test.
-    if let Ok(result) = calibrate(initial, &current, options) {
+    if let Ok(result) = fits.fit("calibration", initial, &current, options) {
         let test = test_fit(&result, &current, options, check)?;
         if test.consistent() {
             let at_fit = residuals_at_fit(&result, &current, options);
@@ -170,13 +211,15 @@ fn checked_fit(
             all: current.clone(),
         });
     }
-    robust_screen(initial, &mut current, options, check, &mut state);
+    // The screen's fit and a fit without what it leaves out, at least.
+    fits.expect(2);
+    robust_screen(initial, &mut current, options, check, &mut state, fits);
     let search = Search {
         initial,
         options,
         check,
     };
-    let checked = test_and_remove(&search, current, &rows, &found, state, plain.as_ref())?;
+    let checked = test_and_remove(&search, current, &rows, &found, state, plain.as_ref(), fits)?;
     // An inconsistent fit is a model (or noise) error, not blunders: the
     // readings left out go back (kept in `set_aside`, with the mistakes named,
     // as hints), and the fit with every reading is the answer, with its verdict.
@@ -230,6 +273,7 @@ fn test_and_remove(
     found: &[Mistake],
     mut state: Exclusions,
     plain: Option<&PlainFit>,
+    fits: &mut FitProgress<'_>,
 ) -> Result<CheckedCalibration> {
     let Search {
         initial,
@@ -243,13 +287,15 @@ fn test_and_remove(
         let (result, test) = match plain {
             Some(PlainFit { result, test, all }) if *all == current => (result.clone(), test.clone()),
             _ => {
-                let result = calibrate(initial, &current, options)?;
+                let result = fits.fit(&search_fit(state.excluded.len()), initial, &current, options)?;
                 let test = test_fit(&result, &current, options, check)?;
                 (result, test)
             }
         };
         let at_fit = residuals_at_fit(&result, &current, options);
         let room = state.limit.saturating_sub(state.counted());
+        // One more fit per reading still to leave out (a reading given back adds one).
+        fits.expect(test.flagged.len().min(room));
         if state.stepped == 0 && test.flagged.len() > room {
             if let Some((cable, rows_off)) = mistakes::offset_step(&current, &at_fit, check.false_alarm) {
                 state.leave_out_step(&mut current, &at_fit, cable, &rows_off);
@@ -393,6 +439,7 @@ fn robust_screen(
     options: &CalibrationOptions,
     check: &GrossErrorOptions,
     state: &mut Exclusions,
+    fits: &mut FitProgress<'_>,
 ) {
     let kernel = |k: RobustKernel| if k == RobustKernel::None { SCREEN_KERNEL } else { k };
     let robust = CalibrationOptions {
@@ -403,7 +450,7 @@ fn robust_screen(
         },
         ..*options
     };
-    let Ok(result) = calibrate(initial, current, &robust) else {
+    let Ok(result) = fits.fit("robust screen", initial, current, &robust) else {
         return;
     };
     let at_fit = residuals_at_fit(&result, current, options);

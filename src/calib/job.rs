@@ -4,7 +4,7 @@
 //! ends format what [`calibrate_job`] returns; the refusal names how to
 //! override it as the caller spells it ([`FrontEnd`]).
 
-use super::gross_errors::{calibrate_checked, CheckedCalibration, Verdict};
+use super::gross_errors::{calibrate_checked_with_progress, CheckedCalibration, Verdict};
 use super::report::{CalibrationReport, CheckedReport, GrossErrorReport};
 use super::settings::CalibrationSettings;
 use super::CalibrationOptions;
@@ -30,7 +30,7 @@ pub struct CalibrationJob {
 
 /// Calibrate `nominal` from `measurements` under `settings`, as `sagcal
 /// calibrate` does: check the settings ([`CalibrationSettings::options`]),
-/// calibrate with the gross-error tests ([`calibrate_checked`]), build the
+/// calibrate with the gross-error tests ([`super::gross_errors::calibrate_checked`]), build the
 /// report (each pose named by its row and its file line,
 /// [`crate::model::DataRow`]) and, for an inconsistent fit not accepted, the refusal.
 /// `source` names the measurements in messages (the file as given); an error
@@ -60,8 +60,24 @@ pub fn calibrate_job(
     settings: &CalibrationSettings,
     front_end: FrontEnd,
 ) -> Result<CalibrationJob> {
+    calibrate_job_with_progress(nominal, measurements, source, settings, front_end, &mut |_, _, _| {})
+}
+
+/// [`calibrate_job`], telling `progress(done, total, what)` before each
+/// stage of each fit, as [`calibrate_checked_with_progress`] does (`sagcal
+/// calibrate` draws it, `sagcal.calibrate(..., progress=)` passes it on); it
+/// changes nothing computed.
+pub fn calibrate_job_with_progress(
+    nominal: &Robot,
+    measurements: &[PoseMeasurement],
+    source: &str,
+    settings: &CalibrationSettings,
+    front_end: FrontEnd,
+    progress: &mut dyn FnMut(usize, usize, &str),
+) -> Result<CalibrationJob> {
     let (options, check) = settings.options(nominal, front_end)?;
-    let checked = calibrate_checked(nominal, measurements, &options, &check).map_err(|e| match e {
+    let checked = calibrate_checked_with_progress(nominal, measurements, &options, &check, progress);
+    let checked = checked.map_err(|e| match e {
         Error::Cancelled => e,
         cause => Error::NotWritten {
             source_name: source.to_string(),

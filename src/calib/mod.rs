@@ -97,6 +97,7 @@
 pub mod effect_factors;
 mod entry;
 pub mod factors;
+mod fit_progress;
 mod graph;
 pub mod gross_errors;
 mod init;
@@ -123,7 +124,7 @@ pub use graph::{
     build_graph, effects_from_graph, robot_from_graph, validate_measurements, CalibrationGraph, MIN_POSES,
 };
 pub use init::warm_start;
-pub use job::{calibrate_job, refusal, CalibrationJob};
+pub use job::{calibrate_job, calibrate_job_with_progress, refusal, CalibrationJob};
 pub use options::{CableModel, CalibrationOptions, OrientationPrior, RobustKernels};
 pub use predict::predict_with_effects;
 pub use prepared::PreparedCalibration;

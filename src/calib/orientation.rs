@@ -66,6 +66,7 @@ fn refit_from(
     result: &CalibrationResult,
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
+    stage: &mut dyn FnMut(&str),
 ) -> Result<CalibrationResult> {
     let used: Vec<PoseMeasurement> = (0..measurements.len())
         .filter(|k| !result.excluded_poses.contains(k))
@@ -80,11 +81,9 @@ fn refit_from(
         options,
     );
     let mut stages = result.stages.clone();
-    stages.push(solve_stage(
-        "catenary (orientation prior, from the fit without it)",
-        &mut built,
-        &options.lm,
-    )?);
+    let name = "catenary (orientation prior, from the fit without it)";
+    stage(name);
+    stages.push(solve_stage(name, &mut built, &options.lm)?);
     finish(&result.robot, built, stages, result.excluded_poses.clone())
 }
 
@@ -110,11 +109,13 @@ impl CalibrationOptions {
 /// and calibrate again without the prior if they are inconsistent (or if the
 /// calibration with it fails), unless a second calibration with the prior,
 /// started from the anchors found without it, passes the test (the first one
-/// had ended in a wrong basin). The test is recorded in the result.
+/// had ended in a wrong basin). The test is recorded in the result. `stage`
+/// is told the name of each stage before it is solved.
 pub(super) fn calibrate_testing_orientation(
     initial: &Robot,
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
+    stage: &mut dyn FnMut(&str),
 ) -> Result<CalibrationResult> {
     let with_prior = CalibrationOptions {
         orientation_prior: OrientationPrior::On,
@@ -122,8 +123,8 @@ pub(super) fn calibrate_testing_orientation(
     };
     // The rigid stage and the warm-ups do not depend on the prior: made once
     // for both calibrations (an error there is the same for both).
-    let prepared = CatenaryPreparation::new(initial, measurements, &with_prior)?;
-    testing_orientation_prepared(initial, measurements, options, &prepared)
+    let prepared = CatenaryPreparation::new(initial, measurements, &with_prior, stage)?;
+    testing_orientation_prepared(initial, measurements, options, &prepared, stage)
 }
 
 /// [`calibrate_testing_orientation`] from the rigid stage and warm-ups of a
@@ -133,6 +134,7 @@ pub(super) fn testing_orientation_prepared(
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
     prepared: &CatenaryPreparation,
+    stage: &mut dyn FnMut(&str),
 ) -> Result<CalibrationResult> {
     let with_prior = CalibrationOptions {
         orientation_prior: OrientationPrior::On,
@@ -142,15 +144,15 @@ pub(super) fn testing_orientation_prepared(
         orientation_prior: OrientationPrior::Off,
         ..*options
     };
-    let Ok(mut result) = calibrate_prepared(initial, measurements, &with_prior, prepared) else {
-        return calibrate_prepared(initial, measurements, &without_prior, prepared);
+    let Ok(mut result) = calibrate_prepared(initial, measurements, &with_prior, prepared, stage) else {
+        return calibrate_prepared(initial, measurements, &without_prior, prepared, stage);
     };
     let mut check = orientation_check(&result, measurements, options.noise.orientation_sigma_rad);
     if check.chi_square <= check.limit {
         result.orientation_check = Some(check);
         return Ok(result);
     }
-    let mut result = calibrate_prepared(initial, measurements, &without_prior, prepared)?;
+    let mut result = calibrate_prepared(initial, measurements, &without_prior, prepared, stage)?;
     // A failed test says the localiser disagrees with the statics *at the
     // anchors found*: if the fit with the prior ended in a wrong basin (its
     // statics orientations then disagree with every localiser reading), the
@@ -158,7 +160,7 @@ pub(super) fn testing_orientation_prepared(
     // does not depend on the orientations, so its solution (anchors, offsets,
     // poses, tensions) is the start of a second fit with the prior, one stage
     // from a minimum; if that one passes, the localiser was right.
-    if let Ok(mut again) = refit_from(&result, measurements, &with_prior) {
+    if let Ok(mut again) = refit_from(&result, measurements, &with_prior, stage) {
         let second = orientation_check(&again, measurements, options.noise.orientation_sigma_rad);
         if second.chi_square <= second.limit {
             again.orientation_check = Some(second);

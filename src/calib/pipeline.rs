@@ -16,18 +16,20 @@ use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::solver::{optimize_cached, LmParams};
 
 /// One calibration with the orientation prior as given (`Auto` counts as `Off`):
-/// the staged pipeline of the module docs.
+/// the staged pipeline of the module docs; `stage` is told the name of each
+/// stage before it is solved.
 pub(super) fn calibrate_once(
     initial: &Robot,
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
+    stage: &mut dyn FnMut(&str),
 ) -> Result<CalibrationResult> {
     if options.model == CableModel::Rigid {
-        let (rigid_stage, rigid) = rigid_calibration(initial, measurements, options)?;
+        let (rigid_stage, rigid) = rigid_calibration(initial, measurements, options, stage)?;
         return finish(initial, rigid, vec![rigid_stage], Vec::new());
     }
-    let prepared = CatenaryPreparation::new(initial, measurements, options)?;
-    calibrate_prepared(initial, measurements, options, &prepared)
+    let prepared = CatenaryPreparation::new(initial, measurements, options, stage)?;
+    calibrate_prepared(initial, measurements, options, &prepared, stage)
 }
 
 /// Stages (1) and (2) of the catenary pipeline, which the orientation prior
@@ -44,10 +46,17 @@ pub(super) struct CatenaryPreparation {
 }
 
 impl CatenaryPreparation {
-    pub(super) fn new(initial: &Robot, measurements: &[PoseMeasurement], options: &CalibrationOptions) -> Result<Self> {
+    /// The stages for `initial` and `measurements`; `stage` is told the name
+    /// of each stage before it is solved.
+    pub(super) fn new(
+        initial: &Robot,
+        measurements: &[PoseMeasurement],
+        options: &CalibrationOptions,
+        stage: &mut dyn FnMut(&str),
+    ) -> Result<Self> {
         // (1) Rigid, massless cables from the initial guess: a second
         // candidate start for the catenary.
-        let (rigid_stage, rigid) = rigid_calibration(initial, measurements, options)?;
+        let (rigid_stage, rigid) = rigid_calibration(initial, measurements, options, stage)?;
         let rigid_robot = robot_from_graph(initial, &rigid);
         let warmed = init::warm_candidates([initial.clone(), rigid_robot.clone()], measurements);
         Ok(CatenaryPreparation {
@@ -59,12 +68,14 @@ impl CatenaryPreparation {
 }
 
 /// The catenary stages (2)-(4) of [`calibrate_once`] under `options` from a
-/// [`CatenaryPreparation`] made for the same initial guess and measurements.
+/// [`CatenaryPreparation`] made for the same initial guess and measurements;
+/// `stage` is told the name of each stage before it is solved.
 pub(super) fn calibrate_prepared(
     initial: &Robot,
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
     prepared: &CatenaryPreparation,
+    stage: &mut dyn FnMut(&str),
 ) -> Result<CalibrationResult> {
     let rigid_stage = prepared.rigid_stage.clone();
     // (2) Two warmed-up starts: the initial guess and the rigid calibration,
@@ -77,7 +88,7 @@ pub(super) fn calibrate_prepared(
     // at the cost of one solve). Otherwise it joins the other starts' solves.
     let mut solves = Vec::with_capacity(starts.len());
     if let Some(first) = starts.first() {
-        match solve_catenary(initial, first, measurements, options, &relaxed_options) {
+        match solve_catenary(initial, first, measurements, options, &relaxed_options, stage) {
             Ok(solved) if solved.final_stage.summary.termination.converged() && solved.consistent_with_noise() => {
                 return finish(
                     initial,
@@ -92,9 +103,11 @@ pub(super) fn calibrate_prepared(
     solves.extend(solve_starts(
         initial,
         starts.iter().skip(1).copied(),
+        "second start",
         measurements,
         options,
         &relaxed_options,
+        stage,
     ));
     let agree = solves.len() == 2 && CatenarySolve::same_minimum(&solves[0], &solves[1]);
     let mut best = best_of(solves, measurements);
@@ -107,7 +120,15 @@ pub(super) fn calibrate_prepared(
             &relaxed_options,
         );
         let more = best_of(
-            solve_starts(initial, mixed.iter(), measurements, options, &relaxed_options),
+            solve_starts(
+                initial,
+                mixed.iter(),
+                "mixed start",
+                measurements,
+                options,
+                &relaxed_options,
+                stage,
+            ),
             measurements,
         );
         best = match (best, more) {
@@ -126,17 +147,29 @@ pub(super) fn calibrate_prepared(
     )
 }
 
-/// The catenary stages solved from every start that can be solved.
+/// The catenary stages solved from every start that can be solved; `stage`
+/// is told each stage's name followed by the start's, `label` (numbered
+/// `label k of n` when there are several).
 fn solve_starts<'a>(
     initial: &Robot,
-    starts: impl IntoIterator<Item = &'a init::CatenaryStart>,
+    starts: impl ExactSizeIterator<Item = &'a init::CatenaryStart>,
+    label: &str,
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
     relaxed_options: &CalibrationOptions,
+    stage: &mut dyn FnMut(&str),
 ) -> Vec<Result<CatenarySolve>> {
+    let count = starts.len();
     starts
-        .into_iter()
-        .map(|start| solve_catenary(initial, start, measurements, options, relaxed_options))
+        .enumerate()
+        .map(|(k, start)| {
+            let which = match count {
+                1 => label.to_string(),
+                _ => format!("{label} {} of {count}", k + 1),
+            };
+            let mut named = |name: &str| stage(&format!("{name}, {which}"));
+            solve_catenary(initial, start, measurements, options, relaxed_options, &mut named)
+        })
         .collect()
 }
 
@@ -227,6 +260,7 @@ fn solve_catenary(
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
     relaxed_options: &CalibrationOptions,
+    stage: &mut dyn FnMut(&str),
 ) -> Result<CatenarySolve> {
     // (3) Continuation on the statics constraint: a tight attachment-height
     // sigma makes the cost a narrow curved valley that Gauss-Newton follows in
@@ -242,7 +276,8 @@ fn solve_catenary(
         CableModel::Catenary,
         relaxed_options,
     );
-    let relaxed_stage = solve_stage("catenary (relaxed statics)", &mut relaxed, &options.lm)?;
+    stage(RELAXED_STAGE);
+    let relaxed_stage = solve_stage(RELAXED_STAGE, &mut relaxed, &options.lm)?;
     // (4) The full catenary graph: the relaxed solution, plus the poses that
     // sat out, warmed up with the relaxed anchors (left out if they still have
     // no equilibrium).
@@ -256,7 +291,8 @@ fn solve_catenary(
         CableModel::Catenary,
         options,
     );
-    let final_stage = solve_stage("catenary", &mut full, &options.lm)?;
+    stage(CATENARY_STAGE);
+    let final_stage = solve_stage(CATENARY_STAGE, &mut full, &options.lm)?;
     Ok(CatenarySolve {
         relaxed_stage,
         final_stage,
@@ -271,6 +307,7 @@ fn rigid_calibration(
     initial: &Robot,
     measurements: &[PoseMeasurement],
     options: &CalibrationOptions,
+    stage: &mut dyn FnMut(&str),
 ) -> Result<(StageSummary, CalibrationGraph)> {
     let (start, measured, placeholder) = init::rigid_start(initial, measurements);
     let mut rigid = build_graph(
@@ -281,9 +318,17 @@ fn rigid_calibration(
         CableModel::Rigid,
         options,
     );
-    let stage = solve_stage("rigid", &mut rigid, &options.lm)?;
-    Ok((stage, rigid))
+    stage(RIGID_STAGE);
+    let summary = solve_stage(RIGID_STAGE, &mut rigid, &options.lm)?;
+    Ok((summary, rigid))
 }
+
+/// The stages' names, as the result's [`StageSummary`]s and a progress display give them.
+const RIGID_STAGE: &str = "rigid";
+/// See [`RIGID_STAGE`].
+const RELAXED_STAGE: &str = "catenary (relaxed statics)";
+/// See [`RIGID_STAGE`].
+const CATENARY_STAGE: &str = "catenary";
 
 /// Solve one stage; errors name the stage.
 pub(super) fn solve_stage(name: &str, built: &mut CalibrationGraph, lm: &LmParams) -> Result<StageSummary> {

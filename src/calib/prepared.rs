@@ -39,7 +39,7 @@ impl PreparedCalibration {
     pub fn new(initial: &Robot, measurements: &[PoseMeasurement], options: &CalibrationOptions) -> Self {
         let _shared_system = super::system_scope::Scope::enter();
         let prepared = (options.model == CableModel::Catenary && validate_measurements(measurements).is_ok())
-            .then(|| CatenaryPreparation::new(initial, measurements, options).ok())
+            .then(|| CatenaryPreparation::new(initial, measurements, options, &mut |_| {}).ok())
             .flatten();
         PreparedCalibration {
             initial: initial.clone(),
@@ -64,9 +64,9 @@ impl PreparedCalibration {
         match &self.prepared {
             Some(prepared) if shared == *options => {
                 if options.orientation_prior == OrientationPrior::Auto {
-                    orientation::testing_orientation_prepared(initial, measurements, options, prepared)
+                    orientation::testing_orientation_prepared(initial, measurements, options, prepared, &mut |_| {})
                 } else {
-                    calibrate_prepared(initial, measurements, options, prepared)
+                    calibrate_prepared(initial, measurements, options, prepared, &mut |_| {})
                 }
             }
             _ => calibrate(initial, measurements, options),

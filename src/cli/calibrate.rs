@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use sagcal::calib::gross_errors::Verdict;
 use sagcal::calib::report::CalibrationReport;
 use sagcal::calib::{
-    calibrate_job, CableModel, CalibrationOptions, CalibrationResult, CalibrationSettings, OrientationPrior,
-    ParameterUncertainty,
+    calibrate_job_with_progress, CableModel, CalibrationOptions, CalibrationResult, CalibrationSettings,
+    OrientationPrior, ParameterUncertainty,
 };
 use sagcal::error::FrontEnd;
 use sagcal::io::measurements::{read_measurements, ReadOptions};
@@ -16,7 +16,7 @@ use sagcal::model::Robot;
 use sagcal::plot::{anchor_plot_svg, figure_bytes, AnchorPlot, AnchorPlotEntry};
 
 use super::gross_errors;
-use super::output::{print_json, Table};
+use super::output::{print_json, progress_bar, Table};
 use super::solver_args::SolverArgs;
 
 #[derive(Debug, clap::Args)]
@@ -64,7 +64,17 @@ pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
         accept_inconsistent: args.accept_inconsistent,
     };
     let source = args.data.display().to_string();
-    let mut job = calibrate_job(&nominal, &data.poses, &source, &settings, FrontEnd::Cli)?;
+    let bar = progress_bar(1, "{msg} [{bar:30}] {pos}/{len} fits, {elapsed}");
+    let job = calibrate_job_with_progress(
+        &nominal,
+        &data.poses,
+        &source,
+        &settings,
+        FrontEnd::Cli,
+        &mut |done, total, what| bar.report(done, total, what),
+    );
+    bar.finish_and_clear();
+    let mut job = job?;
     if let Some(refusal) = job.refusal.take() {
         // Nothing is written: the report goes out (as text or JSON), then the error names the sensors.
         if args.json {

@@ -103,11 +103,7 @@ pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
         &data.poses,
         truth.as_ref(),
         &options,
-        &mut |done, total, what| {
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
-            bar.set_message(what.to_string());
-        },
+        &mut |done, total, what| bar.report(done, total, what),
     )?;
     bar.finish_and_clear();
     // Files only after everything succeeded: all of them or none, none over an input.

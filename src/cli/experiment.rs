@@ -196,8 +196,6 @@ fn run_trials(
     protocol: &Protocol,
 ) -> sagcal::Result<Vec<PoseCountResult>> {
     let total = (args.poses.len() * args.trials) as u64;
-    let bar = progress_bar(total, "{msg} [{bar:40}] {pos}/{len} trials, {elapsed} (eta {eta})");
-    bar.set_message(format!("table2 seed {}", args.seed));
     eprintln!(
         "sagcal experiment table2: seed {}, {} trials x {} poses, {} noise, {} model, {} data ({} usable poses)",
         args.seed,
@@ -218,6 +216,9 @@ fn run_trials(
             args.select, args.plan_criterion, args.plan_anchor_error_m
         );
     }
+    // The bar after the lines above: a live bar would be written over.
+    let bar = progress_bar(total, "{msg} [{bar:40}] {pos}/{len} trials, {elapsed} (eta {eta})");
+    bar.set_message(format!("table2 seed {}", args.seed));
     let results = run_selected_protocol(
         truth,
         pool,

@@ -15,7 +15,7 @@ use sagcal::model::Robot;
 use sagcal::sim::closed_form::Closure;
 use serde::Serialize;
 
-use super::output::{print_json, progress_bar, Table};
+use super::output::{counted, print_json, progress_bar, Table};
 use super::parse::parse_noises;
 
 #[derive(Debug, clap::Args)]
@@ -168,16 +168,7 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
         diagnosed: cases,
         unmeasurable,
     } = sweep(args, &robots, &options)?;
-    // The identifiability of each robot's smallest effects: independent, in parallel.
-    let mut studies = Vec::new();
-    for robot in &robots {
-        let mean_tension = mean_reference_tension_n(robot, args.poses, args.seed)?;
-        studies.extend(smallest_effects(robot, mean_tension).into_iter().map(|s| (robot, s)));
-    }
-    let smallest = studies
-        .par_iter()
-        .map(|(robot, (kind, effects))| identifiability(robot, *kind, effects, args.poses, args.seed, &options))
-        .collect::<sagcal::Result<Vec<_>>>()?;
+    let smallest = smallest_identifiability(args, &robots, &options)?;
     let scores = scores(&robots, &args.noise, &cases);
     let report = Report {
         seed: args.seed,
@@ -215,14 +206,14 @@ fn hidden_sets() -> Vec<String> {
 fn sweep(args: &HiddenEffectsArgs, robots: &[Robot], options: &HiddenEffectOptions) -> sagcal::Result<SweepCases> {
     let total = robots.len() * args.noise.len() * hidden_sets().len() * args.seeds;
     eprintln!(
-        "sagcal experiment hidden-effects: seed {}, {} closure, {} seeds x {} hidden sets (none, {} effects, {} pairs) x {} robot(s) x {} noise, {} poses",
+        "sagcal experiment hidden-effects: seed {}, {} closure, {} x {} hidden sets (none, {} effects, {} pairs) x {} x {} noise, {} poses",
         args.seed,
         args.closure,
-        args.seeds,
+        counted(args.seeds, "seed", "seeds"),
         hidden_sets().len(),
         EffectKind::ALL.len(),
         PAIRS.len(),
-        robots.len(),
+        counted(robots.len(), "robot", "robots"),
         noise_names(&args.noise),
         args.poses
     );
@@ -233,6 +224,40 @@ fn sweep(args: &HiddenEffectsArgs, robots: &[Robot], options: &HiddenEffectOptio
     let cases = run_sweep(robots, &args.noise, args.seeds, args.seed, options, &|| bar.inc(1))?;
     bar.finish_and_clear();
     Ok(cases)
+}
+
+/// The identifiability of each robot's smallest effects (independent
+/// studies, in parallel), with a progress bar: seconds after the sweep.
+fn smallest_identifiability(
+    args: &HiddenEffectsArgs,
+    robots: &[Robot],
+    options: &HiddenEffectOptions,
+) -> sagcal::Result<Vec<Identifiability>> {
+    let bar = progress_bar(robots.len() as u64, "{msg} [{bar:40}] {pos}/{len}, {elapsed}");
+    bar.set_message("identifiability of the smallest effects: mean tension per robot");
+    let mut studies = Vec::new();
+    for robot in robots {
+        let mean_tension = match mean_reference_tension_n(robot, args.poses, args.seed) {
+            Ok(tension) => tension,
+            Err(e) => {
+                bar.finish_and_clear();
+                return Err(e);
+            }
+        };
+        studies.extend(smallest_effects(robot, mean_tension).into_iter().map(|s| (robot, s)));
+        bar.inc(1);
+    }
+    bar.report(0, studies.len(), "identifiability of the smallest effects: studies");
+    let smallest = studies
+        .par_iter()
+        .map(|(robot, (kind, effects))| {
+            let study = identifiability(robot, *kind, effects, args.poses, args.seed, options);
+            bar.inc(1);
+            study
+        })
+        .collect::<sagcal::Result<Vec<_>>>();
+    bar.finish_and_clear();
+    smallest
 }
 
 /// The score of every robot, noise reading and hidden set.

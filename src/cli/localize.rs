@@ -14,7 +14,7 @@ use sagcal::model::DataRow;
 use sagcal::model::Robot;
 use sagcal::plot::localize::{localize_plot_svg, LocalizePlot, PlottedPose};
 
-use super::output::{opt, print_json, Table};
+use super::output::{opt, print_json, progress_bar, Table};
 
 #[derive(Debug, clap::Args)]
 pub(super) struct LocalizeArgs {
@@ -191,7 +191,13 @@ fn localize_file(
             localiser_pose: row.localiser_pose,
         })
         .collect();
-    let solved = localizer.localize_sequence(&readings, search, &mut || false)?;
+    let bar = progress_bar(1, "{msg} [{bar:30}] {pos}/{len} rows, {elapsed}");
+    let solved =
+        localizer.localize_sequence_with_progress(&readings, search, &mut || false, &mut |done, total, what| {
+            bar.report(done, total, what)
+        });
+    bar.finish_and_clear();
+    let solved = solved?;
     let mut rows = Vec::with_capacity(file.rows.len());
     let mut plotted = Vec::new();
     for (k, (row, solved)) in file.rows.iter().zip(solved).enumerate() {

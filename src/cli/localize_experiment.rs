@@ -119,7 +119,7 @@ pub fn run_experiment(args: &LocalizeExperimentArgs) -> sagcal::Result<()> {
         let pool = pose_pool(&truth, &data.poses, source)?;
         for &noise in &args.noise {
             let bar = progress_bar(args.trials as u64, "{msg} [{bar:40}] {pos}/{len} trials, {elapsed}");
-            bar.set_message(format!("{source:?} data, {noise:?} noise"));
+            bar.set_message(format!("{source} data, {noise} noise"));
             let protocol = table2_protocol(&truth, noise);
             let trials = run(&truth, &pool, args.poses, args.trials, args.seed, &protocol, &|| {
                 bar.inc(1)

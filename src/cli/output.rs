@@ -1,6 +1,11 @@
-//! Plain-text tables and JSON output shared by the commands.
+//! Plain-text tables, JSON output and progress displays shared by the commands.
 
-use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::ops::Deref;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle, TermLike};
 use serde::Serialize;
 
 /// `n` things in words: `1 reading`, `2 readings` (`plural` for every count but one).
@@ -68,15 +73,166 @@ pub fn opt(value: Option<f64>, decimals: usize) -> String {
     value.map_or_else(|| "-".to_string(), |v| format!("{v:.decimals$}"))
 }
 
-/// A progress bar of `len` steps drawn with `template` (indicatif's syntax), filled with `=>`.
-pub fn progress_bar(len: u64, template: &str) -> ProgressBar {
-    let bar = ProgressBar::new(len);
+/// Where stderr is not a terminal (a pipe, a log file, `TERM=dumb`), where
+/// indicatif would draw nothing, a progress display is written as a plain
+/// line at most this often, and its final state once more at its end if it
+/// wrote any: a run shorter than this adds nothing to a log.
+pub const LOG_INTERVAL: Duration = Duration::from_secs(10);
+
+/// A progress display on stderr ([`progress_bar`]): an indicatif bar (its
+/// methods through `Deref`) redrawn in place on a terminal, written as lines
+/// elsewhere.
+pub struct Progress {
+    bar: ProgressBar,
+    /// The lines of a display that is not on a terminal.
+    log: Option<Arc<LogLines>>,
+}
+
+impl Deref for Progress {
+    type Target = ProgressBar;
+
+    fn deref(&self) -> &ProgressBar {
+        &self.bar
+    }
+}
+
+impl Progress {
+    /// Show `done` of `total` steps of `what` (a job's `(done, total, what)` report).
+    pub fn report(&self, done: usize, total: usize, what: &str) {
+        self.bar.set_message(what.to_string());
+        self.bar.update(|state| {
+            state.set_len(total as u64);
+            state.set_pos(done as u64);
+        });
+    }
+
+    /// End the display: cleared from a terminal; on a log, its final state
+    /// written as a line if it wrote any before.
+    pub fn finish_and_clear(&self) {
+        match &self.log {
+            None => self.bar.finish_and_clear(),
+            Some(log) => {
+                log.lock().finishing = true;
+                self.bar.finish();
+            }
+        }
+    }
+}
+
+/// A progress bar of `len` steps drawn with `template` (indicatif's syntax),
+/// filled with `=>`, on stderr, ticking every second (so that its elapsed
+/// time and estimate move while a step runs); not on a terminal, written as
+/// lines ([`LOG_INTERVAL`]). Progress is never written to stdout.
+pub fn progress_bar(len: u64, template: &str) -> Progress {
+    let dumb = match std::env::var("TERM") {
+        Ok(term) => term == "dumb",
+        Err(_) => !cfg!(windows),
+    };
+    let log = (!std::io::stderr().is_terminal() || dumb).then(|| Arc::new(LogLines::default()));
+    let target = match &log {
+        None => ProgressDrawTarget::stderr(),
+        Some(log) => ProgressDrawTarget::term_like_with_hz(Box::new(LogTarget(log.clone())), 1),
+    };
+    let bar = ProgressBar::with_draw_target(Some(len), target);
     bar.set_style(
         ProgressStyle::with_template(template)
             .unwrap_or_else(|_| ProgressStyle::default_bar())
             .progress_chars("=> "),
     );
-    bar
+    bar.enable_steady_tick(Duration::from_secs(1));
+    Progress { bar, log }
+}
+
+/// What a display off the terminal has drawn, and when it last wrote a line.
+#[derive(Debug)]
+struct LogState {
+    /// The text of the draw under way.
+    drawn: String,
+    /// When the last line was written (or the display began).
+    last: Instant,
+    /// Whether any line was written.
+    wrote: bool,
+    /// The next draw is the display's final state.
+    finishing: bool,
+}
+
+/// The lines of a display off the terminal (see [`LOG_INTERVAL`]).
+#[derive(Debug)]
+struct LogLines(Mutex<LogState>);
+
+impl Default for LogLines {
+    fn default() -> Self {
+        LogLines(Mutex::new(LogState {
+            drawn: String::new(),
+            last: Instant::now(),
+            wrote: false,
+            finishing: false,
+        }))
+    }
+}
+
+impl LogLines {
+    fn lock(&self) -> MutexGuard<'_, LogState> {
+        self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+}
+
+/// indicatif's terminal for a display off the terminal: each draw collected,
+/// then written as one line when it is due.
+#[derive(Debug)]
+struct LogTarget(Arc<LogLines>);
+
+impl TermLike for LogTarget {
+    fn width(&self) -> u16 {
+        1000
+    }
+
+    fn move_cursor_up(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    fn move_cursor_down(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    fn move_cursor_right(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    fn move_cursor_left(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    fn write_line(&self, s: &str) -> std::io::Result<()> {
+        self.write_str(s)
+    }
+
+    fn write_str(&self, s: &str) -> std::io::Result<()> {
+        self.0.lock().drawn.push_str(s);
+        Ok(())
+    }
+
+    fn clear_line(&self) -> std::io::Result<()> {
+        self.0.lock().drawn.clear();
+        Ok(())
+    }
+
+    fn flush(&self) -> std::io::Result<()> {
+        let mut state = self.0.lock();
+        let line = std::mem::take(&mut state.drawn);
+        let line = line.trim_end();
+        let due = if state.finishing {
+            state.wrote
+        } else {
+            state.last.elapsed() >= LOG_INTERVAL
+        };
+        if !line.is_empty() && due {
+            eprintln!("{line}");
+            state.last = Instant::now();
+            state.wrote = true;
+        }
+        Ok(())
+    }
 }
 
 /// Serialise `value` as pretty JSON to stdout.
@@ -85,4 +241,33 @@ pub fn print_json<T: Serialize>(value: &T) -> sagcal::Result<()> {
         .map_err(|e| sagcal::Error::InvalidInput(format!("cannot serialise the report as JSON: {e}")))?;
     println!("{text}");
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Off the terminal a draw becomes a line only when one is due: after
+    /// [`LOG_INTERVAL`], or at the end of a display that wrote one.
+    #[test]
+    fn a_log_gets_a_line_when_one_is_due() {
+        let lines = Arc::new(LogLines::default());
+        let target = LogTarget(lines.clone());
+        let draw = |text: &str| {
+            target.clear_line().unwrap();
+            target.write_str(text).unwrap();
+            target.write_str("   ").unwrap();
+            target.flush().unwrap();
+        };
+        draw("step [=>  ] 1/4, 0s");
+        assert!(!lines.lock().wrote, "a line before it is due");
+        lines.lock().last = Instant::now() - LOG_INTERVAL;
+        draw("step [==> ] 2/4, 10s");
+        let written = lines.lock().last;
+        assert!(lines.lock().wrote && written.elapsed() < LOG_INTERVAL);
+        assert!(lines.lock().drawn.is_empty(), "each draw starts afresh");
+        lines.lock().finishing = true;
+        draw("step [====] 4/4, 12s");
+        assert!(lines.lock().last >= written, "the end is written");
+    }
 }

@@ -105,23 +105,13 @@ pub fn run(args: &PlanArgs) -> sagcal::Result<()> {
         args.seed, args.poses, args.criterion
     );
     let settings = settings(args, &robot)?;
-    let (mut bar, mut what) = (None, String::new());
-    let mut progress = |step: PlanProgress<'_>| match step {
-        PlanProgress::Drawing(message) => {
-            let spinner = progress_bar(1, "{msg} {spinner} {elapsed}");
-            what = message.to_string();
-            spinner.set_message(what.clone());
-            spinner.enable_steady_tick(std::time::Duration::from_millis(200));
-            bar = Some(spinner);
-        }
-        PlanProgress::Found { found, count } => {
-            if let Some(b) = &bar {
-                b.set_message(format!("{what}: {found} of {count} found"));
-            }
-        }
-        PlanProgress::Drawn => bar.take().into_iter().for_each(|b| b.finish_and_clear()),
-    };
-    let planned = plan_calibration(&robot, &settings, &mut progress)?;
+    let bar = progress_bar(1, "{msg} [{bar:30}] {pos}/{len}, {elapsed}");
+    let planned = plan_calibration(&robot, &settings, &mut |step: PlanProgress<'_>| {
+        let (done, total, what) = step.counts();
+        bar.report(done, total, &what);
+    });
+    bar.finish_and_clear();
+    let planned = planned?;
     let (report, plan) = (&planned.report, &planned.plan);
     let candidates = &report.candidates.equilibria;
     // All the files or none, none over an input.

@@ -47,6 +47,11 @@ use crate::sim::closed_form::{sample_equilibria_counted, Closure, FIRST_DRAWS};
 /// Draws per candidate before giving up on it (most of a frame is reachable).
 pub const ATTEMPTS_PER_CANDIDATE: usize = 50;
 
+/// The largest batch of candidates drawn together, per thread: about a
+/// second of work at ~30 ms a candidate, so that the threads wait little
+/// for a batch's last candidate and progress is reported often.
+pub const BATCH_PER_THREAD: usize = 32;
+
 /// Candidates and what was left out.
 #[derive(Debug, Clone, Serialize)]
 pub struct CandidateSet {
@@ -199,7 +204,8 @@ fn draw_one(robot: &Robot, slots: &SlotRobot, workspace: &Workspace, margins: &M
 /// batches of 1, 4, 16, ... in candidate order, and the first batch with a
 /// candidate that gave up ends the drawing with an error saying why (a
 /// hopeless box fails on its first candidate, within [`ATTEMPTS_PER_CANDIDATE`]
-/// poses).
+/// poses); a batch holds at most [`BATCH_PER_THREAD`] candidates per thread,
+/// so that progress is reported about every second.
 pub fn draw_candidates(
     robot: &Robot,
     workspace: &Workspace,
@@ -247,7 +253,7 @@ pub fn draw_candidates_with_progress(
         }
         progress(set.equilibria.len());
         start = end;
-        batch *= 4;
+        batch = (batch * 4).min(BATCH_PER_THREAD * rayon::current_num_threads());
     }
     Ok(set)
 }

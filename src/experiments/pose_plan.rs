@@ -35,7 +35,9 @@ use crate::model::robot::{Robot, Workspace};
 use crate::model::sensors::NoisePreset;
 use crate::model::statics::Equilibrium;
 use crate::model::PoseMeasurement;
-use crate::plan::{candidate_information, distinct_poses, plan_poses, Criterion, DesignOptions, Margins, Plan};
+use crate::plan::{
+    candidate_information, distinct_poses, plan_poses, Criterion, DesignOptions, DesignProgress, Margins, Plan,
+};
 
 /// Candidates drawn when none are given (`sagcal plan --candidates`'s default).
 pub const DEFAULT_CANDIDATES: usize = 1000;
@@ -102,20 +104,63 @@ impl PlanSettings {
     }
 }
 
-/// How far the job is, for a progress display.
+/// How far the job is, for a progress display ([`PlanProgress::counts`]).
+/// Drawing the candidates is the long part (~30 ms of CPU each); choosing
+/// the poses takes a second or more only for about a hundred poses among
+/// 10 000 candidates; the candidates' information, the visiting order and
+/// the random sets take milliseconds to a few tenths of a second and report
+/// nothing.
 #[derive(Debug, Clone, Copy)]
 pub enum PlanProgress<'a> {
-    /// Drawing candidates (the long part), described in the command's words.
-    Drawing(&'a str),
-    /// Candidates found so far, of the count asked for (after each batch of [`draw_candidates_with_progress`]).
-    Found {
+    /// Drawing candidates: `found` of the `count` asked for (reported from 0,
+    /// then after each batch of [`draw_candidates_with_progress`]).
+    Drawing {
+        /// The draw in the command's words (how many, where, the seed).
+        what: &'a str,
         /// Candidates found.
         found: usize,
         /// Candidates asked for.
         count: usize,
     },
-    /// The candidates are drawn.
-    Drawn,
+    /// Choosing the poses among the candidates.
+    Choosing(DesignProgress),
+    /// The plan is made.
+    Done,
+}
+
+impl PlanProgress<'_> {
+    /// The report as `(done, total, what)`, as `sagcal plan` draws it and
+    /// `sagcal.plan` passes it on (the form of the diagnosis' progress): the
+    /// count within the stage `what` names, ending with `(1, 1, "done")`.
+    ///
+    /// ```
+    /// use sagcal::experiments::pose_plan::PlanProgress;
+    /// use sagcal::plan::DesignProgress;
+    /// let drawing = PlanProgress::Drawing { what: "drawing 40 candidate poses", found: 21, count: 40 };
+    /// assert_eq!(drawing.counts(), (21, 40, "drawing 40 candidate poses".to_string()));
+    /// let greedy = PlanProgress::Choosing(DesignProgress::Greedy { chosen: 3, poses: 9 });
+    /// assert_eq!(greedy.counts(), (3, 9, "choosing the poses one by one".to_string()));
+    /// assert_eq!(PlanProgress::Done.counts(), (1, 1, "done".to_string()));
+    /// ```
+    pub fn counts(&self) -> (usize, usize, String) {
+        match *self {
+            PlanProgress::Drawing { what, found, count } => (found, count, what.to_string()),
+            PlanProgress::Choosing(DesignProgress::Greedy { chosen, poses }) => {
+                (chosen, poses, "choosing the poses one by one".to_string())
+            }
+            PlanProgress::Choosing(DesignProgress::Exchange {
+                pass,
+                max_passes,
+                tried,
+                poses,
+            }) => (
+                tried,
+                poses,
+                format!("exchanging poses, pass {pass} of at most {max_passes}"),
+            ),
+            PlanProgress::Done => (1, 1, "done".to_string()),
+        }
+    }
 }
 
 /// One pose of the plan, in visiting order.
@@ -257,14 +302,19 @@ fn candidates(
             robot.name
         ))
     })?;
-    progress(PlanProgress::Drawing(&format!(
-        "drawing {count} candidate poses in {from}, seed {}",
-        settings.seed
-    )));
+    let what = format!("drawing {count} candidate poses in {from}, seed {}", settings.seed);
+    progress(PlanProgress::Drawing {
+        what: &what,
+        found: 0,
+        count,
+    });
     let set = draw_candidates_with_progress(robot, &workspace, count, margins, settings.seed, &mut |found| {
-        progress(PlanProgress::Found { found, count })
+        progress(PlanProgress::Drawing {
+            what: &what,
+            found,
+            count,
+        })
     })?;
-    progress(PlanProgress::Drawn);
     Ok((set, Some(workspace), format!("{count} drawn in {from}")))
 }
 
@@ -309,6 +359,8 @@ fn too_few_distinct(label: &str, lines: &[usize], groups: &[Vec<usize>]) -> Erro
 /// Plan the calibration of `robot` (the nominal model): the candidates of
 /// `settings`, each one's information, the chosen poses in visiting order
 /// from the start point ([`start_point`]), and the comparison with random sets.
+/// `progress` is told how far the job is ([`PlanProgress`]); it changes
+/// nothing computed.
 pub fn plan_calibration(
     robot: &Robot,
     settings: &PlanSettings,
@@ -334,7 +386,15 @@ pub fn plan_calibration(
         ..DesignOptions::new(settings.poses)
     };
     let start = start_point(&set.equilibria);
-    let plan = plan_poses(&set.equilibria, &information, &design, &start, settings.seed)?;
+    let plan = plan_poses(
+        &set.equilibria,
+        &information,
+        &design,
+        &start,
+        settings.seed,
+        &mut |step| progress(PlanProgress::Choosing(step)),
+    )?;
+    progress(PlanProgress::Done);
     let report = PlanReport {
         robot: robot.name.clone(),
         seed: settings.seed,

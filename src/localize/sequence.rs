@@ -67,12 +67,47 @@ impl Localizer {
         search: bool,
         stop: &mut dyn FnMut() -> bool,
     ) -> Result<Vec<SequenceRow>> {
+        self.localize_sequence_with_progress(rows, search, stop, &mut |_, _, _| {})
+    }
+
+    /// [`Localizer::localize_sequence`], telling `progress(done, total,
+    /// what)` the rows localised: `(k, n, "localising rows")` before row
+    /// `k` (from 0) of `n`, and `(n, n, "done")` after the last (not when
+    /// stopped). It changes nothing computed.
+    ///
+    /// ```
+    /// use nalgebra::Vector3;
+    /// use sagcal::localize::{Localizer, Readings};
+    /// use sagcal::model::sensors::NoisePreset;
+    /// use sagcal::model::statics::{solve_level, StaticsOptions};
+    /// use sagcal::model::Robot;
+    /// let robot = Robot::builtin("small")?;
+    /// let truth = solve_level(&robot, Vector3::new(0.2, -0.1, 0.8), &StaticsOptions::default())?;
+    /// let row = Readings { encoder_lengths_m: truth.cable_lengths_m, load_cell_n: None, localiser_pose: None };
+    /// let localizer = Localizer::new(&robot, &NoisePreset::Paper.sigmas(robot.platform_weight_n))?;
+    /// let mut reports = Vec::new();
+    /// localizer.localize_sequence_with_progress(&[row; 3], false, &mut || false, &mut |done, total, what| {
+    ///     reports.push((done, total, what.to_string()))
+    /// })?;
+    /// let counts: Vec<(usize, usize)> = reports.iter().map(|r| (r.0, r.1)).collect();
+    /// assert_eq!(counts, [(0, 3), (1, 3), (2, 3), (3, 3)]);
+    /// assert_eq!(reports[3].2, "done");
+    /// # Ok::<(), sagcal::Error>(())
+    /// ```
+    pub fn localize_sequence_with_progress(
+        &self,
+        rows: &[Readings],
+        search: bool,
+        stop: &mut dyn FnMut() -> bool,
+        progress: &mut dyn FnMut(usize, usize, &str),
+    ) -> Result<Vec<SequenceRow>> {
         let mut warm: Option<PlatformPose> = None;
         let mut solved = Vec::with_capacity(rows.len());
-        for readings in rows {
+        for (k, readings) in rows.iter().enumerate() {
             if stop() {
-                break;
+                return Ok(solved);
             }
+            progress(k, rows.len(), "localising rows");
             let row = match self.localize(readings, warm.as_ref()) {
                 Ok(found) => {
                     let flag = self.flag(&found);
@@ -99,6 +134,7 @@ impl Localizer {
             };
             solved.push(row);
         }
+        progress(rows.len(), rows.len(), "done");
         Ok(solved)
     }
 

@@ -276,6 +276,34 @@ pub fn updated_values(
     Some(gains.into_iter().map(|g| base - g).collect())
 }
 
+/// How far the search is, for a progress display: reported at the start of
+/// the greedy pass and of each exchange pass, and after each sweep over the
+/// candidates (one greedy step, or one chosen pose tried for a swap).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DesignProgress {
+    /// The greedy pass has chosen `chosen` of the `poses` to choose
+    /// (reported from 0).
+    Greedy {
+        /// Poses chosen so far.
+        chosen: usize,
+        /// Poses to choose.
+        poses: usize,
+    },
+    /// Exchange pass `pass` (from 1; at most `max_passes`, fewer when a pass
+    /// gains too little) has tried to swap `tried` of the `poses` chosen
+    /// (reported from 0).
+    Exchange {
+        /// The pass, from 1.
+        pass: usize,
+        /// [`DesignOptions::max_exchange_passes`].
+        max_passes: usize,
+        /// Chosen poses tried in this pass.
+        tried: usize,
+        /// Chosen poses a pass tries.
+        poses: usize,
+    },
+}
+
 /// Choose `options.poses` of the candidates `poses` (module docs).
 pub fn choose_poses(poses: &[PoseInformation], options: &DesignOptions) -> Result<Design> {
     choose_more_poses(poses, &[], options)
@@ -285,6 +313,33 @@ pub fn choose_poses(poses: &[PoseInformation], options: &DesignOptions) -> Resul
 /// already measured (the sequential mode): the greedy pass starts from them
 /// and the exchanges never remove them. [`Design::chosen`] lists the new ones only.
 pub fn choose_more_poses(poses: &[PoseInformation], fixed: &[usize], options: &DesignOptions) -> Result<Design> {
+    choose_more_poses_with_progress(poses, fixed, options, &mut |_| {})
+}
+
+/// [`choose_more_poses`], telling `progress` how far the search is
+/// ([`DesignProgress`]; it changes nothing chosen).
+///
+/// ```
+/// use nalgebra::DMatrix;
+/// use sagcal::plan::information::PoseInformation;
+/// use sagcal::plan::{choose_more_poses_with_progress, DesignOptions, DesignProgress};
+/// let unit = |k: usize| PoseInformation { factor: DMatrix::from_fn(16, 1, |r, _| if r == k % 16 { 1.0 } else { 0.5 }) };
+/// let candidates: Vec<PoseInformation> = (0..40).map(unit).collect();
+/// let mut greedy = Vec::new();
+/// choose_more_poses_with_progress(&candidates, &[], &DesignOptions::new(16), &mut |step| {
+///     if let DesignProgress::Greedy { chosen, poses } = step {
+///         greedy.push((chosen, poses));
+///     }
+/// })?;
+/// assert_eq!(greedy, (0..=16).map(|k| (k, 16)).collect::<Vec<_>>());
+/// # Ok::<(), sagcal::Error>(())
+/// ```
+pub fn choose_more_poses_with_progress(
+    poses: &[PoseInformation],
+    fixed: &[usize],
+    options: &DesignOptions,
+    progress: &mut dyn FnMut(DesignProgress),
+) -> Result<Design> {
     if options.poses == 0 || options.poses + fixed.len() > poses.len() || fixed.iter().any(|&k| k >= poses.len()) {
         return Err(Error::InvalidInput(format!(
             "cannot choose {} poses from {} candidates",
@@ -301,13 +356,22 @@ pub fn choose_more_poses(poses: &[PoseInformation], fixed: &[usize], options: &D
     for &k in fixed {
         taken[k] = true;
     }
-    for _ in 0..options.poses {
+    let wanted = options.poses;
+    progress(DesignProgress::Greedy {
+        chosen: 0,
+        poses: wanted,
+    });
+    for step in 1..=wanted {
         crate::steps::add(poses.len() as u64);
         let c = covariance_of(&information_sum(poses, &chosen, ridge)).ok_or_else(singular)?;
         let gains = stack.gains(&c, options.criterion);
         let best = best_free(&gains, &taken).ok_or_else(singular)?;
         taken[best] = true;
         chosen.push(best);
+        progress(DesignProgress::Greedy {
+            chosen: step,
+            poses: wanted,
+        });
     }
     let value_of = |chosen: &[usize]| -> Result<f64> {
         let m = information_sum(poses, chosen, ridge);
@@ -320,7 +384,14 @@ pub fn choose_more_poses(poses: &[PoseInformation], fixed: &[usize], options: &D
     while passes < options.max_exchange_passes {
         passes += 1;
         let mut swapped = false;
-        for slot in fixed.len()..chosen.len() {
+        let exchange = |tried| DesignProgress::Exchange {
+            pass: passes,
+            max_passes: options.max_exchange_passes,
+            tried,
+            poses: wanted,
+        };
+        for (tried, slot) in (fixed.len()..chosen.len()).enumerate() {
+            progress(exchange(tried));
             crate::steps::add(poses.len() as u64);
             let current = chosen[slot];
             let others: Vec<usize> = chosen.iter().copied().filter(|&k| k != current).collect();
@@ -337,6 +408,7 @@ pub fn choose_more_poses(poses: &[PoseInformation], fixed: &[usize], options: &D
                 swapped = true;
             }
         }
+        progress(exchange(wanted));
         if !swapped {
             break;
         }

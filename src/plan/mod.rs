@@ -45,7 +45,9 @@ mod random;
 
 pub use bound::{plan_bound, PlanBound};
 pub use candidates::{distinct_poses, Margins};
-pub use design::{choose_more_poses, choose_poses, Criterion, Design, DesignOptions};
+pub use design::{
+    choose_more_poses, choose_more_poses_with_progress, choose_poses, Criterion, Design, DesignOptions, DesignProgress,
+};
 pub use information::{candidate_information, pose_information, PoseInformation};
 pub use order::{path_length_m, visiting_order};
 pub use plan_poses::{plan_poses, Plan};

@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::bound::{plan_bound, PlanBound};
 use super::candidates::distinct_poses;
-use super::design::{choose_poses, Design, DesignOptions};
+use super::design::{choose_more_poses_with_progress, Design, DesignOptions, DesignProgress};
 use super::information::PoseInformation;
 use super::order::{path_length_m, visiting_order};
 use super::random::{random_bounds, RandomBounds, RANDOM_DRAWS};
@@ -35,14 +35,18 @@ pub struct Plan {
 
 /// Choose, order and compare (the [module docs](crate::plan)); `seed` draws the random sets,
 /// `start_m` is where the path begins (the point nearest it is visited first).
+/// `progress` follows the choice ([`DesignProgress`]), the one step that can
+/// take seconds (choosing 100 of 10 000 candidates); the order and the
+/// random sets take milliseconds.
 pub fn plan_poses(
     candidates: &[Equilibrium],
     information: &[PoseInformation],
     options: &DesignOptions,
     start_m: &Vector3<f64>,
     seed: u64,
+    progress: &mut dyn FnMut(DesignProgress),
 ) -> Result<Plan> {
-    let design = choose_poses(information, options)?;
+    let design = choose_more_poses_with_progress(information, &[], options, progress)?;
     let bound = plan_bound(information, &design.chosen).ok_or_else(|| undetermined(candidates, &design.chosen))?;
     let points: Vec<Vector3<f64>> = design.chosen.iter().map(|&k| candidates[k].pose.position_m).collect();
     let order: Vec<usize> = visiting_order(&points, start_m)
