@@ -253,6 +253,13 @@ impl Robot {
         dict.set_item("com_shift_m", out1(py, &e.com_shift_m)?)?;
         dict.set_item("cable_segments", e.cable_segments)?;
         dict.set_item("localiser_mount_deg", out1(py, &e.localiser_mount_deg)?)?;
+        dict.set_item("platform_weight_scale", e.platform_weight_scale)?;
+        dict.set_item("cable_weight_scale", e.cable_weight_scale)?;
+        dict.set_item("encoder_drift_m_per_row", out1(py, &e.encoder_drift_m_per_row)?)?;
+        dict.set_item("encoder_backlash_m", out1(py, &e.encoder_backlash_m)?)?;
+        dict.set_item("load_cell_drift_n_per_row", e.load_cell_drift_n_per_row)?;
+        dict.set_item("load_cell_friction", e.load_cell_friction)?;
+        dict.set_item("attachment_shift_m", out2(py, &e.attachment_shift_m)?)?;
         Ok(dict)
     }
 
@@ -284,6 +291,19 @@ fn effects_from_dict(dict: &Bound<'_, PyDict>) -> PyResult<Effects> {
             serde_json::Value::Null
         } else if let Ok(number) = value.extract::<f64>() {
             number_json(number).ok_or_else(|| fail(format!("`{key}` is not finite")))?
+        } else if key == "attachment_shift_m" {
+            // Four `[dx, dy]` pairs: a (4, 2) array, as the getter gives it.
+            let pairs = exact_rows::<2>(&value, CABLE_COUNT, &key)?;
+            let rows: Option<Vec<serde_json::Value>> = pairs
+                .into_iter()
+                .map(|pair| {
+                    pair.into_iter()
+                        .map(number_json)
+                        .collect::<Option<Vec<_>>>()
+                        .map(serde_json::Value::Array)
+                })
+                .collect();
+            serde_json::Value::Array(rows.ok_or_else(|| fail(format!("`{key}` is not finite")))?)
         } else {
             let values = crate::arrays::any_vector(&value, &key)?;
             let numbers: Option<Vec<serde_json::Value>> = values.into_iter().map(number_json).collect();

@@ -62,6 +62,32 @@ def test_setting_values_and_the_toml_round_trip(tmp_path):
     again.effects = robot.effects
     assert again.effects["axial_stiffness_n"] == 3e6
     np.testing.assert_array_equal(again.effects["encoder_gain"], robot.effects["encoder_gain"])
+    # Every key of the robot file's [effects], the same as the file holds.
+    every = {
+        "axial_stiffness_n": 2e6,
+        "pulley_radius_m": 0.05,
+        "encoder_gain": [1.001, 1.0, 0.999, 1.0],
+        "load_cell_bias_n": 1.5,
+        "load_cell_gain": 1.01,
+        "com_shift_m": [0.01, 0.0, -0.02],
+        "cable_segments": 40.0,
+        "localiser_mount_deg": [0.5, 0.0, 0.0],
+        "platform_weight_scale": 1.05,
+        "cable_weight_scale": 0.95,
+        "encoder_drift_m_per_row": [1e-4, 0.0, 0.0, 2e-4],
+        "encoder_backlash_m": [0.0, 1e-3, 0.0, 0.0],
+        "load_cell_drift_n_per_row": 0.02,
+        "load_cell_friction": 0.03,
+        "attachment_shift_m": [[0.01, 0.0], [0.0, 0.0], [0.0, -0.01], [0.0, 0.0]],
+    }
+    full = sagcal.Robot.builtin("large")
+    full.effects = every
+    read = full.effects
+    assert sorted(read) == sorted(every)
+    for key, value in every.items():
+        np.testing.assert_array_equal(read[key], value, err_msg=key)
+    full.to_toml(tmp_path / "full.toml")
+    assert sagcal.Robot.from_toml(tmp_path / "full.toml") == full
     copied = copy.deepcopy(robot)
     copied.name = "other"
     assert robot.name != "other"
