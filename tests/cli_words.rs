@@ -52,6 +52,19 @@ fn unreadable(what: &str, text: &str) -> Option<String> {
     None
 }
 
+/// The widest table diagnose may print, in columns (its parameter lists wrap).
+const DIAGNOSE_TABLE_COLUMNS: usize = 150;
+
+/// Why `text` has a table wider than `columns`, or `None`: a table's rule
+/// (a line of dashes) spans the table.
+fn too_wide(what: &str, text: &str, columns: usize) -> Option<String> {
+    text.lines()
+        .map(|l| l.chars().count())
+        .zip(text.lines())
+        .find(|(n, l)| *n > columns && l.chars().all(|c| c == '-'))
+        .map(|(n, _)| format!("{what}: a table {n} columns wide, over {columns}"))
+}
+
 /// stdout and stderr of `sagcal ARGS` run in `dir`.
 fn printed(dir: &Path, args: &[&str]) -> String {
     let out = sagcal(dir, args);
@@ -82,6 +95,8 @@ fn the_self_check_finds_what_it_forbids() {
     assert!(unreadable("t", "1 readings left out").is_some());
     assert!(unreadable("t", "as in issue 4's sweep").is_some());
     assert!(unreadable("t", "11 readings left out, 1 reading flagged").is_none());
+    assert!(too_wide("t", &format!("a  b\n{}\n", "-".repeat(151)), 150).is_some());
+    assert!(too_wide("t", &format!("a  b\n{}\n{}\n", "-".repeat(150), "x".repeat(200)), 150).is_none());
     let help = "Usage: x\n\nCommands:\n  plan  Plan\n  help  Print\n\nOptions:\n  -h\n";
     assert_eq!(subcommands(help), ["plan"]);
 }
@@ -141,6 +156,16 @@ fn the_quick_jobs_print_no_internal_names() {
         if let Some(why) = unreadable(&args.join(" "), &text) {
             panic!("{why}");
         }
+    }
+    // diagnose's tables (candidates with their parameters, sensors, drivers)
+    // fit a wide terminal: a table's rule is as wide as the table.
+    let diagnosis = printed(
+        dir.path(),
+        &["diagnose", "--robot", "D/guess.toml", "--data", "D/data.csv"],
+    );
+    assert!(diagnosis.contains("parameters (1-sigma)"), "{diagnosis}");
+    if let Some(why) = too_wide("diagnose", &diagnosis, DIAGNOSE_TABLE_COLUMNS) {
+        panic!("{why}");
     }
     let one = printed(
         dir.path(),

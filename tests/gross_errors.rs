@@ -121,6 +121,44 @@ fn wrong_units_are_named_and_refused() {
     );
 }
 
+/// Weights written as masses (kg, kg/m) make the statics' tensions 9.81
+/// times too small, and a load cell in kilograms-force reads 9.81 times too
+/// little: each is named and the calibration refused. A platform mass alone
+/// (the cables' weight right) gives a smaller ratio, 6.8 on this robot whose
+/// cables carry a third of the tension: named too.
+#[test]
+fn masses_for_weights_and_kilograms_force_are_named() {
+    let (_, data, guess) = case(NoisePreset::Paper, 65);
+    let options = CalibrationOptions::new(NoisePreset::Paper.sigmas(guess.platform_weight_n));
+    let refusal = |robot: &Robot, data: &[PoseMeasurement]| {
+        calibrate_checked(robot, data, &options, &GrossErrorOptions::default())
+            .unwrap_err()
+            .to_string()
+    };
+    let mut masses = guess.clone();
+    masses.platform_weight_n /= 9.81;
+    masses.cable_weight_n_per_m /= 9.81;
+    let error = refusal(&masses, &data);
+    assert!(
+        error.contains("weights look like masses in kg") && error.contains("`platform_weight_n`"),
+        "{error}"
+    );
+    let mut kilograms_force = data.clone();
+    for m in &mut kilograms_force {
+        m.reference_tension_n /= 9.81;
+    }
+    let error = refusal(&guess, &kilograms_force);
+    assert!(error.contains("they look like kilograms-force, not N"), "{error}");
+    let mut platform_mass = guess.clone();
+    platform_mass.platform_weight_n /= 9.81;
+    let found = sagcal::calib::mistakes::before_calibration(&platform_mass, &data);
+    println!("platform mass only: {found:#?}");
+    assert!(
+        found[0].message.contains("weights look like masses in kg"),
+        "{found:#?}"
+    );
+}
+
 #[test]
 fn a_rehomed_encoder_is_found_as_an_offset_step() {
     let (truth, mut data, guess) = case(NoisePreset::Paper, 66);

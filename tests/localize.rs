@@ -459,6 +459,25 @@ fn recurdyn_log_accuracy() {
             "position RMS {rms} m, max {max_position} m"
         );
         assert!(max_tension < 0.05, "tension error {max_tension}");
+        // The README's Localise table and docs/localize.md quote these figures.
+        let row = format!(
+            "position RMS {:.1} mm, max {:.1} mm; tensions {:.2} % mean, {:.2} % max ({}{} logged){} |",
+            rms * 1e3,
+            max_position * 1e3,
+            100.0 * mean_tension,
+            100.0 * max_tension,
+            if load_cell { "cables 2-4, " } else { "" },
+            tension_errors.len(),
+            match (load_cell, consistent == log.rows.len()) {
+                (false, true) => "; all rows consistent",
+                (false, false) => "; some rows inconsistent",
+                (true, _) => "",
+            }
+        );
+        for page in ["README.md", "docs/localize.md"] {
+            let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(page)).unwrap();
+            assert!(text.contains(&row), "{page}'s table of checks should say: {row}");
+        }
     }
 }
 

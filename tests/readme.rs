@@ -289,26 +289,117 @@ fn the_calibrate_table_says_what_calibrate_prints() {
     says(&readme, "| (refused, with `--accept-inconsistent` too) |");
 }
 
+/// The README's plan command prints what the library's plan gives (checked
+/// on 50 candidates, the command's only difference from
+/// [`every_plan_row_says_what_plan_gives`], which checks the table's rows).
 #[test]
-fn the_plan_table_says_what_plan_prints() {
+fn the_plan_command_prints_what_the_library_plans() {
+    use sagcal::experiments::pose_plan::{plan_calibration, CandidateSource, PlanSettings};
     let readme = readme();
     let dir = tempfile::tempdir().unwrap();
-    let mut plan = command_with(&readme, "plan", &["robots/large.toml", "9"]);
-    plan.push("--json".into());
+    let mut plan = command_with(&readme, "plan", &["robots/large.toml", "9", "1"]);
+    plan.extend(["--candidates", "50", "--json"].map(String::from));
     let report: serde_json::Value = serde_json::from_str(&stdout(&sagcal(dir.path(), &args(&plan)))).unwrap();
-    let number = |key: &str| report[key].as_f64().unwrap_or_else(|| panic!("no number `{key}`"));
-    assert_eq!(
-        (report["noise"].as_str(), report["seed"].as_u64()),
-        (Some("paper"), Some(1))
-    );
-    says(
-        &readme,
-        &format!(
-            "| large, 1000 in the frame | paper | {:.3} | {:.3} | {:.3} | {:.0} |",
-            number("anchor_bound_m"),
-            number("random_anchor_bound_m"),
-            number("random35_anchor_bound_m"),
-            number("path_length_m")
-        ),
-    );
+    let large = Robot::from_file(&root().join("robots/large.toml")).unwrap();
+    let settings = PlanSettings {
+        candidates: CandidateSource::Drawn {
+            workspace: None,
+            count: 50,
+        },
+        ..PlanSettings::new(9)
+    };
+    let planned = plan_calibration(&large, &settings, &mut |_| {}).unwrap().report;
+    // Both through the same text: serde_json reads a float to within an ulp.
+    let planned: serde_json::Value = serde_json::from_str(&serde_json::to_string(&planned).unwrap()).unwrap();
+    assert_eq!(report, planned);
+    assert!(dir.path().join("plan.csv").exists() && dir.path().join("plan.svg").exists());
+}
+
+/// The plan table's every row and the sentence above it, from the library
+/// calls `sagcal plan` makes (`plan_candidates`, then `plan_among` for each
+/// noise and criterion: the large robot's 1000 candidates are drawn once
+/// for its three rows). Row 1 is also run as the command above.
+#[test]
+fn every_plan_row_says_what_plan_gives() {
+    use sagcal::experiments::pose_plan::{plan_among, plan_candidates, CandidateSource, PlanReport, PlanSettings};
+    use sagcal::io::measurements::{read_measurements, ReadOptions};
+    use sagcal::model::sensors::NoisePreset;
+    use sagcal::plan::Criterion;
+
+    // The table and the sentence stand in the README and in docs/plan.md.
+    let plan_page = std::fs::read_to_string(root().join("docs/plan.md")).unwrap();
+    let pages = [readme(), plan_page.split_whitespace().collect::<Vec<_>>().join(" ")];
+    let says = |phrase: &str| {
+        for (page, name) in pages.iter().zip(["README.md", "docs/plan.md"]) {
+            assert!(
+                page.contains(phrase),
+                "{name} should say `{phrase}`, what `sagcal plan` gives"
+            );
+        }
+    };
+    let robot = |name: &str| Robot::from_file(&root().join("robots").join(name)).unwrap();
+    let row = |label: &str, noise: &str, r: &PlanReport| {
+        format!(
+            "| {label} | {noise} | {:.3} | {:.3} | {:.3} | {:.0} |",
+            r.anchor_bound_m,
+            r.random_anchor_bound_m,
+            r.random35_anchor_bound_m.expect("35 candidates or more"),
+            r.path_length_m
+        )
+    };
+    let settings = |noise, criterion| PlanSettings {
+        noise,
+        criterion,
+        ..PlanSettings::new(9)
+    };
+    let quiet = &mut |_: sagcal::experiments::pose_plan::PlanProgress<'_>| {};
+
+    let large = robot("large.toml");
+    let drawn = plan_candidates(&large, &PlanSettings::new(9), quiet).unwrap();
+    for (label, noise, criterion) in [
+        ("large, 1000 in the frame", NoisePreset::Paper, Criterion::A),
+        ("large, 1000 in the frame, D-optimal", NoisePreset::Paper, Criterion::D),
+        ("large, 1000 in the frame", NoisePreset::Authors, Criterion::A),
+    ] {
+        let planned = plan_among(&large, &settings(noise, criterion), &drawn, quiet).unwrap();
+        says(&row(label, &noise.to_string(), &planned.report));
+    }
+
+    let small = robot("small.toml");
+    let planned = plan_among(
+        &small,
+        &PlanSettings::new(9),
+        &plan_candidates(&small, &PlanSettings::new(9), quiet).unwrap(),
+        quiet,
+    )
+    .unwrap();
+    says(&row("small, 1000 in its `[workspace]`", "paper", &planned.report));
+
+    let log = root().join("../shared/data/recurdyn-large/recurdyn_large.csv");
+    if !log.exists() {
+        println!("skipped the RecurDyn row: {} is absent", log.display());
+        return;
+    }
+    let read = ReadOptions {
+        reference_cable: large.reference_cable,
+        keep_rounded: false,
+    };
+    let from = PlanSettings {
+        candidates: CandidateSource::Logged {
+            poses: read_measurements(&log, &read).unwrap().poses,
+            label: log.display().to_string(),
+        },
+        ..PlanSettings::new(9)
+    };
+    let planned = plan_among(&large, &from, &plan_candidates(&large, &from, quiet).unwrap(), quiet).unwrap();
+    let r = &planned.report;
+    says(&row("large, the 57 RecurDyn poses (`--from`)", "paper", r));
+    let random35 = r.random35_anchor_bound_m.unwrap();
+    says(&format!(
+        "the bound of 9 random RecurDyn poses is {:.2} m and of 35 is {:.2} m (RMS per anchor), a factor {:.1} where \
+         `sqrt(35/9)` would give 2",
+        r.random_anchor_bound_m,
+        random35,
+        r.random_anchor_bound_m / random35
+    ));
 }

@@ -615,7 +615,10 @@ fn verdict(test: &ConsistencyTest, excluded: usize, limit: usize, found: &[Mista
     if !units.is_empty() {
         // The readings cannot be tested one by one until the column is fixed.
         return Verdict::Inconsistent {
-            reason: format!("{}; fix the data and calibrate again", units.join("; ")),
+            reason: format!(
+                "{}; fix the data (or the robot file) and calibrate again",
+                units.join("; ")
+            ),
         };
     }
     let mut reasons = Vec::new();

@@ -3,7 +3,8 @@
 //!
 //! - **a sensor in the wrong unit**: the load cell's readings are about 1000
 //!   times (mN) or 1/1000 of (kN) the tensions the straight-cable statics give
-//!   at the initial anchors; an encoder's readings spread about 1000 (mm) or
+//!   at the initial anchors, or 1/9.81 of them (kilograms-force); about 9.81
+//!   times them when the robot file's weights are masses in kg; an encoder's readings spread about 1000 (mm) or
 //!   100 (cm) times as much over the poses as the anchor-to-attachment
 //!   distances do (the spread, because the offsets are unknown). Ratios
 //!   within a factor of 3 of those are named; the model's own error at a
@@ -56,6 +57,7 @@ use std::collections::HashMap;
 
 use super::snooping::{row_name, ExcludedReading, ReadingTest};
 use crate::model::measurement::{PoseMeasurement, Sensor};
+use crate::model::plausibility::STANDARD_GRAVITY_M_S2;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::statics::{cable_geometry, reference_tension_magnitude_guess};
@@ -145,18 +147,37 @@ fn unit_for(ratio: f64, candidates: &[(f64, &'static str)]) -> Option<&'static s
         .map(|(_, unit)| *unit)
 }
 
+/// What a load cell reading about `ratio` times the statics' tension means.
+/// The statics' tensions are linear in the robot file's weights, so weights
+/// written as masses (kg, kg/m: `g` = 9.81 times too light) give the ratio
+/// 9.81, and a load cell reading kilograms-force gives 1/9.81.
+const LOAD_CELL_UNITS: [(f64, &str); 4] = [
+    (1e3, "they look like mN, not N (convert the column to newtons)"),
+    (1e-3, "they look like kN, not N (convert the column to newtons)"),
+    (
+        1.0 / STANDARD_GRAVITY_M_S2,
+        "they look like kilograms-force, not N (multiply the column by 9.81)",
+    ),
+    (
+        STANDARD_GRAVITY_M_S2,
+        "the robot file's weights look like masses in kg, not weights m g in N: multiply each one given as a mass \
+         (`platform_weight_n`, `cable_weight_n_per_m`) by 9.81 (both as masses give 9.81, the platform's alone less; \
+         if they are weights, the load cell's unit is 9.81 times too small)",
+    ),
+];
+
 fn load_cell_unit(initial: &Robot, measurements: &[PoseMeasurement]) -> Option<Mistake> {
     let ratios = measurements
         .iter()
         .map(|m| m.reference_tension_n / reference_tension_magnitude_guess(initial, Vector3::from(m.position_m)))
         .collect();
     let ratio = median(ratios)?;
-    let unit = unit_for(ratio, &[(1e3, "mN"), (1e-3, "kN")])?;
+    let meaning = unit_for(ratio, &LOAD_CELL_UNITS)?;
     Some(Mistake {
         kind: MistakeKind::WrongUnit,
         message: format!(
             "the load cell's readings are {ratio:.3e} times the reference tension the statics give at the initial anchors: \
-             they look like {unit}, not N (convert the column to newtons)"
+             {meaning}"
         ),
         rows: Vec::new(),
     })

@@ -3,8 +3,8 @@
 use std::path::Path;
 
 use super::report::{RobotSummary, Span, WorkspaceSummary};
-use crate::io::robot_init::STANDARD_GRAVITY_M_S2;
 use crate::model::geometry::{platform_reach_m, Footprint};
+use crate::model::plausibility::STANDARD_GRAVITY_M_S2;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::sim::closed_form::Workspace;
 

@@ -324,20 +324,25 @@ fn render_residual_tests(d: &Diagnosis) -> String {
     out
 }
 
+/// The width of the hypotheses' parameter lists, wrapped onto lines of their
+/// own: with the other columns the table stays within about 140 columns.
+const PARAMETERS_WIDTH: usize = 48;
+
 /// Step 3: every hypothesis tested, step by step.
 fn render_candidates(d: &Diagnosis) -> String {
     let mut table = Table::new([
         "step",
         "hypothesis",
         "extends",
-        "parameters (1-sigma)",
         "LR",
         "dof",
         "p-value",
         "needs <",
         "power",
         "anchor MAE m",
-    ]);
+        "parameters (1-sigma)",
+    ])
+    .wrap_last(PARAMETERS_WIDTH);
     for c in &d.candidates {
         let params = if let Some(error) = &c.error {
             format!("failed: {error}")
@@ -356,13 +361,13 @@ fn render_candidates(d: &Diagnosis) -> String {
             c.step.to_string(),
             format!("{}{}", c.effect, if c.significant { " *" } else { "" }),
             c.extends.clone(),
-            params,
             format!("{:.1}", c.lr_statistic),
             c.added_parameters.to_string(),
             format!("{:.2e}", c.p_value),
             format!("{:.1e}", c.p_threshold),
             opt(c.power, 2),
             opt(c.anchor_mae_m, 4),
+            params,
         ]);
     }
     let mut out = table.to_string();

@@ -13,10 +13,14 @@ pub fn counted(n: usize, singular: &str, plural: &str) -> String {
     format!("{n} {}", if n == 1 { singular } else { plural })
 }
 
-/// A left-aligned first column, right-aligned others, columns sized to fit.
+/// A left-aligned first column, right-aligned others, columns sized to fit;
+/// optionally a last column of free text, left-aligned and wrapped.
 pub struct Table {
     header: Vec<String>,
     rows: Vec<Vec<String>>,
+    /// The last column's width in characters, its cells wrapped onto lines
+    /// of their own (the other cells blank) at `, ` or at a space.
+    wrap_last: Option<usize>,
 }
 
 impl Table {
@@ -25,6 +29,7 @@ impl Table {
         Self {
             header: header.into_iter().map(Into::into).collect(),
             rows: Vec::new(),
+            wrap_last: None,
         }
     }
 
@@ -32,15 +37,75 @@ impl Table {
     pub fn row<S: Into<String>>(&mut self, cells: impl IntoIterator<Item = S>) {
         self.rows.push(cells.into_iter().map(Into::into).collect());
     }
+
+    /// Left-align the last column and wrap its cells at `width` characters,
+    /// so that a list of parameters does not run the table off the screen.
+    pub fn wrap_last(mut self, width: usize) -> Self {
+        self.wrap_last = Some(width.max(1));
+        self
+    }
+
+    /// The rows as printed: a wrapped last cell spread over several lines.
+    fn lines(&self) -> Vec<Vec<String>> {
+        let Some(width) = self.wrap_last else {
+            return self.rows.clone();
+        };
+        let last = self.header.len().saturating_sub(1);
+        let mut lines = Vec::new();
+        for row in &self.rows {
+            let cell = row.get(last).map(String::as_str).unwrap_or("");
+            for (k, piece) in wrapped(cell, width).into_iter().enumerate() {
+                let mut line: Vec<String> = if k == 0 {
+                    row.iter().take(last).cloned().collect()
+                } else {
+                    vec![String::new(); last]
+                };
+                line.push(piece);
+                lines.push(line);
+            }
+        }
+        lines
+    }
+}
+
+/// `text` in lines of at most `width` characters, broken after `, ` where it
+/// can be and at a space otherwise (a word longer than `width` stays whole).
+fn wrapped(text: &str, width: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    let mut current = String::new();
+    for word in text.split(' ') {
+        let fits = current.is_empty() || current.chars().count() + 1 + word.chars().count() <= width;
+        if !fits {
+            // Break after a list item: at the line's end when it ends one,
+            // else after the last `, ` on it when it has one.
+            match current.rfind(", ") {
+                _ if current.ends_with(',') => lines.push(std::mem::take(&mut current)),
+                Some(at) if at > 0 => {
+                    let rest = current[at + 2..].to_string();
+                    current.truncate(at + 1);
+                    lines.push(std::mem::take(&mut current));
+                    current = rest;
+                }
+                _ => lines.push(std::mem::take(&mut current)),
+            }
+        }
+        if !current.is_empty() {
+            current.push(' ');
+        }
+        current.push_str(word);
+    }
+    lines.push(current);
+    lines
 }
 
 impl std::fmt::Display for Table {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let columns = self.header.len();
+        let rows = self.lines();
         let widths: Vec<usize> = (0..columns)
             .map(|c| {
                 std::iter::once(&self.header)
-                    .chain(&self.rows)
+                    .chain(&rows)
                     .filter_map(|r| r.get(c))
                     .map(|s| s.chars().count())
                     .max()
@@ -52,6 +117,8 @@ impl std::fmt::Display for Table {
                 let cell = cells.get(c).map(String::as_str).unwrap_or("");
                 if c == 0 {
                     write!(f, "{cell:<width$}")?;
+                } else if self.wrap_last.is_some() && c + 1 == columns {
+                    write!(f, "  {}", cell.trim_end())?;
                 } else {
                     write!(f, "  {cell:>width$}")?;
                 }
@@ -61,7 +128,7 @@ impl std::fmt::Display for Table {
         line(f, &self.header)?;
         let total: usize = widths.iter().sum::<usize>() + 2 * columns.saturating_sub(1);
         writeln!(f, "{}", "-".repeat(total))?;
-        for row in &self.rows {
+        for row in &rows {
             line(f, row)?;
         }
         Ok(())
@@ -269,5 +336,27 @@ mod tests {
         lines.lock().finishing = true;
         draw("step [====] 4/4, 12s");
         assert!(lines.lock().last >= written, "the end is written");
+    }
+
+    /// A wrapped last column breaks after `, `, keeps every word, and leaves
+    /// the other cells of its continuation lines blank.
+    #[test]
+    fn a_wrapped_last_column_breaks_after_commas() {
+        let text = "alpha 1.0e0 (1e-1), beta 2.0e0 (2e-1), gamma 3.0e0 (3e-1)";
+        let lines = wrapped(text, 40);
+        assert_eq!(lines, ["alpha 1.0e0 (1e-1), beta 2.0e0 (2e-1),", "gamma 3.0e0 (3e-1)"]);
+        // A line that ends an item breaks there; one that does not, after its last item.
+        assert_eq!(wrapped("a 1, b 2, c 3", 9), ["a 1, b 2,", "c 3"]);
+        assert_eq!(wrapped("a 1, b 2, c 3", 8), ["a 1,", "b 2, c 3"]);
+        assert_eq!(wrapped("a 1, b 2 [why not]", 12), ["a 1,", "b 2 [why", "not]"]);
+        assert_eq!(wrapped("a-very-long-single-word", 5), ["a-very-long-single-word"]);
+        let mut table = Table::new(["step", "parameters"]).wrap_last(40);
+        table.row(["1", text]);
+        let printed = table.to_string();
+        let rows: Vec<&str> = printed.lines().collect();
+        assert_eq!(rows.len(), 4, "{printed}");
+        assert_eq!(rows[2], "1     alpha 1.0e0 (1e-1), beta 2.0e0 (2e-1),");
+        assert_eq!(rows[3], "      gamma 3.0e0 (3e-1)");
+        assert!(printed.lines().all(|l| l.chars().count() <= 46), "{printed}");
     }
 }

@@ -38,7 +38,7 @@ pub enum CalibrationError {
         reason: String,
     },
     /// Readings off by a unit (millimetres for metres, ...): the data must be fixed.
-    #[error("{}; fix the data and calibrate again", .mistakes.join("; "))]
+    #[error("{}; fix the data (or the robot file) and calibrate again", .mistakes.join("; "))]
     UnitMistakes {
         /// One message per mistake found.
         mistakes: Vec<String>,

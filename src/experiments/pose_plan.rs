@@ -259,6 +259,30 @@ pub fn parse_workspace(text: &str) -> std::result::Result<Workspace, ParseError>
     workspace_from_bounds(&v, text)
 }
 
+/// A plan's candidates, drawn or logged, as [`plan_among`] takes them:
+/// the choice among one set under other noises or criteria needs one draw.
+#[derive(Debug, Clone)]
+pub struct PlanCandidates {
+    /// The candidates kept and what was left out.
+    pub set: CandidateSet,
+    /// The box they were drawn in (`None` for logged poses).
+    pub workspace: Option<Workspace>,
+    /// Where they came from, in the report's words.
+    pub from: String,
+}
+
+/// The candidates `settings` name, drawn (the long part, reported to
+/// `progress`) or read from the logged poses and filtered.
+pub fn plan_candidates(
+    robot: &Robot,
+    settings: &PlanSettings,
+    progress: &mut dyn FnMut(PlanProgress<'_>),
+) -> Result<PlanCandidates> {
+    check_counts(settings)?;
+    let (set, workspace, from) = candidates(robot, settings, &Margins::for_robot(robot), progress)?;
+    Ok(PlanCandidates { set, workspace, from })
+}
+
 /// The candidates with the box they were drawn in and their description.
 fn candidates(
     robot: &Robot,
@@ -366,9 +390,23 @@ pub fn plan_calibration(
     settings: &PlanSettings,
     progress: &mut dyn FnMut(PlanProgress<'_>),
 ) -> Result<PlannedCalibration> {
+    let candidates = plan_candidates(robot, settings, progress)?;
+    plan_among(robot, settings, &candidates, progress)
+}
+
+/// The plan of `settings` among `candidates` ([`plan_candidates`] of
+/// settings that draw or read the same poses): each candidate's
+/// information, the choice, the visiting order and the random sets, as
+/// [`plan_calibration`] makes them.
+pub fn plan_among(
+    robot: &Robot,
+    settings: &PlanSettings,
+    candidates: &PlanCandidates,
+    progress: &mut dyn FnMut(PlanProgress<'_>),
+) -> Result<PlannedCalibration> {
     check_counts(settings)?;
     let margins = Margins::for_robot(robot);
-    let (set, workspace, from) = candidates(robot, settings, &margins, progress)?;
+    let PlanCandidates { set, workspace, from } = candidates.clone();
     if set.equilibria.len() < settings.poses {
         return Err(Error::InvalidInput(format!(
             "{} poses requested but only {} candidates keep the margins and are stable ({} outside the margins, {} unstable)",

@@ -56,9 +56,7 @@ use crate::io::robot_text::{commented_text, Notes};
 use crate::model::geometry::{Footprint, MIN_FOOTPRINT_WIDTH_FRACTION};
 use crate::model::robot::{Robot, Workspace, CABLE_COUNT};
 
-/// Standard gravity, m/s^2: a mass `m` weighs `m g` newtons, the `g` of the
-/// built-in robot files and of [`crate::model::plausibility`].
-pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
+pub use crate::model::plausibility::STANDARD_GRAVITY_M_S2;
 
 /// The largest distance between two anchors a new robot may have, metres:
 /// over three times the 600 m circle of towers the FAST telescope hangs its

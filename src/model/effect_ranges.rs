@@ -20,12 +20,11 @@
 use serde::Serialize;
 
 use crate::model::effect_kind::EffectKind;
+use crate::model::plausibility::STANDARD_GRAVITY_M_S2 as GRAVITY;
 use crate::model::robot::Robot;
 
 /// Density of the synthetic-fibre (aramid) cables, kg/m^3.
 pub const CABLE_DENSITY_KG_M3: f64 = 1440.0;
-/// Standard gravity, m/s^2.
-const GRAVITY: f64 = 9.81;
 
 /// The range an effect's magnitude is drawn from, for one robot.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -31,8 +31,10 @@
 use crate::model::effects::Effects;
 use crate::model::robot::Robot;
 
-/// Standard gravity, m/s^2 (the robot files' weights are `m g` with this `g`).
-const GRAVITY: f64 = 9.81;
+/// Standard gravity, m/s^2: a mass `m` weighs `m g` newtons, the `g` of the
+/// built-in robot files, of `sagcal init` and of every range here.
+pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
+const GRAVITY: f64 = STANDARD_GRAVITY_M_S2;
 
 /// The lightest plausible platform, newtons: 1 g, lighter than any that can
 /// carry four cable attachment points.
