@@ -108,11 +108,16 @@ impl Mistake {
 const UNIT_TOLERANCE: f64 = 3.0;
 
 /// The mistakes visible before any fit: units and poses outside the frame.
+/// The units are judged on the rows inside the frame only: the statics at a
+/// position no cable can reach (a localiser logged in mm) say nothing about
+/// the load cell's unit.
 pub fn before_calibration(initial: &Robot, measurements: &[PoseMeasurement]) -> Vec<Mistake> {
+    let outside = outside_frame(initial, measurements);
+    let (inside, _) = without_rows_outside(measurements, &outside);
     let mut found = Vec::new();
-    found.extend(load_cell_unit(initial, measurements));
-    found.extend(encoder_units(initial, measurements));
-    found.extend(outside_frame(initial, measurements));
+    found.extend(load_cell_unit(initial, &inside));
+    found.extend(encoder_units(initial, &inside));
+    found.extend(outside);
     found
 }
 
