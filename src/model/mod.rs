@@ -8,7 +8,8 @@
 //! ([`geometry`]) and the magnitudes no real robot falls outside
 //! ([`plausibility`]); the typical magnitudes of each effect
 //! ([`effect_ranges`]) and the largest any real robot could show
-//! ([`effect_limits`]). No file format is seen here.
+//! ([`effect_limits`]); the statics of a platform on any number of cables,
+//! three to eight and more ([`suspended`]). No file format is seen here.
 //!
 //! ```
 //! use nalgebra::Vector3;
@@ -43,6 +44,7 @@ pub mod pose;
 pub mod robot;
 pub mod sensors;
 pub mod statics;
+pub mod suspended;
 
 pub use catenary::Catenary;
 pub use data_row::DataRow;
