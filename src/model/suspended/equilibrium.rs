@@ -25,22 +25,19 @@
 //! What is verified: four cables, where it is the four-cable solver's
 //! equilibrium ([`crate::model::statics`]) at a held yaw, and the level
 //! closure's member no more tilted than the four-cable solver's most level
-//! one (to a thousandth of a degree), and the nearest to its target. Not yet solved: three cables,
-//! whose horizontal forces (rows `F_x`, `F_y`, `M_z` of `J^T`, which the
-//! vertical forces do not enter and gravity does not load) form a
-//! homogeneous 3 x 3 system, non-zero only at the orientations where the
-//! cables' horizontal lines meet in one point: there the dependent block is
-//! singular by construction, and the unknowns must be the orientation and
-//! the horizontal tension's scale with that condition as an equation (the
-//! solver refuses three cables). From five cables on the start (straight
-//! cables' taut tensions over a grid of orientations) does not yet bring
-//! the iteration home on every robot: an irregular eight-cable ring stalls
-//! with heights of metres.
+//! one (to a thousandth of a degree), and the nearest to its target. Three
+//! cables have one equilibrium at a position, at an orientation where the
+//! dependent block is singular by construction: `three_cables.rs` solves
+//! them in other unknowns. Not yet solved: from five cables on, the start
+//! (straight cables' taut tensions over a grid of orientations) does not
+//! bring the iteration home on every robot: an irregular eight-cable ring
+//! stalls with heights of metres.
 
 use nalgebra::{DMatrix, DVector, UnitQuaternion, Vector3};
 
 use super::robot::SuspendedRobot;
 use super::tension_distribution::taut_tensions;
+use super::three_cables::ThreeCables;
 use crate::error::{Error, Result};
 use crate::model::pose::PlatformPose;
 use crate::model::statics::CableTension;
@@ -212,6 +209,11 @@ pub fn solve_at(
             robot.cable_count()
         ))
     };
+    if robot.cable_count() == 3 {
+        return solve_three_cables(robot, position_m, options).ok_or_else(|| {
+            unsolved("no taut equilibrium within 30 degrees of level reaches the height tolerance".into())
+        });
+    }
     let (mut x, mut h) = match problem.heights(&problem.target) {
         Some(h) => (problem.target.clone(), h),
         None => start(&mut problem).ok_or_else(|| {
@@ -257,6 +259,27 @@ pub fn solve_at(
     )))
 }
 
+/// Three cables' one equilibrium at `position_m` ([`ThreeCables`]).
+fn solve_three_cables(
+    robot: &SuspendedRobot,
+    position_m: Vector3<f64>,
+    options: &EquilibriumOptions,
+) -> Option<SuspendedEquilibrium> {
+    let three = ThreeCables::new(robot, position_m);
+    let (x, iterations) = three.solve(options.height_tolerance_m, options.max_iterations)?;
+    let pose = three.pose(&x);
+    let (tensions, _) = three.forces(&x)?;
+    let cables = robot.catenaries(&pose, &tensions);
+    Some(SuspendedEquilibrium {
+        cable_lengths_m: cables.iter().map(|c| c.length_m()).collect(),
+        height_residuals_m: robot.height_residuals(&pose, &tensions),
+        pose,
+        tensions,
+        dependent: [0, 1, 2],
+        iterations,
+    })
+}
+
 /// The unknowns, target and metric of `closure` at `position_m`.
 fn problem(robot: &SuspendedRobot, position_m: Vector3<f64>, closure: Closure) -> Result<Problem<'_>> {
     if !position_m.iter().all(|v| v.is_finite()) {
@@ -265,14 +288,13 @@ fn problem(robot: &SuspendedRobot, position_m: Vector3<f64>, closure: Closure) -
             position_m.as_slice()
         )));
     }
-    if robot.cable_count() < 4 {
-        return Err(Error::InvalidInput(
-            "three cables: their horizontal forces balance only at the orientations where the cables' \
-             horizontal lines meet in one point, which this solver does not yet search (module docs)"
-                .into(),
-        ));
-    }
     let (base, rotations) = match closure {
+        Closure::Yaw { yaw_rad } if robot.cable_count() < 4 => {
+            return Err(Error::InvalidInput(format!(
+                "a yaw of {yaw_rad} rad cannot be held on three cables: they fix the orientation at a position \
+                 (use the level closure)"
+            )))
+        }
         Closure::Yaw { yaw_rad } if !yaw_rad.is_finite() => {
             return Err(Error::InvalidInput(format!(
                 "the yaw must be finite, got {yaw_rad} rad"
@@ -469,23 +491,32 @@ mod tests {
         }
     }
 
-    /// Three cables are refused with the reason (module docs), not sent
-    /// into an iteration that cannot converge.
+    /// Three cables have one equilibrium at a position (its horizontal
+    /// lines of action meeting in one point), found from a level start; a
+    /// held yaw is refused.
     #[test]
-    fn three_cables_are_refused_with_the_reason() {
+    fn three_cables_hang_in_their_one_equilibrium() {
         let robot = ring(3);
-        for closure in [Closure::Level, Closure::Yaw { yaw_rad: 0.0 }] {
-            let refused = solve_at(
-                &robot,
-                Vector3::new(1.0, -1.5, 5.0),
-                closure,
-                &EquilibriumOptions::default(),
+        for position in [Vector3::new(1.0, -1.5, 5.0), Vector3::new(-4.0, 3.0, 9.0)] {
+            let eq = solve_at(&robot, position, Closure::Level, &EquilibriumOptions::default()).unwrap();
+            assert_equilibrium(&robot, &eq);
+            println!(
+                "three cables at {position:?}: tilt {:.3} deg, yaw {:.3} deg",
+                tilt_deg(&eq.pose),
+                eq.pose.yaw_rad().to_degrees()
             );
-            assert!(
-                matches!(&refused, Err(Error::InvalidInput(m)) if m.contains("horizontal lines meet")),
-                "{refused:?}"
-            );
+            assert!(tilt_deg(&eq.pose) < 30.0 && eq.pose.yaw_rad().abs() < 30f64.to_radians());
         }
+        let refused = solve_at(
+            &robot,
+            Vector3::new(1.0, -1.5, 5.0),
+            Closure::Yaw { yaw_rad: 0.0 },
+            &EquilibriumOptions::default(),
+        );
+        assert!(
+            matches!(&refused, Err(Error::InvalidInput(m)) if m.contains("three cables")),
+            "{refused:?}"
+        );
     }
 
     /// The level closure's answer is the member nearest its target: at the

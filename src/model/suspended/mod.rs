@@ -49,6 +49,7 @@
 mod equilibrium;
 mod robot;
 mod tension_distribution;
+mod three_cables;
 
 pub use equilibrium::{solve_at, Closure, EquilibriumOptions, SuspendedEquilibrium, FORCE_WEIGHT, YAW_WEIGHT};
 pub use robot::{SuspendedRobot, MIN_CABLES, MIN_RECIPROCAL_CONDITION};
