@@ -1,47 +1,45 @@
 //! The static equilibrium of a platform on `N` cables at a given position
 //! ([`solve_at`]).
 //!
-//! At a position the unknowns are the orientation (3) and the free force
-//! components (`2N - 6`), against one attachment-height equation per cable
-//! (paper eq. 15): `N - 3` more unknowns than equations (0 for three
-//! cables, 1 for four, 5 for eight). A [`Closure`] picks one member of that
-//! family: the one nearest a target, in the metric `M` below, with the
-//! heights held exactly. The target is the orientation asked for and the
-//! free components of the straight-cable minimum-norm tensions at it
-//! (`(J^T)^+ w`, paper eq. 8 without sag); the metric weighs a radian of
-//! rotation as 1 and a platform weight of force as [`FORCE_WEIGHT`], so the
-//! orientation is kept first and the forces chosen among what remains.
+//! Each cable that reaches its attachment has one degree of freedom: given
+//! its horizontal tension `f_h`, the catenary through its anchor and its
+//! attachment fixes its vertical tension (paper eq. 1 at `x = span`,
+//! inverted in closed form: [`vertical_for_height`]), so the attachment
+//! heights (eq. 15) hold by construction. The unknowns at a position are
+//! then the orientation (3) and the `N` horizontal tensions, against the
+//! six equations of equilibrium (eq. 8): `N - 3` more unknowns than
+//! equations (0 for three cables, 1 for four, 5 for eight). No set of
+//! dependent forces is chosen, so none can be singular: with three cables
+//! the horizontal rows `F_x`, `F_y`, `M_z` are homogeneous (gravity loads
+//! none of them) and hold only where the cables' horizontal lines meet in
+//! one point, which the orientation unknowns find.
 //!
-//! The solve is Gauss-Newton on the heights with the minimum-`M`-norm step
-//! towards the target (the projection
-//! `dx = (t - x) - M^-1 J^T (J M^-1 J^T)^-1 (h + J (t - x))`, whose fixed
+//! A [`Closure`] picks one member of that family: the one nearest a target
+//! in the metric `M` below, the equations held exactly. The target is the
+//! orientation asked for and the horizontal parts of the straight cables'
+//! taut tension distribution there (`tension_distribution.rs`); the metric
+//! weighs a radian of tilt as 1, of yaw as [`YAW_WEIGHT`] (level closure)
+//! and a platform weight of horizontal tension as [`FORCE_WEIGHT`], so the
+//! tilt is kept first and the tensions chosen among what remains.
+//!
+//! The solve is Gauss-Newton with the minimum-`M`-norm step towards the
+//! target (the projection
+//! `dx = (t - x) - M^-1 J^T (J M^-1 J^T)^-1 (e + J (t - x))`, whose fixed
 //! points are the first-order conditions of `min |x - t|_M` subject to
-//! `h(x) = 0`), halved until the heights fall; the Jacobian `J = dh/dx` by
-//! central differences. The dependent three cables are chosen at the
-//! target pose and kept through the solve. Every answer is an equilibrium
-//! (heights within the tolerance, the six equations by construction, every
-//! cable taut); where the iteration does not get there it fails.
-//!
-//! What is verified: four cables, where it is the four-cable solver's
-//! equilibrium ([`crate::model::statics`]) at a held yaw, and the level
-//! closure's member no more tilted than the four-cable solver's most level
-//! one (to a thousandth of a degree), and the nearest to its target. Not yet solved: three cables,
-//! whose horizontal forces (rows `F_x`, `F_y`, `M_z` of `J^T`, which the
-//! vertical forces do not enter and gravity does not load) form a
-//! homogeneous 3 x 3 system, non-zero only at the orientations where the
-//! cables' horizontal lines meet in one point: there the dependent block is
-//! singular by construction, and the unknowns must be the orientation and
-//! the horizontal tension's scale with that condition as an equation (the
-//! solver refuses three cables). From five cables on the start (straight
-//! cables' taut tensions over a grid of orientations) does not yet bring
-//! the iteration home on every robot: an irregular eight-cable ring stalls
-//! with heights of metres.
+//! `e(x) = 0`), halved until the unbalance falls and every cable stays
+//! taut; the Jacobian `J = de/dx` by central differences. Every answer is
+//! an equilibrium: balanced to [`EquilibriumOptions::wrench_tolerance`],
+//! the heights to rounding, every cable taut; where the iteration does not
+//! get there it fails. Verified: the four-cable solver's equilibria
+//! ([`crate::model::statics`]) at a held yaw; three to eight cables on an
+//! irregular ring; the first-order conditions at the answer.
 
 use nalgebra::{DMatrix, DVector, UnitQuaternion, Vector3};
 
 use super::robot::SuspendedRobot;
 use super::tension_distribution::taut_tensions;
 use crate::error::{Error, Result};
+use crate::model::catenary::sinhc;
 use crate::model::pose::PlatformPose;
 use crate::model::statics::CableTension;
 
@@ -53,12 +51,13 @@ pub const FORCE_WEIGHT: f64 = 1e-6;
 /// Which member of the equilibria at a position (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Closure {
-    /// The platform as level as the heights allow, its yaw where the cables
+    /// The platform as level as the balance allows, its yaw where the cables
     /// put it (weighed [`YAW_WEIGHT`] against the tilt): the most level
     /// member for four cables, the one equilibrium of three.
     Level,
-    /// The yaw held at `yaw_rad` and the platform as level as the heights
-    /// allow (exactly level from six cables on, where the yaw is one the
+    /// The yaw held at `yaw_rad` and the platform as level as the balance
+    /// allows (from six cables on, level to within what the tilt trades
+    /// against the tensions at [`FORCE_WEIGHT`], where the yaw is one the
     /// cables can hold). Needs four cables or more: three fix the
     /// orientation at a position.
     Yaw {
@@ -76,16 +75,19 @@ pub const YAW_WEIGHT: f64 = 1e-3;
 pub struct EquilibriumOptions {
     /// Most Gauss-Newton iterations.
     pub max_iterations: usize,
-    /// Largest attachment-height residual accepted, metres.
-    pub height_tolerance_m: f64,
+    /// Largest unbalanced force accepted, as a fraction of the platform's
+    /// weight (moments: of its weight times its attachment radius).
+    pub wrench_tolerance: f64,
 }
 
 impl Default for EquilibriumOptions {
-    /// 100 iterations, 1e-9 m height tolerance (the four-cable solver's).
+    /// 100 iterations, 1e-9 of the platform's weight unbalanced (a
+    /// micronewton on a kilonewton platform; rounding stops the iteration at
+    /// about 1e-12 .. 1e-10).
     fn default() -> Self {
         Self {
             max_iterations: 100,
-            height_tolerance_m: 1e-9,
+            wrench_tolerance: 1e-9,
         }
     }
 }
@@ -101,8 +103,6 @@ pub struct SuspendedEquilibrium {
     pub cable_lengths_m: Vec<f64>,
     /// The attachment-height residuals left, metres.
     pub height_residuals_m: Vec<f64>,
-    /// The three cables whose forces the balance gave (0-based).
-    pub dependent: [usize; 3],
     /// Gauss-Newton iterations used.
     pub iterations: usize,
 }
@@ -115,10 +115,20 @@ struct Problem<'a> {
     base: UnitQuaternion<f64>,
     /// Rotation unknowns (2: roll and pitch about the base; 3: all).
     rotations: usize,
-    dependent: [usize; 3],
-    free: Vec<usize>,
     target: DVector<f64>,
     metric: DVector<f64>,
+}
+
+/// The vertical tension at the attachment of a cable of weight
+/// `weight_n_per_m` over `span_m` whose anchor is `height_difference_m`
+/// above its attachment, at horizontal tension `horizontal_n` (paper eq. 1
+/// at `x = span` inverted: `drop = span sinhc(lambda/2) sinh(A + lambda/2)`,
+/// so `A = asinh(drop / (span sinhc(lambda/2))) - lambda/2` and
+/// `f_v = f_h sinh A`, `lambda = g_c span / f_h`).
+pub fn vertical_for_height(span_m: f64, height_difference_m: f64, horizontal_n: f64, weight_n_per_m: f64) -> f64 {
+    let half = 0.5 * weight_n_per_m * span_m / horizontal_n;
+    let a = (height_difference_m / (span_m * sinhc(half))).asinh() - half;
+    horizontal_n * a.sinh()
 }
 
 impl Problem<'_> {
@@ -131,63 +141,70 @@ impl Problem<'_> {
         PlatformPose::new(self.position_m, UnitQuaternion::from_euler_angles(x[0], x[1], yaw))
     }
 
-    fn tensions(&self, x: &DVector<f64>) -> Result<Vec<CableTension>> {
+    /// Every cable's forces at `x`: its horizontal tension from `x`, its
+    /// vertical one the catenary's through its anchor and attachment;
+    /// `None` where a cable is slack (`f_h <= 0`).
+    fn tensions(&self, x: &DVector<f64>) -> Option<Vec<CableTension>> {
         let weight = self.robot.platform_weight_n;
-        let free: Vec<(usize, f64, f64)> = self
-            .free
-            .iter()
+        let runs = self.robot.runs(&self.pose(x));
+        runs.iter()
+            .zip(&self.robot.cable_weights_n_per_m)
             .enumerate()
-            .map(|(k, &i)| {
-                let at = self.rotations + 2 * k;
-                (i, x[at] * weight, x[at + 1] * weight)
+            .map(|(i, (run, &cable_weight))| {
+                let horizontal_n = x[self.rotations + i] * weight;
+                (horizontal_n > 0.0).then(|| CableTension {
+                    horizontal_n,
+                    vertical_n: vertical_for_height(run.span_m, run.height_difference_m, horizontal_n, cable_weight),
+                })
             })
-            .collect();
-        self.robot.balance(&self.pose(x), &self.dependent, &free)
+            .collect()
     }
 
-    /// Set `x`'s free components to the straight cables' taut tensions at
-    /// `x`'s orientation, scaled by the platform's weight.
-    fn set_forces(&self, x: &mut DVector<f64>) {
-        let straight = straight_cable_forces(self.robot, &self.pose(x));
-        for (k, &i) in self.free.iter().enumerate() {
-            x[self.rotations + 2 * k] = straight[2 * i] / self.robot.platform_weight_n;
-            x[self.rotations + 2 * k + 1] = straight[2 * i + 1] / self.robot.platform_weight_n;
-        }
+    /// The six equations of equilibrium at `x`, forces over the platform's
+    /// weight and moments over its weight times the attachment radius.
+    fn equations(&self, x: &DVector<f64>) -> Option<DVector<f64>> {
+        let tensions = self.tensions(x)?;
+        let residual = self.robot.wrench_residual(&self.pose(x), &tensions);
+        let (weight, radius) = (self.robot.platform_weight_n, self.robot.attachment_radius_m());
+        let e = DVector::from_fn(6, |r, _| residual[r] / if r < 3 { weight } else { weight * radius });
+        e.iter().all(|v| v.is_finite()).then_some(e)
     }
 
-    /// The heights at `x`, or `None` where a cable goes slack or the balance fails.
-    fn heights(&self, x: &DVector<f64>) -> Option<DVector<f64>> {
-        let tensions = self.tensions(x).ok()?;
-        if !tensions.iter().all(CableTension::is_taut) {
-            return None;
-        }
-        let h = DVector::from_vec(self.robot.height_residuals(&self.pose(x), &tensions));
-        h.iter().all(|v| v.is_finite()).then_some(h)
-    }
-
-    /// `dh/dx` by central differences.
+    /// `de/dx` by central differences.
     fn jacobian(&self, x: &DVector<f64>) -> Option<DMatrix<f64>> {
-        let mut jacobian = DMatrix::zeros(self.robot.cable_count(), x.len());
+        let mut jacobian = DMatrix::zeros(6, x.len());
         for j in 0..x.len() {
             let step = 1e-7 * x[j].abs().max(1e-2);
             let (mut up, mut down) = (x.clone(), x.clone());
             up[j] += step;
             down[j] -= step;
-            let column = (self.heights(&up)? - self.heights(&down)?) / (2.0 * step);
+            let column = (self.equations(&up)? - self.equations(&down)?) / (2.0 * step);
             jacobian.set_column(j, &column);
         }
         Some(jacobian)
     }
 
-    /// The projected step of the module docs.
-    fn step(&self, x: &DVector<f64>, h: &DVector<f64>, jacobian: &DMatrix<f64>) -> Option<DVector<f64>> {
-        let towards = &self.target - x;
+    /// The projected step of the module docs; with `towards_target` false
+    /// only its correction, the minimum-`M`-norm step that balances the
+    /// linearised equations.
+    fn step(
+        &self,
+        x: &DVector<f64>,
+        e: &DVector<f64>,
+        jacobian: &DMatrix<f64>,
+        towards_target: bool,
+    ) -> Option<DVector<f64>> {
+        let towards = if towards_target {
+            &self.target - x
+        } else {
+            DVector::zeros(x.len())
+        };
         let inverse_metric = self.metric.map(|m| 1.0 / m);
         let weighted = DMatrix::from_fn(jacobian.nrows(), jacobian.ncols(), |r, c| {
             jacobian[(r, c)] * inverse_metric[c]
         });
         let gram = &weighted * jacobian.transpose();
-        let multipliers = gram.lu().solve(&(h + jacobian * &towards))?;
+        let multipliers = gram.lu().solve(&(e + jacobian * &towards))?;
         Some(towards - weighted.transpose() * multipliers)
     }
 }
@@ -195,16 +212,16 @@ impl Problem<'_> {
 /// The equilibrium at `position_m` that `closure` picks (module docs).
 ///
 /// Fails with [`Error::InvalidInput`] for a yaw with three cables or a
-/// non-finite input, and with [`Error::NoEquilibrium`] where no member
-/// keeps every cable taut near the target or the iteration does not reach
-/// the height tolerance.
+/// non-finite input, and with [`Error::NoEquilibrium`] where the iteration
+/// meets a slack cable it cannot step around or does not balance the
+/// platform to [`EquilibriumOptions::wrench_tolerance`].
 pub fn solve_at(
     robot: &SuspendedRobot,
     position_m: Vector3<f64>,
     closure: Closure,
     options: &EquilibriumOptions,
 ) -> Result<SuspendedEquilibrium> {
-    let mut problem = problem(robot, position_m, closure)?;
+    let problem = problem(robot, position_m, closure)?;
     let unsolved = |why: String| {
         Error::NoEquilibrium(format!(
             "position {:?} on {} cables: {why}",
@@ -212,48 +229,57 @@ pub fn solve_at(
             robot.cable_count()
         ))
     };
-    let (mut x, mut h) = match problem.heights(&problem.target) {
-        Some(h) => (problem.target.clone(), h),
-        None => start(&mut problem).ok_or_else(|| {
-            unsolved("a cable is slack at every orientation within 30 degrees of the target's".into())
-        })?,
-    };
+    let mut x = problem.target.clone();
+    let mut e = problem
+        .equations(&x)
+        .ok_or_else(|| unsolved("the straight cables' tensions leave a cable slack".into()))?;
+    let tolerance = options.wrench_tolerance;
     for iteration in 0..options.max_iterations {
         let jacobian = problem
             .jacobian(&x)
             .ok_or_else(|| unsolved("a cable goes slack next to the current estimate".into()))?;
-        let dx = problem
-            .step(&x, &h, &jacobian)
-            .ok_or_else(|| unsolved("the heights' Jacobian lost its rank".into()))?;
-        let feasible = h.amax() <= options.height_tolerance_m;
-        if feasible && dx.amax() <= 1e-12 * x.amax().max(1.0) {
+        let rank = || unsolved("the equations' Jacobian lost its rank".into());
+        let dx = problem.step(&x, &e, &jacobian, true).ok_or_else(rank)?;
+        let balanced = e.amax() <= tolerance;
+        if balanced && dx.amax() <= 1e-10 * x.amax().max(1.0) {
             return Ok(finish(&problem, &x, iteration));
         }
-        let mut scale = 1.0;
-        loop {
-            let trial = &x + &dx * scale;
-            if let Some(trial_h) = problem.heights(&trial) {
-                if trial_h.amax() <= (h.amax() * (1.0 - 0.5 * scale)).max(options.height_tolerance_m) {
-                    (x, h) = (trial, trial_h);
-                    break;
+        // The step towards the target, halved until the unbalance falls;
+        // where a thousandth of it does not, the correction alone.
+        let correction = problem.step(&x, &e, &jacobian, false).ok_or_else(rank)?;
+        let accepted = [(&dx, 1e-3), (&correction, 1e-12)]
+            .into_iter()
+            .find_map(|(step, smallest)| {
+                let mut scale = 1.0;
+                while scale >= smallest {
+                    let trial = &x + step * scale;
+                    if let Some(trial_e) = problem.equations(&trial) {
+                        if trial_e.amax() <= (e.amax() * (1.0 - 0.5 * scale)).max(tolerance) {
+                            return Some((trial, trial_e));
+                        }
+                    }
+                    scale *= 0.5;
                 }
-            }
-            scale *= 0.5;
-            if scale < 1e-12 {
-                if feasible {
-                    return Ok(finish(&problem, &x, iteration));
-                }
-                return Err(unsolved(format!("the heights stalled at {:.3e} m", h.amax())));
+                None
+            });
+        match accepted {
+            Some(next) => (x, e) = next,
+            None if balanced => return Ok(finish(&problem, &x, iteration)),
+            None => {
+                return Err(unsolved(format!(
+                    "the balance stalled at {:.3e} of the platform's weight",
+                    e.amax()
+                )))
             }
         }
     }
-    if h.amax() <= options.height_tolerance_m {
+    if e.amax() <= tolerance {
         return Ok(finish(&problem, &x, options.max_iterations));
     }
     Err(unsolved(format!(
-        "{} iterations left a height residual of {:.3e} m",
+        "{} iterations left {:.3e} of the platform's weight unbalanced",
         options.max_iterations,
-        h.amax()
+        e.amax()
     )))
 }
 
@@ -265,14 +291,13 @@ fn problem(robot: &SuspendedRobot, position_m: Vector3<f64>, closure: Closure) -
             position_m.as_slice()
         )));
     }
-    if robot.cable_count() < 4 {
-        return Err(Error::InvalidInput(
-            "three cables: their horizontal forces balance only at the orientations where the cables' \
-             horizontal lines meet in one point, which this solver does not yet search (module docs)"
-                .into(),
-        ));
-    }
     let (base, rotations) = match closure {
+        Closure::Yaw { yaw_rad } if robot.cable_count() < 4 => {
+            return Err(Error::InvalidInput(format!(
+                "a yaw of {yaw_rad} rad cannot be held on three cables: they fix the orientation at a position \
+                 (use the level closure)"
+            )))
+        }
         Closure::Yaw { yaw_rad } if !yaw_rad.is_finite() => {
             return Err(Error::InvalidInput(format!(
                 "the yaw must be finite, got {yaw_rad} rad"
@@ -281,27 +306,22 @@ fn problem(robot: &SuspendedRobot, position_m: Vector3<f64>, closure: Closure) -
         Closure::Yaw { yaw_rad } => (UnitQuaternion::from_euler_angles(0.0, 0.0, yaw_rad), 2),
         Closure::Level => (UnitQuaternion::identity(), 3),
     };
-    let start = PlatformPose::new(position_m, base);
-    let dependent = robot.dependent_cables(&start);
-    let free: Vec<usize> = (0..robot.cable_count()).filter(|i| !dependent.contains(i)).collect();
-    let straight = straight_cable_forces(robot, &start);
-    let mut target = DVector::zeros(rotations + 2 * free.len());
+    let n = robot.cable_count();
+    let straight = straight_cable_forces(robot, &PlatformPose::new(position_m, base));
+    let mut target = DVector::zeros(rotations + n);
     let mut metric = DVector::from_element(target.len(), FORCE_WEIGHT);
     metric.rows_mut(0, rotations).fill(1.0);
     if rotations == 3 {
         metric[2] = YAW_WEIGHT;
     }
-    for (k, &i) in free.iter().enumerate() {
-        target[rotations + 2 * k] = straight[2 * i] / robot.platform_weight_n;
-        target[rotations + 2 * k + 1] = straight[2 * i + 1] / robot.platform_weight_n;
+    for i in 0..n {
+        target[rotations + i] = straight[2 * i] / robot.platform_weight_n;
     }
     Ok(Problem {
         robot,
         position_m,
         base,
         rotations,
-        dependent,
-        free,
         target,
         metric,
     })
@@ -333,58 +353,15 @@ fn straight_cable_forces(robot: &SuspendedRobot, pose: &PlatformPose) -> DVector
     })
 }
 
-/// The start of the iteration: over a grid of orientations about the
-/// base (every 5 degrees to 30 of tilt, and of yaw where it is free), the
-/// straight cables' taut tensions at each ([`straight_cable_forces`]) as
-/// the free components, and of those points where every cable is taut the
-/// one with the smallest heights. The target's forces become the start's:
-/// the forces at the base orientation may be no taut distribution at all.
-fn start(problem: &mut Problem<'_>) -> Option<(DVector<f64>, DVector<f64>)> {
-    let steps: Vec<f64> = (-6..=6).map(|k| (5.0 * k as f64).to_radians()).collect();
-    let yaws: Vec<f64> = if problem.rotations == 3 {
-        steps.clone()
-    } else {
-        vec![0.0]
-    };
-    let mut best: Option<(DVector<f64>, DVector<f64>)> = None;
-    for &roll in &steps {
-        for &pitch in &steps {
-            for &yaw in &yaws {
-                let mut x = problem.target.clone();
-                x[0] = roll;
-                x[1] = pitch;
-                if problem.rotations == 3 {
-                    x[2] = yaw;
-                }
-                problem.set_forces(&mut x);
-                let Some(h) = problem.heights(&x) else {
-                    continue;
-                };
-                if best.as_ref().is_none_or(|(_, b)| h.norm() < b.norm()) {
-                    best = Some((x, h));
-                }
-            }
-        }
-    }
-    let (x, h) = best?;
-    let forces = problem.rotations..x.len();
-    problem
-        .target
-        .rows_range_mut(forces.clone())
-        .copy_from(&x.rows_range(forces));
-    Some((x, h))
-}
-
 fn finish(problem: &Problem<'_>, x: &DVector<f64>, iterations: usize) -> SuspendedEquilibrium {
     let pose = problem.pose(x);
-    let tensions = problem.tensions(x).expect("the last accepted estimate balances");
+    let tensions = problem.tensions(x).expect("the last accepted estimate is taut");
     let cables = problem.robot.catenaries(&pose, &tensions);
     SuspendedEquilibrium {
         cable_lengths_m: cables.iter().map(|c| c.length_m()).collect(),
         height_residuals_m: problem.robot.height_residuals(&pose, &tensions),
         pose,
         tensions,
-        dependent: problem.dependent,
         iterations,
     }
 }
@@ -469,56 +446,114 @@ mod tests {
         }
     }
 
-    /// Three cables are refused with the reason (module docs), not sent
-    /// into an iteration that cannot converge.
+    /// Three cables have one equilibrium at a position (its horizontal
+    /// lines of action meeting in one point), found from a level start; a
+    /// held yaw is refused.
     #[test]
-    fn three_cables_are_refused_with_the_reason() {
+    fn three_cables_hang_in_their_one_equilibrium() {
         let robot = ring(3);
-        for closure in [Closure::Level, Closure::Yaw { yaw_rad: 0.0 }] {
-            let refused = solve_at(
-                &robot,
-                Vector3::new(1.0, -1.5, 5.0),
-                closure,
-                &EquilibriumOptions::default(),
+        for position in [Vector3::new(1.0, -1.5, 5.0), Vector3::new(-4.0, 3.0, 9.0)] {
+            let eq = solve_at(&robot, position, Closure::Level, &EquilibriumOptions::default()).unwrap();
+            assert_equilibrium(&robot, &eq);
+            println!(
+                "three cables at {position:?}: tilt {:.3} deg, yaw {:.3} deg",
+                tilt_deg(&eq.pose),
+                eq.pose.yaw_rad().to_degrees()
             );
-            assert!(
-                matches!(&refused, Err(Error::InvalidInput(m)) if m.contains("horizontal lines meet")),
-                "{refused:?}"
-            );
+            assert!(tilt_deg(&eq.pose) < 30.0 && eq.pose.yaw_rad().abs() < 30f64.to_radians());
+        }
+        let refused = solve_at(
+            &robot,
+            Vector3::new(1.0, -1.5, 5.0),
+            Closure::Yaw { yaw_rad: 0.0 },
+            &EquilibriumOptions::default(),
+        );
+        assert!(
+            matches!(&refused, Err(Error::InvalidInput(m)) if m.contains("three cables")),
+            "{refused:?}"
+        );
+    }
+
+    /// From six cables on the platform hangs level to a hundredth of a
+    /// degree (the tensions take up what the balance leaves; the tilt left
+    /// trades against their distance from the target at [`FORCE_WEIGHT`]);
+    /// with three to five it tilts as it must.
+    #[test]
+    fn three_to_eight_cables_hang_in_equilibrium() {
+        for n in 3..=8 {
+            let robot = ring(n);
+            for position in [Vector3::new(2.0, 1.0, 6.0), Vector3::new(-3.0, 2.0, 7.0)] {
+                let eq = solve_at(&robot, position, Closure::Level, &EquilibriumOptions::default()).unwrap();
+                assert_equilibrium(&robot, &eq);
+                println!(
+                    "{n} cables at {position:?}: tilt {:.3e} deg, yaw {:.3e} deg, {} iterations",
+                    tilt_deg(&eq.pose),
+                    eq.pose.yaw_rad().to_degrees(),
+                    eq.iterations
+                );
+                if n >= 6 {
+                    assert!(tilt_deg(&eq.pose) < 1e-2, "{n} cables tilt {} deg", tilt_deg(&eq.pose));
+                }
+            }
         }
     }
 
-    /// The level closure's answer is the member nearest its target: at the
+    /// The closure's answer is the member nearest its target: at the
     /// solution the metric-weighted offset from the target lies in the span
-    /// of the heights' gradients (the first-order conditions). Four cables,
-    /// five unknowns, four heights: one direction is free.
+    /// of the equations' gradients (the first-order conditions), for four
+    /// cables (one free direction) and eight (five).
     #[test]
     fn the_level_equilibrium_is_the_nearest_to_its_target() {
-        let robot = SuspendedRobot::from_robot(&Robot::builtin("large").unwrap());
-        let position = Vector3::new(-20.0, 30.0, 15.0);
-        let eq = solve_at(&robot, position, Closure::Level, &EquilibriumOptions::default()).unwrap();
-        let mut problem = problem(&robot, position, Closure::Level).unwrap();
-        if problem.heights(&problem.target).is_none() {
-            start(&mut problem).unwrap();
+        let large = SuspendedRobot::from_robot(&Robot::builtin("large").unwrap());
+        for (robot, position) in [
+            (large, Vector3::new(-20.0, 30.0, 15.0)),
+            (ring(8), Vector3::new(-3.0, 2.0, 7.0)),
+        ] {
+            let eq = solve_at(&robot, position, Closure::Level, &EquilibriumOptions::default()).unwrap();
+            let problem = problem(&robot, position, Closure::Level).unwrap();
+            let mut x = DVector::zeros(problem.target.len());
+            let (roll, pitch, yaw) = eq.pose.rotation.euler_angles();
+            (x[0], x[1], x[2]) = (roll, pitch, yaw);
+            for (i, t) in eq.tensions.iter().enumerate() {
+                x[3 + i] = t.horizontal_n / robot.platform_weight_n;
+            }
+            let jacobian = problem.jacobian(&x).unwrap();
+            let gradient = (&x - &problem.target).component_mul(&problem.metric);
+            // Least squares of J^T lambda = gradient: the remainder is what no equation can explain.
+            let lambda = jacobian.transpose().svd(true, true).solve(&gradient, 1e-14).unwrap();
+            let remainder = &gradient - jacobian.transpose() * lambda;
+            println!(
+                "{} cables: first-order remainder {:.3e} of a gradient {:.3e}",
+                robot.cable_count(),
+                remainder.amax(),
+                gradient.amax()
+            );
+            assert!(gradient.amax() > 0.0, "the target itself is no equilibrium here");
+            assert!(remainder.amax() < 1e-6 * gradient.amax(), "{remainder} of {gradient}");
         }
-        let mut x = DVector::zeros(problem.target.len());
-        let (roll, pitch, yaw) = eq.pose.rotation.euler_angles();
-        (x[0], x[1], x[2]) = (roll, pitch, yaw);
-        for (k, &i) in problem.free.iter().enumerate() {
-            x[3 + 2 * k] = eq.tensions[i].horizontal_n / robot.platform_weight_n;
-            x[4 + 2 * k] = eq.tensions[i].vertical_n / robot.platform_weight_n;
+    }
+
+    /// The closed-form vertical tension puts the catenary's end at the
+    /// attachment (the forward drop of `model::catenary`), light to heavy.
+    #[test]
+    fn the_vertical_tension_reaches_the_attachment() {
+        for (span, drop, horizontal, weight) in [
+            (30.0, 12.0, 400.0, 0.0),
+            (30.0, 12.0, 400.0, 0.71),
+            (120.0, -5.0, 150.0, 6.0),
+        ] {
+            let vertical_n = vertical_for_height(span, drop, horizontal, weight);
+            let cable = crate::model::Catenary {
+                span_m: span,
+                horizontal_tension_n: horizontal,
+                vertical_tension_n: vertical_n,
+                cable_weight_n_per_m: weight,
+            };
+            assert!(
+                (cable.drop_m() - drop).abs() < 1e-12 * span,
+                "{} vs {drop}",
+                cable.drop_m()
+            );
         }
-        let jacobian = problem.jacobian(&x).unwrap();
-        let gradient = (&x - &problem.target).component_mul(&problem.metric);
-        // Least squares of J^T lambda = gradient: the remainder is what no height can explain.
-        let lambda = jacobian.transpose().svd(true, true).solve(&gradient, 1e-14).unwrap();
-        let remainder = &gradient - jacobian.transpose() * lambda;
-        println!(
-            "first-order remainder {:.3e} of a gradient {:.3e}",
-            remainder.amax(),
-            gradient.amax()
-        );
-        assert!(gradient.amax() > 0.0, "the target itself is no equilibrium here");
-        assert!(remainder.amax() < 1e-6 * gradient.amax(), "{remainder} of {gradient}");
     }
 }

@@ -14,13 +14,20 @@
 //! ones), they follow from the 6 x 6 solve `J_dep^T f_dep = w - J_free^T f_free`
 //! (the paper's eq. 11 with the reference cable free, for `N = 4`). Three
 //! cables' `(f_h, f_v)` make the dependent set, the three whose 6 x 6 block
-//! is best conditioned at the pose ([`SuspendedRobot::dependent_cables`]): among the
-//! `C(N, 3)` triples, the one with the largest smallest singular value of
+//! is best conditioned at the pose ([`SuspendedRobot::dependent_cables`]):
+//! among the `C(N, 3)` triples, the one with the largest smallest singular value of
 //! the block with its moment rows divided by the platform's attachment
 //! radius (so that forces and moments weigh alike). A triple whose block is
 //! near singular (three cables pulling in one vertical plane, or through one
-//! line) is never chosen while a better one exists; for `N = 3` there is
-//! one triple, and no free component.
+//! line) is never chosen while a better one exists. For `N = 3` there is
+//! one triple and no free component, and its block is singular at every
+//! equilibrium: gravity loads none of the rows `F_x`, `F_y`, `M_z` and the
+//! vertical forces enter none of them, so the horizontal tensions solve a
+//! homogeneous system that has a non-zero solution only where the block is
+//! singular (the cables' horizontal lines meeting in one point). The
+//! balance serves where some forces are known (a load cell's cable free);
+//! the equilibrium solver ([`solve_at`]) takes the horizontal tensions as
+//! its unknowns instead, each cable's vertical one from its catenary.
 //!
 //! Each cable must also reach its attachment: the catenary from anchor `i`
 //! with `(f_h,i, f_v,i)` ends at the attachment's height (paper eq. 15,
@@ -50,5 +57,7 @@ mod equilibrium;
 mod robot;
 mod tension_distribution;
 
-pub use equilibrium::{solve_at, Closure, EquilibriumOptions, SuspendedEquilibrium, FORCE_WEIGHT, YAW_WEIGHT};
+pub use equilibrium::{
+    solve_at, vertical_for_height, Closure, EquilibriumOptions, SuspendedEquilibrium, FORCE_WEIGHT, YAW_WEIGHT,
+};
 pub use robot::{SuspendedRobot, MIN_CABLES, MIN_RECIPROCAL_CONDITION};

@@ -40,11 +40,11 @@ pub struct SuspendedRobot {
 /// horizontal unit vector from its anchor towards it, the horizontal span
 /// and the anchor's height above it (metres).
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Run {
-    attachment_world_m: Vector3<f64>,
-    horizontal_direction: Vector3<f64>,
-    span_m: f64,
-    height_difference_m: f64,
+pub(super) struct Run {
+    pub(super) attachment_world_m: Vector3<f64>,
+    pub(super) horizontal_direction: Vector3<f64>,
+    pub(super) span_m: f64,
+    pub(super) height_difference_m: f64,
 }
 
 impl SuspendedRobot {
@@ -121,7 +121,7 @@ impl SuspendedRobot {
         self.attachments_m.iter().map(|b| b.norm()).fold(1e-3, f64::max)
     }
 
-    fn runs(&self, pose: &PlatformPose) -> Vec<Run> {
+    pub(super) fn runs(&self, pose: &PlatformPose) -> Vec<Run> {
         let rotation = pose.rotation_matrix();
         (0..self.cable_count())
             .map(|i| {
