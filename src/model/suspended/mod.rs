@@ -28,6 +28,7 @@
 //! balance serves where some forces are known (a load cell's cable free);
 //! the equilibrium solver ([`solve_at`]) takes the horizontal tensions as
 //! its unknowns instead, each cable's vertical one from its catenary.
+//! Whether an equilibrium is stable: [`stiffness`] at fixed cable lengths.
 //!
 //! Each cable must also reach its attachment: the catenary from anchor `i`
 //! with `(f_h,i, f_v,i)` ends at the attachment's height (paper eq. 15,
@@ -55,9 +56,11 @@
 
 mod equilibrium;
 mod robot;
+mod stiffness;
 mod tension_distribution;
 
 pub use equilibrium::{
     solve_at, vertical_for_height, Closure, EquilibriumOptions, SuspendedEquilibrium, FORCE_WEIGHT, YAW_WEIGHT,
 };
 pub use robot::{SuspendedRobot, MIN_CABLES, MIN_RECIPROCAL_CONDITION};
+pub use stiffness::{smallest_stiffness, stiffness};
