@@ -372,26 +372,10 @@ mod tests {
     use crate::model::robot::Robot;
     use crate::model::statics::{solve_level, StaticsOptions};
 
-    /// `n` anchors around a 20 m circle at about 15 m height, each at its
-    /// own radius and height (a fixed pattern), attachments on a 0.5 m
-    /// circle facing their anchors, 0.5 N/m cables, a 500 N platform whose
-    /// centre of mass is off its axis.
+    /// The irregular ring of the tests, attachments 0.2 m up, the centre of
+    /// mass off the platform's axis.
     fn ring(n: usize) -> SuspendedRobot {
-        let angle = |k: usize| std::f64::consts::TAU * k as f64 / n as f64;
-        let anchor = |k: usize| {
-            let r = 20.0 + 2.0 * (3.0 * k as f64).cos();
-            Vector3::new(r * angle(k).cos(), r * angle(k).sin(), 15.0 + (2.0 * k as f64).sin())
-        };
-        SuspendedRobot::new(
-            (0..n).map(anchor).collect(),
-            (0..n)
-                .map(|k| Vector3::new(0.5 * angle(k).cos(), 0.5 * angle(k).sin(), 0.2))
-                .collect(),
-            vec![0.5; n],
-            Vector3::new(0.05, -0.03, -0.1),
-            500.0,
-        )
-        .unwrap()
+        super::super::test_ring::ring(n, 0.2, Vector3::new(0.05, -0.03, -0.1))
     }
 
     /// What every equilibrium holds: the heights, the six equations, taut cables.

@@ -58,6 +58,8 @@ mod equilibrium;
 mod robot;
 mod stiffness;
 mod tension_distribution;
+#[cfg(test)]
+mod test_ring;
 
 pub use equilibrium::{
     solve_at, vertical_for_height, Closure, EquilibriumOptions, SuspendedEquilibrium, FORCE_WEIGHT, YAW_WEIGHT,

@@ -127,26 +127,10 @@ mod tests {
     use crate::model::suspended::{solve_at, Closure, EquilibriumOptions};
     use nalgebra::Vector3;
 
-    /// `n` anchors around a 20 m circle at about 15 m, each at its own
-    /// radius and height (a fixed pattern), attachments facing them on a
-    /// 0.5 m circle, 0.5 N/m cables, a 500 N platform with its centre of
-    /// mass `com_z_m` above the attachments' plane.
+    /// The irregular ring of the tests with its centre of mass `com_z_m`
+    /// above the attachments' plane.
     fn ring(n: usize, com_z_m: f64) -> SuspendedRobot {
-        let angle = |k: usize| std::f64::consts::TAU * k as f64 / n as f64;
-        let anchor = |k: usize| {
-            let r = 20.0 + 2.0 * (3.0 * k as f64).cos();
-            Vector3::new(r * angle(k).cos(), r * angle(k).sin(), 15.0 + (2.0 * k as f64).sin())
-        };
-        SuspendedRobot::new(
-            (0..n).map(anchor).collect(),
-            (0..n)
-                .map(|k| Vector3::new(0.5 * angle(k).cos(), 0.5 * angle(k).sin(), 0.0))
-                .collect(),
-            vec![0.5; n],
-            Vector3::new(0.0, 0.0, com_z_m),
-            500.0,
-        )
-        .unwrap()
+        super::super::test_ring::ring(n, 0.0, Vector3::new(0.0, 0.0, com_z_m))
     }
 
     /// A platform hanging below its attachments is stable on three to eight
