@@ -481,6 +481,39 @@ fn recurdyn_log_accuracy() {
     }
 }
 
+/// The N-cable stiffness (`model::suspended`, central differences of the
+/// whole generalised force) is the four-cable one of `localize/stiffness.rs`
+/// (derivatives in parts) on the large and the small robot.
+#[test]
+fn the_n_cable_stiffness_is_the_four_cable_one() {
+    use sagcal::localize::stiffness::{smallest_stiffness, stiffness};
+    use sagcal::model::suspended::{self, solve_at, Closure, EquilibriumOptions, SuspendedRobot};
+    for name in ["large", "small"] {
+        let robot = robot(name);
+        let localizer = localizer(&robot);
+        let suspended = SuspendedRobot::from_robot(&robot);
+        for eq in equilibria(&robot, 3, 23) {
+            let t = eq.tensions[robot.reference_cable];
+            let model =
+                model_at_pose(localizer.slots(), &eq.pose, &Vector2::new(t.horizontal_n, t.vertical_n)).unwrap();
+            let four = stiffness(&robot, localizer.slots(), &eq.pose, &model);
+            let closure = Closure::Yaw {
+                yaw_rad: eq.pose.yaw_rad(),
+            };
+            let general = solve_at(&suspended, eq.pose.position_m, closure, &EquilibriumOptions::default()).unwrap();
+            assert!(general.pose.rotation.angle_to(&eq.pose.rotation) < 1e-8);
+            let n = suspended::stiffness(&suspended, &general).unwrap();
+            let difference = (n - four).amax() / four.amax();
+            println!(
+                "{name}: smallest stiffness {:.6e} (four-cable {:.6e}), largest entry difference {difference:.1e}",
+                suspended::smallest_stiffness(&n),
+                smallest_stiffness(&four)
+            );
+            assert!(difference < 1e-4, "{name}: {difference:e}\n{n}\n{four}");
+        }
+    }
+}
+
 #[test]
 fn stiffness_is_symmetric_and_a_flipped_start_is_not_kept() {
     use sagcal::localize::stiffness::{smallest_stiffness, stiffness};
