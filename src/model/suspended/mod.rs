@@ -54,6 +54,7 @@
 //! # Ok::<(), sagcal::Error>(())
 //! ```
 
+mod closure_steps;
 mod equilibrium;
 mod robot;
 mod stiffness;

@@ -26,3 +26,24 @@ pub(super) fn ring(n: usize, attachment_z_m: f64, com_m: Vector3<f64>) -> Suspen
     )
     .expect("a ring of three cables or more is a robot")
 }
+
+/// `n` anchors evenly on a 20 m circle at 15 m, attachments on a 0.5 m
+/// circle facing them (so the yaw is held only by the cables' small lever
+/// arms), 0.5 N/m cables, a 500 N platform with its centre of mass 1 m
+/// below the attachments: the symmetric robot on which an equilibrium
+/// search meets its flattest directions.
+pub(super) fn regular_ring(n: usize) -> SuspendedRobot {
+    let angle = |k: usize| std::f64::consts::TAU * k as f64 / n as f64;
+    SuspendedRobot::new(
+        (0..n)
+            .map(|k| Vector3::new(20.0 * angle(k).cos(), 20.0 * angle(k).sin(), 15.0))
+            .collect(),
+        (0..n)
+            .map(|k| Vector3::new(0.5 * angle(k).cos(), 0.5 * angle(k).sin(), 0.0))
+            .collect(),
+        vec![0.5; n],
+        Vector3::new(0.0, 0.0, -1.0),
+        500.0,
+    )
+    .expect("a ring of three cables or more is a robot")
+}
