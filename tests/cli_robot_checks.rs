@@ -343,3 +343,78 @@ fn a_verification_that_solves_no_row_is_an_error() {
     fails_with(&out, "nothing verified");
     assert!(out.stdout.is_empty(), "no report printed as if verified");
 }
+
+/// `simulate` on robots of three, six and eight cables writes what the
+/// library draws for the same seed (the CLI adds nothing), in a file with a
+/// column per cable and per load cell; the commands that model four cables
+/// refuse such a robot and say what it has.
+#[test]
+fn simulate_takes_three_to_eight_cables() {
+    use rand::SeedableRng;
+    use sagcal::io::suspended_measurements::read_suspended_measurements;
+    use sagcal::model::sensors::NoisePreset;
+    use sagcal::model::suspended::SuspendedRobot;
+    use sagcal::sim::closed_form::Closure;
+    use sagcal::sim::suspended::{measure_suspended, sample_suspended};
+
+    let dir = tempfile::tempdir().unwrap();
+    for (name, header_end) in [
+        ("three", "l3_m,f1_n"),
+        ("six", "l6_m,f1_n"),
+        ("eight", "l8_m,f1_n,f5_n"),
+    ] {
+        let out = sagcal(
+            dir.path(),
+            &[
+                "simulate",
+                "--robot",
+                &robot(name),
+                "--poses",
+                "7",
+                "--seed",
+                "5",
+                "--out",
+                "d.csv",
+            ],
+        );
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        let path = dir.path().join("d.csv");
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains(&format!("{header_end}\n")), "{name}: {text}");
+        let suspended = SuspendedRobot::from_file(Path::new(&robot(name))).unwrap();
+        let rows = read_suspended_measurements(&path, &suspended).unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let poses = sample_suspended(&suspended, &suspended.workspace.unwrap(), 7, Closure::Level, &mut rng).unwrap();
+        let expected = measure_suspended(
+            &suspended,
+            &poses,
+            &NoisePreset::Paper.sigmas(suspended.platform_weight_n),
+            &mut rng,
+        );
+        assert_eq!(rows.len(), 7);
+        for (row, want) in rows.iter().zip(&expected) {
+            assert_eq!(row.encoder_lengths_m, want.encoder_lengths_m, "{name}");
+            assert_eq!(row.load_cell_tensions_n, want.load_cell_tensions_n, "{name}");
+            assert_eq!(row.position_m, want.position_m, "{name}");
+        }
+        let refused = sagcal(
+            dir.path(),
+            &[
+                "calibrate",
+                "--robot",
+                &robot(name),
+                "--data",
+                "d.csv",
+                "--out",
+                "c.toml",
+            ],
+        );
+        let message = String::from_utf8_lossy(&refused.stderr);
+        assert_eq!(refused.status.code(), Some(1), "{name}: {message}");
+        assert!(
+            message.contains("field `cables`") && message.contains("this command models 4"),
+            "{message}"
+        );
+        assert!(!dir.path().join("c.toml").exists());
+    }
+}

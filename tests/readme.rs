@@ -403,3 +403,19 @@ fn every_plan_row_says_what_plan_gives() {
         r.random_anchor_bound_m / random35
     ));
 }
+
+/// The example of a robot of 3 to 8 cables prints what the README shows.
+#[test]
+fn the_eight_cable_example_prints_what_the_readme_shows() {
+    let readme = readme();
+    let command = command_with(&readme, "simulate", &["robots/eight.toml"]);
+    let dir = tempfile::tempdir().unwrap();
+    let printed = stdout(&sagcal(dir.path(), &args(&command)));
+    for line in printed.lines() {
+        says(&readme, &line.split_whitespace().collect::<Vec<_>>().join(" "));
+    }
+    assert!(
+        printed.contains("8 cables, load cells on cable 1, cable 5"),
+        "{printed}"
+    );
+}

@@ -101,8 +101,10 @@ def run_interruptibly(function, args, kwargs):
 
     worker = threading.Thread(target=work, name=f"sagcal.{getattr(function, '__name__', 'call')}", daemon=True)
     _sagcal._reset_cancel()
-    worker.start()
     try:
+        # Started inside the ``try``: ``Thread.start`` waits for the thread
+        # to run, and a Ctrl-C in that wait must stop the job too.
+        worker.start()
         while not done.wait(POLL_S):
             pass
     except KeyboardInterrupt:

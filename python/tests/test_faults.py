@@ -135,7 +135,11 @@ def test_ctrl_c_interrupts_a_long_call():
     # a 10 s wait once ran out with two other long jobs on both cores).
     script = textwrap.dedent(
         """
-        import sys, threading, time, sagcal
+        import faulthandler, signal, sys, threading, time, sagcal
+        faulthandler.register(signal.SIGUSR1, all_threads=True)
+        # A shell starts a background job (`make test &`, a CI runner) with
+        # SIGINT ignored, and a child inherits that: Ctrl-C as a terminal sends it.
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         print("ready", flush=True)
         start = time.monotonic()
         try:
@@ -149,7 +153,9 @@ def test_ctrl_c_interrupts_a_long_call():
         sys.exit(1)
         """
     )
-    process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        [sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
     assert process.stdout.readline().strip() == "ready"
     import time
 
@@ -157,6 +163,13 @@ def test_ctrl_c_interrupts_a_long_call():
     process.send_signal(signal.SIGINT)
     try:
         out, _ = process.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        # Where every thread of the child is, for the report.
+        process.send_signal(signal.SIGUSR1)
+        time.sleep(2)
+        process.kill()
+        out, err = process.communicate()
+        raise AssertionError(f"no end within 60 s of Ctrl-C; stdout {out!r}; the child's threads:\n{err}")
     finally:
         process.kill()
     assert process.returncode == 0, out

@@ -15,7 +15,7 @@ use super::init::InitArgs;
 use super::localize::LocalizeArgs;
 use super::localize_experiment::LocalizeExperimentArgs;
 use super::plan::PlanArgs;
-use super::simulate::SimulateArgs;
+use super::simulate_args::SimulateArgs;
 use super::verify::VerifyArgs;
 
 /// Self-calibration of suspended cable-driven parallel robots with sagging cables.

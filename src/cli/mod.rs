@@ -22,6 +22,8 @@ mod parse;
 mod plan;
 mod run;
 mod simulate;
+mod simulate_args;
+mod simulate_suspended;
 mod solver_args;
 mod verify;
 

@@ -1,67 +1,36 @@
 //! `sagcal simulate`: measurements of a robot from the closed-form model, or,
 //! with `--effect` (or a robot file with `[effects]`), from the discretised
-//! simulator with those effects acting; its flags ([`SimulateArgs`]) and the
-//! run.
-
-use std::path::PathBuf;
+//! simulator with those effects acting: the run.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sagcal::error::FrontEnd;
 use sagcal::io::measurements::measurements_text;
 use sagcal::io::OutputSet;
-use sagcal::model::sensors::NoisePreset;
 use sagcal::model::statics::Equilibrium;
+use sagcal::model::suspended::SuspendedRobot;
 use sagcal::model::{PoseMeasurement, Robot};
-use sagcal::sim::closed_form::{measure, sample_equilibria_with, Closure, Workspace};
+use sagcal::sim::closed_form::{measure, sample_equilibria_with, Workspace};
 use sagcal::sim::effects::{measure_with_effects, simulation_truth};
 
 use super::output::counted;
-
-#[derive(Debug, clap::Args)]
-pub(super) struct SimulateArgs {
-    /// The true robot (TOML): anchors and length offsets of the simulation.
-    #[arg(long)]
-    robot: PathBuf,
-    /// Number of static poses.
-    #[arg(long)]
-    poses: usize,
-    /// Random seed (the same seed gives the same file).
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// Sensor noise: paper, authors or none.
-    #[arg(long, default_value = "paper", value_parser = sagcal::model::sensors::NoisePreset::parse)]
-    noise: sagcal::model::sensors::NoisePreset,
-    /// Output measurement file (CSV).
-    #[arg(long)]
-    out: PathBuf,
-    /// Also write the truth (robot TOML with offsets, and `[effects]` with `--effect`) here.
-    #[arg(long)]
-    truth: Option<PathBuf>,
-    /// A physical effect the closed-form model lacks, `NAME:PARAM=VALUE[,PARAM=VALUE...]`
-    /// (repeatable). The data then come from the discretised simulator.
-    #[arg(long = "effect", value_name = "SPEC", long_help = effect_help())]
-    effects: Vec<String>,
-    /// Segments per cable of the discretised simulator (only used with effects).
-    #[arg(long, default_value_t = 100)]
-    segments: usize,
-    /// How each pose closes its family of equilibria: level (the most level member),
-    /// yaw (a random yaw within +-1 degree) or mixed (about half each).
-    #[arg(long, default_value = "level", value_parser = sagcal::sim::closed_form::Closure::parse)]
-    closure: sagcal::sim::closed_form::Closure,
-}
-
-/// `simulate --effect`'s long help: every effect with its parameters.
-fn effect_help() -> String {
-    format!(
-        "A physical effect the closed-form model lacks, `NAME:PARAM=VALUE[,PARAM=VALUE...]` \
-         (repeatable): {}. The data then come from the discretised simulator.",
-        sagcal::model::effect_specs::EFFECT_NAMES
-    )
-}
+use super::simulate_args::{closure_note, noise_phrase, ranges_line, SimulateArgs};
 
 /// Simulate measurements of the robot, write them (and the truth), report what was drawn.
+///
+/// A robot file the four-cable model does not take (another number of
+/// cables, per-cable weights, several load cells) goes to the model of 3 to
+/// 8 cables.
 pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
+    if let Err(four_cable) = Robot::from_file(&args.robot) {
+        return match SuspendedRobot::from_file(&args.robot) {
+            Ok(robot) => super::simulate_suspended::run(args, &robot),
+            Err(_) if !matches!(four_cable, sagcal::Error::Robot { ref message, .. } if message.contains("field `cables`")) => {
+                Err(four_cable)
+            }
+            Err(n_cables) => Err(n_cables),
+        };
+    }
     let (truth, from_file) = load_truth(args)?;
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     let workspace = Workspace::default_for(&truth);
@@ -82,10 +51,7 @@ pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
         args.seed,
         counted(args.poses, "pose", "poses"),
         truth.name,
-        match args.noise {
-            NoisePreset::None => "without noise".to_string(),
-            noise => format!("with {noise} noise"),
-        },
+        noise_phrase(args.noise),
         closure_note(args.closure),
         args.out.display()
     );
@@ -178,28 +144,16 @@ fn truth_text(args: &SimulateArgs, truth: &Robot) -> sagcal::Result<String> {
     ))
 }
 
-/// `, closure yaw (+-1 deg)` for a closure other than level (whose files and
-/// messages stay as they were), else nothing.
-fn closure_note(closure: Closure) -> String {
-    if closure == Closure::Level {
-        String::new()
-    } else {
-        format!(", closure {closure}")
-    }
-}
-
 /// The workspace and the ranges of cable lengths and tensions it gave.
 fn print_ranges(workspace: &Workspace, equilibria: &[Equilibrium]) {
-    let range = |values: &mut dyn Iterator<Item = f64>| {
-        values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)))
-    };
-    let (length_min, length_max) = range(&mut equilibria.iter().flat_map(|eq| eq.cable_lengths_m));
-    let (tension_min, tension_max) = range(
-        &mut equilibria
-            .iter()
-            .flat_map(|eq| eq.tensions.iter().map(|t| t.magnitude_n())),
-    );
     println!(
-        "workspace {workspace}: cable lengths {length_min:.1} .. {length_max:.1} m, tensions {tension_min:.1} .. {tension_max:.1} N"
+        "{}",
+        ranges_line(
+            workspace,
+            equilibria.iter().flat_map(|eq| eq.cable_lengths_m),
+            equilibria
+                .iter()
+                .flat_map(|eq| eq.tensions.iter().map(|t| t.magnitude_n())),
+        )
     );
 }

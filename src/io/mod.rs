@@ -2,6 +2,8 @@
 //! formats and validation of single values, no physics.
 //!
 //! - [`robot_file`]: the robot description (TOML);
+//! - [`suspended_file`]: a robot of 3 to 8 cables, per-cable weights and load cells;
+//!   [`suspended_measurements`]: its measurement file;
 //! - [`robot_init`]: a new, commented robot file from a few numbers (`sagcal init`);
 //! - [`measurements`]: what `calibrate`, `diagnose` and `verify` read: sagcal's
 //!   CSV, a RecurDyn log ([`recurdyn`]) or the authors' dataset folder
@@ -45,6 +47,8 @@ pub mod recurdyn;
 pub mod robot_file;
 pub mod robot_init;
 mod robot_text;
+pub mod suspended_file;
+pub mod suspended_measurements;
 
 pub use atomic::write_atomically;
 pub use outputs::OutputSet;

@@ -172,7 +172,7 @@ pub struct WorkspaceEntry {
 
 impl WorkspaceEntry {
     /// The box, validated: finite corners, `min_m <= max_m` on every axis.
-    fn validated(self) -> std::result::Result<Workspace, String> {
+    pub(super) fn validated(self) -> std::result::Result<Workspace, String> {
         let WorkspaceEntry { min_m, max_m } = self;
         if !(0..3).all(|k| min_m[k].is_finite() && max_m[k].is_finite() && min_m[k] <= max_m[k]) {
             return Err(format!(
@@ -185,11 +185,21 @@ impl WorkspaceEntry {
 
 impl RobotFile {
     /// Read and parse a robot file (no physical validation: see `model::Robot`).
+    /// A file of another number of cables (with the fields only such a
+    /// robot has) is refused for its number of cables.
     pub fn read(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        toml::from_str(&text).map_err(|e| Error::Format {
-            path: path.to_path_buf(),
-            message: format!("not a valid robot file: {e}"),
+        toml::from_str(&text).map_err(|e| match cable_count(&text).filter(|&n| n != CABLE_COUNT) {
+            Some(n) => Error::Robot {
+                path: path.to_path_buf(),
+                message: format!(
+                    "field `cables`: the file has {n} cables; this command models {CABLE_COUNT} (`sagcal simulate` takes 3 to 8)"
+                ),
+            },
+            None => Error::Format {
+                path: path.to_path_buf(),
+                message: format!("not a valid robot file: {e}"),
+            },
         })
     }
 
@@ -219,7 +229,7 @@ impl RobotFile {
     fn check_fields(&self) -> std::result::Result<(), String> {
         if self.cables.len() != CABLE_COUNT {
             return Err(format!(
-                "field `cables`: sagcal models a suspended robot with {CABLE_COUNT} cables, the file has {}",
+                "field `cables`: the file has {} cables; this command models {CABLE_COUNT} (`sagcal simulate` takes 3 to 8)",
                 self.cables.len()
             ));
         }
@@ -229,24 +239,8 @@ impl RobotFile {
                 self.reference_cable
             ));
         }
-        let finite3 = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
-        for (i, CableEntry { anchor_m, attachment_m }) in self.cables.iter().enumerate() {
-            if !finite3(anchor_m) {
-                return Err(format!("cable {}: field `anchor_m` is not finite", i + 1));
-            }
-            if !finite3(attachment_m) {
-                return Err(format!("cable {}: field `attachment_m` is not finite", i + 1));
-            }
-        }
-        if !finite3(&self.com_offset_m) {
-            return Err("field `com_offset_m` is not finite".into());
-        }
-        if !(self.platform_weight_n.is_finite() && self.platform_weight_n > 0.0) {
-            return Err(format!(
-                "field `platform_weight_n` must be a positive weight in newtons, got {}",
-                self.platform_weight_n
-            ));
-        }
+        let points = self.cables.iter().map(|c| (&c.anchor_m, &c.attachment_m));
+        check_points_and_platform(points, &self.com_offset_m, self.platform_weight_n)?;
         if !(self.cable_weight_n_per_m.is_finite() && self.cable_weight_n_per_m >= 0.0) {
             return Err(format!(
                 "field `cable_weight_n_per_m` must be >= 0, got {}",
@@ -268,13 +262,48 @@ impl RobotFile {
     }
 }
 
-/// Every cable has its own pulley and its own attachment point.
-fn distinct_points(
-    anchors_m: &[Vector3<f64>; CABLE_COUNT],
-    attachments_m: &[Vector3<f64>; CABLE_COUNT],
+/// Every cable's anchor and attachment (in cable order), the centre of
+/// mass finite, and the platform's weight a positive number of newtons;
+/// the error names the cable and the field.
+pub(super) fn check_points_and_platform<'a>(
+    cables: impl Iterator<Item = (&'a [f64; 3], &'a [f64; 3])>,
+    com_offset_m: &[f64; 3],
+    platform_weight_n: f64,
 ) -> std::result::Result<(), String> {
-    for i in 0..CABLE_COUNT {
-        for j in i + 1..CABLE_COUNT {
+    let finite3 = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
+    for (i, (anchor_m, attachment_m)) in cables.enumerate() {
+        if !finite3(anchor_m) {
+            return Err(format!("cable {}: field `anchor_m` is not finite", i + 1));
+        }
+        if !finite3(attachment_m) {
+            return Err(format!("cable {}: field `attachment_m` is not finite", i + 1));
+        }
+    }
+    if !finite3(com_offset_m) {
+        return Err("field `com_offset_m` is not finite".into());
+    }
+    if !(platform_weight_n.is_finite() && platform_weight_n > 0.0) {
+        return Err(format!(
+            "field `platform_weight_n` must be a positive weight in newtons, got {platform_weight_n}"
+        ));
+    }
+    Ok(())
+}
+
+/// The number of `[[cables]]` tables in a robot file's text, nothing else
+/// validated; `None` where the text is no TOML or has no cables.
+pub fn cable_count(text: &str) -> Option<usize> {
+    let table = toml::from_str::<toml::Table>(text).ok()?;
+    Some(table.get("cables")?.as_array()?.len())
+}
+
+/// Every cable has its own pulley and its own attachment point.
+pub(super) fn distinct_points(
+    anchors_m: &[Vector3<f64>],
+    attachments_m: &[Vector3<f64>],
+) -> std::result::Result<(), String> {
+    for i in 0..anchors_m.len() {
+        for j in i + 1..anchors_m.len() {
             if (anchors_m[i] - anchors_m[j]).norm() < 1e-6 {
                 let anchor: [f64; 3] = anchors_m[i].into();
                 return Err(format!(

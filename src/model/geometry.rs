@@ -50,7 +50,7 @@
 
 use nalgebra::{Vector2, Vector3};
 
-use crate::model::robot::{Robot, Workspace, CABLE_COUNT};
+use crate::model::robot::{Robot, Workspace};
 
 /// The narrowest extent of the anchors' footprint must be at least this
 /// fraction of its largest (module docs): at 1 % the cables' pulls across
@@ -79,7 +79,7 @@ impl Footprint {
     }
 
     /// The footprint of these anchors.
-    pub fn of_anchors(anchors_m: &[Vector3<f64>; CABLE_COUNT]) -> Self {
+    pub fn of_anchors(anchors_m: &[Vector3<f64>]) -> Self {
         let points: Vec<Vector2<f64>> = anchors_m.iter().map(|a| a.xy()).collect();
         let mut diameter_m = 0.0f64;
         let mut width_m = f64::INFINITY;

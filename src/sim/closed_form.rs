@@ -55,12 +55,13 @@ impl Workspace {
     /// anchors' half-extent around their centre, z from 2 % to 58 % of the
     /// anchors' height.
     pub fn around_anchors(robot: &Robot) -> Self {
-        let min = robot
-            .anchors_m
-            .iter()
-            .fold(Vector3::repeat(f64::INFINITY), |m, a| m.inf(a));
-        let max = robot
-            .anchors_m
+        Self::around_anchor_points(&robot.anchors_m)
+    }
+
+    /// [`Workspace::around_anchors`] for any number of anchors.
+    pub fn around_anchor_points(anchors_m: &[Vector3<f64>]) -> Self {
+        let min = anchors_m.iter().fold(Vector3::repeat(f64::INFINITY), |m, a| m.inf(a));
+        let max = anchors_m
             .iter()
             .fold(Vector3::repeat(f64::NEG_INFINITY), |m, a| m.sup(a));
         let centre = (min + max) / 2.0;
@@ -143,7 +144,7 @@ impl Closure {
         }
     }
 
-    fn validate(&self) -> Result<()> {
+    pub(super) fn validate(&self) -> Result<()> {
         let (fraction, max_yaw_deg) = match *self {
             Self::Level => return Ok(()),
             Self::Yaw { max_yaw_deg } => (1.0, max_yaw_deg),
@@ -162,7 +163,7 @@ impl Closure {
 
     /// The next pose's yaw bound, degrees, or `None` for the level closure
     /// (draws one number for [`Closure::Mixed`], none otherwise).
-    fn draw(&self, rng: &mut impl Rng) -> Option<f64> {
+    pub(super) fn draw(&self, rng: &mut impl Rng) -> Option<f64> {
         match *self {
             Self::Level => None,
             Self::Yaw { max_yaw_deg } => Some(max_yaw_deg),
@@ -228,6 +229,42 @@ pub fn sample_equilibria_counted(
     geometry::check_workspace(robot, workspace)
         .map_err(|e| Error::InvalidInput(format!("robot `{}`: no pose can be drawn: {e}", robot.name)))?;
     let options = StaticsOptions::default();
+    let failure = "no equilibrium with every cable taut";
+    draw_poses(
+        &robot.name,
+        workspace,
+        count,
+        closure,
+        first_draws,
+        failure,
+        rng,
+        |position, max_yaw_deg, rng| match max_yaw_deg {
+            None => level_pose(robot, position, &options, rng),
+            Some(max) => {
+                let yaw_rad = rng.random_range(-max..=max).to_radians();
+                statics::solve_with_yaw(robot, position, yaw_rad, &options).ok()
+            }
+        },
+    )
+}
+
+/// The draws of the samplers (four cables here, `N` in `sim::suspended`):
+/// per pose its closure's yaw bound (`None`: level), then positions drawn
+/// uniformly in `workspace` until `try_pose` finds that pose there; an
+/// error (naming `robot_name` and what the failed positions lacked,
+/// `failure`) after `first_draws` draws without any pose or
+/// `100 count + 1000` in all. Returns the poses and the number of draws.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn draw_poses<T, R: Rng>(
+    robot_name: &str,
+    workspace: &Workspace,
+    count: usize,
+    closure: Closure,
+    first_draws: usize,
+    failure: &str,
+    rng: &mut R,
+    mut try_pose: impl FnMut(Vector3<f64>, Option<f64>, &mut R) -> Option<T>,
+) -> Result<(Vec<T>, usize)> {
     let mut poses = Vec::with_capacity(count);
     let mut attempts = 0;
     let limit = 100 * count + 1000;
@@ -239,23 +276,15 @@ pub fn sample_equilibria_counted(
             if attempts > limit || (poses.is_empty() && attempts > first_draws) {
                 let drawn = attempts - 1;
                 return Err(Error::InvalidInput(format!(
-                    "robot `{}`: only {} of {count} reachable static poses ({closure} closure) found in the box {workspace} \
-                     after {drawn} draws: {:.1} % of the positions drawn had no equilibrium with every cable taut",
-                    robot.name,
+                    "robot `{robot_name}`: only {} of {count} reachable static poses ({closure} closure) found in the box {workspace} \
+                     after {drawn} draws: {:.1} % of the positions drawn had {failure}",
                     poses.len(),
                     100.0 * (drawn - poses.len()) as f64 / drawn as f64
                 )));
             }
             let position = Vector3::from_fn(|i, _| rng.random_range(workspace.min_m[i]..=workspace.max_m[i]));
-            let pose = match max_yaw_deg {
-                None => level_pose(robot, position, &options, rng),
-                Some(max) => {
-                    let yaw_rad = rng.random_range(-max..=max).to_radians();
-                    statics::solve_with_yaw(robot, position, yaw_rad, &options).ok()
-                }
-            };
-            if let Some(eq) = pose {
-                poses.push(eq);
+            if let Some(pose) = try_pose(position, max_yaw_deg, rng) {
+                poses.push(pose);
                 break;
             }
         }
@@ -300,6 +329,30 @@ impl SensorSampler {
         }
     }
 
+    /// What the localiser reads at `true_pose`: the pose perturbed on its
+    /// tangent space (three rotation draws, then three position draws).
+    pub fn localiser(&self, true_pose: &PlatformPose, rng: &mut impl Rng) -> PlatformPose {
+        let xi = Vector6::new(
+            self.orientation.sample(rng),
+            self.orientation.sample(rng),
+            self.orientation.sample(rng),
+            self.position.sample(rng),
+            self.position.sample(rng),
+            self.position.sample(rng),
+        );
+        true_pose.retract(&xi)
+    }
+
+    /// What an encoder reads for a cable of `length_m` (offset included).
+    pub fn encoder(&self, length_m: f64, rng: &mut impl Rng) -> f64 {
+        length_m + self.encoder.sample(rng)
+    }
+
+    /// What a load cell reads for a tension of `tension_n`.
+    pub fn load_cell(&self, tension_n: f64, rng: &mut impl Rng) -> f64 {
+        tension_n + self.load_cell.sample(rng)
+    }
+
     /// One pose's readings: the localiser's pose is `true_pose` perturbed on its
     /// tangent space, the encoders and load cell get additive noise. Draws in a
     /// fixed order (orientation, position, encoders, load cell).
@@ -310,15 +363,7 @@ impl SensorSampler {
         reference_tension_n: f64,
         rng: &mut impl Rng,
     ) -> PoseMeasurement {
-        let xi = Vector6::new(
-            self.orientation.sample(rng),
-            self.orientation.sample(rng),
-            self.orientation.sample(rng),
-            self.position.sample(rng),
-            self.position.sample(rng),
-            self.position.sample(rng),
-        );
-        let pose = true_pose.retract(&xi);
+        let pose = self.localiser(true_pose, rng);
         let (roll_deg, pitch_deg, yaw_deg) = pose.roll_pitch_yaw_deg();
         let encoder_lengths_m = encoder_lengths_m.map(|l| l + self.encoder.sample(rng));
         PoseMeasurement {

@@ -2,6 +2,7 @@
 //! mismatch: what the Cramer-Rao bound describes).
 //! [`discretised`]: an independent check, elastic lumped-mass chains over swivelling pulleys.
 //! [`effects`]: data with effects the closed-form model lacks, through [`discretised`].
+//! [`suspended`]: the closed-form model on robots of 3 to 8 cables.
 //!
 //! ```
 //! use rand::SeedableRng;
@@ -26,3 +27,4 @@
 pub mod closed_form;
 pub mod discretised;
 pub mod effects;
+pub mod suspended;

@@ -56,6 +56,8 @@
 
 mod closure_steps;
 mod equilibrium;
+mod measurement;
+mod plausible;
 mod robot;
 mod stiffness;
 mod tension_distribution;
@@ -65,5 +67,7 @@ mod test_ring;
 pub use equilibrium::{
     solve_at, vertical_for_height, Closure, EquilibriumOptions, SuspendedEquilibrium, FORCE_WEIGHT, YAW_WEIGHT,
 };
+pub use measurement::SuspendedMeasurement;
+pub use plausible::check_suspended;
 pub use robot::{SuspendedRobot, MIN_CABLES, MIN_RECIPROCAL_CONDITION};
 pub use stiffness::{smallest_stiffness, stiffness};

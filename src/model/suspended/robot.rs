@@ -9,7 +9,7 @@ use nalgebra::{DMatrix, Matrix6, Vector3, Vector6};
 use crate::error::{Error, Result};
 use crate::model::catenary::Catenary;
 use crate::model::pose::PlatformPose;
-use crate::model::robot::Robot;
+use crate::model::robot::{Robot, Workspace};
 use crate::model::statics::CableTension;
 
 /// The fewest cables that can hold a platform in all six directions.
@@ -34,6 +34,14 @@ pub struct SuspendedRobot {
     pub com_offset_m: Vector3<f64>,
     /// Platform weight `m_e g`, newtons.
     pub platform_weight_n: f64,
+    /// Human-readable name.
+    pub name: String,
+    /// The cables with a load cell at their attachment, 0-based, ascending.
+    pub load_cells: Vec<usize>,
+    /// Encoder length offsets `l_i^0`, metres, one per cable.
+    pub length_offsets_m: Vec<f64>,
+    /// The box of platform positions the robot works in, if its file gives one.
+    pub workspace: Option<Workspace>,
 }
 
 /// Where one cable runs at a pose: its attachment in the world, the
@@ -48,9 +56,10 @@ pub(super) struct Run {
 }
 
 impl SuspendedRobot {
-    /// A robot of `anchors_m.len()` cables; fails unless every list has one
-    /// entry per cable, there are at least [`MIN_CABLES`], and every number
-    /// is finite with positive weights.
+    /// A robot of `anchors_m.len()` cables, named `suspended`, with a load
+    /// cell on its first cable, zero length offsets and no workspace of its
+    /// own; fails unless every list has one entry per cable, there are at
+    /// least [`MIN_CABLES`], and every number is finite with positive weights.
     pub fn new(
         anchors_m: Vec<Vector3<f64>>,
         attachments_m: Vec<Vector3<f64>>,
@@ -85,15 +94,20 @@ impl SuspendedRobot {
             ));
         }
         Ok(Self {
+            length_offsets_m: vec![0.0; n],
             anchors_m,
             attachments_m,
             cable_weights_n_per_m,
             com_offset_m,
             platform_weight_n,
+            name: "suspended".into(),
+            load_cells: vec![0],
+            workspace: None,
         })
     }
 
-    /// The four-cable robot as a suspended robot (its effects aside).
+    /// The four-cable robot as a suspended robot (its effects and its
+    /// calibration's covariance aside), the load cell on its reference cable.
     pub fn from_robot(robot: &Robot) -> Self {
         Self {
             anchors_m: robot.anchors_m.to_vec(),
@@ -101,7 +115,17 @@ impl SuspendedRobot {
             cable_weights_n_per_m: vec![robot.cable_weight_n_per_m; robot.anchors_m.len()],
             com_offset_m: robot.com_offset_m,
             platform_weight_n: robot.platform_weight_n,
+            name: robot.name.clone(),
+            load_cells: vec![robot.reference_cable],
+            length_offsets_m: robot.length_offsets_m.to_vec(),
+            workspace: robot.workspace,
         }
+    }
+
+    /// The cables with a load cell as a reader says them: `cable 1, cable 5`.
+    pub fn load_cells_phrase(&self) -> String {
+        let cables: Vec<String> = self.load_cells.iter().map(|c| format!("cable {}", c + 1)).collect();
+        cables.join(", ")
     }
 
     /// Number of cables `N`.
