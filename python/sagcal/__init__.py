@@ -7,7 +7,9 @@ in and out, the same jobs with the same options, results and error messages.
 
 - :class:`Robot`: a robot description (TOML), its anchors, attachments,
   weights, encoder offsets and effects as numpy arrays and floats.
-- :func:`simulate`: measurements of a robot (``sagcal simulate``).
+- :func:`simulate`: measurements of a robot (``sagcal simulate``);
+  :class:`SuspendedRobot` and :func:`simulate_suspended`: a robot of 3 to 8
+  cables and its measurements.
 - :func:`calibrate`: anchors and encoder offsets from measurements
   (``sagcal calibrate``), with their covariance and the gross-error tests.
 - :func:`diagnose`: what the calibration model gets wrong (``sagcal diagnose``).
@@ -61,6 +63,8 @@ from ._sagcal import (
     SagcalError,
     Simulation,
     SolverError,
+    SuspendedRobot,
+    SuspendedSimulation,
     __version__,
 )
 
@@ -76,6 +80,7 @@ localize = _entry(_sagcal.localize)
 plan = _entry(_sagcal.plan, ints={"poses": _COUNT, "seed": _COUNT})
 read_measurements = _entry(_sagcal.read_measurements, ints={"reference_cable": (1, 5)})
 simulate = _entry(_sagcal.simulate, ints={"poses": _COUNT, "seed": _COUNT, "segments": _COUNT}, lists=("effects",))
+simulate_suspended = _entry(_sagcal.simulate_suspended, ints={"poses": _COUNT, "seed": _COUNT})
 write_measurements = _entry(_sagcal.write_measurements, lists=("comments",))
 
 __all__ = [
@@ -96,6 +101,8 @@ __all__ = [
     "SagcalError",
     "Simulation",
     "SolverError",
+    "SuspendedRobot",
+    "SuspendedSimulation",
     "__version__",
     "calibrate",
     "check",
@@ -105,5 +112,6 @@ __all__ = [
     "plan",
     "read_measurements",
     "simulate",
+    "simulate_suspended",
     "write_measurements",
 ]

@@ -324,6 +324,41 @@ class Simulation:
     def seed(self) -> int:
         """The random seed."""
 
+class SuspendedRobot:
+    """A robot of 3 to 8 sagging cables (a robot TOML file with any number
+    of ``[[cables]]``, per-cable weights and ``load_cells``)."""
+
+    @staticmethod
+    def builtin(name: str) -> "SuspendedRobot":
+        """A built-in robot: ``"three"``, ``"six"``, ``"eight"``, ``"large"`` or ``"small"``."""
+    @staticmethod
+    def from_file(path: PathLike) -> "SuspendedRobot":
+        """Read and validate a robot TOML file of 3 to 8 cables."""
+    @property
+    def name(self) -> str:
+        """The robot's name."""
+    @property
+    def cable_count(self) -> int:
+        """The number of cables."""
+    @property
+    def load_cells(self) -> list[int]:
+        """The cables with a load cell, 1-based."""
+    @property
+    def columns(self) -> list[str]:
+        """The columns of the robot's measurements."""
+
+class SuspendedSimulation:
+    """The result of :func:`simulate_suspended`."""
+
+    @property
+    def measurements(self) -> FloatArray:
+        """The simulated measurements: (N, 6 + cables + load cells)."""
+    @property
+    def seed(self) -> int:
+        """The random seed."""
+    def write(self, path: PathLike, comments: Optional[Sequence[str]] = None) -> None:
+        """Write the measurements as ``sagcal simulate`` writes them (atomically)."""
+
 def calibrate(
     robot: Robot,
     measurements: Union[ArrayLike, PathLike],
@@ -403,6 +438,16 @@ def simulate(
     closure: str = "level",
 ) -> Simulation:
     """Simulated measurements, as ``sagcal simulate`` draws them."""
+
+def simulate_suspended(
+    robot: SuspendedRobot,
+    poses: int,
+    seed: int = 1,
+    noise: str = "paper",
+    *,
+    closure: str = "level",
+) -> SuspendedSimulation:
+    """Simulated measurements of a robot of 3 to 8 cables, as ``sagcal simulate`` draws them."""
 
 def init_robot(
     anchors_m: Optional[ArrayLike] = None,

@@ -127,7 +127,7 @@ pub fn out3<'py, const R: usize, const C: usize>(
 }
 
 /// `array` as a read-only numpy array.
-fn frozen<'py, D: Dimension>(py: Python<'py>, array: Array<f64, D>) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn frozen<'py, D: Dimension>(py: Python<'py>, array: Array<f64, D>) -> PyResult<Bound<'py, PyAny>> {
     let out = array.into_pyarray(py);
     out.call_method1("setflags", (false,))?;
     Ok(out.into_any())

@@ -21,6 +21,7 @@ mod plan;
 mod progress;
 mod robot;
 mod simulate;
+mod suspended;
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -153,10 +154,13 @@ fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<localize::Localization>()?;
     m.add_class::<plan::PosePlan>()?;
     m.add_class::<simulate::Simulation>()?;
+    m.add_class::<suspended::SuspendedRobot>()?;
+    m.add_class::<suspended::SuspendedSimulation>()?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose::diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(localize::localize, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(suspended::simulate_suspended, m)?)?;
     m.add_function(wrap_pyfunction!(data::read_measurements, m)?)?;
     m.add_function(wrap_pyfunction!(data::write_measurements, m)?)?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;

@@ -154,8 +154,10 @@ fn unit_for(ratio: f64, candidates: &[(f64, &'static str)]) -> Option<&'static s
 
 /// What a load cell reading about `ratio` times the statics' tension means.
 /// The statics' tensions are linear in the robot file's weights, so weights
-/// written as masses (kg, kg/m: `g` = 9.81 times too light) give the ratio
-/// 9.81, and a load cell reading kilograms-force gives 1/9.81.
+/// written as masses (kg, kg/m: `g` = 9.81 times too light) multiply the
+/// ratio that correct weights give (about 1: the straight-cable statics at
+/// the initial anchors, so above 1 for heavy cables) by 9.81, and a load
+/// cell reading kilograms-force divides it by 9.81.
 const LOAD_CELL_UNITS: [(f64, &str); 4] = [
     (1e3, "they look like mN, not N (convert the column to newtons)"),
     (1e-3, "they look like kN, not N (convert the column to newtons)"),
@@ -166,8 +168,8 @@ const LOAD_CELL_UNITS: [(f64, &str); 4] = [
     (
         STANDARD_GRAVITY_M_S2,
         "the robot file's weights look like masses in kg, not weights m g in N: multiply each one given as a mass \
-         (`platform_weight_n`, `cable_weight_n_per_m`) by 9.81 (both as masses give 9.81, the platform's alone less; \
-         if they are weights, the load cell's unit is 9.81 times too small)",
+         (`platform_weight_n`, `cable_weight_n_per_m`) by 9.81 (both as masses make the readings about 9.81 times what correct \
+         weights give, the platform's alone less; if they are weights, the load cell's unit is 9.81 times too small)",
     ),
 ];
 

@@ -61,8 +61,8 @@ pub fn suspended_header(robot: &SuspendedRobot) -> Vec<String> {
         .collect()
 }
 
-/// The values of a row in header order.
-fn row_values(row: &SuspendedMeasurement) -> Vec<f64> {
+/// The values of a row in the order of [`suspended_header`].
+pub fn row_values(row: &SuspendedMeasurement) -> Vec<f64> {
     row.position_m
         .iter()
         .copied()
