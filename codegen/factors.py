@@ -571,3 +571,80 @@ def load_cell_residual(
     """
     tension = reference_tension_n.norm(epsilon=epsilon)
     return sf.V1(load_cell_bias_n + (1 + load_cell_gain_error) * tension - measured_tension_n)
+
+
+def suspended_cable_residual(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    cable_tension_n: sf.V2,
+    anchor_m: sf.V3,
+    attachment_m: sf.V3,
+    cable_weight_n_per_m: sf.Scalar,
+    length_offset_m: sf.Scalar,
+    encoder_length_m: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> sf.Matrix:
+    """One cable of a robot of any number of cables, its forces its own: eq. (14) and (15).
+
+    The rows are ``l_C + l0 - z_enc`` (eq. 14) and ``(p + R b)_z - a_z +
+    drop`` (eq. 15) of one cable, with ``(f_h, f_v)`` given rather than
+    solved from a reference cable (a robot of ``N`` cables carries its
+    forces as variables, balanced by :func:`cable_wrench`).
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        cable_tension_n: ``[f_h, f_v]`` of this cable at its attachment, newtons.
+        anchor_m: The cable's anchor, world frame, metres.
+        attachment_m: The cable's attachment, platform frame, metres.
+        cable_weight_n_per_m: The cable's weight per metre ``g_c``, N/m (0: massless).
+        length_offset_m: The encoder's length offset ``l0``, metres.
+        encoder_length_m: The encoder's reading ``z_enc``, metres.
+        epsilon: Small positive number (safe divisions, ``sinhc`` at ``g_c = 0``).
+
+    Returns:
+        ``[length error (m), height error (m)]``.
+    """
+    rotation = rotation_from_storage(rotation_xyzw)
+    attachment = position_m + rotation * attachment_m
+    span, _ = cable_model.horizontal_span(anchor_m, attachment, epsilon)
+    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
+    f_h, f_v = cable_tension_n[0], cable_tension_n[1]
+    length = cable_model.catenary_length(span, f_h, f_v, cable, epsilon) + length_offset_m - encoder_length_m
+    height = attachment[2] - anchor_m[2] + cable_model.catenary_drop(span, f_h, f_v, cable, epsilon)
+    return sf.Matrix([length, height])
+
+
+def cable_wrench(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    cable_tension_n: sf.V2,
+    anchor_m: sf.V3,
+    attachment_m: sf.V3,
+    epsilon: sf.Scalar,
+) -> sf.Matrix:
+    """The wrench one cable puts on the platform about its origin (paper eq. 5-8, one column pair).
+
+    The cable pulls its attachment ``r = R b`` with ``F = -s f_h + z f_v``
+    (``s`` the horizontal unit vector from the anchor towards the
+    attachment, ``cable_model.horizontal_span``); the platform is in
+    equilibrium where the cables' wrenches and gravity's
+    (``cable_model.platform_wrench``) sum to zero.
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        cable_tension_n: ``[f_h, f_v]`` of this cable at its attachment, newtons.
+        anchor_m: The cable's anchor, world frame, metres.
+        attachment_m: The cable's attachment, platform frame, metres.
+        epsilon: Small positive number (safe divisions).
+
+    Returns:
+        ``[F (3), r x F (3)]``, newtons and newton-metres, world axes.
+    """
+    rotation = rotation_from_storage(rotation_xyzw)
+    lever = rotation * attachment_m
+    _, direction = cable_model.horizontal_span(anchor_m, position_m + lever, epsilon)
+    force = -direction * cable_tension_n[0] + sf.V3(0, 0, 1) * cable_tension_n[1]
+    moment = lever.cross(force)
+    return sf.Matrix([force[0], force[1], force[2], moment[0], moment[1], moment[2]])

@@ -268,6 +268,11 @@ ARGUMENT_TYPES: dict[str, type] = {
     "vertical_tension_n": sf.Symbol,
     "load_cell_bias_n": sf.Symbol,
     "load_cell_gain_error": sf.Symbol,
+    "cable_tension_n": sf.V2,
+    "anchor_m": sf.V3,
+    "attachment_m": sf.V3,
+    "length_offset_m": sf.Symbol,
+    "encoder_length_m": sf.Symbol,
     "epsilon": sf.Symbol,
 }
 
@@ -293,6 +298,9 @@ JACOBIAN_BLOCKS: dict[str, tuple[str, str]] = {
     "load_cell_bias_n": ("jacobian_load_cell_bias", "`load_cell_bias_n`"),
     "load_cell_gain_error": ("jacobian_load_cell_gain_error", "`load_cell_gain_error`"),
     "localiser_mount_rad": ("jacobian_localiser_mount", "`localiser_mount_rad`, columns `[x, y, z]` of the rotation vector"),
+    "cable_tension_n": ("jacobian_cable_tension", "`cable_tension_n`, columns `[f_h, f_v]`"),
+    "anchor_m": ("jacobian_anchor", "`anchor_m`, columns `[x, y, z]`"),
+    "length_offset_m": ("jacobian_length_offset", "`length_offset_m`"),
 }
 
 
@@ -350,6 +358,12 @@ FUNCTIONS = (
         "residual",
         ("reference_tension_n", "load_cell_bias_n", "load_cell_gain_error"),
     ),
+    FunctionSpec(
+        factors.suspended_cable_residual,
+        "residual",
+        ("pose", "cable_tension_n", "anchor_m", "length_offset_m"),
+    ),
+    FunctionSpec(factors.cable_wrench, "wrench", ("pose", "cable_tension_n", "anchor_m")),
 )
 
 

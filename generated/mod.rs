@@ -40,6 +40,7 @@
 mod attachment_height_residual;
 mod cable_geometry;
 mod cable_tensions_from_reference;
+mod cable_wrench;
 mod catenary_cable_residuals;
 mod catenary_length_residual;
 mod extended_cable;
@@ -48,10 +49,12 @@ mod mounted_pose_prior_residual;
 mod pose_prior_residual;
 mod reference_tension_residual;
 mod rigid_length_residual;
+mod suspended_cable_residual;
 
 pub use attachment_height_residual::attachment_height_residual;
 pub use cable_geometry::cable_geometry;
 pub use cable_tensions_from_reference::cable_tensions_from_reference;
+pub use cable_wrench::cable_wrench;
 pub use catenary_cable_residuals::catenary_cable_residuals;
 pub use catenary_length_residual::catenary_length_residual;
 pub use extended_cable::extended_cable;
@@ -60,3 +63,4 @@ pub use mounted_pose_prior_residual::mounted_pose_prior_residual;
 pub use pose_prior_residual::pose_prior_residual;
 pub use reference_tension_residual::reference_tension_residual;
 pub use rigid_length_residual::rigid_length_residual;
+pub use suspended_cable_residual::suspended_cable_residual;

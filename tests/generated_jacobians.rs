@@ -1230,3 +1230,160 @@ fn mounted_pose_prior_matches_the_rotation_algebra() {
         }
     }
 }
+
+/// The per-cable factors of a robot of any number of cables
+/// (`suspended_cable_residual`, `cable_wrench`) against the model they
+/// derive from (`model::suspended`): at equilibria of the eight-cable robot
+/// each cable's residuals vanish with encoders reading its catenary length,
+/// the cables' wrenches are the model's structure matrix times the forces
+/// and balance gravity; their Jacobians are those of central differences.
+#[test]
+fn per_cable_factors_agree_with_the_n_cable_model() {
+    use sagcal::model::suspended::{solve_at, Closure, EquilibriumOptions, SuspendedRobot};
+    let robot = SuspendedRobot::builtin("eight").unwrap();
+    let weight = robot.platform_weight_n;
+    let mut worst: f64 = 0.0;
+    for position in [
+        Vector3::new(1.0, -0.5, 2.0),
+        Vector3::new(-3.5, 2.0, 1.5),
+        Vector3::new(4.0, 2.5, 3.2),
+    ] {
+        let eq = solve_at(&robot, position, Closure::Level, &EquilibriumOptions::default()).unwrap();
+        let (p, q) = (eq.pose.position_m, eq.pose.rotation_xyzw());
+        let forces = DVector::from_iterator(16, eq.tensions.iter().flat_map(|t| [t.horizontal_n, t.vertical_n]));
+        let mut total = Vector6::zeros();
+        for i in 0..8 {
+            let tension = Vector2::new(eq.tensions[i].horizontal_n, eq.tensions[i].vertical_n);
+            let (anchor, attachment) = (robot.anchors_m[i], robot.attachments_m[i]);
+            let g_c = robot.cable_weights_n_per_m[i];
+            let (offset, reading) = (0.25, eq.cable_lengths_m[i] + 0.25);
+            let residual = |pose: &PlatformPose, tension: &Vector2<f64>, anchor: &Vector3<f64>, offset: f64| {
+                generated::suspended_cable_residual(
+                    &pose.position_m,
+                    &pose.rotation_xyzw(),
+                    tension,
+                    anchor,
+                    &attachment,
+                    g_c,
+                    offset,
+                    reading,
+                    EPSILON,
+                    None,
+                    None,
+                    None,
+                    None,
+                )
+            };
+            let wrench = |pose: &PlatformPose, tension: &Vector2<f64>, anchor: &Vector3<f64>| {
+                generated::cable_wrench(
+                    &pose.position_m,
+                    &pose.rotation_xyzw(),
+                    tension,
+                    anchor,
+                    &attachment,
+                    EPSILON,
+                    None,
+                    None,
+                    None,
+                )
+            };
+            assert!(residual(&eq.pose, &tension, &anchor, offset).amax() < 1e-9, "cable {i}");
+            total += wrench(&eq.pose, &tension, &anchor);
+            // Analytic Jacobians against central differences.
+            let (mut r_pose, mut r_tension, mut r_anchor, mut r_offset) = (
+                SMatrix::<f64, 2, 6>::zeros(),
+                SMatrix::<f64, 2, 2>::zeros(),
+                SMatrix::<f64, 2, 3>::zeros(),
+                SMatrix::<f64, 2, 1>::zeros(),
+            );
+            generated::suspended_cable_residual(
+                &p,
+                &q,
+                &tension,
+                &anchor,
+                &attachment,
+                g_c,
+                offset,
+                reading,
+                EPSILON,
+                Some(&mut r_pose),
+                Some(&mut r_tension),
+                Some(&mut r_anchor),
+                Some(&mut r_offset),
+            );
+            let (mut w_pose, mut w_tension, mut w_anchor) = (
+                SMatrix::<f64, 6, 6>::zeros(),
+                SMatrix::<f64, 6, 2>::zeros(),
+                SMatrix::<f64, 6, 3>::zeros(),
+            );
+            generated::cable_wrench(
+                &p,
+                &q,
+                &tension,
+                &anchor,
+                &attachment,
+                EPSILON,
+                Some(&mut w_pose),
+                Some(&mut w_tension),
+                Some(&mut w_anchor),
+            );
+            let relative = |analytic: f64, numeric: f64, scale: f64| (analytic - numeric).abs() / scale.max(1e-12);
+            for k in 0..6 {
+                let h = 1e-6;
+                let step = |t: f64| eq.pose.retract(&Vector6::from_fn(|j, _| if j == k { t } else { 0.0 }));
+                let dr = (residual(&step(h), &tension, &anchor, offset)
+                    - residual(&step(-h), &tension, &anchor, offset))
+                    / (2.0 * h);
+                let dw = (wrench(&step(h), &tension, &anchor) - wrench(&step(-h), &tension, &anchor)) / (2.0 * h);
+                for row in 0..2 {
+                    worst = worst.max(relative(r_pose[(row, k)], dr[row], r_pose.amax()));
+                }
+                for row in 0..6 {
+                    worst = worst.max(relative(w_pose[(row, k)], dw[row], w_pose.amax()));
+                }
+            }
+            for k in 0..2 {
+                let h = 1e-3;
+                let moved = |t: f64| tension + Vector2::from_fn(|j, _| if j == k { t } else { 0.0 });
+                let dr = (residual(&eq.pose, &moved(h), &anchor, offset)
+                    - residual(&eq.pose, &moved(-h), &anchor, offset))
+                    / (2.0 * h);
+                let dw = (wrench(&eq.pose, &moved(h), &anchor) - wrench(&eq.pose, &moved(-h), &anchor)) / (2.0 * h);
+                for row in 0..2 {
+                    worst = worst.max(relative(r_tension[(row, k)], dr[row], r_tension.amax()));
+                }
+                for row in 0..6 {
+                    worst = worst.max(relative(w_tension[(row, k)], dw[row], w_tension.amax()));
+                }
+            }
+            for k in 0..3 {
+                let h = 1e-6;
+                let moved = |t: f64| anchor + Vector3::from_fn(|j, _| if j == k { t } else { 0.0 });
+                let dr = (residual(&eq.pose, &tension, &moved(h), offset)
+                    - residual(&eq.pose, &tension, &moved(-h), offset))
+                    / (2.0 * h);
+                let dw = (wrench(&eq.pose, &tension, &moved(h)) - wrench(&eq.pose, &tension, &moved(-h))) / (2.0 * h);
+                for row in 0..2 {
+                    worst = worst.max(relative(r_anchor[(row, k)], dr[row], r_anchor.amax()));
+                }
+                for row in 0..6 {
+                    worst = worst.max(relative(w_anchor[(row, k)], dw[row], w_anchor.amax()));
+                }
+            }
+            assert_eq!(r_offset, SMatrix::<f64, 2, 1>::new(1.0, 0.0));
+        }
+        let model = robot.structure_matrix(&eq.pose) * &forces;
+        for row in 0..6 {
+            assert!(
+                (total[row] - model[row]).abs() < 1e-9 * weight,
+                "row {row}: {} vs {}",
+                total[row],
+                model[row]
+            );
+        }
+        let unbalanced = total - robot.gravity_wrench(&eq.pose);
+        assert!(unbalanced.amax() < 1e-8 * weight, "{unbalanced}");
+    }
+    println!("worst relative Jacobian error {worst:.2e}");
+    assert!(worst < TOLERANCE, "{worst}");
+}

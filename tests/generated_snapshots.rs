@@ -55,6 +55,11 @@ fn generated_sources() {
         ("cable_geometry", include_str!("../generated/cable_geometry.rs")),
         ("extended_cable", include_str!("../generated/extended_cable.rs")),
         ("load_cell_residual", include_str!("../generated/load_cell_residual.rs")),
+        (
+            "suspended_cable_residual",
+            include_str!("../generated/suspended_cable_residual.rs"),
+        ),
+        ("cable_wrench", include_str!("../generated/cable_wrench.rs")),
     ];
     for (name, source) in sources {
         insta::assert_snapshot!(format!("source_{name}"), source);
@@ -442,5 +447,56 @@ fn load_cell_residual_outputs() {
     format_block(&mut out, "jacobian_reference_tension", &reference);
     format_block(&mut out, "jacobian_load_cell_bias", &bias);
     format_block(&mut out, "jacobian_load_cell_gain_error", &gain);
+    insta::assert_snapshot!(out);
+}
+
+#[test]
+fn suspended_cable_residual_outputs() {
+    let x = inputs();
+    let (mut pose, mut tension, mut anchor, mut offset) = (nan::<2, 6>(), nan::<2, 2>(), nan::<2, 3>(), nan::<2, 1>());
+    let value = generated::suspended_cable_residual(
+        &x.pose.position_m,
+        &x.pose.rotation_xyzw(),
+        &x.reference_tension_n,
+        &x.anchors_m.column(1).into_owned(),
+        &x.attachments_m.column(1).into_owned(),
+        x.cable_weight_n_per_m,
+        x.length_offsets_m[1],
+        x.encoder_lengths_m[1],
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut tension),
+        Some(&mut anchor),
+        Some(&mut offset),
+    );
+    let mut out = String::new();
+    format_block(&mut out, "residual", &value);
+    format_block(&mut out, "jacobian_pose", &pose);
+    format_block(&mut out, "jacobian_cable_tension", &tension);
+    format_block(&mut out, "jacobian_anchor", &anchor);
+    format_block(&mut out, "jacobian_length_offset", &offset);
+    insta::assert_snapshot!(out);
+}
+
+#[test]
+fn cable_wrench_outputs() {
+    let x = inputs();
+    let (mut pose, mut tension, mut anchor) = (nan::<6, 6>(), nan::<6, 2>(), nan::<6, 3>());
+    let value = generated::cable_wrench(
+        &x.pose.position_m,
+        &x.pose.rotation_xyzw(),
+        &x.reference_tension_n,
+        &x.anchors_m.column(1).into_owned(),
+        &x.attachments_m.column(1).into_owned(),
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut tension),
+        Some(&mut anchor),
+    );
+    let mut out = String::new();
+    format_block(&mut out, "wrench", &value);
+    format_block(&mut out, "jacobian_pose", &pose);
+    format_block(&mut out, "jacobian_cable_tension", &tension);
+    format_block(&mut out, "jacobian_anchor", &anchor);
     insta::assert_snapshot!(out);
 }
