@@ -177,6 +177,52 @@ mod tests {
         }
     }
 
+    /// Noise-free readings with length offsets are what the calibration's
+    /// per-cable factors expect at the truth: with the localiser's pose and
+    /// the equilibrium's forces, every cable's length and height residual
+    /// (`generated::suspended_cable_residual`) vanishes, and each load cell
+    /// reads its cable's tension.
+    #[test]
+    fn noise_free_readings_satisfy_the_per_cable_factors_at_the_truth() {
+        use nalgebra::Vector2;
+        let mut robot = SuspendedRobot::builtin("six").unwrap();
+        robot.length_offsets_m = vec![0.5, -1.25, 2.0, 0.0, -0.75, 3.5];
+        robot.load_cells = vec![1, 4];
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        let poses = sample_suspended(&robot, &robot.workspace.unwrap(), 5, Closure::Level, &mut rng).unwrap();
+        let none = crate::model::sensors::NoisePreset::None.sigmas(robot.platform_weight_n);
+        let rows = measure_suspended(&robot, &poses, &none, &mut rng);
+        for (row, eq) in rows.iter().zip(&poses) {
+            let pose = crate::model::pose::PlatformPose::from_roll_pitch_yaw_deg(
+                row.position_m.into(),
+                row.roll_deg,
+                row.pitch_deg,
+                row.yaw_deg,
+            );
+            for i in 0..6 {
+                let residual = crate::generated::suspended_cable_residual(
+                    &pose.position_m,
+                    &pose.rotation_xyzw(),
+                    &Vector2::new(eq.tensions[i].horizontal_n, eq.tensions[i].vertical_n),
+                    &robot.anchors_m[i],
+                    &robot.attachments_m[i],
+                    robot.cable_weights_n_per_m[i],
+                    robot.length_offsets_m[i],
+                    row.encoder_lengths_m[i],
+                    1e-15,
+                    None,
+                    None,
+                    None,
+                    None,
+                );
+                assert!(residual.amax() < 1e-9, "cable {i}: {residual}");
+            }
+            for (reading, &cable) in row.load_cell_tensions_n.iter().zip(&robot.load_cells) {
+                assert_eq!(*reading, eq.tensions[cable].magnitude_n());
+            }
+        }
+    }
+
     /// Three cables refuse a held yaw; an empty box far from the anchors is refused.
     #[test]
     fn impossible_requests_are_refused() {
