@@ -28,7 +28,8 @@
 //! balance serves where some forces are known (a load cell's cable free);
 //! the equilibrium solver ([`solve_at`]) takes the horizontal tensions as
 //! its unknowns instead, each cable's vertical one from its catenary.
-//! Whether an equilibrium is stable: [`stiffness`] at fixed cable lengths.
+//! Whether an equilibrium is stable: [`stiffness`] at fixed cable lengths;
+//! the equilibrium that given cable lengths hold: [`equilibrium_at_lengths`].
 //!
 //! Each cable must also reach its attachment: the catenary from anchor `i`
 //! with `(f_h,i, f_v,i)` ends at the attachment's height (paper eq. 15,
@@ -56,6 +57,7 @@
 
 mod closure_steps;
 mod equilibrium;
+mod fixed_lengths;
 mod measurement;
 mod plausible;
 mod robot;
@@ -67,6 +69,7 @@ mod test_ring;
 pub use equilibrium::{
     solve_at, vertical_for_height, Closure, EquilibriumOptions, SuspendedEquilibrium, FORCE_WEIGHT, YAW_WEIGHT,
 };
+pub use fixed_lengths::equilibrium_at_lengths;
 pub use measurement::SuspendedMeasurement;
 pub use plausible::check_suspended;
 pub use robot::{SuspendedRobot, MIN_CABLES, MIN_RECIPROCAL_CONDITION};
