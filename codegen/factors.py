@@ -648,3 +648,28 @@ def cable_wrench(
     force = -direction * cable_tension_n[0] + sf.V3(0, 0, 1) * cable_tension_n[1]
     moment = lever.cross(force)
     return sf.Matrix([force[0], force[1], force[2], moment[0], moment[1], moment[2]])
+
+
+def platform_weight_wrench(
+    rotation_xyzw: sf.V4,
+    com_offset_m: sf.V3,
+    platform_weight_n: sf.Scalar,
+) -> sf.Matrix:
+    """The wrench the cables must supply to hold the platform, paper eq. (6), about its origin.
+
+    ``w = [z; (R b_com) x z] m_e g`` (``cable_model.platform_wrench``): a
+    robot of ``N`` cables is in equilibrium where the sum of its cables'
+    :func:`cable_wrench` equals it. The position does not enter (the
+    moment is about the platform origin), so the Jacobian is the
+    orientation's alone: the first three columns of a pose block.
+
+    Args:
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        com_offset_m: Centre of mass ``b_com``, platform frame, metres.
+        platform_weight_n: ``m_e g``, newtons.
+
+    Returns:
+        ``[force (3), moment (3)]``, newtons and newton-metres, world axes.
+    """
+    rotation = rotation_from_storage(rotation_xyzw)
+    return cable_model.platform_wrench(rotation, com_offset_m, platform_weight_n)

@@ -79,8 +79,11 @@ class Tape:
             expanded[symbol] = expr.subs(expanded)
         return matrix.applyfunc(lambda entry: sf.S(entry).subs(expanded))
 
-    def pose_seeds(self, rotation_xyzw: sf.V4, position_m: sf.V3) -> dict[sf.Symbol, Row]:
+    def pose_seeds(self, rotation_xyzw: sf.V4, position_m: sf.V3 | None) -> dict[sf.Symbol, Row]:
         """Seeds of the pose block, tangent ``[dtheta (3), dp (3)]`` of ``(R Exp(dtheta), p + dp)``.
+
+        Without a position (``None``), the seeds of the orientation alone,
+        tangent ``dtheta (3)`` of ``R Exp(dtheta)``.
 
         The quaternion's storage gets SymForce's ``storage_D_tangent`` (the
         ``Rot3`` tangent of ``sf.Matrix.jacobian``); the rotation matrices
@@ -89,11 +92,11 @@ class Tape:
         """
         storage = list(rotation_xyzw)
         storage_d_tangent = LieGroupOps.storage_D_tangent(sf.Rot3.from_storage(storage))
-        zero3 = [sf.S(0)] * 3
+        zero3 = [sf.S(0)] * (3 if position_m is not None else 0)
         seeds: dict[sf.Symbol, Row] = {}
         for i, symbol in enumerate(storage):
             seeds[symbol] = [storage_d_tangent[i, k] for k in range(3)] + zero3
-        for i, symbol in enumerate(position_m):
+        for i, symbol in enumerate(position_m if position_m is not None else []):
             seeds[symbol] = zero3 + [sf.S(1 if k == i else 0) for k in range(3)]
         matrix = self.rotation_matrices.get(tuple(storage))
         if matrix is not None:

@@ -282,6 +282,10 @@ JACOBIAN_BLOCKS: dict[str, tuple[str, str]] = {
         "jacobian_pose",
         "the pose, columns `[dtheta (3), dp (3)]` of the retraction `(R * Exp(dtheta), p + dp)` (`src/model/pose.rs`)",
     ),
+    "rotation": (
+        "jacobian_rotation",
+        "the orientation, columns `dtheta (3)` of the retraction `R * Exp(dtheta)` (`src/model/pose.rs`)",
+    ),
     "reference_tension_n": ("jacobian_reference_tension", "`reference_tension_n`, columns `[f_h, f_v]`"),
     "anchors_m": ("jacobian_anchors", "`anchors_m`, columns `[slot 0 x, y, z, slot 1 x, y, z, ...]`"),
     "length_offsets_m": ("jacobian_length_offsets", "`length_offsets_m`, columns in slot order"),
@@ -364,6 +368,7 @@ FUNCTIONS = (
         ("pose", "cable_tension_n", "anchor_m", "length_offset_m"),
     ),
     FunctionSpec(factors.cable_wrench, "wrench", ("pose", "cable_tension_n", "anchor_m")),
+    FunctionSpec(factors.platform_weight_wrench, "wrench", ("rotation",)),
 )
 
 
@@ -382,6 +387,8 @@ def jacobian(expr: sf.Matrix, inputs: Values, block: str) -> sf.Matrix:
         rotation = sf.Rot3.from_storage(list(inputs["rotation_xyzw"]))
         # Rot3 tangent: d expr / d dtheta of R * Exp(dtheta) at dtheta = 0 (right perturbation).
         return expr.jacobian(rotation).row_join(expr.jacobian(inputs["position_m"]))
+    if block == "rotation":
+        return expr.jacobian(sf.Rot3.from_storage(list(inputs["rotation_xyzw"])))
     if isinstance(inputs[block], sf.Symbol):
         return expr.jacobian(sf.V1(inputs[block]))
     return expr.jacobian(inputs[block])
@@ -416,6 +423,8 @@ def block_seeds(tape: forward_mode.Tape, inputs: Values, block: str) -> tuple[di
     """
     if block == "pose":
         return tape.pose_seeds(inputs["rotation_xyzw"], inputs["position_m"]), 6
+    if block == "rotation":
+        return tape.pose_seeds(inputs["rotation_xyzw"], None), 3
     argument = inputs[block]
     symbols = [argument] if isinstance(argument, sf.Symbol) else list(argument.to_storage())
     return {symbol: [sf.S(int(k == i)) for k in range(len(symbols))] for i, symbol in enumerate(symbols)}, len(symbols)

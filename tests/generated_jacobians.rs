@@ -1383,6 +1383,26 @@ fn per_cable_factors_agree_with_the_n_cable_model() {
         }
         let unbalanced = total - robot.gravity_wrench(&eq.pose);
         assert!(unbalanced.amax() < 1e-8 * weight, "{unbalanced}");
+        // Gravity's wrench: the model's, and its orientation columns, with
+        // the centre of mass off the origin (the eight-cable robot's is on it).
+        let mut shifted = robot.clone();
+        shifted.com_offset_m = Vector3::new(0.12, -0.07, -0.3);
+        let gravity = |pose: &PlatformPose, jacobian: Option<&mut SMatrix<f64, 6, 3>>| {
+            generated::platform_weight_wrench(&pose.rotation_xyzw(), &shifted.com_offset_m, weight, jacobian)
+        };
+        let mut g_rotation = SMatrix::<f64, 6, 3>::zeros();
+        let g = gravity(&eq.pose, Some(&mut g_rotation));
+        assert!((g - shifted.gravity_wrench(&eq.pose)).amax() < 1e-12 * weight, "{g}");
+        assert!(g_rotation.amax() > 0.01 * weight, "{g_rotation}");
+        for k in 0..3 {
+            let h = 1e-6;
+            let step = |t: f64| eq.pose.retract(&Vector6::from_fn(|j, _| if j == k { t } else { 0.0 }));
+            let dg = (gravity(&step(h), None) - gravity(&step(-h), None)) / (2.0 * h);
+            for row in 0..6 {
+                let relative = (g_rotation[(row, k)] - dg[row]).abs() / g_rotation.amax().max(1e-12);
+                worst = worst.max(relative);
+            }
+        }
     }
     println!("worst relative Jacobian error {worst:.2e}");
     assert!(worst < TOLERANCE, "{worst}");

@@ -60,6 +60,10 @@ fn generated_sources() {
             include_str!("../generated/suspended_cable_residual.rs"),
         ),
         ("cable_wrench", include_str!("../generated/cable_wrench.rs")),
+        (
+            "platform_weight_wrench",
+            include_str!("../generated/platform_weight_wrench.rs"),
+        ),
     ];
     for (name, source) in sources {
         insta::assert_snapshot!(format!("source_{name}"), source);
@@ -498,5 +502,21 @@ fn cable_wrench_outputs() {
     format_block(&mut out, "jacobian_pose", &pose);
     format_block(&mut out, "jacobian_cable_tension", &tension);
     format_block(&mut out, "jacobian_anchor", &anchor);
+    insta::assert_snapshot!(out);
+}
+
+#[test]
+fn platform_weight_wrench_outputs() {
+    let x = inputs();
+    let mut rotation = nan::<6, 3>();
+    let value = generated::platform_weight_wrench(
+        &x.pose.rotation_xyzw(),
+        &x.com_offset_m,
+        x.platform_weight_n,
+        Some(&mut rotation),
+    );
+    let mut out = String::new();
+    format_block(&mut out, "wrench", &value);
+    format_block(&mut out, "jacobian_rotation", &rotation);
     insta::assert_snapshot!(out);
 }
