@@ -673,3 +673,35 @@ def platform_weight_wrench(
     """
     rotation = rotation_from_storage(rotation_xyzw)
     return cable_model.platform_wrench(rotation, com_offset_m, platform_weight_n)
+
+
+def straight_cable_residual(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    anchor_m: sf.V3,
+    attachment_m: sf.V3,
+    length_offset_m: sf.Scalar,
+    encoder_length_m: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> sf.V1:
+    """One massless cable's length factor: ``||a - (p + R b)|| + l0 - z_enc``.
+
+    :func:`rigid_length_residual` for one cable of a robot of any number of
+    cables: the straight-cable stage that brings a calibration of ``N``
+    cables from a rough guess to where the catenary graph starts.
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        anchor_m: The cable's anchor, world frame, metres.
+        attachment_m: The cable's attachment, platform frame, metres.
+        length_offset_m: The encoder's length offset ``l0``, metres.
+        encoder_length_m: The encoder's reading ``z_enc``, metres.
+        epsilon: Small positive number (inside the norm's square root).
+
+    Returns:
+        The 1-vector length error in metres.
+    """
+    attachment = position_m + rotation_from_storage(rotation_xyzw) * attachment_m
+    length = cable_model.straight_cable_length(anchor_m, attachment, epsilon)
+    return sf.V1(length + length_offset_m - encoder_length_m)

@@ -369,6 +369,7 @@ FUNCTIONS = (
     ),
     FunctionSpec(factors.cable_wrench, "wrench", ("pose", "cable_tension_n", "anchor_m")),
     FunctionSpec(factors.platform_weight_wrench, "wrench", ("rotation",)),
+    FunctionSpec(factors.straight_cable_residual, "residual", ("pose", "anchor_m", "length_offset_m")),
 )
 
 

@@ -50,6 +50,7 @@ mod platform_weight_wrench;
 mod pose_prior_residual;
 mod reference_tension_residual;
 mod rigid_length_residual;
+mod straight_cable_residual;
 mod suspended_cable_residual;
 
 pub use attachment_height_residual::attachment_height_residual;
@@ -65,4 +66,5 @@ pub use platform_weight_wrench::platform_weight_wrench;
 pub use pose_prior_residual::pose_prior_residual;
 pub use reference_tension_residual::reference_tension_residual;
 pub use rigid_length_residual::rigid_length_residual;
+pub use straight_cable_residual::straight_cable_residual;
 pub use suspended_cable_residual::suspended_cable_residual;

@@ -1232,7 +1232,8 @@ fn mounted_pose_prior_matches_the_rotation_algebra() {
 }
 
 /// The per-cable factors of a robot of any number of cables
-/// (`suspended_cable_residual`, `cable_wrench`) against the model they
+/// (`suspended_cable_residual`, `cable_wrench`, `straight_cable_residual`,
+/// and gravity's `platform_weight_wrench`) against the model they
 /// derive from (`model::suspended`): at equilibria of the eight-cable robot
 /// each cable's residuals vanish with encoders reading its catenary length,
 /// the cables' wrenches are the model's structure matrix times the forces
@@ -1371,6 +1372,50 @@ fn per_cable_factors_agree_with_the_n_cable_model() {
                 }
             }
             assert_eq!(r_offset, SMatrix::<f64, 2, 1>::new(1.0, 0.0));
+            // The straight cable: the chord plus the offset, and its Jacobians.
+            let straight = |pose: &PlatformPose, anchor: &Vector3<f64>| {
+                generated::straight_cable_residual(
+                    &pose.position_m,
+                    &pose.rotation_xyzw(),
+                    anchor,
+                    &attachment,
+                    offset,
+                    reading,
+                    EPSILON,
+                    None,
+                    None,
+                    None,
+                )[0]
+            };
+            let chord = (anchor - (eq.pose.position_m + eq.pose.rotation_matrix() * attachment)).norm();
+            assert!((straight(&eq.pose, &anchor) - (chord + offset - reading)).abs() < 1e-12);
+            let (mut s_pose, mut s_anchor, mut s_offset) =
+                (SMatrix::<f64, 1, 6>::zeros(), SMatrix::<f64, 1, 3>::zeros(), SMatrix::<f64, 1, 1>::zeros());
+            generated::straight_cable_residual(
+                &p,
+                &q,
+                &anchor,
+                &attachment,
+                offset,
+                reading,
+                EPSILON,
+                Some(&mut s_pose),
+                Some(&mut s_anchor),
+                Some(&mut s_offset),
+            );
+            assert_eq!(s_offset[0], 1.0);
+            for k in 0..6 {
+                let h = 1e-6;
+                let step = |t: f64| eq.pose.retract(&Vector6::from_fn(|j, _| if j == k { t } else { 0.0 }));
+                let numeric = (straight(&step(h), &anchor) - straight(&step(-h), &anchor)) / (2.0 * h);
+                worst = worst.max(relative(s_pose[k], numeric, s_pose.amax()));
+            }
+            for k in 0..3 {
+                let h = 1e-6;
+                let moved = |t: f64| anchor + Vector3::from_fn(|j, _| if j == k { t } else { 0.0 });
+                let numeric = (straight(&eq.pose, &moved(h)) - straight(&eq.pose, &moved(-h))) / (2.0 * h);
+                worst = worst.max(relative(s_anchor[k], numeric, s_anchor.amax()));
+            }
         }
         let model = robot.structure_matrix(&eq.pose) * &forces;
         for row in 0..6 {

@@ -64,6 +64,10 @@ fn generated_sources() {
             "platform_weight_wrench",
             include_str!("../generated/platform_weight_wrench.rs"),
         ),
+        (
+            "straight_cable_residual",
+            include_str!("../generated/straight_cable_residual.rs"),
+        ),
     ];
     for (name, source) in sources {
         insta::assert_snapshot!(format!("source_{name}"), source);
@@ -518,5 +522,29 @@ fn platform_weight_wrench_outputs() {
     let mut out = String::new();
     format_block(&mut out, "wrench", &value);
     format_block(&mut out, "jacobian_rotation", &rotation);
+    insta::assert_snapshot!(out);
+}
+
+#[test]
+fn straight_cable_residual_outputs() {
+    let x = inputs();
+    let (mut pose, mut anchor, mut offset) = (nan::<1, 6>(), nan::<1, 3>(), nan::<1, 1>());
+    let value = generated::straight_cable_residual(
+        &x.pose.position_m,
+        &x.pose.rotation_xyzw(),
+        &x.anchors_m.column(1).into_owned(),
+        &x.attachments_m.column(1).into_owned(),
+        x.length_offsets_m[1],
+        x.encoder_lengths_m[1],
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut anchor),
+        Some(&mut offset),
+    );
+    let mut out = String::new();
+    format_block(&mut out, "residual", &value);
+    format_block(&mut out, "jacobian_pose", &pose);
+    format_block(&mut out, "jacobian_anchor", &anchor);
+    format_block(&mut out, "jacobian_length_offset", &offset);
     insta::assert_snapshot!(out);
 }
