@@ -1389,8 +1389,11 @@ fn per_cable_factors_agree_with_the_n_cable_model() {
             };
             let chord = (anchor - (eq.pose.position_m + eq.pose.rotation_matrix() * attachment)).norm();
             assert!((straight(&eq.pose, &anchor) - (chord + offset - reading)).abs() < 1e-12);
-            let (mut s_pose, mut s_anchor, mut s_offset) =
-                (SMatrix::<f64, 1, 6>::zeros(), SMatrix::<f64, 1, 3>::zeros(), SMatrix::<f64, 1, 1>::zeros());
+            let (mut s_pose, mut s_anchor, mut s_offset) = (
+                SMatrix::<f64, 1, 6>::zeros(),
+                SMatrix::<f64, 1, 3>::zeros(),
+                SMatrix::<f64, 1, 1>::zeros(),
+            );
             generated::straight_cable_residual(
                 &p,
                 &q,

@@ -115,7 +115,9 @@ pub mod report;
 mod result;
 pub mod screen;
 mod settings;
+
 mod snooping;
+pub mod suspended;
 mod system_scope;
 mod uncertainty;
 

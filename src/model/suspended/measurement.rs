@@ -24,3 +24,15 @@ pub struct SuspendedMeasurement {
     /// the robot's `load_cells`.
     pub load_cell_tensions_n: Vec<f64>,
 }
+
+impl SuspendedMeasurement {
+    /// The localiser's pose: its position and `R = Rz(yaw) Ry(pitch) Rx(roll)`.
+    pub fn localiser_pose(&self) -> crate::model::pose::PlatformPose {
+        crate::model::pose::PlatformPose::from_roll_pitch_yaw_deg(
+            self.position_m.into(),
+            self.roll_deg,
+            self.pitch_deg,
+            self.yaw_deg,
+        )
+    }
+}

@@ -1,0 +1,152 @@
+//! The staged calibration of `N` cables ([`calibrate_suspended`]): straight
+//! cables from the initial guess, then every pose's equilibrium for those
+//! anchors with the offsets in closed form, then the catenary graph with the
+//! anchors held, then the full graph.
+
+use super::graph::{
+    build_suspended_graph, min_poses, pose_starts_from_graph, robot_from_suspended_graph, PoseStart, SuspendedGraph,
+    SuspendedStage,
+};
+use super::start::{catenary_starts, offsets_in_closed_form, straight_offsets};
+use crate::calib::options::{CalibrationOptions, OrientationPrior};
+use crate::calib::result::{factor_statistics, FactorStatistics, StageSummary};
+use crate::error::{Error, Result};
+use crate::model::pose::PlatformPose;
+use crate::model::statics::CableTension;
+use crate::model::suspended::{SuspendedMeasurement, SuspendedRobot};
+use crate::solver::optimize;
+
+/// A calibration of `N` cables.
+#[derive(Debug, Clone)]
+pub struct SuspendedCalibration {
+    /// The robot with the calibrated anchors and length offsets.
+    pub robot: SuspendedRobot,
+    /// Every measurement's platform pose at the solution.
+    pub poses: Vec<PlatformPose>,
+    /// Every measurement's cable forces at the solution, cable order.
+    pub forces: Vec<Vec<CableTension>>,
+    /// The solver stages, in order.
+    pub stages: Vec<StageSummary>,
+    /// The poses whose catenary start fell back to the measured pose (no
+    /// equilibrium at its position for the straight-cable anchors).
+    pub fell_back: Vec<usize>,
+    /// Normalised residuals per factor type at the solution.
+    pub statistics: Vec<FactorStatistics>,
+    /// The final cost `1/2 chi^2`.
+    pub final_cost: f64,
+}
+
+/// The stages' names.
+const STRAIGHT_STAGE: &str = "straight cables";
+/// See [`STRAIGHT_STAGE`].
+const HELD_ANCHORS_STAGE: &str = "catenary (anchors held)";
+/// See [`STRAIGHT_STAGE`].
+const CATENARY_STAGE: &str = "catenary";
+
+/// Calibrate the anchors and length offsets of `initial` (its anchors the
+/// guess, everything else known) from `measurements`; `stage` is told the
+/// name of each stage before it is solved. The localiser's orientation
+/// enters as a prior unless `options.orientation_prior` is `Off`.
+pub fn calibrate_suspended(
+    initial: &SuspendedRobot,
+    measurements: &[SuspendedMeasurement],
+    options: &CalibrationOptions,
+    stage: &mut dyn FnMut(&str),
+) -> Result<SuspendedCalibration> {
+    let with_orientation = options.orientation_prior != OrientationPrior::Off;
+    validate(initial, measurements, with_orientation)?;
+    // (1) Straight cables from the guess, the offsets in closed form.
+    let mut start_robot = initial.clone();
+    start_robot.length_offsets_m = straight_offsets(initial, measurements);
+    let measured: Vec<PoseStart> = measurements
+        .iter()
+        .map(|m| PoseStart {
+            pose: m.localiser_pose(),
+            forces: Vec::new(),
+        })
+        .collect();
+    let build = |robot: &SuspendedRobot, starts: &[PoseStart], stage: SuspendedStage| {
+        build_suspended_graph(robot, measurements, starts, stage, options, with_orientation)
+    };
+    let mut straight = build(&start_robot, &measured, SuspendedStage::Straight);
+    let mut stages = vec![solve(STRAIGHT_STAGE, &mut straight, options, stage)?];
+    // (2) Each pose's equilibrium for those anchors; offsets in closed form.
+    let mut robot = robot_from_suspended_graph(initial, &straight);
+    let (starts, fell_back) = catenary_starts(&robot, measurements);
+    robot.length_offsets_m = offsets_in_closed_form(&robot, measurements, &starts);
+    // (3) The catenary graph with the anchors held, then (4) all free.
+    let mut held = build(&robot, &starts, SuspendedStage::Catenary);
+    for &anchor in &held.anchors {
+        held.graph.values.set_fixed(anchor, true);
+    }
+    stages.push(solve(HELD_ANCHORS_STAGE, &mut held, options, stage)?);
+    let robot = robot_from_suspended_graph(initial, &held);
+    let starts = pose_starts_from_graph(&held);
+    let mut full = build(&robot, &starts, SuspendedStage::Catenary);
+    stages.push(solve(CATENARY_STAGE, &mut full, options, stage)?);
+    let solved = pose_starts_from_graph(&full);
+    Ok(SuspendedCalibration {
+        robot: robot_from_suspended_graph(initial, &full),
+        poses: solved.iter().map(|s| s.pose).collect(),
+        forces: solved.into_iter().map(|s| s.forces).collect(),
+        final_cost: stages.last().map_or(f64::NAN, |s| s.summary.final_cost),
+        stages,
+        fell_back,
+        statistics: factor_statistics(&full.graph),
+    })
+}
+
+/// Enough distinct poses with finite readings, one per cable and load cell.
+fn validate(robot: &SuspendedRobot, measurements: &[SuspendedMeasurement], with_orientation: bool) -> Result<()> {
+    let needed = min_poses(robot, with_orientation);
+    if measurements.len() < needed {
+        return Err(Error::InvalidInput(format!(
+            "{} poses cannot determine the {} anchor coordinates and {} offsets of {} cables with {} load cell(s): at least {needed} are needed",
+            measurements.len(),
+            3 * robot.cable_count(),
+            robot.cable_count(),
+            robot.cable_count(),
+            robot.load_cells.len()
+        )));
+    }
+    for (k, m) in measurements.iter().enumerate() {
+        let row = crate::model::DataRow::at(k, m.line);
+        if m.encoder_lengths_m.len() != robot.cable_count() || m.load_cell_tensions_n.len() != robot.load_cells.len() {
+            return Err(Error::InvalidInput(format!(
+                "{row}: {} encoder readings and {} load-cell readings, where the robot has {} cables and {} load cell(s)",
+                m.encoder_lengths_m.len(),
+                m.load_cell_tensions_n.len(),
+                robot.cable_count(),
+                robot.load_cells.len()
+            )));
+        }
+        let finite = m
+            .position_m
+            .iter()
+            .chain(&m.encoder_lengths_m)
+            .chain(&m.load_cell_tensions_n)
+            .chain([&m.roll_deg, &m.pitch_deg, &m.yaw_deg])
+            .all(|v| v.is_finite());
+        if !finite || m.load_cell_tensions_n.iter().any(|t| *t <= 0.0) {
+            return Err(Error::InvalidInput(format!(
+                "{row}: values must be finite and the tensions positive"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Solve one stage; errors name it.
+fn solve(
+    name: &str,
+    built: &mut SuspendedGraph,
+    options: &CalibrationOptions,
+    stage: &mut dyn FnMut(&str),
+) -> Result<StageSummary> {
+    stage(name);
+    let summary = optimize(&mut built.graph, &options.lm).map_err(|e| e.during(format!("{name} stage")))?;
+    Ok(StageSummary {
+        name: name.to_string(),
+        summary,
+    })
+}

@@ -1,0 +1,387 @@
+//! The factors of a calibration of `N` cables: thin wrappers that gather the
+//! variables, call the SymForce-generated residual and copy its Jacobian
+//! blocks. Each cable of each pose carries its own end forces `(f_h, f_v)`
+//! as a variable; the equilibrium factor balances them against gravity.
+//!
+//! - [`CatenaryCableFactor`]: one cable's length (paper eq. 14) and
+//!   attachment height (eq. 15) rows;
+//! - [`StraightCableFactor`]: one massless cable's length row (the rigid stage);
+//! - [`EquilibriumFactor`]: the six equations of equilibrium (eq. 5-8), the
+//!   cables' wrenches minus the weight's;
+//! - [`CableLoadCellFactor`]: a load cell on one cable (eq. 16).
+//!
+//! ```
+//! use nalgebra::{DMatrix, DVector, Vector3};
+//! use sagcal::calib::suspended::factors::{CableConstants, CableVariables, CatenaryCableFactor, EquilibriumFactor};
+//! use sagcal::graph::{Factor, RobustKernel, Values, VariableValue};
+//! use sagcal::model::suspended::{solve_at, Closure, EquilibriumOptions, SuspendedRobot};
+//! let robot = SuspendedRobot::builtin("three")?;
+//! let eq = solve_at(&robot, Vector3::new(1.0, -0.5, 2.0), Closure::Level, &EquilibriumOptions::default())?;
+//! let vector = |v: &[f64]| VariableValue::Vector(DVector::from_column_slice(v));
+//! let mut values = Values::new();
+//! let pose = values.insert("pose", VariableValue::Pose(eq.pose));
+//! let forces: Vec<_> =
+//!     eq.tensions.iter().map(|t| values.insert("forces", vector(&[t.horizontal_n, t.vertical_n]))).collect();
+//! let anchors: Vec<_> = robot.anchors_m.iter().map(|a| values.insert("anchor", vector(a.as_slice()))).collect();
+//! let offset = values.insert("offset", vector(&[0.2]));
+//! // At an equilibrium every cable reaches its attachment with the length its encoder reads ...
+//! let cable = CatenaryCableFactor::new(
+//!     CableVariables { pose, forces: forces[1], anchor: anchors[1], length_offset: offset },
+//!     CableConstants { attachment_m: robot.attachments_m[1], weight_n_per_m: robot.cable_weights_n_per_m[1] },
+//!     eq.cable_lengths_m[1] + 0.2,
+//!     0.01,
+//!     1e-4,
+//!     RobustKernel::None,
+//! );
+//! assert!(cable.evaluate(&values, None).unwrap().amax() < 1e-9);
+//! // ... and the cables hold the platform's weight: six equations, one block per variable.
+//! let statics = EquilibriumFactor::new(
+//!     pose, &forces, &anchors, &robot.attachments_m, robot.com_offset_m, robot.platform_weight_n, 1e-3, 1.0,
+//! );
+//! let mut blocks: Vec<DMatrix<f64>> =
+//!     [6, 2, 2, 2, 3, 3, 3].iter().map(|&d| DMatrix::zeros(6, d)).collect();
+//! let wrench = statics.evaluate(&values, Some(&mut blocks)).unwrap();
+//! assert!(wrench.amax() < 1e-6 * robot.platform_weight_n);
+//! // d F_z / d f_v of a cable is 1: it pulls straight up.
+//! assert_eq!(blocks[1][(2, 1)], 1.0);
+//! # Ok::<(), sagcal::Error>(())
+//! ```
+
+use nalgebra::{DMatrix, DVector, SMatrix, Vector2, Vector3};
+
+use crate::calib::factors::{pose_arguments, EPSILON};
+use crate::generated;
+use crate::graph::{evaluate_through_into, Factor, Noise, RobustKernel, Values, VariableId};
+
+/// The methods every factor of this file shares: its variables, `$rows`
+/// residual rows evaluated through `evaluate_into`, its noise and `$kind`;
+/// each fills every entry of every block it is given.
+macro_rules! factor_basics {
+    ($rows:expr, $kind:literal) => {
+        fn variables(&self) -> &[VariableId] {
+            &self.variables
+        }
+        fn residual_dim(&self) -> usize {
+            $rows
+        }
+        fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
+            evaluate_through_into(self, values, jacobians)
+        }
+        fn noise(&self) -> &Noise {
+            &self.noise
+        }
+        fn kind(&self) -> &'static str {
+            $kind
+        }
+        fn writes_every_jacobian_entry(&self) -> bool {
+            true
+        }
+    };
+}
+
+/// The variables of one cable at one pose, in the order of the Jacobian
+/// blocks of [`CatenaryCableFactor`]: `[pose, forces, anchor, offset]`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CableVariables {
+    /// The platform's pose.
+    pub pose: VariableId,
+    /// The cable's `(f_h, f_v)` at its attachment at this pose, newtons.
+    pub forces: VariableId,
+    /// The cable's anchor, world frame, metres.
+    pub anchor: VariableId,
+    /// The cable's encoder length offset, metres.
+    pub length_offset: VariableId,
+}
+
+/// What one cable is: its attachment on the platform and its weight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CableConstants {
+    /// Attachment, platform frame, metres.
+    pub attachment_m: Vector3<f64>,
+    /// Weight per metre, N/m.
+    pub weight_n_per_m: f64,
+}
+
+/// Paper eq. (14) and (15) for one cable with its own forces: the rows
+/// `[l_C + l0 - z_enc (m), (p + R b)_z - a_z + drop (m)]`, sigmas the
+/// encoder's and the height constraint's.
+pub struct CatenaryCableFactor {
+    variables: [VariableId; 4],
+    cable: CableConstants,
+    encoder_length_m: f64,
+    noise: Noise,
+}
+
+impl CatenaryCableFactor {
+    /// The factor of `cable` reading `encoder_length_m`.
+    pub fn new(
+        variables: CableVariables,
+        cable: CableConstants,
+        encoder_length_m: f64,
+        encoder_sigma_m: f64,
+        height_sigma_m: f64,
+        kernel: RobustKernel,
+    ) -> Self {
+        Self {
+            variables: [
+                variables.pose,
+                variables.forces,
+                variables.anchor,
+                variables.length_offset,
+            ],
+            cable,
+            encoder_length_m,
+            noise: Noise::new(DVector::from_row_slice(&[encoder_sigma_m, height_sigma_m]), kernel),
+        }
+    }
+}
+
+/// A vector variable as a fixed-size vector.
+fn fixed<const D: usize>(values: &Values, id: VariableId) -> SMatrix<f64, D, 1> {
+    SMatrix::<f64, D, 1>::from_column_slice(values.vector(id).as_slice())
+}
+
+impl Factor for CatenaryCableFactor {
+    factor_basics!(2, "cable");
+    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
+        let (position, rotation) = pose_arguments(values, self.variables[0]);
+        let forces: Vector2<f64> = fixed(values, self.variables[1]);
+        let anchor: Vector3<f64> = fixed(values, self.variables[2]);
+        let offset = values.vector(self.variables[3])[0];
+        let (mut j_pose, mut j_forces, mut j_anchor, mut j_offset) = (
+            SMatrix::<f64, 2, 6>::zeros(),
+            SMatrix::<f64, 2, 2>::zeros(),
+            SMatrix::<f64, 2, 3>::zeros(),
+            SMatrix::<f64, 2, 1>::zeros(),
+        );
+        let want = jacobians.is_some();
+        let r = generated::suspended_cable_residual(
+            &position,
+            &rotation,
+            &forces,
+            &anchor,
+            &self.cable.attachment_m,
+            self.cable.weight_n_per_m,
+            offset,
+            self.encoder_length_m,
+            EPSILON,
+            want.then_some(&mut j_pose),
+            want.then_some(&mut j_forces),
+            want.then_some(&mut j_anchor),
+            want.then_some(&mut j_offset),
+        );
+        if let Some(blocks) = jacobians {
+            blocks[0].copy_from(&j_pose);
+            blocks[1].copy_from(&j_forces);
+            blocks[2].copy_from(&j_anchor);
+            blocks[3].copy_from(&j_offset);
+        }
+        residual.copy_from_slice(r.as_slice());
+        r.iter().all(|v| v.is_finite())
+    }
+}
+
+/// One massless cable's length, `||a - (p + R b)|| + l0 - z_enc` (the
+/// `g_c -> 0` limit of eq. 14): the rigid stage. Blocks `[pose, anchor, offset]`.
+pub struct StraightCableFactor {
+    variables: [VariableId; 3],
+    attachment_m: Vector3<f64>,
+    encoder_length_m: f64,
+    noise: Noise,
+}
+
+impl StraightCableFactor {
+    /// The factor of the cable with `anchor` and `length_offset` at `pose`, reading `encoder_length_m`.
+    pub fn new(
+        [pose, anchor, length_offset]: [VariableId; 3],
+        attachment_m: Vector3<f64>,
+        encoder_length_m: f64,
+        encoder_sigma_m: f64,
+        kernel: RobustKernel,
+    ) -> Self {
+        Self {
+            variables: [pose, anchor, length_offset],
+            attachment_m,
+            encoder_length_m,
+            noise: Noise::isotropic(1, encoder_sigma_m, kernel),
+        }
+    }
+}
+
+impl Factor for StraightCableFactor {
+    factor_basics!(1, "straight_cable");
+    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
+        let (position, rotation) = pose_arguments(values, self.variables[0]);
+        let anchor: Vector3<f64> = fixed(values, self.variables[1]);
+        let offset = values.vector(self.variables[2])[0];
+        let (mut j_pose, mut j_anchor, mut j_offset) = (
+            SMatrix::<f64, 1, 6>::zeros(),
+            SMatrix::<f64, 1, 3>::zeros(),
+            SMatrix::<f64, 1, 1>::zeros(),
+        );
+        let want = jacobians.is_some();
+        let r = generated::straight_cable_residual(
+            &position,
+            &rotation,
+            &anchor,
+            &self.attachment_m,
+            offset,
+            self.encoder_length_m,
+            EPSILON,
+            want.then_some(&mut j_pose),
+            want.then_some(&mut j_anchor),
+            want.then_some(&mut j_offset),
+        );
+        if let Some(blocks) = jacobians {
+            blocks[0].copy_from(&j_pose);
+            blocks[1].copy_from(&j_anchor);
+            blocks[2].copy_from(&j_offset);
+        }
+        residual[0] = r[0];
+        r[0].is_finite()
+    }
+}
+
+/// The six equations of equilibrium of one pose (paper eq. 5-8):
+/// `sum_i [F_i; r_i x F_i] - [z; (R b_com) x z] m_e g` (newtons, then
+/// newton-metres about the platform origin). Blocks `[pose, forces 1..N,
+/// anchors 1..N]`. A model equation: its sigmas are tight.
+pub struct EquilibriumFactor {
+    variables: Vec<VariableId>,
+    attachments_m: Vec<Vector3<f64>>,
+    com_offset_m: Vector3<f64>,
+    platform_weight_n: f64,
+    noise: Noise,
+}
+
+impl EquilibriumFactor {
+    /// The equilibrium of the pose `pose` held by cables with `forces` and
+    /// `anchors` (one each per cable, cable order), with sigma
+    /// `force_sigma_n` on the force rows and `force_sigma_n * lever_m` on
+    /// the moment rows.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        pose: VariableId,
+        forces: &[VariableId],
+        anchors: &[VariableId],
+        attachments_m: &[Vector3<f64>],
+        com_offset_m: Vector3<f64>,
+        platform_weight_n: f64,
+        force_sigma_n: f64,
+        lever_m: f64,
+    ) -> Self {
+        let mut variables = Vec::with_capacity(1 + 2 * forces.len());
+        variables.push(pose);
+        variables.extend_from_slice(forces);
+        variables.extend_from_slice(anchors);
+        let sigmas = DVector::from_fn(6, |row, _| {
+            if row < 3 {
+                force_sigma_n
+            } else {
+                force_sigma_n * lever_m
+            }
+        });
+        Self {
+            variables,
+            attachments_m: attachments_m.to_vec(),
+            com_offset_m,
+            platform_weight_n,
+            noise: Noise::new(sigmas, RobustKernel::None),
+        }
+    }
+
+    fn cable_count(&self) -> usize {
+        self.attachments_m.len()
+    }
+}
+
+impl Factor for EquilibriumFactor {
+    factor_basics!(6, "equilibrium");
+    fn evaluate_into(&self, values: &Values, residual: &mut [f64], mut jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
+        let n = self.cable_count();
+        let (position, rotation) = pose_arguments(values, self.variables[0]);
+        let want = jacobians.is_some();
+        let mut j_gravity = SMatrix::<f64, 6, 3>::zeros();
+        let mut total = -generated::platform_weight_wrench(
+            &rotation,
+            &self.com_offset_m,
+            self.platform_weight_n,
+            want.then_some(&mut j_gravity),
+        );
+        let mut j_pose_total = SMatrix::<f64, 6, 6>::zeros();
+        j_pose_total.fixed_columns_mut::<3>(0).copy_from(&(-j_gravity));
+        for i in 0..n {
+            let forces: Vector2<f64> = fixed(values, self.variables[1 + i]);
+            let anchor: Vector3<f64> = fixed(values, self.variables[1 + n + i]);
+            let (mut j_pose, mut j_forces, mut j_anchor) = (
+                SMatrix::<f64, 6, 6>::zeros(),
+                SMatrix::<f64, 6, 2>::zeros(),
+                SMatrix::<f64, 6, 3>::zeros(),
+            );
+            total += generated::cable_wrench(
+                &position,
+                &rotation,
+                &forces,
+                &anchor,
+                &self.attachments_m[i],
+                EPSILON,
+                want.then_some(&mut j_pose),
+                want.then_some(&mut j_forces),
+                want.then_some(&mut j_anchor),
+            );
+            if let Some(blocks) = jacobians.as_deref_mut() {
+                j_pose_total += j_pose;
+                blocks[1 + i].copy_from(&j_forces);
+                blocks[1 + n + i].copy_from(&j_anchor);
+            }
+        }
+        if let Some(blocks) = jacobians {
+            blocks[0].copy_from(&j_pose_total);
+        }
+        residual.copy_from_slice(total.as_slice());
+        total.iter().all(|v| v.is_finite())
+    }
+}
+
+/// A load cell at one cable's attachment (paper eq. 16):
+/// `||(f_h, f_v)|| - f_m`, newtons. Block `[forces]`.
+pub struct CableLoadCellFactor {
+    variables: [VariableId; 1],
+    measured_tension_n: f64,
+    noise: Noise,
+}
+
+impl CableLoadCellFactor {
+    /// The load cell on the cable with `forces`, reading `measured_tension_n`.
+    pub fn new(forces: VariableId, measured_tension_n: f64, sigma_n: f64, kernel: RobustKernel) -> Self {
+        Self {
+            variables: [forces],
+            measured_tension_n,
+            noise: Noise::isotropic(1, sigma_n, kernel),
+        }
+    }
+}
+
+impl Factor for CableLoadCellFactor {
+    factor_basics!(1, "load_cell");
+    fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
+        let forces: Vector2<f64> = fixed(values, self.variables[0]);
+        let mut j = SMatrix::<f64, 1, 2>::zeros();
+        let want = jacobians.is_some();
+        let r = generated::load_cell_residual(
+            &forces,
+            0.0,
+            0.0,
+            self.measured_tension_n,
+            EPSILON,
+            want.then_some(&mut j),
+            None,
+            None,
+        );
+        if let Some(blocks) = jacobians {
+            blocks[0].copy_from(&j);
+        }
+        residual[0] = r[0];
+        r[0].is_finite()
+    }
+}

@@ -1,0 +1,151 @@
+//! Calibration of robots of 3 to 8 cables: round trips from simulated,
+//! noiseless readings, starting away from the truth.
+
+use nalgebra::Vector3;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use sagcal::calib::suspended::calibrate_suspended;
+use sagcal::calib::CalibrationOptions;
+use sagcal::model::sensors::{NoisePreset, SensorNoise};
+use sagcal::model::suspended::{SuspendedMeasurement, SuspendedRobot};
+use sagcal::sim::closed_form::{Closure, Workspace};
+use sagcal::sim::suspended::{measure_suspended, sample_suspended};
+
+/// `count` noiseless readings of `truth` (seed `seed`).
+fn readings(truth: &SuspendedRobot, count: usize, seed: u64) -> Vec<SuspendedMeasurement> {
+    let workspace = truth
+        .workspace
+        .unwrap_or_else(|| Workspace::around_anchor_points(&truth.anchors_m));
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let closure = if truth.cable_count() > 3 {
+        Closure::Yaw { max_yaw_deg: 5.0 }
+    } else {
+        Closure::Level
+    };
+    let equilibria = sample_suspended(truth, &workspace, count, closure, &mut rng).unwrap();
+    let silent = NoisePreset::None.sigmas(truth.platform_weight_n);
+    measure_suspended(truth, &equilibria, &silent, &mut rng)
+}
+
+/// `truth` with offsets of a few decimetres, and a guess of it with every
+/// anchor `guess_m` away along a fixed direction per cable.
+fn truth_and_guess(name: &str, guess_m: f64) -> (SuspendedRobot, SuspendedRobot) {
+    let mut truth = robot(name);
+    truth.length_offsets_m = (0..truth.cable_count()).map(|i| 0.1 + 0.07 * i as f64).collect();
+    let mut guess = truth.clone();
+    for (i, anchor) in guess.anchors_m.iter_mut().enumerate() {
+        let angle = 1.3 * i as f64;
+        *anchor += guess_m * Vector3::new(angle.cos(), angle.sin(), 0.5).normalize();
+    }
+    guess.length_offsets_m = vec![0.0; truth.cable_count()];
+    (truth, guess)
+}
+
+/// A built-in robot, or `five` / `seven`: the six- and eight-cable robots
+/// without their last cable.
+fn robot(name: &str) -> SuspendedRobot {
+    let (source, drop) = match name {
+        "five" => ("six", true),
+        "seven" => ("eight", true),
+        other => (other, false),
+    };
+    let mut robot = SuspendedRobot::builtin(source).unwrap();
+    if drop {
+        robot.anchors_m.pop();
+        robot.attachments_m.pop();
+        robot.cable_weights_n_per_m.pop();
+        robot.length_offsets_m.pop();
+        robot.name = name.into();
+    }
+    robot
+}
+
+fn paper_options(robot: &SuspendedRobot) -> CalibrationOptions {
+    let noise: SensorNoise = NoisePreset::Paper.sigmas(robot.platform_weight_n);
+    CalibrationOptions::new(noise)
+}
+
+#[test]
+fn noiseless_round_trips_recover_every_robot() {
+    for name in ["three", "large", "five", "six", "seven", "eight"] {
+        let (truth, guess) = truth_and_guess(name, 0.5);
+        let measurements = readings(&truth, 24, 11);
+        let mut stages = Vec::new();
+        // Noiseless data: stop on the step alone, not on a relative cost decrease.
+        let mut options = paper_options(&truth);
+        options.lm.relative_cost_tolerance = 0.0;
+        options.lm.relative_step_tolerance = 1e-14;
+        let result = calibrate_suspended(&guess, &measurements, &options, &mut |s| stages.push(s.to_string())).unwrap();
+        let anchor_error = truth
+            .anchors_m
+            .iter()
+            .zip(&result.robot.anchors_m)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        let offset_error = truth
+            .length_offsets_m
+            .iter()
+            .zip(&result.robot.length_offsets_m)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        println!(
+            "{name}: {} cables, anchors {anchor_error:.2e} m, offsets {offset_error:.2e} m, stages {:?}, fell back {:?}",
+            truth.cable_count(),
+            result
+                .stages
+                .iter()
+                .map(|s| (s.summary.iterations, s.summary.termination))
+                .collect::<Vec<_>>(),
+            result.fell_back
+        );
+        assert!(anchor_error < 1e-9 && offset_error < 1e-9, "{name}");
+    }
+}
+
+/// The four-cable robot calibrated by the graph of `N` cables (every
+/// cable's forces its own variables) and by the four-cable graph (the other
+/// forces from the reference cable's, eq. 11) from the same noisy readings:
+/// the same model, so the same minimum, up to the finite sigmas of the
+/// equilibrium and height constraints.
+#[test]
+fn four_cables_agree_with_the_four_cable_graph() {
+    use sagcal::calib::{calibrate, OrientationPrior};
+    use sagcal::model::measurement::PoseMeasurement;
+    use sagcal::model::Robot;
+    let four = Robot::builtin("large").unwrap();
+    let truth = SuspendedRobot::from_robot(&four);
+    let workspace = Workspace::default_for(&four);
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let equilibria = sample_suspended(&truth, &workspace, 20, Closure::Yaw { max_yaw_deg: 5.0 }, &mut rng).unwrap();
+    let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
+    let measurements = measure_suspended(&truth, &equilibria, &noise, &mut rng);
+    let rows: Vec<PoseMeasurement> = measurements
+        .iter()
+        .map(|m| PoseMeasurement {
+            position_m: m.position_m,
+            roll_deg: m.roll_deg,
+            pitch_deg: m.pitch_deg,
+            yaw_deg: m.yaw_deg,
+            encoder_lengths_m: m.encoder_lengths_m.clone().try_into().unwrap(),
+            reference_tension_n: m.load_cell_tensions_n[0],
+            line: 0,
+            excluded: Default::default(),
+            order: None,
+        })
+        .collect();
+    let mut options = paper_options(&truth);
+    options.orientation_prior = OrientationPrior::On;
+    let by_four = calibrate(&four, &rows, &options).unwrap();
+    let by_n = calibrate_suspended(&truth, &measurements, &options, &mut |_| {}).unwrap();
+    let mut largest_difference: f64 = 0.0;
+    let mut largest_error: f64 = 0.0;
+    for i in 0..4 {
+        largest_difference = largest_difference.max((by_four.robot.anchors_m[i] - by_n.robot.anchors_m[i]).norm());
+        largest_error = largest_error.max((by_four.robot.anchors_m[i] - truth.anchors_m[i]).norm());
+    }
+    println!("anchors: graphs differ by {largest_difference:.2e} m; the four-cable graph is {largest_error:.2e} m from the truth");
+    assert!(
+        largest_difference < 1e-3 * largest_error.max(1e-3),
+        "{largest_difference} vs {largest_error}"
+    );
+}
