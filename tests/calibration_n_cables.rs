@@ -149,3 +149,175 @@ fn four_cables_agree_with_the_four_cable_graph() {
         "{largest_difference} vs {largest_error}"
     );
 }
+
+/// From a guess with every anchor 10 m off (the paper's Table II start),
+/// noisy readings: the calibration ends where it ends from the truth.
+#[test]
+fn ten_metre_guesses_reach_the_minimum_of_the_truth() {
+    for name in ["three", "large", "five", "six", "seven", "eight"] {
+        let (truth, guess) = truth_and_guess(name, 10.0);
+        let workspace = truth
+            .workspace
+            .unwrap_or_else(|| Workspace::around_anchor_points(&truth.anchors_m));
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let closure = if truth.cable_count() > 3 {
+            Closure::Yaw { max_yaw_deg: 5.0 }
+        } else {
+            Closure::Level
+        };
+        let equilibria = sample_suspended(&truth, &workspace, 30, closure, &mut rng).unwrap();
+        let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
+        let measurements = measure_suspended(&truth, &equilibria, &noise, &mut rng);
+        let options = paper_options(&truth);
+        let from_guess = calibrate_suspended(&guess, &measurements, &options, &mut |_| {}).unwrap();
+        let from_truth = calibrate_suspended(&truth, &measurements, &options, &mut |_| {}).unwrap();
+        let apart = from_guess
+            .robot
+            .anchors_m
+            .iter()
+            .zip(&from_truth.robot.anchors_m)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        let error = from_truth
+            .robot
+            .anchors_m
+            .iter()
+            .zip(&truth.anchors_m)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        println!(
+            "{name}: from 10 m {apart:.2e} m from the truth's minimum (costs {:.3} / {:.3}), which is {error:.3} m from the truth; fell back {:?}",
+            from_guess.final_cost, from_truth.final_cost, from_guess.fell_back
+        );
+        assert!(apart < 1e-6, "{name}: {apart}");
+    }
+}
+
+fn sagcal(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_sagcal"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("sagcal runs")
+}
+
+fn robot_path(name: &str) -> String {
+    format!("{}/robots/{name}.toml", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `sagcal calibrate` on simulated readings of the six- and eight-cable
+/// robots: the JSON report's anchors lie within 4 sigma of the truth (the
+/// robot file simulated from), the fit passes its chi-square test, and the
+/// written robot reads back with the reported anchors and offsets.
+#[test]
+fn the_command_calibrates_six_and_eight_cables() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["six", "eight"] {
+        let truth = SuspendedRobot::builtin(name).unwrap();
+        let data = format!("{name}.csv");
+        let out = sagcal(
+            dir.path(),
+            &[
+                "simulate",
+                "--robot",
+                &robot_path(name),
+                "--poses",
+                "30",
+                "--seed",
+                "7",
+                "--out",
+                &data,
+            ],
+        );
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let written = format!("{name}-calibrated.toml");
+        let out = sagcal(
+            dir.path(),
+            &[
+                "calibrate",
+                "--robot",
+                &robot_path(name),
+                "--data",
+                &data,
+                "--out",
+                &written,
+                "--json",
+            ],
+        );
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(report["cables"], truth.cable_count());
+        assert_eq!(report["consistent"], true, "{}", report["chi_square"]);
+        let calibrated = SuspendedRobot::from_file(&dir.path().join(&written)).unwrap();
+        let mut worst: f64 = 0.0;
+        for i in 0..truth.cable_count() {
+            for k in 0..3 {
+                let estimate = report["anchors_m"][i][k].as_f64().unwrap();
+                let sigma = report["anchor_sigma_m"][i][k].as_f64().unwrap();
+                assert!((calibrated.anchors_m[i][k] - estimate).abs() < 1e-12);
+                worst = worst.max((estimate - truth.anchors_m[i][k]).abs() / sigma);
+            }
+            let offset = report["length_offsets_m"][i].as_f64().unwrap();
+            assert!((calibrated.length_offsets_m[i] - offset).abs() < 1e-12);
+        }
+        println!("{name}: worst anchor coordinate {worst:.2} sigma from the truth");
+        assert!(worst < 4.0, "{name}: {worst}");
+    }
+}
+
+/// A blunder in a well-formed file (one encoder reading 0.5 m long) fails
+/// the chi-square test: the report says so, the robot is not written, the
+/// command exits 1; options of the four-cable pipeline alone are refused.
+#[test]
+fn a_blunder_is_not_calibrated_into_a_robot() {
+    let dir = tempfile::tempdir().unwrap();
+    let six = robot_path("six");
+    let out = sagcal(
+        dir.path(),
+        &[
+            "simulate", "--robot", &six, "--poses", "30", "--seed", "7", "--out", "six.csv",
+        ],
+    );
+    assert!(out.status.success());
+    let text = std::fs::read_to_string(dir.path().join("six.csv")).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let header = lines.iter().position(|l| l.starts_with("x_m")).unwrap();
+    let column = lines[header].split(',').position(|c| c == "l2_m").unwrap();
+    let mut cells: Vec<String> = lines[header + 5].split(',').map(String::from).collect();
+    cells[column] = format!("{}", cells[column].parse::<f64>().unwrap() + 0.5);
+    lines[header + 5] = cells.join(",");
+    std::fs::write(dir.path().join("blunder.csv"), lines.join("\n") + "\n").unwrap();
+    let out = sagcal(
+        dir.path(),
+        &[
+            "calibrate",
+            "--robot",
+            &six,
+            "--data",
+            "blunder.csv",
+            "--out",
+            "cal.toml",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("fails its chi-square test"), "{stderr}");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("INCONSISTENT"));
+    assert!(!dir.path().join("cal.toml").exists());
+    for (flag, value, expected) in [
+        ("--model", "rigid", "--model rigid: robot `six` has 6 cables"),
+        (
+            "--false-alarm",
+            "0.01",
+            "--false-alarm: the tests for single gross errors take robots of four cables",
+        ),
+    ] {
+        let out = sagcal(
+            dir.path(),
+            &["calibrate", "--robot", &six, "--data", "six.csv", flag, value],
+        );
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(stderr.contains(expected), "{stderr}");
+    }
+}

@@ -136,4 +136,6 @@ pub use result::{
     StageSummary,
 };
 pub use settings::{check_false_alarm, CalibrationSettings, SolverSettings};
-pub use uncertainty::{anchor_rms_bound_m, cramer_rao_bound, parameter_uncertainty, CalibrationError};
+pub use uncertainty::{
+    anchor_and_offset_uncertainty, anchor_rms_bound_m, cramer_rao_bound, parameter_uncertainty, CalibrationError,
+};

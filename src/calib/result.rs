@@ -49,8 +49,9 @@ pub enum ParameterUncertainty {
         anchor_sigma_m: Vec<[f64; 3]>,
         /// Per offset, its 1-sigma, metres.
         offset_sigma_m: Vec<f64>,
-        /// The joint covariance, m^2, 16 rows of 16: anchors 1..4 (x, y, z
-        /// each), then offsets 1..4 (what `localize` propagates).
+        /// The joint covariance, m^2, `4N` rows of `4N` (16 for four
+        /// cables): anchors 1..N (x, y, z each), then offsets 1..N (what
+        /// `localize` propagates).
         covariance_m2: Vec<Vec<f64>>,
     },
     /// Some directions of parameter space are not observable from these poses.

@@ -66,7 +66,13 @@ impl SolverSettings {
     /// overrides (each a positive number, named as `front_end` spells it),
     /// every sigma positive.
     pub fn options(&self, robot: &Robot, front_end: FrontEnd) -> Result<CalibrationOptions> {
-        let mut noise = self.noise.sigmas(robot.platform_weight_n);
+        self.options_for_weight(robot.platform_weight_n, front_end)
+    }
+
+    /// [`SolverSettings::options`] for a robot whose platform weighs
+    /// `platform_weight_n` (the noise preset's load-cell sigma depends on it).
+    pub fn options_for_weight(&self, platform_weight_n: f64, front_end: FrontEnd) -> Result<CalibrationOptions> {
+        let mut noise = self.noise.sigmas(platform_weight_n);
         for (value, target, keyword) in [
             (self.encoder_sigma_m, &mut noise.encoder_sigma_m, "encoder_sigma_m"),
             (

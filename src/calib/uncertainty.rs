@@ -9,7 +9,7 @@ use super::graph::{build_graph, CalibrationGraph};
 use super::options::{CalibrationOptions, RobustKernels};
 use super::result::{EffectEstimate, ParameterUncertainty};
 use crate::error::{Error, Result};
-use crate::graph::VariableId;
+use crate::graph::{FactorGraph, VariableId};
 use crate::model::effect_kind::EffectKind;
 use crate::model::measurement::PoseMeasurement;
 use crate::model::pose::PlatformPose;
@@ -43,30 +43,39 @@ pub(super) fn effect_estimate(built: &CalibrationGraph, kind: EffectKind) -> Res
 
 /// Marginal covariance of anchors and offsets at the graph's current values.
 pub fn parameter_uncertainty(built: &CalibrationGraph) -> Result<ParameterUncertainty> {
-    let selected: Vec<VariableId> = built
-        .globals
-        .anchors
-        .iter()
-        .chain(&built.globals.length_offsets)
-        .copied()
-        .collect();
+    anchor_and_offset_uncertainty(&built.graph, &built.globals.anchors, &built.globals.length_offsets)
+}
+
+/// Marginal covariance of the `anchors` (3-vectors) and `length_offsets`
+/// (1-vectors, one per anchor) of `graph` at its current values: the
+/// inverse of the information `J^T Sigma^-1 J` with every other variable
+/// marginalised out.
+pub fn anchor_and_offset_uncertainty(
+    graph: &FactorGraph,
+    anchors: &[VariableId],
+    length_offsets: &[VariableId],
+) -> Result<ParameterUncertainty> {
+    let selected: Vec<VariableId> = anchors.iter().chain(length_offsets).copied().collect();
     let covariance =
-        super::system_scope::with_system_cache(|cache| marginal_covariance_cached(&built.graph, &selected, cache))?;
+        super::system_scope::with_system_cache(|cache| marginal_covariance_cached(graph, &selected, cache))?;
     Ok(match covariance {
-        Covariance::Full(c) => uncertainty_from_covariance(&c),
+        Covariance::Full(c) => uncertainty_from_covariance(&c, anchors.len()),
         Covariance::RankDeficient(directions) => ParameterUncertainty::RankDeficient { directions },
     })
 }
 
-fn uncertainty_from_covariance(c: &DMatrix<f64>) -> ParameterUncertainty {
-    let anchor_covariance_m2: Vec<[[f64; 3]; 3]> = (0..CABLE_COUNT)
+/// The uncertainty of `cables` anchors and offsets from their joint covariance.
+fn uncertainty_from_covariance(c: &DMatrix<f64>, cables: usize) -> ParameterUncertainty {
+    let anchor_covariance_m2: Vec<[[f64; 3]; 3]> = (0..cables)
         .map(|i| std::array::from_fn(|r| std::array::from_fn(|col| c[(3 * i + r, 3 * i + col)])))
         .collect();
     let anchor_sigma_m = anchor_covariance_m2
         .iter()
         .map(|m| std::array::from_fn(|k| m[k][k].max(0.0).sqrt()))
         .collect();
-    let offset_sigma_m = (0..CABLE_COUNT).map(|i| c[(12 + i, 12 + i)].max(0.0).sqrt()).collect();
+    let offset_sigma_m = (0..cables)
+        .map(|i| c[(3 * cables + i, 3 * cables + i)].max(0.0).sqrt())
+        .collect();
     ParameterUncertainty::Full {
         anchor_covariance_m2,
         anchor_sigma_m,

@@ -1,56 +1,32 @@
 //! `sagcal calibrate`: anchors and offsets from a measurement file; its
 //! flags ([`CalibrateArgs`]) and the run.
 
-use std::path::PathBuf;
-
 use sagcal::calib::gross_errors::Verdict;
 use sagcal::calib::report::CalibrationReport;
 use sagcal::calib::{
     calibrate_job_with_progress, CableModel, CalibrationOptions, CalibrationResult, CalibrationSettings,
-    OrientationPrior, ParameterUncertainty,
+    OrientationPrior,
 };
 use sagcal::error::FrontEnd;
 use sagcal::io::measurements::{read_measurements, ReadOptions};
 use sagcal::io::OutputSet;
 use sagcal::model::Robot;
-use sagcal::plot::{anchor_plot_svg, figure_bytes, AnchorPlot, AnchorPlotEntry};
+use sagcal::plot::figure_bytes;
 
+pub(super) use super::calibrate_args::CalibrateArgs;
+use super::calibration_tables::{calibrated_anchor_plot, fit_tables, parameter_tables};
 use super::gross_errors;
-use super::output::{print_json, progress_bar, Table};
-use super::solver_args::SolverArgs;
+use super::output::{print_json, progress_bar};
+use super::robot_kind::{read_robot, AnyRobot};
 
-#[derive(Debug, clap::Args)]
-pub(super) struct CalibrateArgs {
-    /// Nominal robot description (TOML): the initial guess of anchors and offsets.
-    #[arg(long)]
-    robot: PathBuf,
-    /// Measurements: sagcal CSV (see docs/measurements.md), a RecurDyn log, or the authors' dataset folder
-    /// (`pos_i_cpp_test.csv`, `R_i_cpp_test.csv`, `lc_meas_cpp_test.csv`, `forces_cpp_test.csv`).
-    #[arg(long)]
-    data: PathBuf,
-    /// Write the calibrated robot (TOML) here.
-    #[arg(long)]
-    out: Option<PathBuf>,
-    /// Write a plot of nominal and calibrated anchors with error ellipses here (PNG if the name ends in `.png`, SVG otherwise).
-    #[arg(long)]
-    plot: Option<PathBuf>,
-    /// Print the report as JSON.
-    #[arg(long)]
-    json: bool,
-    /// Write the calibrated robot even when the fit fails its own consistency
-    /// tests (the verdict is recorded in the file's header comment).
-    #[arg(long)]
-    accept_inconsistent: bool,
-    /// False-alarm rate of the gross-error tests (per reading, over all
-    /// readings; per sensor type, over the types).
-    #[arg(long, default_value_t = 1e-3)]
-    false_alarm: f64,
-    #[command(flatten)]
-    solver: SolverArgs,
-}
-
+/// Calibrate the robot of `--robot` from `--data`: the four-cable
+/// pipeline with its gross-error tests, or for a robot of 3 to 8 cables
+/// [`super::calibrate_suspended::run`].
 pub fn run(args: &CalibrateArgs) -> sagcal::Result<()> {
-    let nominal = Robot::from_file(&args.robot)?;
+    let nominal = match read_robot(&args.robot)? {
+        AnyRobot::Four(robot) => *robot,
+        AnyRobot::Suspended(robot) => return super::calibrate_suspended::run(args, &robot),
+    };
     let data = read_measurements(
         &args.data,
         &ReadOptions {
@@ -135,36 +111,23 @@ pub fn plot_svg(
     positions: &[[f64; 3]],
     caption: &str,
 ) -> String {
-    let covariances = match &result.uncertainty {
-        ParameterUncertainty::Full {
-            anchor_covariance_m2, ..
-        } => Some(anchor_covariance_m2.clone()),
-        ParameterUncertainty::RankDeficient { .. } => None,
-    };
-    let plot = AnchorPlot {
-        title: format!(
-            "sagcal: calibrated anchors of `{}` ({} poses)",
-            nominal.name,
-            result.poses.len()
-        ),
-        caption: caption.to_string(),
-        anchors: (0..4)
-            .map(|i| AnchorPlotEntry {
-                label: format!("anchor {}", i + 1),
-                nominal_m: nominal.anchors_m[i].into(),
-                initial_m: Some(nominal.anchors_m[i].into()),
-                estimate_m: result.robot.anchors_m[i].into(),
-                covariance_m2: covariances.as_ref().map(|c| c[i]),
-                truth_m: truth.map(|t| t.anchors_m[i].into()),
-            })
-            .collect(),
-        platform_positions_m: positions.to_vec(),
-    };
-    anchor_plot_svg(&plot)
-}
-
-fn sigma(value: Option<f64>) -> String {
-    value.map_or_else(|| "n/a".to_string(), |s| format!("{s:.3}"))
+    let title = format!(
+        "sagcal: calibrated anchors of `{}` ({} poses)",
+        nominal.name,
+        result.poses.len()
+    );
+    let estimates: Vec<[f64; 3]> = result.robot.anchors_m.iter().map(|a| (*a).into()).collect();
+    let nominal_m: Vec<[f64; 3]> = nominal.anchors_m.iter().map(|a| (*a).into()).collect();
+    let truth_m: Option<Vec<[f64; 3]>> = truth.map(|t| t.anchors_m.iter().map(|a| (*a).into()).collect());
+    calibrated_anchor_plot(
+        title,
+        caption,
+        &nominal_m,
+        &estimates,
+        &result.uncertainty,
+        truth_m.as_deref(),
+        positions,
+    )
 }
 
 /// How the orientation was handled, in words.
@@ -200,72 +163,14 @@ pub fn render(report: &CalibrationReport, options: &CalibrationOptions) -> Strin
         n.position_sigma_m,
         orientation_text(report, options)
     );
-    let mut anchors = Table::new([
-        "anchor",
-        "x m",
-        "y m",
-        "z m",
-        "1-sigma x,y,z m",
-        "change from nominal m",
-    ]);
-    for (i, a) in report.anchors_m.iter().enumerate() {
-        let s = report.anchor_sigma_m.as_ref().map(|s| s[i]);
-        let d = report.anchor_change_m[i];
-        anchors.row([
-            format!("{}", i + 1),
-            format!("{:.3}", a[0]),
-            format!("{:.3}", a[1]),
-            format!("{:.3}", a[2]),
-            s.map_or("n/a".into(), |s| format!("{:.3} {:.3} {:.3}", s[0], s[1], s[2])),
-            format!("{:+.3} {:+.3} {:+.3}", d[0], d[1], d[2]),
-        ]);
-    }
-    out += &anchors.to_string();
-    out += "\n";
-    let mut offsets = Table::new(["cable", "length offset m", "1-sigma m"]);
-    for (i, o) in report.length_offsets_m.iter().enumerate() {
-        offsets.row([
-            format!("{}", i + 1),
-            format!("{o:.4}"),
-            sigma(report.offset_sigma_m.as_ref().map(|s| s[i])),
-        ]);
-    }
-    out += &offsets.to_string();
-    if let ParameterUncertainty::RankDeficient { directions } = &report.uncertainty {
-        out += "\nNOT OBSERVABLE from these poses (add poses spread over the workspace):\n";
-        for d in directions {
-            let parts: Vec<String> = d
-                .components
-                .iter()
-                .take(6)
-                .map(|(name, c, w)| format!("{w:+.2} {name}[{}]", ["x", "y", "z"].get(*c).unwrap_or(&"?")))
-                .collect();
-            out += &format!("  direction: {}\n", parts.join(" "));
-        }
-    }
-    out += "\nnormalised residuals r/sigma per factor type (rms ~ 1 when the stated noise is right):\n";
-    let mut stats = Table::new(["factor", "count", "rms", "max |r/sigma|"]);
-    for s in &report.factor_statistics {
-        stats.row([
-            s.kind.clone(),
-            s.factors.to_string(),
-            format!("{:.3}", s.rms),
-            format!("{:.2}", s.max_abs),
-        ]);
-    }
-    out += &stats.to_string();
-    out += "\nsolver:\n";
-    let mut stages = Table::new(["stage", "iterations", "initial cost", "final cost", "termination"]);
-    for s in &report.stages {
-        stages.row([
-            s.name.clone(),
-            s.summary.iterations.to_string(),
-            format!("{:.4e}", s.summary.initial_cost),
-            format!("{:.4e}", s.summary.final_cost),
-            s.summary.termination.to_string(),
-        ]);
-    }
-    out += &stages.to_string();
+    out += &parameter_tables(
+        &report.anchors_m,
+        report.anchor_sigma_m.as_deref(),
+        &report.anchor_change_m,
+        &report.length_offsets_m,
+        report.offset_sigma_m.as_deref(),
+    );
+    out += &fit_tables(&report.uncertainty, &report.factor_statistics, &report.stages);
     if !report.excluded_poses.is_empty() {
         let rows: Vec<String> = report.excluded_poses.iter().map(ToString::to_string).collect();
         out += &format!(

@@ -8,6 +8,9 @@
 
 mod args;
 mod calibrate;
+mod calibrate_args;
+mod calibrate_suspended;
+mod calibration_tables;
 mod check;
 mod demo;
 mod diagnose;
@@ -20,6 +23,7 @@ mod localize_experiment;
 mod output;
 mod parse;
 mod plan;
+mod robot_kind;
 mod run;
 mod simulate;
 mod simulate_args;

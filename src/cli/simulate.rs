@@ -8,12 +8,12 @@ use sagcal::error::FrontEnd;
 use sagcal::io::measurements::measurements_text;
 use sagcal::io::OutputSet;
 use sagcal::model::statics::Equilibrium;
-use sagcal::model::suspended::SuspendedRobot;
 use sagcal::model::{PoseMeasurement, Robot};
 use sagcal::sim::closed_form::{measure, sample_equilibria_with, Workspace};
 use sagcal::sim::effects::{measure_with_effects, simulation_truth};
 
 use super::output::counted;
+use super::robot_kind::{read_robot, AnyRobot};
 use super::simulate_args::{closure_note, noise_phrase, ranges_line, SimulateArgs};
 
 /// Simulate measurements of the robot, write them (and the truth), report what was drawn.
@@ -22,14 +22,8 @@ use super::simulate_args::{closure_note, noise_phrase, ranges_line, SimulateArgs
 /// cables, per-cable weights, several load cells) goes to the model of 3 to
 /// 8 cables.
 pub fn run(args: &SimulateArgs) -> sagcal::Result<()> {
-    if let Err(four_cable) = Robot::from_file(&args.robot) {
-        return match SuspendedRobot::from_file(&args.robot) {
-            Ok(robot) => super::simulate_suspended::run(args, &robot),
-            Err(_) if !matches!(four_cable, sagcal::Error::Robot { ref message, .. } if message.contains("field `cables`")) => {
-                Err(four_cable)
-            }
-            Err(n_cables) => Err(n_cables),
-        };
+    if let AnyRobot::Suspended(robot) = read_robot(&args.robot)? {
+        return super::simulate_suspended::run(args, &robot);
     }
     let (truth, from_file) = load_truth(args)?;
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);

@@ -34,7 +34,7 @@
 use std::path::{Path, PathBuf};
 
 use nalgebra::Vector3;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use super::robot_file::{CalibrationEntry, WorkspaceEntry};
 use crate::error::{Error, Result};
@@ -49,37 +49,37 @@ pub const MAX_CABLES: usize = 8;
 pub const BUILTIN_SUSPENDED: [&str; 5] = ["three", "large", "small", "six", "eight"];
 
 /// One cable of an N-cable robot file.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CableEntry {
     anchor_m: [f64; 3],
     attachment_m: [f64; 3],
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     weight_n_per_m: Option<f64>,
 }
 
 /// The contents of an N-cable robot file, before validation.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SuspendedFile {
     name: String,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     paper_robot: Option<PaperRobot>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     reference_cable: Option<usize>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     load_cells: Option<Vec<usize>>,
     platform_weight_n: f64,
     cable_weight_n_per_m: f64,
     com_offset_m: [f64; 3],
-    cables: Vec<CableEntry>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     length_offsets_m: Option<Vec<f64>>,
-    #[serde(default)]
+    cables: Vec<CableEntry>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     workspace: Option<WorkspaceEntry>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     effects: Option<Effects>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     calibration: Option<CalibrationEntry>,
 }
 
@@ -210,6 +210,50 @@ impl SuspendedRobot {
         Self::from_text(text, &PathBuf::from(format!("<built-in {name}>")))
     }
 
+    /// The robot as the text of its file (which [`SuspendedRobot::from_file`]
+    /// reads back to the same robot), with `covariance_m2` (anchors 1..N
+    /// x, y, z, then offsets 1..N; m^2) as its `[calibration]` table if given.
+    pub fn to_toml(&self, covariance_m2: Option<&[Vec<f64>]>) -> Result<String> {
+        let shared = self.cable_weights_n_per_m.first().copied().unwrap_or(0.0);
+        let file = SuspendedFile {
+            name: self.name.clone(),
+            paper_robot: None,
+            reference_cable: None,
+            load_cells: Some(self.load_cells.iter().map(|c| c + 1).collect()),
+            platform_weight_n: self.platform_weight_n,
+            cable_weight_n_per_m: shared,
+            com_offset_m: self.com_offset_m.into(),
+            length_offsets_m: Some(self.length_offsets_m.clone()),
+            cables: (0..self.cable_count())
+                .map(|i| CableEntry {
+                    anchor_m: self.anchors_m[i].into(),
+                    attachment_m: self.attachments_m[i].into(),
+                    weight_n_per_m: (self.cable_weights_n_per_m[i] != shared).then_some(self.cable_weights_n_per_m[i]),
+                })
+                .collect(),
+            workspace: self.workspace.map(|w| WorkspaceEntry {
+                min_m: w.min_m,
+                max_m: w.max_m,
+            }),
+            effects: None,
+            calibration: None,
+        };
+        let mut text =
+            toml::to_string(&file).map_err(|e| Error::InvalidInput(format!("cannot serialise robot: {e}")))?;
+        if let Some(covariance) = covariance_m2 {
+            text += &format!(
+                "\n[calibration]\n# Covariance of the calibrated parameters, m^2: anchors 1..{n} (x, y, z), then offsets 1..{n}.\ncovariance_m2 = [\n",
+                n = self.cable_count()
+            );
+            for row in covariance {
+                let cells: Vec<String> = row.iter().map(|v| format!("{v:e}")).collect();
+                text += &format!("    [{}],\n", cells.join(", "));
+            }
+            text += "]\n";
+        }
+        Ok(text)
+    }
+
     fn from_text(text: &str, path: &Path) -> Result<Self> {
         let file: SuspendedFile = toml::from_str(text).map_err(|e| Error::Format {
             path: path.to_path_buf(),
@@ -231,6 +275,25 @@ mod tests {
     }
 
     const SIX: &str = include_str!("../../robots/six.toml");
+
+    #[test]
+    fn a_written_robot_reads_back_the_same() {
+        for name in ["three", "large", "six", "eight"] {
+            let mut robot = SuspendedRobot::builtin(name).unwrap();
+            robot.length_offsets_m = (0..robot.cable_count()).map(|i| 0.1 * i as f64 - 0.05).collect();
+            robot.cable_weights_n_per_m[1] *= 1.5;
+            robot.anchors_m[0].x += 1.0 / 3.0;
+            let text = robot.to_toml(None).unwrap();
+            assert_eq!(read(&text).unwrap(), robot, "{name}:\n{text}");
+            let n = 4 * robot.cable_count();
+            let covariance: Vec<Vec<f64>> = (0..n)
+                .map(|r| (0..n).map(|k| if r == k { 1e-4 } else { 0.0 }).collect())
+                .collect();
+            let with = robot.to_toml(Some(&covariance)).unwrap();
+            assert_eq!(read(&with).unwrap(), robot);
+            assert!(with.contains(&format!("anchors 1..{}", robot.cable_count())));
+        }
+    }
 
     #[test]
     fn every_builtin_robot_reads() {

@@ -9,7 +9,8 @@ use super::graph::{
 };
 use super::start::{catenary_starts, offsets_in_closed_form, straight_offsets};
 use crate::calib::options::{CalibrationOptions, OrientationPrior};
-use crate::calib::result::{factor_statistics, FactorStatistics, StageSummary};
+use crate::calib::result::{factor_statistics, FactorStatistics, ParameterUncertainty, StageSummary};
+use crate::calib::uncertainty::anchor_and_offset_uncertainty;
 use crate::error::{Error, Result};
 use crate::model::pose::PlatformPose;
 use crate::model::statics::CableTension;
@@ -32,6 +33,12 @@ pub struct SuspendedCalibration {
     pub fell_back: Vec<usize>,
     /// Normalised residuals per factor type at the solution.
     pub statistics: Vec<FactorStatistics>,
+    /// The anchors' and offsets' covariance at the solution, or the
+    /// directions the poses leave unobservable.
+    pub uncertainty: ParameterUncertainty,
+    /// Residual rows minus unknowns of the final graph: the degrees of
+    /// freedom of its chi-square `2 * final_cost`.
+    pub degrees_of_freedom: usize,
     /// The final cost `1/2 chi^2`.
     pub final_cost: f64,
 }
@@ -85,7 +92,10 @@ pub fn calibrate_suspended(
     let mut full = build(&robot, &starts, SuspendedStage::Catenary);
     stages.push(solve(CATENARY_STAGE, &mut full, options, stage)?);
     let solved = pose_starts_from_graph(&full);
+    let uncertainty = anchor_and_offset_uncertainty(&full.graph, &full.anchors, &full.length_offsets)?;
     Ok(SuspendedCalibration {
+        uncertainty,
+        degrees_of_freedom: degrees_of_freedom(&full),
         robot: robot_from_suspended_graph(initial, &full),
         poses: solved.iter().map(|s| s.pose).collect(),
         forces: solved.into_iter().map(|s| s.forces).collect(),
@@ -149,4 +159,17 @@ fn solve(
         name: name.to_string(),
         summary,
     })
+}
+
+/// Residual rows minus the free variables' tangent dimensions (0 where
+/// there are more unknowns than rows).
+fn degrees_of_freedom(built: &SuspendedGraph) -> usize {
+    let rows: usize = built.graph.factors.iter().map(|f| f.residual_dim()).sum();
+    let values = &built.graph.values;
+    let unknowns: usize = (0..values.len())
+        .map(crate::graph::VariableId)
+        .filter(|&id| !values.variable(id).fixed)
+        .map(|id| values.tangent_dim(id))
+        .sum();
+    rows.saturating_sub(unknowns)
 }

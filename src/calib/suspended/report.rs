@@ -1,0 +1,98 @@
+//! What a calibration of `N` cables tells its user
+//! ([`SuspendedCalibrationReport`]): the anchors and offsets with their
+//! 1-sigma, how far they moved from the nominal robot, the residuals per
+//! factor type, the solver's stages and the chi-square test of the fit.
+
+use serde::Serialize;
+
+use super::calibrate::SuspendedCalibration;
+use crate::calib::result::{FactorStatistics, ParameterUncertainty, StageSummary};
+use crate::model::suspended::SuspendedRobot;
+use crate::stats::chi_square_quantile_999;
+
+/// The report of one calibration of `N` cables (serialised as the
+/// command's `--json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SuspendedCalibrationReport {
+    /// Robot name.
+    pub robot: String,
+    /// Number of cables.
+    pub cables: usize,
+    /// The cables with a load cell, 1-based.
+    pub load_cells: Vec<usize>,
+    /// Number of poses.
+    pub poses_used: usize,
+    /// Calibrated anchors, world frame, metres (N x 3).
+    pub anchors_m: Vec<[f64; 3]>,
+    /// 1-sigma of each anchor coordinate, metres (`null` where not observable).
+    pub anchor_sigma_m: Option<Vec<[f64; 3]>>,
+    /// Calibrated minus nominal anchors, metres.
+    pub anchor_change_m: Vec<[f64; 3]>,
+    /// Calibrated length offsets, metres.
+    pub length_offsets_m: Vec<f64>,
+    /// 1-sigma of each offset, metres (`null` where not observable).
+    pub offset_sigma_m: Option<Vec<f64>>,
+    /// Full uncertainty, or the unobservable directions.
+    pub uncertainty: ParameterUncertainty,
+    /// Normalised residual statistics per factor type.
+    pub factor_statistics: Vec<FactorStatistics>,
+    /// Solver stages.
+    pub stages: Vec<StageSummary>,
+    /// Whether the final stage stopped at a minimum.
+    pub converged: bool,
+    /// The fit's chi-square, `sum (r / sigma)^2`.
+    pub chi_square: f64,
+    /// Its degrees of freedom: residual rows minus unknowns.
+    pub degrees_of_freedom: usize,
+    /// The chi-square's 99.9 % quantile for those degrees of freedom: a fit
+    /// with the stated noise exceeds it once in a thousand.
+    pub chi_square_limit: f64,
+    /// Whether the chi-square is within its limit (the model and the stated
+    /// noise explain the readings).
+    pub consistent: bool,
+    /// The poses (1-based) whose start fell back to the measured pose.
+    pub poses_without_start: Vec<usize>,
+}
+
+impl SuspendedCalibrationReport {
+    /// The report of `result`, calibrated from `nominal`.
+    pub fn new(nominal: &SuspendedRobot, result: &SuspendedCalibration) -> Self {
+        let robot = &result.robot;
+        let (anchor_sigma_m, offset_sigma_m) = match &result.uncertainty {
+            ParameterUncertainty::Full {
+                anchor_sigma_m,
+                offset_sigma_m,
+                ..
+            } => (Some(anchor_sigma_m.clone()), Some(offset_sigma_m.clone())),
+            ParameterUncertainty::RankDeficient { .. } => (None, None),
+        };
+        let chi_square = 2.0 * result.final_cost;
+        let chi_square_limit = chi_square_quantile_999(result.degrees_of_freedom.max(1));
+        let converged = result.stages.last().is_some_and(|s| s.summary.termination.converged());
+        Self {
+            robot: robot.name.clone(),
+            cables: robot.cable_count(),
+            load_cells: robot.load_cells.iter().map(|c| c + 1).collect(),
+            poses_used: result.poses.len(),
+            anchors_m: robot.anchors_m.iter().map(|a| (*a).into()).collect(),
+            anchor_sigma_m,
+            anchor_change_m: robot
+                .anchors_m
+                .iter()
+                .zip(&nominal.anchors_m)
+                .map(|(a, n)| (a - n).into())
+                .collect(),
+            length_offsets_m: robot.length_offsets_m.clone(),
+            offset_sigma_m,
+            uncertainty: result.uncertainty.clone(),
+            factor_statistics: result.statistics.clone(),
+            stages: result.stages.clone(),
+            converged,
+            chi_square,
+            degrees_of_freedom: result.degrees_of_freedom,
+            chi_square_limit,
+            consistent: converged && chi_square <= chi_square_limit,
+            poses_without_start: result.fell_back.iter().map(|k| k + 1).collect(),
+        }
+    }
+}

@@ -1,0 +1,192 @@
+//! `sagcal calibrate` on a robot of 3 to 8 cables
+//! ([`sagcal::calib::suspended`]): the report, the calibrated robot file and
+//! the anchor plot.
+
+use sagcal::calib::suspended::{calibrate_suspended, SuspendedCalibration, SuspendedCalibrationReport};
+use sagcal::calib::{CableModel, CalibrationOptions, OrientationPrior, ParameterUncertainty};
+use sagcal::error::FrontEnd;
+use sagcal::io::suspended_measurements::read_suspended_measurements;
+use sagcal::io::OutputSet;
+use sagcal::model::suspended::SuspendedRobot;
+use sagcal::plot::figure_bytes;
+use sagcal::Error;
+
+use super::calibrate_args::CalibrateArgs;
+use super::calibration_tables::{calibrated_anchor_plot, fit_tables, parameter_tables};
+use super::output::{print_json, progress_bar};
+
+/// The stages of [`calibrate_suspended`], for the progress display.
+const STAGES: u64 = 3;
+
+/// Calibrate `nominal` from `args.data`, write what `args` ask for, report.
+pub(super) fn run(args: &CalibrateArgs, nominal: &SuspendedRobot) -> sagcal::Result<()> {
+    let options = options(args, nominal)?;
+    let data = read_suspended_measurements(&args.data, nominal)?;
+    let bar = progress_bar(STAGES, "{msg} [{bar:30}] {pos}/{len} stages, {elapsed}");
+    let mut done = 0;
+    let result = calibrate_suspended(nominal, &data, &options, &mut |stage| {
+        bar.report(done, STAGES as usize, stage);
+        done += 1;
+    });
+    bar.finish_and_clear();
+    let result = result?;
+    let report = SuspendedCalibrationReport::new(nominal, &result);
+    let text = render(&report, &options);
+    if !report.consistent && args.out.is_some() && !args.accept_inconsistent {
+        if args.json {
+            print_json(&report)?;
+        } else {
+            print!("{text}");
+        }
+        return Err(Error::InvalidInput(format!(
+            "the calibrated robot was not written: the fit fails its chi-square test ({:.1} for {} degrees of freedom, 99.9 % limit {:.1}){}; fix the data (or the robot file), or pass --accept-inconsistent",
+            report.chi_square,
+            report.degrees_of_freedom,
+            report.chi_square_limit,
+            if report.converged { "" } else { " and the solver did not converge" }
+        )));
+    }
+    // Files only after everything succeeded: all of them or none, none over an input.
+    let mut outputs = OutputSet::new();
+    outputs.input("--robot", &args.robot).input("--data", &args.data);
+    if let Some(out) = &args.out {
+        outputs.file("--out", out, robot_text(&result, &report)?);
+    }
+    if let Some(plot) = &args.plot {
+        let positions: Vec<[f64; 3]> = data.iter().map(|m| m.position_m).collect();
+        let caption = format!("sagcal calibrate --data {}", args.data.display());
+        let svg = plot_svg(nominal, &result, &positions, &caption);
+        outputs.file("--plot", plot, figure_bytes(plot, &svg)?);
+    }
+    outputs.write()?;
+    if args.json {
+        return print_json(&report);
+    }
+    print!("{text}");
+    match &args.out {
+        Some(out) => println!("calibrated robot written to {}", out.display()),
+        None => println!("the calibrated robot was not saved: no --out given (--out calibrated.toml writes it)"),
+    }
+    if let Some(plot) = &args.plot {
+        println!("plot written to {}", plot.display());
+    }
+    Ok(())
+}
+
+/// The options of `args` for `nominal`; the choices only the four-cable
+/// pipeline has are refused by name.
+fn options(args: &CalibrateArgs, nominal: &SuspendedRobot) -> sagcal::Result<CalibrationOptions> {
+    let settings = args.solver.settings();
+    if settings.model == CableModel::Rigid {
+        return Err(Error::InvalidInput(format!(
+            "--model rigid: robot `{}` has {} cables, which sagcal calibrates with catenaries (straight cables are its first stage)",
+            nominal.name,
+            nominal.cable_count()
+        )));
+    }
+    if args.false_alarm != 1e-3 {
+        return Err(Error::InvalidInput(format!(
+            "--false-alarm: the tests for single gross errors take robots of four cables; robot `{}` has {} cables, whose calibration is checked by the fit's chi-square test",
+            nominal.name,
+            nominal.cable_count()
+        )));
+    }
+    settings.options_for_weight(nominal.platform_weight_n, FrontEnd::Cli)
+}
+
+/// The human-readable report.
+fn render(report: &SuspendedCalibrationReport, options: &CalibrationOptions) -> String {
+    let n = &options.noise;
+    let orientation = match options.orientation_prior {
+        OrientationPrior::Off => "not used".to_string(),
+        _ => format!("{:.4} rad prior", n.orientation_sigma_rad),
+    };
+    let mut out = format!(
+        "sagcal calibrate: robot `{}`, {} cables (load cells on {}), catenary model, {} poses\nnoise: encoders {:.4} m, load cells {:.2} N, position {:.4} m, orientation {orientation}\n\n",
+        report.robot,
+        report.cables,
+        cable_list(&report.load_cells),
+        report.poses_used,
+        n.encoder_sigma_m,
+        n.load_cell_sigma_n,
+        n.position_sigma_m,
+    );
+    out += &parameter_tables(
+        &report.anchors_m,
+        report.anchor_sigma_m.as_deref(),
+        &report.anchor_change_m,
+        &report.length_offsets_m,
+        report.offset_sigma_m.as_deref(),
+    );
+    out += &fit_tables(&report.uncertainty, &report.factor_statistics, &report.stages);
+    out += &format!(
+        "\nchi-square {:.1} for {} degrees of freedom (99.9 % limit {:.1}): {}\n",
+        report.chi_square,
+        report.degrees_of_freedom,
+        report.chi_square_limit,
+        if report.consistent {
+            "the model and the stated noise explain the readings"
+        } else {
+            "INCONSISTENT: the readings disagree with the model or the stated noise"
+        }
+    );
+    if !report.poses_without_start.is_empty() {
+        out += &format!(
+            "note: poses {} had no equilibrium at their measured position for the straight-cable anchors; they started from the measured pose\n",
+            cable_list(&report.poses_without_start)
+        );
+    }
+    if !report.converged {
+        out += "WARNING: the solver did not converge\n";
+    }
+    out
+}
+
+/// `1, 3 and 5`.
+fn cable_list(items: &[usize]) -> String {
+    let words: Vec<String> = items.iter().map(ToString::to_string).collect();
+    match words.split_last() {
+        None => "none".into(),
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
+    }
+}
+
+/// The calibrated robot's file, its covariance as `[calibration]`, with the
+/// consistency verdict in its header comment.
+fn robot_text(result: &SuspendedCalibration, report: &SuspendedCalibrationReport) -> sagcal::Result<String> {
+    let covariance = match &result.uncertainty {
+        ParameterUncertainty::Full { covariance_m2, .. } => Some(covariance_m2.as_slice()),
+        ParameterUncertainty::RankDeficient { .. } => None,
+    };
+    let mut header =
+        "# Calibrated by sagcal: anchors and encoder length offsets estimated from measurements.\n".to_string();
+    if !report.consistent {
+        header += &format!(
+            "# WARNING: written with --accept-inconsistent; the fit FAILS its chi-square test ({:.1} for {} degrees of freedom, limit {:.1})\n",
+            report.chi_square, report.degrees_of_freedom, report.chi_square_limit
+        );
+    }
+    Ok(format!("{header}{}", result.robot.to_toml(covariance)?))
+}
+
+/// The anchor plot of a calibration of `N` cables (SVG).
+fn plot_svg(nominal: &SuspendedRobot, result: &SuspendedCalibration, positions: &[[f64; 3]], caption: &str) -> String {
+    let title = format!(
+        "sagcal: calibrated anchors of `{}` ({} cables, {} poses)",
+        nominal.name,
+        nominal.cable_count(),
+        result.poses.len()
+    );
+    let estimates: Vec<[f64; 3]> = result.robot.anchors_m.iter().map(|a| (*a).into()).collect();
+    let nominal_m: Vec<[f64; 3]> = nominal.anchors_m.iter().map(|a| (*a).into()).collect();
+    calibrated_anchor_plot(
+        title,
+        caption,
+        &nominal_m,
+        &estimates,
+        &result.uncertainty,
+        None,
+        positions,
+    )
+}
