@@ -400,12 +400,12 @@ fn simulate_takes_three_to_eight_cables() {
         let refused = sagcal(
             dir.path(),
             &[
-                "calibrate",
+                "diagnose",
                 "--robot",
                 &robot(name),
                 "--data",
                 "d.csv",
-                "--out",
+                "--plots",
                 "c.toml",
             ],
         );

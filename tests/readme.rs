@@ -418,4 +418,41 @@ fn the_eight_cable_example_prints_what_the_readme_shows() {
         printed.contains("8 cables, load cells on cable 1, cable 5"),
         "{printed}"
     );
+    // The calibration of those readings prints the README's lines, and its
+    // error (the data come from the file itself) is what the README says.
+    let mut calibrate = command_with(&readme, "calibrate", &["robots/eight.toml"]);
+    let printed = stdout(&sagcal(dir.path(), &args(&calibrate)));
+    let anchor_row = |l: &str| (l.starts_with("1 ") || l.starts_with("8 ")) && l.split_whitespace().count() == 10;
+    for line in printed.lines().filter(|l| anchor_row(l) || l.starts_with("chi-square")) {
+        says(&readme, &line.split_whitespace().collect::<Vec<_>>().join(" "));
+    }
+    assert!(dir.path().join("eight-calibrated.toml").exists());
+    calibrate.push("--json".into());
+    let report: serde_json::Value = serde_json::from_str(&stdout(&sagcal(dir.path(), &args(&calibrate)))).unwrap();
+    let mut worst: f64 = 0.0;
+    for (change, sigma) in report["anchor_change_m"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(report["anchor_sigma_m"].as_array().unwrap())
+    {
+        for k in 0..3 {
+            worst = worst.max(change[k].as_f64().unwrap().abs() / sigma[k].as_f64().unwrap());
+        }
+    }
+    says(
+        &readme,
+        &format!("within {:.1} of its 1-sigma on every coordinate", worst.ceil_to_tenth()),
+    );
+}
+
+/// Rounding up to a tenth, as the README states a bound.
+trait CeilToTenth {
+    fn ceil_to_tenth(self) -> f64;
+}
+
+impl CeilToTenth for f64 {
+    fn ceil_to_tenth(self) -> f64 {
+        (self * 10.0).ceil() / 10.0
+    }
 }

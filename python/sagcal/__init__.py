@@ -9,7 +9,7 @@ in and out, the same jobs with the same options, results and error messages.
   weights, encoder offsets and effects as numpy arrays and floats.
 - :func:`simulate`: measurements of a robot (``sagcal simulate``);
   :class:`SuspendedRobot` and :func:`simulate_suspended`: a robot of 3 to 8
-  cables and its measurements.
+  cables and its measurements; :func:`calibrate_suspended` calibrates it.
 - :func:`calibrate`: anchors and encoder offsets from measurements
   (``sagcal calibrate``), with their covariance and the gross-error tests.
 - :func:`diagnose`: what the calibration model gets wrong (``sagcal diagnose``).
@@ -63,6 +63,7 @@ from ._sagcal import (
     SagcalError,
     Simulation,
     SolverError,
+    SuspendedCalibration,
     SuspendedRobot,
     SuspendedSimulation,
     __version__,
@@ -73,6 +74,7 @@ from ._sagcal import (
 # anything but a SagcalError, and Ctrl-C raising KeyboardInterrupt.
 _COUNT = (0, _SEED_LIMIT)
 calibrate = _entry(_sagcal.calibrate)
+calibrate_suspended = _entry(_sagcal.calibrate_suspended)
 check = _entry(_sagcal.check)
 diagnose = _entry(_sagcal.diagnose, ints={"folds": _COUNT}, lists=("candidates",))
 init_robot = _entry(_sagcal.init_robot)
@@ -101,10 +103,12 @@ __all__ = [
     "SagcalError",
     "Simulation",
     "SolverError",
+    "SuspendedCalibration",
     "SuspendedRobot",
     "SuspendedSimulation",
     "__version__",
     "calibrate",
+    "calibrate_suspended",
     "check",
     "diagnose",
     "init_robot",

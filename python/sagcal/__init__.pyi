@@ -346,6 +346,14 @@ class SuspendedRobot:
     @property
     def columns(self) -> list[str]:
         """The columns of the robot's measurements."""
+    @property
+    def anchors_m(self) -> FloatArray:
+        """The anchors of cables 1..N, metres: (N, 3)."""
+    @property
+    def length_offsets_m(self) -> FloatArray:
+        """The encoder length offsets, metres: (N,)."""
+    def toml(self) -> str:
+        """The robot file's text (TOML)."""
 
 class SuspendedSimulation:
     """The result of :func:`simulate_suspended`."""
@@ -358,6 +366,66 @@ class SuspendedSimulation:
         """The random seed."""
     def write(self, path: PathLike, comments: Optional[Sequence[str]] = None) -> None:
         """Write the measurements as ``sagcal simulate`` writes them (atomically)."""
+
+class SuspendedCalibration:
+    """The result of :func:`calibrate_suspended`."""
+
+    @property
+    def robot(self) -> SuspendedRobot:
+        """The calibrated robot."""
+    @property
+    def anchors_m(self) -> FloatArray:
+        """Calibrated anchors, metres: (N, 3)."""
+    @property
+    def length_offsets_m(self) -> FloatArray:
+        """Calibrated length offsets, metres: (N,)."""
+    @property
+    def anchor_covariance_m2(self) -> Optional[FloatArray]:
+        """Per anchor its 3x3 covariance, m^2: (N, 3, 3); ``None`` if not observable."""
+    @property
+    def anchor_sigma_m(self) -> Optional[FloatArray]:
+        """1-sigma per anchor coordinate, metres: (N, 3); ``None`` if not observable."""
+    @property
+    def offset_sigma_m(self) -> Optional[FloatArray]:
+        """1-sigma per offset, metres: (N,); ``None`` if not observable."""
+    @property
+    def positions_m(self) -> FloatArray:
+        """Estimated platform positions, metres: (M, 3)."""
+    @property
+    def forces_n(self) -> FloatArray:
+        """Estimated ``(f_h, f_v)`` of every cable, newtons: (M, N, 2)."""
+    @property
+    def chi_square(self) -> float:
+        """The fit's chi-square."""
+    @property
+    def degrees_of_freedom(self) -> int:
+        """Residual rows minus unknowns."""
+    @property
+    def consistent(self) -> bool:
+        """Whether the fit passes its chi-square test and the solver converged."""
+    @property
+    def inconsistency(self) -> Optional[str]:
+        """Why the fit fails its test; ``None`` when it passes."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The report as ``sagcal calibrate --json`` prints it."""
+
+def calibrate_suspended(
+    robot: SuspendedRobot,
+    measurements: Union[ArrayLike, PathLike],
+    noise: str = "paper",
+    *,
+    encoder_sigma_m: Optional[float] = None,
+    load_cell_sigma_n: Optional[float] = None,
+    position_sigma_m: Optional[float] = None,
+    orientation_prior: str = "auto",
+    robust_encoder: str = "none",
+    robust_load_cell: str = "none",
+    robust_pose: str = "none",
+    accept_inconsistent: bool = False,
+    progress: Optional[Callable[[int, int, str], Any]] = None,
+) -> SuspendedCalibration:
+    """Calibrate anchors and encoder offsets of a robot of 3 to 8 cables, as ``sagcal calibrate`` does."""
 
 def calibrate(
     robot: Robot,

@@ -45,6 +45,20 @@ fn split_rows<const C: usize>(values: &[f64]) -> Vec<[f64; C]> {
         .collect()
 }
 
+/// The rows of an `(N, width)` array with `N >= 1`, `width` known only at
+/// run time (a robot's number of cables and load cells); `columns` names
+/// the columns in the error.
+pub fn dynamic_rows(value: &Bound<'_, PyAny>, width: usize, columns: &str, what: &str) -> PyResult<Vec<Vec<f64>>> {
+    let (shape, values) = float_array(value, what)?;
+    if shape.len() != 2 || shape[1] != width || shape[0] == 0 {
+        return Err(invalid(format!(
+            "{what} must be an (N, {width}) array with N >= 1 ({columns}), got shape {}",
+            shape_text(&shape)
+        )));
+    }
+    Ok(values.chunks_exact(width).map(<[f64]>::to_vec).collect())
+}
+
 /// The rows of an `(N, C)` array with `N >= 1`.
 pub fn rows<const C: usize>(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f64; C]>> {
     let (shape, values) = float_array(value, what)?;

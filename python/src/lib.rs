@@ -10,6 +10,7 @@
 
 mod arrays;
 mod calibrate;
+mod calibrate_suspended;
 mod check;
 mod data;
 mod diagnose;
@@ -156,11 +157,13 @@ fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<simulate::Simulation>()?;
     m.add_class::<suspended::SuspendedRobot>()?;
     m.add_class::<suspended::SuspendedSimulation>()?;
+    m.add_class::<calibrate_suspended::SuspendedCalibration>()?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose::diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(localize::localize, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(suspended::simulate_suspended, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate_suspended::calibrate_suspended, m)?)?;
     m.add_function(wrap_pyfunction!(data::read_measurements, m)?)?;
     m.add_function(wrap_pyfunction!(data::write_measurements, m)?)?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;

@@ -25,7 +25,7 @@ use crate::to_py;
 /// :meth:`SuspendedRobot.from_file`.
 #[pyclass(module = "sagcal", name = "SuspendedRobot", frozen)]
 pub struct SuspendedRobot {
-    inner: sagcal::model::suspended::SuspendedRobot,
+    pub(crate) inner: sagcal::model::suspended::SuspendedRobot,
 }
 
 #[pymethods]
@@ -69,6 +69,25 @@ impl SuspendedRobot {
     #[getter]
     fn columns(&self) -> Vec<String> {
         suspended_header(&self.inner)
+    }
+
+    /// The anchors of cables 1..N, world frame, metres: an (N, 3) array.
+    #[getter]
+    fn anchors_m<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let rows: Vec<[f64; 3]> = self.inner.anchors_m.iter().map(|a| (*a).into()).collect();
+        crate::arrays::out2(py, &rows)
+    }
+
+    /// The encoder length offsets of cables 1..N, metres: an (N,) array.
+    #[getter]
+    fn length_offsets_m<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        crate::arrays::out1(py, &self.inner.length_offsets_m)
+    }
+
+    /// The robot file's text (TOML), as ``sagcal calibrate --out`` writes it
+    /// (without a covariance).
+    fn toml(&self) -> PyResult<String> {
+        self.inner.to_toml(None).map_err(to_py)
     }
 
     fn __repr__(&self) -> String {

@@ -1,5 +1,7 @@
 """Robots of 3 to 8 cables from Python: the same numbers as ``sagcal simulate``."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -36,3 +38,39 @@ def test_suspended_robot_errors_name_what_is_wrong(tmp_path):
         sagcal.SuspendedRobot.from_file(path)
     with pytest.raises(sagcal.SagcalError, match="three cables fix the platform's orientation"):
         sagcal.simulate_suspended(sagcal.SuspendedRobot.builtin("three"), 2, closure="yaw")
+
+
+@pytest.mark.parametrize("name", ["three", "eight"])
+def test_calibrate_suspended_gives_the_commands_report(cli, tmp_path, name):
+    robot = sagcal.SuspendedRobot.builtin(name)
+    simulation = sagcal.simulate_suspended(robot, 24, seed=3)
+    data = tmp_path / "d.csv"
+    simulation.write(data)
+    stages = []
+    result = sagcal.calibrate_suspended(robot, simulation.measurements, progress=lambda d, t, w: stages.append(w))
+    assert stages == ["straight cables", "catenary (anchors held)", "catenary", "done"]
+    assert result.anchors_m.shape == (robot.cable_count, 3)
+    assert result.forces_n.shape == (24, robot.cable_count, 2)
+    assert result.consistent and result.inconsistency is None
+    # Within 4 sigma of the truth the data were simulated from, per coordinate.
+    assert np.all(np.abs(result.anchors_m - robot.anchors_m) < 4 * result.anchor_sigma_m)
+    report = cli("calibrate", "--robot", ROOT / "robots" / f"{name}.toml", "--data", data, "--json")
+    command = json.loads(report.stdout)
+    assert command["anchors_m"] == result.report["anchors_m"], "an array and its file give the command's numbers"
+    assert command["chi_square"] == result.chi_square
+    assert result.robot.toml().count("[[cables]]") == robot.cable_count
+
+
+def test_calibrate_suspended_refuses_a_blunder_and_a_bad_array():
+    robot = sagcal.SuspendedRobot.builtin("six")
+    data = np.array(sagcal.simulate_suspended(robot, 30, seed=7).measurements)
+    data[4, 7] += 0.5  # cable 2 of row 5 reads 0.5 m long
+    with pytest.raises(sagcal.CalibrationRefused, match=r"accept_inconsistent=True returns it anyway.*chi-square"):
+        sagcal.calibrate_suspended(robot, data)
+    accepted = sagcal.calibrate_suspended(robot, data, accept_inconsistent=True)
+    assert not accepted.consistent and "chi-square" in accepted.inconsistency
+    with pytest.raises(sagcal.SagcalError, match=r"measurements must be an \(N, 13\) array"):
+        sagcal.calibrate_suspended(robot, data[:, :12])
+    data[2, 12] = -1.0
+    with pytest.raises(sagcal.SagcalError, match="row 3.*f1_n.*must be positive"):
+        sagcal.calibrate_suspended(robot, data)

@@ -2,8 +2,10 @@
 //! ([`sagcal::calib::suspended`]): the report, the calibrated robot file and
 //! the anchor plot.
 
-use sagcal::calib::suspended::{calibrate_suspended, SuspendedCalibration, SuspendedCalibrationReport};
-use sagcal::calib::{CableModel, CalibrationOptions, OrientationPrior, ParameterUncertainty};
+use sagcal::calib::suspended::{
+    calibrate_suspended, suspended_options, SuspendedCalibration, SuspendedCalibrationReport,
+};
+use sagcal::calib::{refusal, CalibrationOptions, OrientationPrior, ParameterUncertainty};
 use sagcal::error::FrontEnd;
 use sagcal::io::suspended_measurements::read_suspended_measurements;
 use sagcal::io::OutputSet;
@@ -32,19 +34,14 @@ pub(super) fn run(args: &CalibrateArgs, nominal: &SuspendedRobot) -> sagcal::Res
     let result = result?;
     let report = SuspendedCalibrationReport::new(nominal, &result);
     let text = render(&report, &options);
-    if !report.consistent && args.out.is_some() && !args.accept_inconsistent {
+    if let Some(reason) = report.inconsistency().filter(|_| !args.accept_inconsistent) {
+        // Nothing is written: the report goes out (as text or JSON), then the refusal.
         if args.json {
             print_json(&report)?;
         } else {
             print!("{text}");
         }
-        return Err(Error::InvalidInput(format!(
-            "the calibrated robot was not written: the fit fails its chi-square test ({:.1} for {} degrees of freedom, 99.9 % limit {:.1}){}; fix the data (or the robot file), or pass --accept-inconsistent",
-            report.chi_square,
-            report.degrees_of_freedom,
-            report.chi_square_limit,
-            if report.converged { "" } else { " and the solver did not converge" }
-        )));
+        return Err(refusal(&args.data.display().to_string(), &reason, FrontEnd::Cli));
     }
     // Files only after everything succeeded: all of them or none, none over an input.
     let mut outputs = OutputSet::new();
@@ -76,14 +73,6 @@ pub(super) fn run(args: &CalibrateArgs, nominal: &SuspendedRobot) -> sagcal::Res
 /// The options of `args` for `nominal`; the choices only the four-cable
 /// pipeline has are refused by name.
 fn options(args: &CalibrateArgs, nominal: &SuspendedRobot) -> sagcal::Result<CalibrationOptions> {
-    let settings = args.solver.settings();
-    if settings.model == CableModel::Rigid {
-        return Err(Error::InvalidInput(format!(
-            "--model rigid: robot `{}` has {} cables, which sagcal calibrates with catenaries (straight cables are its first stage)",
-            nominal.name,
-            nominal.cable_count()
-        )));
-    }
     if args.false_alarm != 1e-3 {
         return Err(Error::InvalidInput(format!(
             "--false-alarm: the tests for single gross errors take robots of four cables; robot `{}` has {} cables, whose calibration is checked by the fit's chi-square test",
@@ -91,7 +80,7 @@ fn options(args: &CalibrateArgs, nominal: &SuspendedRobot) -> sagcal::Result<Cal
             nominal.cable_count()
         )));
     }
-    settings.options_for_weight(nominal.platform_weight_n, FrontEnd::Cli)
+    suspended_options(&args.solver.settings(), nominal, FrontEnd::Cli)
 }
 
 /// The human-readable report.
@@ -161,11 +150,9 @@ fn robot_text(result: &SuspendedCalibration, report: &SuspendedCalibrationReport
     };
     let mut header =
         "# Calibrated by sagcal: anchors and encoder length offsets estimated from measurements.\n".to_string();
-    if !report.consistent {
-        header += &format!(
-            "# WARNING: written with --accept-inconsistent; the fit FAILS its chi-square test ({:.1} for {} degrees of freedom, limit {:.1})\n",
-            report.chi_square, report.degrees_of_freedom, report.chi_square_limit
-        );
+    if let Some(reason) = report.inconsistency() {
+        header +=
+            &format!("# WARNING: written with --accept-inconsistent; the fit FAILS its consistency tests: {reason}\n");
     }
     Ok(format!("{header}{}", result.robot.to_toml(covariance)?))
 }

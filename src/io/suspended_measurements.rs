@@ -218,8 +218,14 @@ fn parse_row(
         }
         values.push(value);
     }
+    Ok(measurement_at(robot, line, &values))
+}
+
+/// The measurement of line `line` from its values in [`suspended_header`]
+/// order (no checks).
+fn measurement_at(robot: &SuspendedRobot, line: usize, values: &[f64]) -> SuspendedMeasurement {
     let n = robot.cable_count();
-    Ok(SuspendedMeasurement {
+    SuspendedMeasurement {
         line,
         position_m: [values[0], values[1], values[2]],
         roll_deg: values[3],
@@ -227,7 +233,45 @@ fn parse_row(
         yaw_deg: values[5],
         encoder_lengths_m: values[6..6 + n].to_vec(),
         load_cell_tensions_n: values[6 + n..].to_vec(),
-    })
+    }
+}
+
+/// One measurement of `robot` from its values in [`suspended_header`]
+/// order, for data that never were a file (the Python binding's arrays):
+/// the checks and messages of [`read_suspended_measurements`] for a row,
+/// `source` naming the data and `row` its 1-based row; the line is 0.
+pub fn suspended_measurement_from_values(
+    source: &Path,
+    robot: &SuspendedRobot,
+    row: usize,
+    values: &[f64],
+) -> Result<SuspendedMeasurement> {
+    let header = suspended_header(robot);
+    let err = |field: &str, message: String| Error::Field {
+        path: source.to_path_buf(),
+        row,
+        line: None,
+        field: field.to_string(),
+        message,
+    };
+    if values.len() != header.len() {
+        return Err(err(
+            "the row",
+            format!(
+                "{} values, but robot `{}` has {} columns: {}",
+                values.len(),
+                robot.name,
+                header.len(),
+                header.join(", ")
+            ),
+        ));
+    }
+    for (column, &value) in header.iter().zip(values) {
+        if let Some(problem) = value_problem(column, value) {
+            return Err(err(column, problem));
+        }
+    }
+    Ok(measurement_at(robot, 0, values))
 }
 
 #[cfg(test)]

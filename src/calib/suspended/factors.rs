@@ -3,8 +3,8 @@
 //! blocks. Each cable of each pose carries its own end forces `(f_h, f_v)`
 //! as a variable; the equilibrium factor balances them against gravity.
 //!
-//! - [`CatenaryCableFactor`]: one cable's length (paper eq. 14) and
-//!   attachment height (eq. 15) rows;
+//! - [`CatenaryCableFactor`]: one cable's length (paper eq. 14) or
+//!   attachment height (eq. 15);
 //! - [`StraightCableFactor`]: one massless cable's length row (the rigid stage);
 //! - [`EquilibriumFactor`]: the six equations of equilibrium (eq. 5-8), the
 //!   cables' wrenches minus the weight's;
@@ -12,7 +12,9 @@
 //!
 //! ```
 //! use nalgebra::{DMatrix, DVector, Vector3};
-//! use sagcal::calib::suspended::factors::{CableConstants, CableVariables, CatenaryCableFactor, EquilibriumFactor};
+//! use sagcal::calib::suspended::factors::{
+//!     CableConstants, CableRow, CableVariables, CatenaryCableFactor, EquilibriumFactor,
+//! };
 //! use sagcal::graph::{Factor, RobustKernel, Values, VariableValue};
 //! use sagcal::model::suspended::{solve_at, Closure, EquilibriumOptions, SuspendedRobot};
 //! let robot = SuspendedRobot::builtin("three")?;
@@ -25,15 +27,14 @@
 //! let anchors: Vec<_> = robot.anchors_m.iter().map(|a| values.insert("anchor", vector(a.as_slice()))).collect();
 //! let offset = values.insert("offset", vector(&[0.2]));
 //! // At an equilibrium every cable reaches its attachment with the length its encoder reads ...
-//! let cable = CatenaryCableFactor::new(
-//!     CableVariables { pose, forces: forces[1], anchor: anchors[1], length_offset: offset },
-//!     CableConstants { attachment_m: robot.attachments_m[1], weight_n_per_m: robot.cable_weights_n_per_m[1] },
-//!     eq.cable_lengths_m[1] + 0.2,
-//!     0.01,
-//!     1e-4,
-//!     RobustKernel::None,
-//! );
-//! assert!(cable.evaluate(&values, None).unwrap().amax() < 1e-9);
+//! let variables = CableVariables { pose, forces: forces[1], anchor: anchors[1], length_offset: offset };
+//! let constants =
+//!     CableConstants { attachment_m: robot.attachments_m[1], weight_n_per_m: robot.cable_weights_n_per_m[1] };
+//! for (row, sigma_m) in [(CableRow::Length, 0.01), (CableRow::Height, 1e-4)] {
+//!     let cable =
+//!         CatenaryCableFactor::new(variables, constants, eq.cable_lengths_m[1] + 0.2, row, sigma_m, RobustKernel::None);
+//!     assert!(cable.evaluate(&values, None).unwrap()[0].abs() < 1e-9);
+//! }
 //! // ... and the cables hold the platform's weight: six equations, one block per variable.
 //! let statics = EquilibriumFactor::new(
 //!     pose, &forces, &anchors, &robot.attachments_m, robot.com_offset_m, robot.platform_weight_n, 1e-3, 1.0,
@@ -53,25 +54,19 @@ use crate::calib::factors::{pose_arguments, EPSILON};
 use crate::generated;
 use crate::graph::{evaluate_through_into, Factor, Noise, RobustKernel, Values, VariableId};
 
-/// The methods every factor of this file shares: its variables, `$rows`
-/// residual rows evaluated through `evaluate_into`, its noise and `$kind`;
-/// each fills every entry of every block it is given.
+/// The methods every factor of this file shares: its variables, its
+/// residual evaluated through `evaluate_into` and its noise; each fills
+/// every entry of every block it is given.
 macro_rules! factor_basics {
-    ($rows:expr, $kind:literal) => {
+    () => {
         fn variables(&self) -> &[VariableId] {
             &self.variables
-        }
-        fn residual_dim(&self) -> usize {
-            $rows
         }
         fn evaluate(&self, values: &Values, jacobians: Option<&mut [DMatrix<f64>]>) -> Option<DVector<f64>> {
             evaluate_through_into(self, values, jacobians)
         }
         fn noise(&self) -> &Noise {
             &self.noise
-        }
-        fn kind(&self) -> &'static str {
-            $kind
         }
         fn writes_every_jacobian_entry(&self) -> bool {
             true
@@ -102,24 +97,35 @@ pub struct CableConstants {
     pub weight_n_per_m: f64,
 }
 
-/// Paper eq. (14) and (15) for one cable with its own forces: the rows
-/// `[l_C + l0 - z_enc (m), (p + R b)_z - a_z + drop (m)]`, sigmas the
-/// encoder's and the height constraint's.
+/// Which row of one cable's eq. (14)-(15) a [`CatenaryCableFactor`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CableRow {
+    /// `l_C + l0 - z_enc` (eq. 14), metres, the encoder's sigma.
+    Length,
+    /// `(p + R b)_z - a_z + drop` (eq. 15), metres, the height constraint's sigma.
+    Height,
+}
+
+/// Paper eq. (14) or (15) for one cable with its own forces (one row of
+/// `generated::suspended_cable_residual`): its statistics are the
+/// encoders' (`catenary_length`) or the constraint's (`attachment_height`),
+/// as the four-cable graph reports them.
 pub struct CatenaryCableFactor {
     variables: [VariableId; 4],
     cable: CableConstants,
     encoder_length_m: f64,
+    row: CableRow,
     noise: Noise,
 }
 
 impl CatenaryCableFactor {
-    /// The factor of `cable` reading `encoder_length_m`.
+    /// The `row` of `cable` reading `encoder_length_m`, with standard deviation `sigma_m`.
     pub fn new(
         variables: CableVariables,
         cable: CableConstants,
         encoder_length_m: f64,
-        encoder_sigma_m: f64,
-        height_sigma_m: f64,
+        row: CableRow,
+        sigma_m: f64,
         kernel: RobustKernel,
     ) -> Self {
         Self {
@@ -131,7 +137,8 @@ impl CatenaryCableFactor {
             ],
             cable,
             encoder_length_m,
-            noise: Noise::new(DVector::from_row_slice(&[encoder_sigma_m, height_sigma_m]), kernel),
+            row,
+            noise: Noise::isotropic(1, sigma_m, kernel),
         }
     }
 }
@@ -142,7 +149,16 @@ fn fixed<const D: usize>(values: &Values, id: VariableId) -> SMatrix<f64, D, 1> 
 }
 
 impl Factor for CatenaryCableFactor {
-    factor_basics!(2, "cable");
+    factor_basics!();
+    fn residual_dim(&self) -> usize {
+        1
+    }
+    fn kind(&self) -> &'static str {
+        match self.row {
+            CableRow::Length => "catenary_length",
+            CableRow::Height => "attachment_height",
+        }
+    }
     fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
         let (position, rotation) = pose_arguments(values, self.variables[0]);
         let forces: Vector2<f64> = fixed(values, self.variables[1]);
@@ -170,14 +186,18 @@ impl Factor for CatenaryCableFactor {
             want.then_some(&mut j_anchor),
             want.then_some(&mut j_offset),
         );
+        let k = match self.row {
+            CableRow::Length => 0,
+            CableRow::Height => 1,
+        };
         if let Some(blocks) = jacobians {
-            blocks[0].copy_from(&j_pose);
-            blocks[1].copy_from(&j_forces);
-            blocks[2].copy_from(&j_anchor);
-            blocks[3].copy_from(&j_offset);
+            blocks[0].copy_from(&j_pose.row(k));
+            blocks[1].copy_from(&j_forces.row(k));
+            blocks[2].copy_from(&j_anchor.row(k));
+            blocks[3].copy_from(&j_offset.row(k));
         }
-        residual.copy_from_slice(r.as_slice());
-        r.iter().all(|v| v.is_finite())
+        residual[0] = r[k];
+        r[k].is_finite()
     }
 }
 
@@ -209,7 +229,13 @@ impl StraightCableFactor {
 }
 
 impl Factor for StraightCableFactor {
-    factor_basics!(1, "straight_cable");
+    factor_basics!();
+    fn residual_dim(&self) -> usize {
+        1
+    }
+    fn kind(&self) -> &'static str {
+        "straight_cable"
+    }
     fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
         let (position, rotation) = pose_arguments(values, self.variables[0]);
         let anchor: Vector3<f64> = fixed(values, self.variables[1]);
@@ -296,7 +322,13 @@ impl EquilibriumFactor {
 }
 
 impl Factor for EquilibriumFactor {
-    factor_basics!(6, "equilibrium");
+    factor_basics!();
+    fn residual_dim(&self) -> usize {
+        6
+    }
+    fn kind(&self) -> &'static str {
+        "equilibrium"
+    }
     fn evaluate_into(&self, values: &Values, residual: &mut [f64], mut jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
         let n = self.cable_count();
         let (position, rotation) = pose_arguments(values, self.variables[0]);
@@ -363,7 +395,13 @@ impl CableLoadCellFactor {
 }
 
 impl Factor for CableLoadCellFactor {
-    factor_basics!(1, "load_cell");
+    factor_basics!();
+    fn residual_dim(&self) -> usize {
+        1
+    }
+    fn kind(&self) -> &'static str {
+        "load_cell"
+    }
     fn evaluate_into(&self, values: &Values, residual: &mut [f64], jacobians: Option<&mut [DMatrix<f64>]>) -> bool {
         let forces: Vector2<f64> = fixed(values, self.variables[0]);
         let mut j = SMatrix::<f64, 1, 2>::zeros();

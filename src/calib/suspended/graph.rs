@@ -10,11 +10,12 @@
 use nalgebra::{DVector, Vector3};
 
 use super::factors::{
-    CableConstants, CableLoadCellFactor, CableVariables, CatenaryCableFactor, EquilibriumFactor, StraightCableFactor,
+    CableConstants, CableLoadCellFactor, CableRow, CableVariables, CatenaryCableFactor, EquilibriumFactor,
+    StraightCableFactor,
 };
 use crate::calib::factors::PosePriorFactor;
 use crate::calib::options::CalibrationOptions;
-use crate::graph::{FactorGraph, Values, VariableId, VariableValue};
+use crate::graph::{FactorGraph, RobustKernel, Values, VariableId, VariableValue};
 use crate::model::pose::PlatformPose;
 use crate::model::statics::CableTension;
 use crate::model::suspended::{SuspendedMeasurement, SuspendedRobot};
@@ -180,22 +181,31 @@ fn add_cable(
             noise.encoder_sigma_m,
             options.robust.encoder,
         )),
-        Some(&forces) => graph.add(CatenaryCableFactor::new(
-            CableVariables {
+        Some(&forces) => {
+            let variables = CableVariables {
                 pose: vars.pose,
                 forces,
                 anchor,
                 length_offset,
-            },
-            CableConstants {
+            };
+            let constants = CableConstants {
                 attachment_m: robot.attachments_m[i],
                 weight_n_per_m: robot.cable_weights_n_per_m[i],
-            },
-            encoder_length_m,
-            noise.encoder_sigma_m,
-            options.height_sigma_m,
-            options.robust.encoder,
-        )),
+            };
+            for (row, sigma_m, kernel) in [
+                (CableRow::Length, noise.encoder_sigma_m, options.robust.encoder),
+                (CableRow::Height, options.height_sigma_m, RobustKernel::None),
+            ] {
+                graph.add(CatenaryCableFactor::new(
+                    variables,
+                    constants,
+                    encoder_length_m,
+                    row,
+                    sigma_m,
+                    kernel,
+                ));
+            }
+        }
     }
 }
 

@@ -33,6 +33,7 @@
 mod calibrate;
 pub mod factors;
 mod graph;
+mod options;
 mod report;
 mod start;
 
@@ -41,5 +42,6 @@ pub use graph::{
     build_suspended_graph, min_poses, pose_starts_from_graph, robot_from_suspended_graph, PoseStart, SuspendedGraph,
     SuspendedPoseVariables, SuspendedStage, EQUILIBRIUM_SIGMA_PER_WEIGHT,
 };
+pub use options::suspended_options;
 pub use report::SuspendedCalibrationReport;
 pub use start::{catenary_starts, offsets_in_closed_form, straight_offsets};

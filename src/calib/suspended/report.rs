@@ -55,6 +55,23 @@ pub struct SuspendedCalibrationReport {
 }
 
 impl SuspendedCalibrationReport {
+    /// Why the fit is not to be trusted, naming the test; `None` when it
+    /// passes its chi-square test and the solver converged.
+    pub fn inconsistency(&self) -> Option<String> {
+        let chi_square = format!(
+            "chi-square {:.1} for {} degrees of freedom, 99.9 % limit {:.1}",
+            self.chi_square, self.degrees_of_freedom, self.chi_square_limit
+        );
+        match (self.converged, self.chi_square <= self.chi_square_limit) {
+            (true, true) => None,
+            (true, false) => Some(format!(
+                "the readings disagree with the model of {} cables or with the stated noise ({chi_square}); look for a blunder in the data or a wrong robot file",
+                self.cables
+            )),
+            (false, _) => Some(format!("the solver did not converge ({chi_square})")),
+        }
+    }
+
     /// The report of `result`, calibrated from `nominal`.
     pub fn new(nominal: &SuspendedRobot, result: &SuspendedCalibration) -> Self {
         let robot = &result.robot;
