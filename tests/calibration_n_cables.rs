@@ -1,18 +1,20 @@
-//! Calibration of robots of 3 to 8 cables: round trips from simulated,
-//! noiseless readings, starting away from the truth.
+//! Calibration and localisation of robots of 3 to 8 cables: round trips
+//! from simulated, noiseless readings, starting away from the truth; noisy
+//! calibrations from 10 m off; the command and its refusals.
 
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sagcal::calib::suspended::calibrate_suspended;
 use sagcal::calib::CalibrationOptions;
+use sagcal::localize::suspended::localize_suspended;
 use sagcal::model::sensors::{NoisePreset, SensorNoise};
-use sagcal::model::suspended::{SuspendedMeasurement, SuspendedRobot};
+use sagcal::model::suspended::{SuspendedEquilibrium, SuspendedMeasurement, SuspendedRobot};
 use sagcal::sim::closed_form::{Closure, Workspace};
 use sagcal::sim::suspended::{measure_suspended, sample_suspended};
 
-/// `count` noiseless readings of `truth` (seed `seed`).
-fn readings(truth: &SuspendedRobot, count: usize, seed: u64) -> Vec<SuspendedMeasurement> {
+/// `count` noiseless readings of `truth` (seed `seed`), and the equilibria they were read at.
+fn readings(truth: &SuspendedRobot, count: usize, seed: u64) -> (Vec<SuspendedMeasurement>, Vec<SuspendedEquilibrium>) {
     let workspace = truth
         .workspace
         .unwrap_or_else(|| Workspace::around_anchor_points(&truth.anchors_m));
@@ -24,7 +26,7 @@ fn readings(truth: &SuspendedRobot, count: usize, seed: u64) -> Vec<SuspendedMea
     };
     let equilibria = sample_suspended(truth, &workspace, count, closure, &mut rng).unwrap();
     let silent = NoisePreset::None.sigmas(truth.platform_weight_n);
-    measure_suspended(truth, &equilibria, &silent, &mut rng)
+    (measure_suspended(truth, &equilibria, &silent, &mut rng), equilibria)
 }
 
 /// `truth` with offsets of a few decimetres, and a guess of it with every
@@ -69,7 +71,7 @@ fn paper_options(robot: &SuspendedRobot) -> CalibrationOptions {
 fn noiseless_round_trips_recover_every_robot() {
     for name in ["three", "large", "five", "six", "seven", "eight"] {
         let (truth, guess) = truth_and_guess(name, 0.5);
-        let measurements = readings(&truth, 24, 11);
+        let (measurements, equilibria) = readings(&truth, 24, 11);
         let mut stages = Vec::new();
         // Noiseless data: stop on the step alone, not on a relative cost decrease.
         let mut options = paper_options(&truth);
@@ -99,6 +101,16 @@ fn noiseless_round_trips_recover_every_robot() {
             result.fell_back
         );
         assert!(anchor_error < 1e-9 && offset_error < 1e-9, "{name}");
+        // The calibrated robot localised from the same readings: every pose found again.
+        let sigmas = NoisePreset::Paper.sigmas(truth.platform_weight_n);
+        let mut worst: f64 = 0.0;
+        for (row, eq) in measurements.iter().zip(&equilibria) {
+            let found = localize_suspended(&result.robot, row, &sigmas, 1e-3).unwrap();
+            assert!(found.consistent && found.stable, "{name}: {found:?}");
+            worst = worst.max((found.pose.position_m - eq.pose.position_m).norm());
+        }
+        println!("{name}: localised positions {worst:.2e} m from the truth");
+        assert!(worst < 1e-9, "{name}: {worst}");
     }
 }
 
@@ -208,7 +220,8 @@ fn robot_path(name: &str) -> String {
 /// `sagcal calibrate` on simulated readings of the six- and eight-cable
 /// robots: the JSON report's anchors lie within 4 sigma of the truth (the
 /// robot file simulated from), the fit passes its chi-square test, and the
-/// written robot reads back with the reported anchors and offsets.
+/// written robot reads back with the reported anchors and offsets;
+/// `sagcal localize` with that robot finds every row.
 #[test]
 fn the_command_calibrates_six_and_eight_cables() {
     let dir = tempfile::tempdir().unwrap();
@@ -262,6 +275,25 @@ fn the_command_calibrates_six_and_eight_cables() {
         }
         println!("{name}: worst anchor coordinate {worst:.2} sigma from the truth");
         assert!(worst < 4.0, "{name}: {worst}");
+        // The calibrated robot localises the same rows: none flagged, each
+        // position within 5 of its 1-sigma (the reading noise's and the
+        // localiser's 5 mm) of the localiser's.
+        let out = sagcal(
+            dir.path(),
+            &["localize", "--robot", &written, "--data", &data, "--json", "--out", "poses.csv"],
+        );
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(report["rows_flagged"], 0, "{name}");
+        for row in report["rows"].as_array().unwrap() {
+            let sigma = row["position_sigma_m"].as_array().unwrap().iter().map(|s| s.as_f64().unwrap());
+            let combined = sigma.map(|s| s * s + 0.005 * 0.005).sum::<f64>().sqrt();
+            let error = row["position_error_m"].as_f64().unwrap();
+            assert!(error < 5.0 * combined, "{name}: {error} m against {combined} m");
+        }
+        let csv = std::fs::read_to_string(dir.path().join("poses.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 31);
+        assert!(csv.starts_with("row,line,x_m"));
     }
 }
 

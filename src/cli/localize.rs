@@ -1,8 +1,6 @@
 //! `sagcal localize`: the calibrated robot's pose and tensions from its cable readings;
 //! its flags ([`LocalizeArgs`]) and the run.
 
-use std::path::PathBuf;
-
 use serde::Serialize;
 
 use sagcal::error::FrontEnd;
@@ -14,45 +12,9 @@ use sagcal::model::DataRow;
 use sagcal::model::Robot;
 use sagcal::plot::localize::{localize_plot_svg, LocalizePlot, PlottedPose};
 
+pub(super) use super::localize_args::LocalizeArgs;
 use super::output::{opt, print_json, progress_bar, Table};
-
-#[derive(Debug, clap::Args)]
-pub(super) struct LocalizeArgs {
-    /// The calibrated robot (TOML): anchors, length offsets, `[effects]`.
-    #[arg(long)]
-    robot: PathBuf,
-    /// Readings: `l1_m,l2_m,l3_m,l4_m[,f_ref_n]`, a sagcal measurement file, a RecurDyn log or
-    /// the authors' dataset folder.
-    #[arg(long)]
-    data: PathBuf,
-    /// Use the input's localiser pose as a prior (by default it is only compared with).
-    #[arg(long)]
-    pose_prior: bool,
-    /// Sensor sigmas of the readings: paper or authors.
-    #[arg(long, default_value = "paper", value_parser = sagcal::model::sensors::NoisePreset::parse)]
-    noise: sagcal::model::sensors::NoisePreset,
-    /// False-alarm rate of each row's chi-square consistency test.
-    #[arg(long, default_value_t = 1e-3)]
-    false_alarm: f64,
-    /// Leave the robot file's recorded calibration covariance out of the sigmas.
-    #[arg(long)]
-    no_calibration_uncertainty: bool,
-    /// Skip the multistart search for every equilibrium of each row (about
-    /// 1000 starts per row): for long trajectories, each row warm-started
-    /// from the previous one.
-    #[arg(long)]
-    fast: bool,
-    /// Write the poses as CSV (atomically).
-    #[arg(long)]
-    out: Option<PathBuf>,
-    /// Draw the localised poses with their 1-sigma ellipses (top and side
-    /// views), beside the input's poses when it has them (PNG if the name ends in `.png`, SVG otherwise).
-    #[arg(long)]
-    plot: Option<PathBuf>,
-    /// Print JSON instead of the table.
-    #[arg(long)]
-    json: bool,
-}
+use super::robot_kind::{read_robot, AnyRobot};
 
 /// What the position sigmas hold, by whether the robot records its calibration's covariance.
 fn covariance_note(robot: &Robot, used: bool) -> &'static str {
@@ -121,8 +83,14 @@ struct Report {
 }
 
 /// Localise every row and print the table (or JSON); `--out` gets the CSV.
+/// Localise every row of `--data` on the robot of `--robot`: the
+/// four-cable localiser, or for a robot of 3 to 8 cables
+/// [`super::localize_suspended::run`].
 pub fn run(args: &LocalizeArgs) -> sagcal::Result<()> {
-    let robot = Robot::from_file(&args.robot)?;
+    let robot = match read_robot(&args.robot)? {
+        AnyRobot::Four(robot) => *robot,
+        AnyRobot::Suspended(robot) => return super::localize_suspended::run(args, &robot),
+    };
     let file = read_readings(&args.data, robot.reference_cable)?;
     let localizer = LocalizeSettings {
         noise: args.noise,

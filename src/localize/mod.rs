@@ -52,6 +52,8 @@ mod newton;
 mod sequence;
 mod settings;
 pub mod stiffness;
+pub mod suspended;
+mod suspended_rows;
 
 pub use equations::{
     model_at_pose, parameter_partials, ModelAtPose, ParameterPartials, SlotRobot, EPSILON, MEASUREMENT_ROWS,
@@ -62,3 +64,4 @@ pub use frame::Frame;
 pub use localizer::{trilaterate, LocalizeOptions, Localized, Localizer, Readings};
 pub use sequence::{EquilibriumSearch, SequenceRow};
 pub use settings::{require_pose_priors, LocalizeSettings};
+pub use suspended_rows::{localize_suspended_rows, SuspendedLocalizationReport, SuspendedRowReport};

@@ -44,4 +44,4 @@ pub use graph::{
 };
 pub use options::suspended_options;
 pub use report::SuspendedCalibrationReport;
-pub use start::{catenary_starts, offsets_in_closed_form, straight_offsets};
+pub use start::{catenary_starts, chord_shares, offsets_in_closed_form, straight_offsets};

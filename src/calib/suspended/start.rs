@@ -49,7 +49,7 @@ pub fn catenary_starts(robot: &SuspendedRobot, measurements: &[SuspendedMeasurem
 
 /// Every cable with `f_v = m_e g / N` and `f_h = f_v / tan(alpha)`, alpha
 /// its chord's elevation (the paper's eq. 17-18 with `N` cables).
-fn chord_shares(robot: &SuspendedRobot, pose: &PlatformPose) -> Vec<CableTension> {
+pub fn chord_shares(robot: &SuspendedRobot, pose: &PlatformPose) -> Vec<CableTension> {
     let vertical_n = robot.platform_weight_n / robot.cable_count() as f64;
     let rotation = pose.rotation_matrix();
     (0..robot.cable_count())
