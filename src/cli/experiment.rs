@@ -1,8 +1,6 @@
 //! `sagcal experiment table2`: the paper's calibration protocol; its flags
 //! ([`Table2Args`]) and the run.
 
-use std::path::PathBuf;
-
 use sagcal::calib::{CableModel, OrientationPrior};
 use sagcal::experiments::selection::{PlanSettings, Selection};
 use sagcal::experiments::table2::{
@@ -16,69 +14,8 @@ use serde::Serialize;
 use sagcal::model::effect_kind::{EffectKind, EffectSet};
 
 use super::output::{print_json, progress_bar, Table};
-use super::parse::{parse_pose_counts, parse_source};
-
-#[derive(Debug, clap::Args)]
-pub(super) struct Table2Args {
-    /// The true robot (TOML).
-    #[arg(long)]
-    robot: PathBuf,
-    /// The log whose poses are sampled (RecurDyn or sagcal CSV, or the authors' dataset folder).
-    #[arg(long)]
-    data: PathBuf,
-    /// Pose counts, comma separated.
-    #[arg(long, default_value = "9,18,35", value_parser = parse_pose_counts)]
-    poses: std::vec::Vec<usize>,
-    /// Trials per pose count.
-    #[arg(long, default_value_t = 100)]
-    trials: usize,
-    /// Random seed.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// Cable model of the calibration: catenary or rigid.
-    #[arg(long, default_value = "catenary", value_parser = sagcal::calib::CableModel::parse)]
-    model: sagcal::calib::CableModel,
-    /// Noise reading: paper (the paper's text) or authors (the authors' program).
-    #[arg(long, default_value = "paper", value_parser = sagcal::model::sensors::NoisePreset::parse)]
-    noise: sagcal::model::sensors::NoisePreset,
-    /// `log`: the log's own lengths and tensions; `model`: the model's equilibria at the logged poses.
-    #[arg(long, default_value = "log", value_parser = parse_source)]
-    source: sagcal::experiments::table2::Source,
-    /// Anchor perturbation of the initial guess, m (default 10, 1 for light robots).
-    #[arg(long)]
-    anchor_perturbation_m: Option<f64>,
-    /// Offset perturbation of the initial guess, m (default 80, 10 for light robots).
-    #[arg(long)]
-    offset_perturbation_m: Option<f64>,
-    /// Right-basin radius: every anchor within it, m (default 0.3 x the anchor perturbation; unlimited for rigid).
-    #[arg(long)]
-    basin_radius_m: Option<f64>,
-    /// The localiser's orientation as a prior: `auto` (used unless a chi-square test finds it
-    /// inconsistent with the statics), `on` or `off` (the statics decide).
-    #[arg(long, default_value = "auto", value_parser = sagcal::calib::OrientationPrior::parse)]
-    orientation_prior: sagcal::calib::OrientationPrior,
-    /// Effects estimated with the anchors (comma separated, e.g. a `diagnose`
-    /// verdict such as `encoder-gain,segments`); default: none.
-    #[arg(long)]
-    estimate: Option<String>,
-    /// Leave out the readings the gross-error tests flag, as `calibrate` does
-    /// (default: every trial is tested and the flags counted, the fit uses every reading).
-    #[arg(long)]
-    apply_gross_errors: bool,
-    /// How each trial's poses are chosen from the pool: random (the paper), planned
-    /// (`sagcal plan` over the pool) or sequential (plan half, calibrate, re-plan the rest at the estimate).
-    #[arg(long, default_value = "random", value_parser = ["random", "planned", "sequential"])]
-    select: String,
-    /// The plan's criterion (with --select planned|sequential): a or d.
-    #[arg(long, default_value = "a", value_parser = sagcal::plan::Criterion::parse)]
-    plan_criterion: sagcal::plan::Criterion,
-    /// The planner's nominal anchors are this far from the truth, each in a random direction, m.
-    #[arg(long, default_value_t = 0.0)]
-    plan_anchor_error_m: f64,
-    /// Print JSON.
-    #[arg(long)]
-    json: bool,
-}
+use super::robot_kind::{read_robot, AnyRobot};
+pub(super) use super::table2_args::Table2Args;
 
 /// The paper's Table II: (poses, anchor MAE m, offset MAE m) per robot.
 const PAPER_LARGE: [(usize, f64, f64); 3] = [(9, 0.387, 0.380), (18, 0.226, 0.217), (35, 0.191, 0.173)];
@@ -114,10 +51,22 @@ fn paper_numbers(robot: &Robot, poses: usize) -> Option<(f64, f64)> {
 }
 
 /// Run the Table II protocol on the log's poses and print the table (or JSON).
+/// Run the protocol on the robot of `--robot`: the four-cable Table II on
+/// the log's poses, or for a robot of 3 to 8 cables
+/// [`super::experiment_suspended::run`].
 pub fn run(args: &Table2Args) -> sagcal::Result<()> {
-    let truth = Robot::from_file(&args.robot)?;
+    let truth = match read_robot(&args.robot)? {
+        AnyRobot::Four(robot) => *robot,
+        AnyRobot::Suspended(robot) => return super::experiment_suspended::run(args, &robot),
+    };
+    let data_path = args.data.as_ref().ok_or_else(|| {
+        sagcal::Error::InvalidInput(format!(
+            "--data is required: robot `{}` has four cables, whose Table II samples the poses of a log",
+            truth.name
+        ))
+    })?;
     let data = read_measurements(
-        &args.data,
+        data_path,
         &ReadOptions {
             reference_cable: truth.reference_cable,
             keep_rounded: false,
@@ -129,7 +78,7 @@ pub fn run(args: &Table2Args) -> sagcal::Result<()> {
     let results = run_trials(args, &truth, &pool, &protocol)?;
     let report = Table2Report {
         robot: truth.name.clone(),
-        data: args.data.display().to_string(),
+        data: data_path.display().to_string(),
         source: args.source,
         noise: args.noise,
         model: args.model,

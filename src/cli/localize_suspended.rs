@@ -5,10 +5,10 @@
 use sagcal::io::suspended_measurements::read_suspended_measurements;
 use sagcal::localize::{localize_suspended_rows, SuspendedLocalizationReport};
 use sagcal::model::suspended::SuspendedRobot;
-use sagcal::Error;
 
 use super::localize_args::LocalizeArgs;
 use super::output::{print_json, progress_bar, Table};
+use super::robot_kind::refuse_four_cable_flags;
 
 /// Localise every row of `args.data` on `robot`, write and report.
 pub(super) fn run(args: &LocalizeArgs, robot: &SuspendedRobot) -> sagcal::Result<()> {
@@ -45,14 +45,11 @@ fn refuse_four_cable_options(args: &LocalizeArgs, robot: &SuspendedRobot) -> sag
         (args.plot.is_some(), "--plot"),
         (args.no_calibration_uncertainty, "--no-calibration-uncertainty"),
     ];
-    match given.iter().find(|(on, _)| *on) {
-        Some((_, flag)) => Err(Error::InvalidInput(format!(
-            "{flag}: robot `{}` has {} cables; its localisation reads the encoders and load cells alone, with the reading noise as its sigmas",
-            robot.name,
-            robot.cable_count()
-        ))),
-        None => Ok(()),
-    }
+    refuse_four_cable_flags(
+        &given,
+        robot,
+        "its localisation reads the encoders and load cells alone, with the reading noise as its sigmas",
+    )
 }
 
 /// The table.

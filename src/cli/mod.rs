@@ -15,6 +15,7 @@ mod check;
 mod demo;
 mod diagnose;
 mod experiment;
+mod experiment_suspended;
 mod gross_errors;
 mod hidden;
 mod init;
@@ -31,6 +32,7 @@ mod simulate;
 mod simulate_args;
 mod simulate_suspended;
 mod solver_args;
+mod table2_args;
 mod verify;
 
 pub use run::run;

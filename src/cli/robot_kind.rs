@@ -30,3 +30,17 @@ pub(super) fn read_robot(path: &Path) -> sagcal::Result<AnyRobot> {
         Err(_) => Err(four_cable),
     }
 }
+
+/// The first of the `given` flags (each `(is it given, its name)`) that a
+/// robot of 3 to 8 cables does not take, refused as `{flag}: robot `name`
+/// has N cables; {why}`.
+pub(super) fn refuse_four_cable_flags(given: &[(bool, &str)], robot: &SuspendedRobot, why: &str) -> sagcal::Result<()> {
+    match given.iter().find(|(on, _)| *on) {
+        Some((_, flag)) => Err(sagcal::Error::InvalidInput(format!(
+            "{flag}: robot `{}` has {} cables; {why}",
+            robot.name,
+            robot.cable_count()
+        ))),
+        None => Ok(()),
+    }
+}

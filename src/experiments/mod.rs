@@ -32,6 +32,7 @@ pub mod localize_after_calibration;
 pub mod plan_candidates;
 pub mod pose_plan;
 pub mod selection;
+pub mod suspended_trials;
 pub mod table2;
 mod trial;
 
