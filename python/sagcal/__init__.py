@@ -9,7 +9,8 @@ in and out, the same jobs with the same options, results and error messages.
   weights, encoder offsets and effects as numpy arrays and floats.
 - :func:`simulate`: measurements of a robot (``sagcal simulate``);
   :class:`SuspendedRobot` and :func:`simulate_suspended`: a robot of 3 to 8
-  cables and its measurements; :func:`calibrate_suspended` calibrates it.
+  cables and its measurements; :func:`calibrate_suspended` calibrates it
+  and :func:`localize_suspended` localises it.
 - :func:`calibrate`: anchors and encoder offsets from measurements
   (``sagcal calibrate``), with their covariance and the gross-error tests.
 - :func:`diagnose`: what the calibration model gets wrong (``sagcal diagnose``).
@@ -64,6 +65,7 @@ from ._sagcal import (
     Simulation,
     SolverError,
     SuspendedCalibration,
+    SuspendedLocalization,
     SuspendedRobot,
     SuspendedSimulation,
     __version__,
@@ -79,6 +81,7 @@ check = _entry(_sagcal.check)
 diagnose = _entry(_sagcal.diagnose, ints={"folds": _COUNT}, lists=("candidates",))
 init_robot = _entry(_sagcal.init_robot)
 localize = _entry(_sagcal.localize)
+localize_suspended = _entry(_sagcal.localize_suspended)
 plan = _entry(_sagcal.plan, ints={"poses": _COUNT, "seed": _COUNT})
 read_measurements = _entry(_sagcal.read_measurements, ints={"reference_cable": (1, 5)})
 simulate = _entry(_sagcal.simulate, ints={"poses": _COUNT, "seed": _COUNT, "segments": _COUNT}, lists=("effects",))
@@ -104,6 +107,7 @@ __all__ = [
     "Simulation",
     "SolverError",
     "SuspendedCalibration",
+    "SuspendedLocalization",
     "SuspendedRobot",
     "SuspendedSimulation",
     "__version__",
@@ -113,6 +117,7 @@ __all__ = [
     "diagnose",
     "init_robot",
     "localize",
+    "localize_suspended",
     "plan",
     "read_measurements",
     "simulate",

@@ -410,6 +410,38 @@ class SuspendedCalibration:
     def report(self) -> dict[str, Any]:
         """The report as ``sagcal calibrate --json`` prints it."""
 
+class SuspendedLocalization:
+    """The result of :func:`localize_suspended`."""
+
+    @property
+    def positions_m(self) -> FloatArray:
+        """Platform positions, metres: (M, 3); ``nan`` where a row has none."""
+    @property
+    def roll_pitch_yaw_deg(self) -> FloatArray:
+        """``(roll, pitch, yaw)`` degrees: (M, 3)."""
+    @property
+    def position_sigma_m(self) -> FloatArray:
+        """1-sigma of each position from the reading noise, metres: (M, 3)."""
+    @property
+    def ok(self) -> list[bool]:
+        """Whether each row passes its chi-square test and is stable."""
+    @property
+    def rows_flagged(self) -> int:
+        """The rows flagged."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The report as ``sagcal localize --json`` prints it."""
+
+def localize_suspended(
+    robot: SuspendedRobot,
+    measurements: Union[ArrayLike, PathLike],
+    noise: str = "paper",
+    *,
+    false_alarm: float = 1e-3,
+    progress: Optional[Callable[[int, int, str], Any]] = None,
+) -> SuspendedLocalization:
+    """Pose and forces of every row of a calibrated robot of 3 to 8 cables, as ``sagcal localize`` does."""
+
 def calibrate_suspended(
     robot: SuspendedRobot,
     measurements: Union[ArrayLike, PathLike],

@@ -156,7 +156,7 @@ impl SuspendedCalibration {
 /// The measurements of `robot` in `value`: a path (the file the command
 /// reads) or an (M, 6 + cables + load cells) array in the columns of
 /// :attr:`SuspendedRobot.columns`, each row checked as a file's row is.
-fn suspended_measurements(
+pub(crate) fn suspended_measurements(
     value: &Bound<'_, PyAny>,
     robot: &sagcal::model::suspended::SuspendedRobot,
 ) -> PyResult<(Vec<SuspendedMeasurement>, PathBuf)> {

@@ -74,3 +74,24 @@ def test_calibrate_suspended_refuses_a_blunder_and_a_bad_array():
     data[2, 12] = -1.0
     with pytest.raises(sagcal.SagcalError, match="row 3.*f1_n.*must be positive"):
         sagcal.calibrate_suspended(robot, data)
+
+
+def test_localize_suspended_gives_the_commands_report(cli, tmp_path):
+    robot = sagcal.SuspendedRobot.builtin("six")
+    simulation = sagcal.simulate_suspended(robot, 12, seed=9)
+    calibrated = sagcal.calibrate_suspended(robot, simulation.measurements)
+    robot_file = tmp_path / "six.toml"
+    robot_file.write_text(calibrated.robot.toml())
+    data = tmp_path / "d.csv"
+    simulation.write(data)
+    found = sagcal.localize_suspended(calibrated.robot, simulation.measurements)
+    assert found.rows_flagged == 0 and all(found.ok)
+    assert found.positions_m.shape == (12, 3)
+    # Each position near the localiser's (5 mm noise) within 5 of its combined 1-sigma.
+    error = np.linalg.norm(found.positions_m - simulation.measurements[:, :3], axis=1)
+    combined = np.sqrt(np.sum(found.position_sigma_m**2, axis=1) + 0.005**2)
+    assert np.all(error < 5 * combined)
+    command = json.loads(cli("localize", "--robot", robot_file, "--data", data, "--json").stdout)
+    assert [r["position_m"] for r in command["rows"]] == [r["position_m"] for r in found.report["rows"]]
+    with pytest.raises(sagcal.SagcalError, match="false_alarm must be between 0 and 1"):
+        sagcal.localize_suspended(calibrated.robot, simulation.measurements, false_alarm=2.0)
