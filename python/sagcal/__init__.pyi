@@ -407,6 +407,9 @@ class SuspendedCalibration:
     def inconsistency(self) -> Optional[str]:
         """Why the fit fails its test; ``None`` when it passes."""
     @property
+    def readings_left_out(self) -> list[dict[str, Any]]:
+        """The readings left out as gross errors, in the order found."""
+    @property
     def report(self) -> dict[str, Any]:
         """The report as ``sagcal calibrate --json`` prints it."""
 
@@ -454,6 +457,7 @@ def calibrate_suspended(
     robust_encoder: str = "none",
     robust_load_cell: str = "none",
     robust_pose: str = "none",
+    false_alarm: float = 1e-3,
     accept_inconsistent: bool = False,
     progress: Optional[Callable[[int, int, str], Any]] = None,
 ) -> SuspendedCalibration:

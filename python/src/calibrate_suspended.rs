@@ -7,11 +7,12 @@ use std::path::PathBuf;
 
 use numpy::ndarray::Array3;
 use pyo3::prelude::*;
+use sagcal::calib::gross_errors::GrossErrorOptions;
 use sagcal::calib::suspended::{
     calibrate_suspended as calibrate_library, suspended_options, SuspendedCalibration as LibraryCalibration,
     SuspendedCalibrationReport,
 };
-use sagcal::calib::{refusal, ParameterUncertainty};
+use sagcal::calib::{check_false_alarm, refusal, ParameterUncertainty};
 use sagcal::error::FrontEnd;
 use sagcal::io::suspended_measurements::{
     read_suspended_measurements, suspended_header, suspended_measurement_from_values,
@@ -135,6 +136,16 @@ impl SuspendedCalibration {
         self.report.inconsistency()
     }
 
+    /// The readings left out as gross errors, in the order found: dicts
+    /// with ``row``, ``line``, ``reading`` (``{"encoder": i}``,
+    /// ``{"load_cell": i}``, ``{"position": axis}``, ``{"orientation":
+    /// axis}``, 0-based), ``residual``, ``sigma``, ``redundancy``, ``w``
+    /// and ``critical``.
+    #[getter]
+    fn readings_left_out<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.json["readings_left_out"])
+    }
+
     /// The whole report as ``sagcal calibrate --json`` prints it (a dict).
     #[getter]
     fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
@@ -189,7 +200,9 @@ pub(crate) fn suspended_measurements(
 /// ``noise`` (``"paper"`` or ``"authors"``), sigma overrides,
 /// ``orientation_prior`` (``"off"`` leaves the localiser's orientation out;
 /// ``"auto"`` and ``"on"`` use it), robust kernels (``"none"``,
-/// ``"huber[:k]"``, ``"cauchy[:c]"``). A fit that fails its chi-square test
+/// ``"huber[:k]"``, ``"cauchy[:c]"``), ``false_alarm`` of the tests for
+/// single gross errors (a reading they find is left out and named in
+/// ``report["readings_left_out"]``). A fit that fails its chi-square test
 /// raises, as the command refuses to write it, unless
 /// ``accept_inconsistent=True``. ``progress`` is an optional
 /// ``callable(done, total, what)`` called before each of the three stages.
@@ -208,6 +221,7 @@ pub(crate) fn suspended_measurements(
     robust_encoder = "none",
     robust_load_cell = "none",
     robust_pose = "none",
+    false_alarm = 1e-3,
     accept_inconsistent = false,
     progress = None,
 ))]
@@ -224,6 +238,7 @@ pub fn calibrate_suspended(
     robust_encoder: &str,
     robust_load_cell: &str,
     robust_pose: &str,
+    false_alarm: f64,
     accept_inconsistent: bool,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<SuspendedCalibration> {
@@ -241,18 +256,24 @@ pub fn calibrate_suspended(
     }
     .settings()?;
     let options = suspended_options(&settings, &nominal, FrontEnd::Python).map_err(to_py)?;
+    let tests = GrossErrorOptions {
+        false_alarm: check_false_alarm(false_alarm, "false_alarm", FrontEnd::Python).map_err(to_py)?,
+        ..GrossErrorOptions::default()
+    };
     let (data, label) = suspended_measurements(measurements, &nominal)?;
     let progress = Progress::new(progress);
     let result = py
         .detach(|| {
             let mut done = 0;
-            calibrate_library(&nominal, &data, &options, &mut |stage| {
-                progress.report(done, 3, stage);
+            calibrate_library(&nominal, &data, &options, Some(&tests), &mut |stage| {
+                // A reading left out adds a solve to the three stages.
+                progress.report(done, (done + 1).max(3), stage);
                 done += 1;
             })
         })
         .map_err(to_py)?;
-    progress.report(3, 3, "done");
+    let solves = result.stages.len();
+    progress.report(solves, solves, "done");
     let report = SuspendedCalibrationReport::new(&nominal, &result);
     if let Some(reason) = report.inconsistency().filter(|_| !accept_inconsistent) {
         return Err(to_py(refusal(&label.display().to_string(), &reason, FrontEnd::Python)));

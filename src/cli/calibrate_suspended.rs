@@ -2,16 +2,16 @@
 //! ([`sagcal::calib::suspended`]): the report, the calibrated robot file and
 //! the anchor plot.
 
+use sagcal::calib::gross_errors::GrossErrorOptions;
 use sagcal::calib::suspended::{
-    calibrate_suspended, suspended_options, SuspendedCalibration, SuspendedCalibrationReport,
+    calibrate_suspended, suspended_options, SuspendedCalibration, SuspendedCalibrationReport, SuspendedReading,
 };
-use sagcal::calib::{refusal, CalibrationOptions, OrientationPrior, ParameterUncertainty};
+use sagcal::calib::{check_false_alarm, refusal, CalibrationOptions, OrientationPrior, ParameterUncertainty};
 use sagcal::error::FrontEnd;
 use sagcal::io::suspended_measurements::read_suspended_measurements;
 use sagcal::io::OutputSet;
 use sagcal::model::suspended::SuspendedRobot;
 use sagcal::plot::figure_bytes;
-use sagcal::Error;
 
 use super::calibrate_args::CalibrateArgs;
 use super::calibration_tables::{calibrated_anchor_plot, fit_tables, parameter_tables};
@@ -24,10 +24,15 @@ const STAGES: u64 = 3;
 pub(super) fn run(args: &CalibrateArgs, nominal: &SuspendedRobot) -> sagcal::Result<()> {
     let options = options(args, nominal)?;
     let data = read_suspended_measurements(&args.data, nominal)?;
+    let tests = GrossErrorOptions {
+        false_alarm: check_false_alarm(args.false_alarm, "false_alarm", FrontEnd::Cli)?,
+        ..GrossErrorOptions::default()
+    };
     let bar = progress_bar(STAGES, "{msg} [{bar:30}] {pos}/{len} stages, {elapsed}");
     let mut done = 0;
-    let result = calibrate_suspended(nominal, &data, &options, &mut |stage| {
-        bar.report(done, STAGES as usize, stage);
+    let result = calibrate_suspended(nominal, &data, &options, Some(&tests), &mut |stage| {
+        // A reading left out adds a solve to the three stages.
+        bar.report(done, (done + 1).max(STAGES as usize), stage);
         done += 1;
     });
     bar.finish_and_clear();
@@ -70,16 +75,8 @@ pub(super) fn run(args: &CalibrateArgs, nominal: &SuspendedRobot) -> sagcal::Res
     Ok(())
 }
 
-/// The options of `args` for `nominal`; the choices only the four-cable
-/// pipeline has are refused by name.
+/// The options of `args` for `nominal`.
 fn options(args: &CalibrateArgs, nominal: &SuspendedRobot) -> sagcal::Result<CalibrationOptions> {
-    if args.false_alarm != 1e-3 {
-        return Err(Error::InvalidInput(format!(
-            "--false-alarm: the tests for single gross errors take robots of four cables; robot `{}` has {} cables, whose calibration is checked by the fit's chi-square test",
-            nominal.name,
-            nominal.cable_count()
-        )));
-    }
     suspended_options(&args.solver.settings(), nominal, FrontEnd::Cli)
 }
 
@@ -119,6 +116,18 @@ fn render(report: &SuspendedCalibrationReport, options: &CalibrationOptions) -> 
             "INCONSISTENT: the readings disagree with the model or the stated noise"
         }
     );
+    for found in &report.readings_left_out {
+        out += &format!(
+            "left out as a gross error: {}, {}: residual {:+.4} (sigma {:.4}, redundancy {:.4}), |w| {:.1} > {:.2}\n",
+            found.at,
+            reading_name(found.reading),
+            found.residual,
+            found.sigma,
+            found.redundancy,
+            found.w.abs(),
+            found.critical
+        );
+    }
     if !report.poses_without_start.is_empty() {
         out += &format!(
             "note: poses {} had no equilibrium at their measured position for the straight-cable anchors; they started from the measured pose\n",
@@ -176,4 +185,15 @@ fn plot_svg(nominal: &SuspendedRobot, result: &SuspendedCalibration, positions: 
         None,
         positions,
     )
+}
+
+/// A reading in words: `encoder of cable 2`, `load cell on cable 5`, `localiser x`.
+fn reading_name(reading: SuspendedReading) -> String {
+    let axis = |a: usize| ["x", "y", "z"].get(a).copied().unwrap_or("?");
+    match reading {
+        SuspendedReading::Encoder(i) => format!("encoder of cable {}", i + 1),
+        SuspendedReading::LoadCell(i) => format!("load cell on cable {}", i + 1),
+        SuspendedReading::Position(a) => format!("localiser {}", axis(a)),
+        SuspendedReading::Orientation(a) => format!("localiser orientation about {}", axis(a)),
+    }
 }

@@ -35,7 +35,7 @@ use rand_distr::StandardNormal;
 use serde::Serialize;
 
 use crate::calib::suspended::{
-    build_suspended_graph, calibrate_suspended, PoseStart, SuspendedCalibrationReport, SuspendedStage,
+    build_suspended_graph, calibrate_suspended, Exclusions, PoseStart, SuspendedCalibrationReport, SuspendedStage,
 };
 use crate::calib::{anchor_and_offset_uncertainty, CalibrationOptions, OrientationPrior, ParameterUncertainty};
 use crate::error::{Error, Result};
@@ -121,7 +121,15 @@ pub fn suspended_trials(
                 forces: eq.tensions.clone(),
             })
             .collect();
-        let at_truth = build_suspended_graph(truth, &data, &starts, SuspendedStage::Catenary, &calibration, true);
+        let at_truth = build_suspended_graph(
+            truth,
+            &data,
+            &starts,
+            SuspendedStage::Catenary,
+            &calibration,
+            true,
+            &Exclusions::new(),
+        );
         match anchor_and_offset_uncertainty(&at_truth.graph, &at_truth.anchors, &at_truth.length_offsets)? {
             ParameterUncertainty::Full {
                 anchor_covariance_m2,
@@ -137,7 +145,8 @@ pub fn suspended_trials(
             }
             ParameterUncertainty::RankDeficient { .. } => sums.unbounded += 1,
         }
-        match calibrate_suspended(&guess, &data, &calibration, &mut |_| {}) {
+        // The protocol's fits use every reading, as the paper's do.
+        match calibrate_suspended(&guess, &data, &calibration, None, &mut |_| {}) {
             Ok(result) => match SuspendedCalibrationReport::new(&guess, &result).inconsistency() {
                 None => {
                     sums.converged += 1;

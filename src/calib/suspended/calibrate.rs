@@ -4,17 +4,19 @@
 //! anchors held, then the full graph.
 
 use super::graph::{
-    build_suspended_graph, min_poses, pose_starts_from_graph, robot_from_suspended_graph, PoseStart, SuspendedGraph,
-    SuspendedStage,
+    build_suspended_graph, min_poses, pose_starts_from_graph, robot_from_suspended_graph, Exclusions, PoseStart,
+    SuspendedGraph, SuspendedStage,
 };
+use super::gross_errors::{reading_count, worst_reading, SuspendedGrossError};
 use super::start::{catenary_starts, offsets_in_closed_form, straight_offsets};
-use crate::calib::options::{CalibrationOptions, OrientationPrior};
+use crate::calib::options::{CalibrationOptions, GrossErrorOptions, OrientationPrior};
 use crate::calib::result::{factor_statistics, FactorStatistics, ParameterUncertainty, StageSummary};
 use crate::calib::uncertainty::anchor_and_offset_uncertainty;
 use crate::error::{Error, Result};
 use crate::model::pose::PlatformPose;
 use crate::model::statics::CableTension;
 use crate::model::suspended::{SuspendedMeasurement, SuspendedRobot};
+use crate::model::DataRow;
 use crate::solver::optimize;
 
 /// A calibration of `N` cables.
@@ -39,6 +41,12 @@ pub struct SuspendedCalibration {
     /// Residual rows minus unknowns of the final graph: the degrees of
     /// freedom of its chi-square `2 * final_cost`.
     pub degrees_of_freedom: usize,
+    /// The readings left out as gross errors, in the order found (empty
+    /// without the tests).
+    pub left_out: Vec<SuspendedGrossError>,
+    /// Whether the tests still found a gross error when the most readings
+    /// they may leave out were out: the model, not single readings, fails.
+    pub search_exhausted: bool,
     /// The final cost `1/2 chi^2`.
     pub final_cost: f64,
 }
@@ -51,13 +59,15 @@ const HELD_ANCHORS_STAGE: &str = "catenary (anchors held)";
 const CATENARY_STAGE: &str = "catenary";
 
 /// Calibrate the anchors and length offsets of `initial` (its anchors the
-/// guess, everything else known) from `measurements`; `stage` is told the
+/// guess, everything else known) from `measurements`, leaving out the
+/// gross errors `gross_errors` finds (none without); `stage` is told the
 /// name of each stage before it is solved. The localiser's orientation
 /// enters as a prior unless `options.orientation_prior` is `Off`.
 pub fn calibrate_suspended(
     initial: &SuspendedRobot,
     measurements: &[SuspendedMeasurement],
     options: &CalibrationOptions,
+    gross_errors: Option<&GrossErrorOptions>,
     stage: &mut dyn FnMut(&str),
 ) -> Result<SuspendedCalibration> {
     let with_orientation = options.orientation_prior != OrientationPrior::Off;
@@ -72,8 +82,9 @@ pub fn calibrate_suspended(
             forces: Vec::new(),
         })
         .collect();
+    let none = Exclusions::new();
     let build = |robot: &SuspendedRobot, starts: &[PoseStart], stage: SuspendedStage| {
-        build_suspended_graph(robot, measurements, starts, stage, options, with_orientation)
+        build_suspended_graph(robot, measurements, starts, stage, options, with_orientation, &none)
     };
     let mut straight = build(&start_robot, &measured, SuspendedStage::Straight);
     let mut stages = vec![solve(STRAIGHT_STAGE, &mut straight, options, stage)?];
@@ -91,6 +102,18 @@ pub fn calibrate_suspended(
     let starts = pose_starts_from_graph(&held);
     let mut full = build(&robot, &starts, SuspendedStage::Catenary);
     stages.push(solve(CATENARY_STAGE, &mut full, options, stage)?);
+    // (5) Gross errors left out one at a time, each followed by a new solve.
+    let mut left_out = Vec::new();
+    let mut search_exhausted = false;
+    if let Some(tests) = gross_errors {
+        let inputs = Inputs {
+            template: initial,
+            measurements,
+            options,
+            with_orientation,
+        };
+        search_exhausted = leave_out_gross_errors(&inputs, tests, &mut full, &mut left_out, &mut stages, stage)?;
+    }
     let solved = pose_starts_from_graph(&full);
     let uncertainty = anchor_and_offset_uncertainty(&full.graph, &full.anchors, &full.length_offsets)?;
     Ok(SuspendedCalibration {
@@ -103,7 +126,62 @@ pub fn calibrate_suspended(
         stages,
         fell_back,
         statistics: factor_statistics(&full.graph),
+        left_out,
+        search_exhausted,
     })
+}
+
+/// What every solve of one calibration shares.
+struct Inputs<'a> {
+    template: &'a SuspendedRobot,
+    measurements: &'a [SuspendedMeasurement],
+    options: &'a CalibrationOptions,
+    with_orientation: bool,
+}
+
+/// Stage (5): while the solved `full` has a reading whose `|w|` exceeds the
+/// critical value of `tests`, leave it out (into `left_out`) and solve again
+/// from where the last solve ended; at most `tests.max_excluded_fraction` of
+/// the readings (and at least one). Whether a gross error was left in
+/// because that many were out already.
+fn leave_out_gross_errors(
+    inputs: &Inputs<'_>,
+    tests: &GrossErrorOptions,
+    full: &mut SuspendedGraph,
+    left_out: &mut Vec<SuspendedGrossError>,
+    stages: &mut Vec<StageSummary>,
+    stage: &mut dyn FnMut(&str),
+) -> Result<bool> {
+    let rows: Vec<DataRow> = inputs
+        .measurements
+        .iter()
+        .enumerate()
+        .map(|(k, m)| DataRow::at(k, m.line))
+        .collect();
+    let most = ((tests.max_excluded_fraction * reading_count(full) as f64).floor() as usize).max(1);
+    let mut excluded = Exclusions::new();
+    while let Some(found) = worst_reading(full, tests.false_alarm, &rows)? {
+        if left_out.len() >= most {
+            return Ok(true);
+        }
+        let pose = found.at.row - 1;
+        excluded.insert((pose, found.reading));
+        left_out.push(found);
+        let robot = robot_from_suspended_graph(inputs.template, full);
+        let starts = pose_starts_from_graph(full);
+        *full = build_suspended_graph(
+            &robot,
+            inputs.measurements,
+            &starts,
+            SuspendedStage::Catenary,
+            inputs.options,
+            inputs.with_orientation,
+            &excluded,
+        );
+        let name = format!("catenary without {} reading(s)", left_out.len());
+        stages.push(solve(&name, full, inputs.options, stage)?);
+    }
+    Ok(false)
 }
 
 /// Enough distinct poses with finite readings, one per cable and load cell.

@@ -7,7 +7,10 @@
 //! adds `L + 3` (or `L + 6`) to what the `4N` anchor and offset unknowns
 //! are determined by ([`min_poses`]).
 
+use std::collections::BTreeSet;
+
 use nalgebra::{DVector, Vector3};
+use serde::Serialize;
 
 use super::factors::{
     CableConstants, CableLoadCellFactor, CableRow, CableVariables, CatenaryCableFactor, EquilibriumFactor,
@@ -15,7 +18,7 @@ use super::factors::{
 };
 use crate::calib::factors::PosePriorFactor;
 use crate::calib::options::CalibrationOptions;
-use crate::graph::{FactorGraph, RobustKernel, Values, VariableId, VariableValue};
+use crate::graph::{Factor, FactorGraph, MaskedFactor, RobustKernel, Values, VariableId, VariableValue};
 use crate::model::pose::PlatformPose;
 use crate::model::statics::CableTension;
 use crate::model::suspended::{SuspendedMeasurement, SuspendedRobot};
@@ -45,6 +48,23 @@ pub struct PoseStart {
     pub forces: Vec<CableTension>,
 }
 
+/// One reading of a pose of a robot of `N` cables.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SuspendedReading {
+    /// The encoder of cable `i` (0-based).
+    Encoder(usize),
+    /// The load cell on cable `i` (0-based).
+    LoadCell(usize),
+    /// The localiser's position along world axis `0..3`.
+    Position(usize),
+    /// The localiser's orientation about axis `0..3` of its rotation error.
+    Orientation(usize),
+}
+
+/// Readings a graph leaves out: `(pose index, reading)`.
+pub type Exclusions = BTreeSet<(usize, SuspendedReading)>;
+
 /// One pose's variables.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct SuspendedPoseVariables {
@@ -64,6 +84,23 @@ pub struct SuspendedGraph {
     pub length_offsets: Vec<VariableId>,
     /// Per measurement.
     pub poses: Vec<SuspendedPoseVariables>,
+    /// Per factor (graph order), the readings its residual rows are, row by
+    /// row as `(pose index, reading)`; empty for the model's equations.
+    pub readings: Vec<Vec<(usize, SuspendedReading)>>,
+}
+
+/// A graph being built, with the readings of its factors' rows.
+struct Builder {
+    graph: FactorGraph,
+    readings: Vec<Vec<(usize, SuspendedReading)>>,
+}
+
+impl Builder {
+    /// Add `factor`, whose rows are `readings`.
+    fn add(&mut self, factor: Box<dyn Factor>, readings: Vec<(usize, SuspendedReading)>) {
+        self.graph.factors.push(factor);
+        self.readings.push(readings);
+    }
 }
 
 /// The fewest poses that determine `robot`'s `4N` anchor and offset
@@ -74,7 +111,7 @@ pub fn min_poses(robot: &SuspendedRobot, with_orientation: bool) -> usize {
 }
 
 /// The graph of `stage` for `measurements`, starting from `robot`'s anchors
-/// and offsets and `starts`' poses and forces.
+/// and offsets and `starts`' poses and forces, without the `excluded` readings.
 pub fn build_suspended_graph(
     robot: &SuspendedRobot,
     measurements: &[SuspendedMeasurement],
@@ -82,62 +119,84 @@ pub fn build_suspended_graph(
     stage: SuspendedStage,
     options: &CalibrationOptions,
     with_orientation: bool,
+    excluded: &Exclusions,
 ) -> SuspendedGraph {
-    let mut graph = FactorGraph::new();
+    let mut built = Builder {
+        graph: FactorGraph::new(),
+        readings: Vec::new(),
+    };
     let vector = |v: &[f64]| VariableValue::Vector(DVector::from_column_slice(v));
     let n = robot.cable_count();
+    let values = &mut built.graph.values;
     let anchors: Vec<VariableId> = (0..n)
-        .map(|i| {
-            graph
-                .values
-                .insert(format!("anchor {}", i + 1), vector(robot.anchors_m[i].as_slice()))
-        })
+        .map(|i| values.insert(format!("anchor {}", i + 1), vector(robot.anchors_m[i].as_slice())))
         .collect();
     let length_offsets: Vec<VariableId> = (0..n)
-        .map(|i| {
-            graph
-                .values
-                .insert(format!("length offset {}", i + 1), vector(&[robot.length_offsets_m[i]]))
-        })
+        .map(|i| values.insert(format!("length offset {}", i + 1), vector(&[robot.length_offsets_m[i]])))
         .collect();
     let mut poses = Vec::with_capacity(measurements.len());
     for (k, (m, start)) in measurements.iter().zip(starts).enumerate() {
-        let vars = insert_pose(&mut graph.values, k, start, stage);
-        let orientation_sigma =
-            (with_orientation || stage == SuspendedStage::Straight).then_some(options.noise.orientation_sigma_rad);
-        graph.add(PosePriorFactor::new(
-            vars.pose,
-            &m.localiser_pose(),
-            options.noise.position_sigma_m,
-            orientation_sigma,
-            options.robust.pose_prior,
-        ));
-        for i in 0..n {
-            add_cable(
-                &mut graph,
-                robot,
-                i,
-                &vars,
-                [anchors[i], length_offsets[i]],
-                m.encoder_lengths_m[i],
-                options,
-            );
+        let vars = insert_pose(&mut built.graph.values, k, start, stage);
+        let with_orientation = with_orientation || stage == SuspendedStage::Straight;
+        add_pose_prior(&mut built, k, vars.pose, m, options, with_orientation, excluded);
+        for i in (0..n).filter(|&i| !excluded.contains(&(k, SuspendedReading::Encoder(i)))) {
+            let cable = [anchors[i], length_offsets[i]];
+            add_cable(&mut built, robot, (k, i), &vars, cable, m.encoder_lengths_m[i], options);
         }
         if stage == SuspendedStage::Catenary {
-            add_statics(&mut graph, robot, &vars, &anchors, m, options);
+            add_statics(&mut built, robot, (k, &vars), &anchors, m, options, excluded);
             let mut group = vec![vars.pose];
             group.extend_from_slice(&vars.forces);
-            graph.local_groups.push(group);
+            built.graph.local_groups.push(group);
         } else {
-            graph.local_groups.push(vec![vars.pose]);
+            built.graph.local_groups.push(vec![vars.pose]);
         }
         poses.push(vars);
     }
     SuspendedGraph {
-        graph,
+        graph: built.graph,
         anchors,
         length_offsets,
         poses,
+        readings: built.readings,
+    }
+}
+
+/// Pose `k`'s localiser prior, its orientation rows if `with_orientation`,
+/// without the excluded axes.
+fn add_pose_prior(
+    built: &mut Builder,
+    k: usize,
+    pose: VariableId,
+    m: &SuspendedMeasurement,
+    options: &CalibrationOptions,
+    with_orientation: bool,
+    excluded: &Exclusions,
+) {
+    let prior = PosePriorFactor::new(
+        pose,
+        &m.localiser_pose(),
+        options.noise.position_sigma_m,
+        with_orientation.then_some(options.noise.orientation_sigma_rad),
+        options.robust.pose_prior,
+    );
+    // Rows `[orientation (3)]; position (3)]`, the orientation rows only with its prior.
+    let mut rows: Vec<SuspendedReading> = Vec::with_capacity(6);
+    if with_orientation {
+        rows.extend((0..3).map(SuspendedReading::Orientation));
+    }
+    rows.extend((0..3).map(SuspendedReading::Position));
+    let dropped: Vec<usize> = (0..rows.len()).filter(|&r| excluded.contains(&(k, rows[r]))).collect();
+    let kept: Vec<(usize, SuspendedReading)> = rows
+        .iter()
+        .enumerate()
+        .filter(|(r, _)| !dropped.contains(r))
+        .map(|(_, &reading)| (k, reading))
+        .collect();
+    if dropped.is_empty() {
+        built.add(Box::new(prior), kept);
+    } else if let Some(masked) = MaskedFactor::new(Box::new(prior), &dropped) {
+        built.add(Box::new(masked), kept);
     }
 }
 
@@ -161,64 +220,71 @@ fn insert_pose(values: &mut Values, k: usize, start: &PoseStart, stage: Suspende
     SuspendedPoseVariables { pose, forces }
 }
 
-/// Cable `i`'s length (and, with its forces, height) factor at one pose:
+/// Cable `i`'s length (and, with its forces, height) factor at pose `k`:
 /// straight without forces, a catenary with them.
 fn add_cable(
-    graph: &mut FactorGraph,
+    built: &mut Builder,
     robot: &SuspendedRobot,
-    i: usize,
+    (k, i): (usize, usize),
     vars: &SuspendedPoseVariables,
     [anchor, length_offset]: [VariableId; 2],
     encoder_length_m: f64,
     options: &CalibrationOptions,
 ) {
     let noise = &options.noise;
-    match vars.forces.get(i) {
-        None => graph.add(StraightCableFactor::new(
+    let encoder = vec![(k, SuspendedReading::Encoder(i))];
+    let Some(&forces) = vars.forces.get(i) else {
+        let straight = StraightCableFactor::new(
             [vars.pose, anchor, length_offset],
             robot.attachments_m[i],
             encoder_length_m,
             noise.encoder_sigma_m,
             options.robust.encoder,
-        )),
-        Some(&forces) => {
-            let variables = CableVariables {
-                pose: vars.pose,
-                forces,
-                anchor,
-                length_offset,
-            };
-            let constants = CableConstants {
-                attachment_m: robot.attachments_m[i],
-                weight_n_per_m: robot.cable_weights_n_per_m[i],
-            };
-            for (row, sigma_m, kernel) in [
-                (CableRow::Length, noise.encoder_sigma_m, options.robust.encoder),
-                (CableRow::Height, options.height_sigma_m, RobustKernel::None),
-            ] {
-                graph.add(CatenaryCableFactor::new(
-                    variables,
-                    constants,
-                    encoder_length_m,
-                    row,
-                    sigma_m,
-                    kernel,
-                ));
-            }
-        }
-    }
+        );
+        built.add(Box::new(straight), encoder);
+        return;
+    };
+    let variables = CableVariables {
+        pose: vars.pose,
+        forces,
+        anchor,
+        length_offset,
+    };
+    let constants = CableConstants {
+        attachment_m: robot.attachments_m[i],
+        weight_n_per_m: robot.cable_weights_n_per_m[i],
+    };
+    let cable = |row, sigma_m, kernel| {
+        Box::new(CatenaryCableFactor::new(
+            variables,
+            constants,
+            encoder_length_m,
+            row,
+            sigma_m,
+            kernel,
+        ))
+    };
+    built.add(
+        cable(CableRow::Length, noise.encoder_sigma_m, options.robust.encoder),
+        encoder,
+    );
+    built.add(
+        cable(CableRow::Height, options.height_sigma_m, RobustKernel::None),
+        Vec::new(),
+    );
 }
 
-/// One pose's equilibrium and load cells.
+/// Pose `k`'s equilibrium and load cells (without the excluded ones).
 fn add_statics(
-    graph: &mut FactorGraph,
+    built: &mut Builder,
     robot: &SuspendedRobot,
-    vars: &SuspendedPoseVariables,
+    (k, vars): (usize, &SuspendedPoseVariables),
     anchors: &[VariableId],
     m: &SuspendedMeasurement,
     options: &CalibrationOptions,
+    excluded: &Exclusions,
 ) {
-    graph.add(EquilibriumFactor::new(
+    let equilibrium = EquilibriumFactor::new(
         vars.pose,
         &vars.forces,
         anchors,
@@ -227,14 +293,20 @@ fn add_statics(
         robot.platform_weight_n,
         EQUILIBRIUM_SIGMA_PER_WEIGHT * robot.platform_weight_n,
         robot.attachment_radius_m().max(1e-3),
-    ));
+    );
+    built.add(Box::new(equilibrium), Vec::new());
     for (&cable, &reading) in robot.load_cells.iter().zip(&m.load_cell_tensions_n) {
-        graph.add(CableLoadCellFactor::new(
+        let cell = (k, SuspendedReading::LoadCell(cable));
+        if excluded.contains(&cell) {
+            continue;
+        }
+        let factor = CableLoadCellFactor::new(
             vars.forces[cable],
             reading,
             options.noise.load_cell_sigma_n,
             options.robust.load_cell,
-        ));
+        );
+        built.add(Box::new(factor), vec![cell]);
     }
 }
 

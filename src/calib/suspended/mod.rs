@@ -26,22 +26,24 @@
 //! // 12 anchor and offset unknowns, 4 equations per pose (one load cell, 3 positions) without the orientation.
 //! assert_eq!(min_poses(&robot, false), 4);
 //! let options = CalibrationOptions::new(NoisePreset::Paper.sigmas(robot.platform_weight_n));
-//! assert!(calibrate_suspended(&robot, &[], &options, &mut |_| {}).is_err());
+//! assert!(calibrate_suspended(&robot, &[], &options, None, &mut |_| {}).is_err());
 //! # Ok::<(), sagcal::Error>(())
 //! ```
 
 mod calibrate;
 pub mod factors;
 mod graph;
+mod gross_errors;
 mod options;
 mod report;
 mod start;
 
 pub use calibrate::{calibrate_suspended, SuspendedCalibration};
 pub use graph::{
-    build_suspended_graph, min_poses, pose_starts_from_graph, robot_from_suspended_graph, PoseStart, SuspendedGraph,
-    SuspendedPoseVariables, SuspendedStage, EQUILIBRIUM_SIGMA_PER_WEIGHT,
+    build_suspended_graph, min_poses, pose_starts_from_graph, robot_from_suspended_graph, Exclusions, PoseStart,
+    SuspendedGraph, SuspendedPoseVariables, SuspendedReading, SuspendedStage, EQUILIBRIUM_SIGMA_PER_WEIGHT,
 };
+pub use gross_errors::{reading_count, worst_reading, SuspendedGrossError};
 pub use options::suspended_options;
 pub use report::SuspendedCalibrationReport;
 pub use start::{catenary_starts, chord_shares, offsets_in_closed_form, straight_offsets};

@@ -6,6 +6,7 @@
 use serde::Serialize;
 
 use super::calibrate::SuspendedCalibration;
+use super::gross_errors::SuspendedGrossError;
 use crate::calib::result::{FactorStatistics, ParameterUncertainty, StageSummary};
 use crate::model::suspended::SuspendedRobot;
 use crate::stats::chi_square_quantile_999;
@@ -52,6 +53,11 @@ pub struct SuspendedCalibrationReport {
     pub consistent: bool,
     /// The poses (1-based) whose start fell back to the measured pose.
     pub poses_without_start: Vec<usize>,
+    /// The readings left out as gross errors, in the order found.
+    pub readings_left_out: Vec<SuspendedGrossError>,
+    /// Whether a gross error was still found with the most readings the
+    /// tests may leave out already out.
+    pub search_exhausted: bool,
 }
 
 impl SuspendedCalibrationReport {
@@ -62,6 +68,12 @@ impl SuspendedCalibrationReport {
             "chi-square {:.1} for {} degrees of freedom, 99.9 % limit {:.1}",
             self.chi_square, self.degrees_of_freedom, self.chi_square_limit
         );
+        if self.search_exhausted {
+            return Some(format!(
+                "after {} readings left out, the tests for single gross errors still find one ({chi_square}): the model, not single readings, disagrees with the data",
+                self.readings_left_out.len()
+            ));
+        }
         match (self.converged, self.chi_square <= self.chi_square_limit) {
             (true, true) => None,
             (true, false) => Some(format!(
@@ -108,8 +120,10 @@ impl SuspendedCalibrationReport {
             chi_square,
             degrees_of_freedom: result.degrees_of_freedom,
             chi_square_limit,
-            consistent: converged && chi_square <= chi_square_limit,
+            consistent: converged && chi_square <= chi_square_limit && !result.search_exhausted,
             poses_without_start: result.fell_back.iter().map(|k| k + 1).collect(),
+            readings_left_out: result.left_out.clone(),
+            search_exhausted: result.search_exhausted,
         }
     }
 }
