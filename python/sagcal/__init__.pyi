@@ -550,8 +550,11 @@ def simulate_suspended(
     noise: str = "paper",
     *,
     closure: str = "level",
+    effects: Optional[Sequence[str]] = None,
+    segments: int = 100,
 ) -> SuspendedSimulation:
-    """Simulated measurements of a robot of 3 to 8 cables, as ``sagcal simulate`` draws them."""
+    """Simulated measurements of a robot of 3 to 8 cables, as ``sagcal simulate`` draws them
+    (with ``effects``, from the discretised simulator with ``segments`` segments per cable)."""
 
 def init_robot(
     anchors_m: Optional[ArrayLike] = None,

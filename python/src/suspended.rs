@@ -9,10 +9,12 @@ use numpy::ndarray::Array2;
 use pyo3::prelude::*;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use sagcal::error::FrontEnd;
 use sagcal::io::suspended_measurements::{row_values, suspended_header, write_suspended_measurements};
 use sagcal::model::suspended::SuspendedMeasurement;
 use sagcal::sim::closed_form::{Closure, Workspace};
-use sagcal::sim::suspended::{measure_suspended, sample_suspended};
+use sagcal::sim::suspended::sample_suspended;
+use sagcal::sim::suspended_effects::{effects_from_specs, simulate_readings};
 
 use crate::arrays::frozen;
 use crate::options::{noise_preset, parse};
@@ -151,11 +153,15 @@ impl SuspendedSimulation {
 /// positions drawn uniformly in the robot's workspace, each the equilibrium
 /// its ``closure`` picks (``"level"``; ``"yaw"`` or ``"mixed"`` from four
 /// cables on), stable and with every cable taut, readings with ``noise``
-/// (``"paper"``, ``"authors"`` or ``"none"``).
+/// (``"paper"``, ``"authors"`` or ``"none"``). With ``effects`` (specs as
+/// ``sagcal simulate --effect`` takes them, e.g. ``"elastic:ea_n=3e6"``)
+/// the readings come from the discretised simulator with ``segments``
+/// segments per cable, the robot commanded to each equilibrium's lengths.
 ///
 /// Raises :class:`SagcalError` with the message the command prints.
 #[pyfunction]
-#[pyo3(signature = (robot, poses, seed = 1, noise = "paper", *, closure = "level"))]
+#[pyo3(signature = (robot, poses, seed = 1, noise = "paper", *, closure = "level", effects = None, segments = 100))]
+#[allow(clippy::too_many_arguments)]
 pub fn simulate_suspended(
     py: Python<'_>,
     robot: &SuspendedRobot,
@@ -163,10 +169,13 @@ pub fn simulate_suspended(
     seed: u64,
     noise: &str,
     closure: &str,
+    effects: Option<Vec<String>>,
+    segments: usize,
 ) -> PyResult<SuspendedSimulation> {
     let robot = robot.inner.clone();
     let noise = noise_preset(noise)?.sigmas(robot.platform_weight_n);
     let closure = parse("closure", closure, Closure::parse)?;
+    let effects = effects_from_specs(&effects.unwrap_or_default(), FrontEnd::Python).map_err(to_py)?;
     let rows = py
         .detach(|| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -174,7 +183,7 @@ pub fn simulate_suspended(
                 .workspace
                 .unwrap_or_else(|| Workspace::around_anchor_points(&robot.anchors_m));
             let equilibria = sample_suspended(&robot, &workspace, poses, closure, &mut rng)?;
-            Ok::<_, sagcal::Error>(measure_suspended(&robot, &equilibria, &noise, &mut rng))
+            simulate_readings(&robot, &effects, &equilibria, &noise, segments, &mut rng)
         })
         .map_err(to_py)?;
     Ok(SuspendedSimulation { rows, robot, seed })

@@ -28,6 +28,25 @@ def test_simulate_suspended_draws_the_commands_numbers(cli, tmp_path, name, cabl
     assert written.read_text().splitlines()[2:] == rows[1:]
 
 
+def test_simulate_suspended_with_effects_is_the_commands_discretised_data(cli, tmp_path):
+    robot = sagcal.SuspendedRobot.builtin("six")
+    effects = ["elastic:ea_n=3e6", "pulley:radius_m=0.15"]
+    simulation = sagcal.simulate_suspended(robot, 5, seed=4, effects=effects, segments=30)
+    out = tmp_path / "cli.csv"
+    cli("simulate", "--robot", ROOT / "robots" / "six.toml", "--poses", 5, "--seed", 4,
+        "--effect", effects[0], "--effect", effects[1], "--segments", 30, "--out", out)
+    rows = [line for line in out.read_text().splitlines() if not line.startswith("#")]
+    command = np.array([[float(v) for v in row.split(",")] for row in rows[1:]])
+    assert np.array_equal(command, simulation.measurements), "the same seed and effects give the command's numbers"
+    # The pulley's wrap and the stretch move the platform: not the closed-form data of the same seed.
+    plain = sagcal.simulate_suspended(robot, 5, seed=4).measurements
+    assert np.abs(plain[:, :3] - simulation.measurements[:, :3]).max() > 1e-3
+    with pytest.raises(sagcal.SagcalError, match="the effect encoder-backlash.*not simulated on robots of 3 to 8 cables"):
+        sagcal.simulate_suspended(robot, 2, effects=["elastic:ea_n=3e6", "encoder-backlash:b_m=0.002"])
+    with pytest.raises(sagcal.SagcalError, match="effects `bogus:x=1`"):
+        sagcal.simulate_suspended(robot, 2, effects=["bogus:x=1"])
+
+
 def test_suspended_robot_errors_name_what_is_wrong(tmp_path):
     with pytest.raises(sagcal.SagcalError, match="unknown built-in robot `nine`"):
         sagcal.SuspendedRobot.builtin("nine")

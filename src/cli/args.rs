@@ -10,7 +10,7 @@ use super::check::CheckArgs;
 use super::demo::DemoArgs;
 use super::diagnose::DiagnoseArgs;
 use super::experiment::Table2Args;
-use super::hidden::HiddenEffectsArgs;
+use super::hidden_args::HiddenEffectsArgs;
 use super::init::InitArgs;
 use super::localize::LocalizeArgs;
 use super::localize_experiment::LocalizeExperimentArgs;

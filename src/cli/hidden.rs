@@ -11,46 +11,14 @@ use sagcal::experiments::hidden_effects::{
 };
 use sagcal::model::effect_kind::EffectKind;
 use sagcal::model::sensors::NoisePreset;
+use sagcal::model::suspended::SuspendedRobot;
 use sagcal::model::Robot;
 use sagcal::sim::closed_form::Closure;
 use serde::Serialize;
 
+use super::hidden_args::HiddenEffectsArgs;
+use super::hidden_suspended;
 use super::output::{counted, print_json, progress_bar, Table};
-use super::parse::parse_noises;
-
-#[derive(Debug, clap::Args)]
-pub(super) struct HiddenEffectsArgs {
-    /// Cases per effect (and with none) per robot.
-    #[arg(long, default_value_t = 20)]
-    seeds: usize,
-    /// Base random seed (each case's seed is derived from it and printed in the JSON).
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// Built-in robots, comma separated.
-    #[arg(long, default_value = "large,small")]
-    robots: String,
-    /// Static poses per case.
-    #[arg(long, default_value_t = 35)]
-    poses: usize,
-    /// Sensor noise of the data and the calibration: paper, authors, or both.
-    #[arg(long, default_value = "both", value_parser = parse_noises)]
-    noise: std::vec::Vec<sagcal::model::sensors::NoisePreset>,
-    /// Segments per cable of the discretised simulator.
-    #[arg(long, default_value_t = 50)]
-    segments: usize,
-    /// How each pose closes its family of equilibria: level (the most level member),
-    /// yaw (a random yaw within +-1 degree) or mixed (about half each).
-    #[arg(long, default_value = "mixed", value_parser = sagcal::sim::closed_form::Closure::parse)]
-    closure: sagcal::sim::closed_form::Closure,
-    /// The diagnosis' catalogue: full, or leave-one-out (each case is also
-    /// diagnosed with each hidden effect left out of the catalogue, and the
-    /// verdict scored for honesty: `unexplained`, and no wrong cause named).
-    #[arg(long, default_value = "full", value_parser = sagcal::experiments::hidden_effects::Catalogue::parse)]
-    catalogue: sagcal::experiments::hidden_effects::Catalogue,
-    /// Print JSON (with every case).
-    #[arg(long)]
-    json: bool,
-}
 
 /// A case is detectable when the diagnosis' test has at least this power at the true magnitude.
 const DETECTABLE_POWER: f64 = 0.9;
@@ -155,6 +123,16 @@ pub fn run(args: &HiddenEffectsArgs) -> sagcal::Result<()> {
             return Err(sagcal::Error::InvalidInput(format!("--robots names `{name}` twice")));
         }
         names.push(name);
+    }
+    let suspended = |name: &&str| Robot::builtin(name).is_err() && SuspendedRobot::builtin(name).is_ok();
+    if names.iter().all(suspended) {
+        return hidden_suspended::run(args, &names);
+    }
+    if let Some(name) = names.iter().find(|n| suspended(n)) {
+        return Err(sagcal::Error::InvalidInput(format!(
+            "--robots: `{name}` has {} cables: sweep robots of 3 to 8 cables in a run of their own",
+            SuspendedRobot::builtin(name)?.cable_count()
+        )));
     }
     let robots: Vec<Robot> = names
         .iter()

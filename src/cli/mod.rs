@@ -18,6 +18,8 @@ mod experiment;
 mod experiment_suspended;
 mod gross_errors;
 mod hidden;
+mod hidden_args;
+mod hidden_suspended;
 mod init;
 mod localize;
 mod localize_args;

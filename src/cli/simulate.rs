@@ -14,7 +14,7 @@ use sagcal::sim::effects::{measure_with_effects, simulation_truth};
 
 use super::output::counted;
 use super::robot_kind::{read_robot, AnyRobot};
-use super::simulate_args::{closure_note, noise_phrase, ranges_line, SimulateArgs};
+use super::simulate_args::{closure_note, model_phrase, noise_phrase, ranges_line, SimulateArgs};
 
 /// Simulate measurements of the robot, write them (and the truth), report what was drawn.
 ///
@@ -93,14 +93,7 @@ fn measure_poses(
 /// The measurement file's comment lines: generator, robot, seed, noise, workspace and effects.
 fn comments(args: &SimulateArgs, truth: &Robot, workspace: &Workspace) -> Vec<String> {
     let effects = truth.effects;
-    let model = if effects.is_none() {
-        "closed-form catenary model".to_string()
-    } else {
-        format!(
-            "discretised elastic-chain model, {} segments per cable, commanded to closed-form equilibria",
-            args.segments
-        )
-    };
+    let model = model_phrase(!effects.is_none(), args.segments);
     let mut comments = vec![
         format!("simulated by sagcal {} ({model})", env!("CARGO_PKG_VERSION")),
         format!(

@@ -60,6 +60,15 @@ pub(super) fn closure_note(closure: Closure) -> String {
     }
 }
 
+/// The model the data come from, as a measurement file's first comment says it.
+pub(super) fn model_phrase(with_effects: bool, segments: usize) -> String {
+    if with_effects {
+        format!("discretised elastic-chain model, {segments} segments per cable, commanded to closed-form equilibria")
+    } else {
+        "closed-form catenary model".to_string()
+    }
+}
+
 /// `without noise` or `with paper noise`.
 pub(super) fn noise_phrase(noise: NoisePreset) -> String {
     match noise {

@@ -1,18 +1,23 @@
 //! `sagcal simulate` on a robot of 3 to 8 cables: the closed-form model
-//! ([`sagcal::sim::suspended`]), written in the N-cable measurement file
+//! ([`sagcal::sim::suspended`]), or with `--effect` the discretised
+//! simulator with those effects acting ([`sagcal::sim::suspended_effects`]),
+//! written in the N-cable measurement file
 //! ([`sagcal::io::suspended_measurements`]).
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use sagcal::error::FrontEnd;
 use sagcal::io::suspended_measurements::suspended_measurements_text;
 use sagcal::io::OutputSet;
-use sagcal::model::suspended::{SuspendedEquilibrium, SuspendedRobot};
+use sagcal::model::effects::Effects;
+use sagcal::model::suspended::{SuspendedEquilibrium, SuspendedMeasurement, SuspendedRobot};
 use sagcal::sim::closed_form::Workspace;
-use sagcal::sim::suspended::{measure_suspended, sample_suspended};
+use sagcal::sim::suspended::sample_suspended;
+use sagcal::sim::suspended_effects::{effects_from_specs, simulate_readings};
 use sagcal::Error;
 
 use super::output::counted;
-use super::simulate_args::{closure_note, noise_phrase, ranges_line, SimulateArgs};
+use super::simulate_args::{closure_note, model_phrase, noise_phrase, ranges_line, SimulateArgs};
 
 /// Simulate `robot` as `args` ask, write the measurements and report what was drawn.
 pub(super) fn run(args: &SimulateArgs, robot: &SuspendedRobot) -> sagcal::Result<()> {
@@ -20,13 +25,14 @@ pub(super) fn run(args: &SimulateArgs, robot: &SuspendedRobot) -> sagcal::Result
     let workspace = robot
         .workspace
         .unwrap_or_else(|| Workspace::around_anchor_points(&robot.anchors_m));
+    let effects = effects_from_specs(&args.effects, FrontEnd::Cli)?;
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     let equilibria = sample_suspended(robot, &workspace, args.poses, args.closure, &mut rng)?;
-    let noise = args.noise.sigmas(robot.platform_weight_n);
-    let rows = measure_suspended(robot, &equilibria, &noise, &mut rng);
-    let comments = vec![
+    let rows = measure(args, robot, &effects, &equilibria, &mut rng)?;
+    let model = model_phrase(!effects.is_none(), args.segments);
+    let mut comments = vec![
         format!(
-            "simulated by sagcal {} (closed-form catenary model, {} cables)",
+            "simulated by sagcal {} ({model}, {} cables)",
             env!("CARGO_PKG_VERSION"),
             robot.cable_count()
         ),
@@ -41,6 +47,9 @@ pub(super) fn run(args: &SimulateArgs, robot: &SuspendedRobot) -> sagcal::Result
         ),
         format!("workspace {workspace}"),
     ];
+    if !effects.is_none() {
+        comments.push(format!("effects {effects}"));
+    }
     let mut outputs = OutputSet::new();
     outputs.input("--robot", &args.robot);
     outputs.file(
@@ -66,23 +75,35 @@ pub(super) fn run(args: &SimulateArgs, robot: &SuspendedRobot) -> sagcal::Result
 
 /// The options only the four-cable model has, refused with the reason.
 fn refuse_four_cable_options(args: &SimulateArgs, robot: &SuspendedRobot) -> sagcal::Result<()> {
-    let refused = if !args.effects.is_empty() {
-        Some("--effect: the model of 3 to 8 cables has none of the effects of the catalogue")
-    } else if args.truth.is_some() {
-        Some("--truth: the robot file is the truth of a simulation of 3 to 8 cables (nothing is drawn for it)")
-    } else {
-        None
-    };
-    match refused {
-        Some(why) => Err(Error::InvalidInput(format!(
-            "robot `{}` ({} cables): {why}",
+    if args.truth.is_some() {
+        return Err(Error::InvalidInput(format!(
+            "robot `{}` ({} cables): --truth: the robot file is the truth of a simulation of 3 to 8 cables \
+             (nothing is drawn for it; the effects are the --effect flags)",
             robot.name,
             robot.cable_count()
-        ))),
-        None => Ok(()),
+        )));
     }
+    Ok(())
 }
 
+/// The readings at `equilibria` (announcing the discretised simulator's
+/// settings on stdout when effects act, as for four cables).
+fn measure(
+    args: &SimulateArgs,
+    robot: &SuspendedRobot,
+    effects: &Effects,
+    equilibria: &[SuspendedEquilibrium],
+    rng: &mut ChaCha8Rng,
+) -> sagcal::Result<Vec<SuspendedMeasurement>> {
+    if !effects.is_none() {
+        println!(
+            "effects: {effects}; seed {}; discretised simulator, {} segments per cable",
+            args.seed, args.segments
+        );
+    }
+    let noise = args.noise.sigmas(robot.platform_weight_n);
+    simulate_readings(robot, effects, equilibria, &noise, args.segments, rng)
+}
 /// The workspace and the ranges of cable lengths and tensions it gave.
 fn print_ranges(workspace: &Workspace, equilibria: &[SuspendedEquilibrium]) {
     println!(

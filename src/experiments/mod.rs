@@ -7,6 +7,8 @@
 //!   scored (`sagcal experiment hidden-effects`);
 //! - [`localize_after_calibration`]: calibrate by the Table II protocol, then
 //!   localise the held-out poses (`sagcal experiment localize`);
+//! - [`suspended_sweep`]: effects hidden in data of robots of 3 to 8 cables,
+//!   scored by the calibration's own verdict (`sagcal experiment hidden-effects --robots six`);
 //! - [`plan_candidates`]: candidate poses for `sagcal plan`;
 //! - [`benchmark`]: the reproducible calibration graph the solver benches and
 //!   the peer comparison share.
@@ -32,6 +34,8 @@ pub mod localize_after_calibration;
 pub mod plan_candidates;
 pub mod pose_plan;
 pub mod selection;
+pub mod suspended_effect_draws;
+pub mod suspended_sweep;
 pub mod suspended_trials;
 pub mod table2;
 mod trial;

@@ -40,7 +40,7 @@ use crate::calib::suspended::{
 use crate::calib::{anchor_and_offset_uncertainty, CalibrationOptions, OrientationPrior, ParameterUncertainty};
 use crate::error::{Error, Result};
 use crate::model::sensors::NoisePreset;
-use crate::model::suspended::SuspendedRobot;
+use crate::model::suspended::{SuspendedEquilibrium, SuspendedRobot};
 use crate::sim::closed_form::{Closure, Workspace};
 use crate::sim::suspended::{measure_suspended, sample_suspended};
 
@@ -98,19 +98,11 @@ pub fn suspended_trials(
     let noise = options.noise.sigmas(truth.platform_weight_n);
     let mut calibration = CalibrationOptions::new(noise);
     calibration.orientation_prior = OrientationPrior::On;
-    let workspace = truth
-        .workspace
-        .unwrap_or_else(|| Workspace::around_anchor_points(&truth.anchors_m));
-    let closure = if truth.cable_count() > 3 {
-        Closure::Yaw { max_yaw_deg: 5.0 }
-    } else {
-        Closure::Level
-    };
     let mut sums = Sums::default();
     let mut failures = Vec::new();
     for trial in 0..options.trials {
         let mut rng = ChaCha8Rng::seed_from_u64(options.seed.wrapping_add(trial as u64));
-        let equilibria = sample_suspended(truth, &workspace, options.poses, closure, &mut rng)?;
+        let equilibria = trial_poses(truth, options.poses, &mut rng)?;
         let data = measure_suspended(truth, &equilibria, &noise, &mut rng);
         let guess = moved_guess(truth, options.guess_m, &mut rng);
         // The bound at the truth: the graph's information at the true values.
@@ -176,6 +168,25 @@ pub fn suspended_trials(
         unbounded: sums.unbounded,
         failures,
     })
+}
+
+/// A trial's poses drawn in the robot's workspace (or around its anchors):
+/// on three cables each the level equilibrium at its position, on more the
+/// member with a yaw drawn within +-5 degrees held.
+pub(crate) fn trial_poses(
+    robot: &SuspendedRobot,
+    poses: usize,
+    rng: &mut impl Rng,
+) -> Result<Vec<SuspendedEquilibrium>> {
+    let workspace = robot
+        .workspace
+        .unwrap_or_else(|| Workspace::around_anchor_points(&robot.anchors_m));
+    let closure = if robot.cable_count() > 3 {
+        Closure::Yaw { max_yaw_deg: 5.0 }
+    } else {
+        Closure::Level
+    };
+    sample_suspended(robot, &workspace, poses, closure, rng)
 }
 
 /// Running sums over the trials.

@@ -96,6 +96,13 @@ pub struct Workspace {
     pub max_m: [f64; 3],
 }
 
+impl Workspace {
+    /// The centre of the box, world frame, metres.
+    pub fn centre(&self) -> Vector3<f64> {
+        (Vector3::from(self.min_m) + Vector3::from(self.max_m)) * 0.5
+    }
+}
+
 impl std::fmt::Display for Workspace {
     /// `[-6, -4, 2] .. [6, 4, 9] m`: the corners, each coordinate to 0.1 mm
     /// (without the binary noise of a computed bound, `29.700000000000003`).

@@ -118,7 +118,7 @@
 
 use std::f64::consts::PI;
 
-use nalgebra::{Matrix3, RowVector3, SMatrix, SVector, Vector3, Vector6};
+use nalgebra::{Const, DMatrix, DVector, DimMin, Matrix3, RowVector3, SMatrix, SVector, Vector3, Vector6};
 
 use crate::error::{Error, Result};
 use crate::model::pose::PlatformPose;
@@ -128,9 +128,15 @@ use crate::model::statics::Equilibrium;
 /// Largest number of segments per cable accepted.
 pub const MAX_SEGMENTS: usize = 1_000_000;
 
-const UNKNOWNS: usize = 6 + 4 * CABLE_COUNT;
+/// Unknowns of the four-cable robot: the pose (6) and each cable's force (3) and free length (1).
+const UNKNOWNS: usize = unknowns(CABLE_COUNT);
+#[cfg(test)]
 type VectorN = SVector<f64, UNKNOWNS>;
-type MatrixN = SMatrix<f64, UNKNOWNS, UNKNOWNS>;
+
+/// Unknowns of a robot of `cables` cables ([`Problem`]).
+pub(crate) const fn unknowns(cables: usize) -> usize {
+    6 + 4 * cables
+}
 
 /// A cable within this angle (rad) of vertical has no defined pulley plane.
 const VERTICAL_CABLE_RAD: f64 = 1e-12;
@@ -442,13 +448,19 @@ fn shoot(force: &Vector3<f64>, length: f64, weight_per_m: f64, segments: usize, 
 
 /// One cable's physical constants and boundary conditions.
 #[derive(Debug, Clone, Copy)]
-struct CableSpec {
-    anchor: Vector3<f64>,
-    radius: f64,
-    paid_out: f64,
-    weight_per_m: f64,
-    segments: usize,
-    compliance: f64,
+pub(crate) struct CableSpec {
+    /// Anchor (pulley entry), world frame, metres.
+    pub(crate) anchor: Vector3<f64>,
+    /// Pulley radius, metres.
+    pub(crate) radius: f64,
+    /// Paid-out (unstretched) length, metres.
+    pub(crate) paid_out: f64,
+    /// Weight per metre, N/m.
+    pub(crate) weight_per_m: f64,
+    /// Straight segments of the chain.
+    pub(crate) segments: usize,
+    /// `1 / EA`, 1/N (0: inextensible).
+    pub(crate) compliance: f64,
 }
 
 /// One cable's residuals (closure, paid-out length) and their derivatives.
@@ -493,32 +505,75 @@ fn cable_block(spec: &CableSpec, start: &Vector3<f64>, force: &Vector3<f64>, len
     })
 }
 
-/// The whole robot's equilibrium equations.
+/// The whole robot's equilibrium equations for `C` cables and `U =
+/// unknowns(C)` unknowns. Rows: each chain's closure (`3 C`), the platform's
+/// force and moment balance (6), each paid-out length (`C`); columns: the
+/// pose's tangent (6), each cable's platform force (`3 C`), each free length
+/// (`C`). One generic code for every cable count: the four-cable robot's
+/// equations are the instance `C = 4`.
 #[derive(Clone, Copy)]
-struct Problem {
-    cables: [CableSpec; CABLE_COUNT],
-    attachments: [Vector3<f64>; CABLE_COUNT],
-    com: Vector3<f64>,
-    platform_weight: f64,
+pub(crate) struct Problem<const C: usize, const U: usize> {
+    pub(crate) cables: [CableSpec; C],
+    pub(crate) attachments: [Vector3<f64>; C],
+    pub(crate) com: Vector3<f64>,
+    pub(crate) platform_weight: f64,
     length_scale: f64,
     force_scale: f64,
     moment_scale: f64,
     /// Subtracted from the residual: `(1 - t) r(x0)` on a Newton-homotopy path, else zero.
-    offset: VectorN,
+    offset: SVector<f64, U>,
 }
 
+/// The unknowns of a [`Problem`].
 #[derive(Debug, Clone, Copy)]
-struct State {
-    pose: PlatformPose,
-    forces: [Vector3<f64>; CABLE_COUNT],
-    lengths: [f64; CABLE_COUNT],
+pub(crate) struct State<const C: usize> {
+    pub(crate) pose: PlatformPose,
+    pub(crate) forces: [Vector3<f64>; C],
+    pub(crate) lengths: [f64; C],
 }
 
-impl Problem {
-    fn evaluate(&self, state: &State) -> Option<(VectorN, MatrixN)> {
+impl<const C: usize, const U: usize> Problem<C, U>
+where
+    Const<U>: DimMin<Const<U>, Output = Const<U>>,
+{
+    /// The equations of `cables` (anchors, weights, paid-out lengths, ...)
+    /// attached at `attachments` to a platform of weight `platform_weight`
+    /// (N) with its centre of mass at `com` (platform frame, metres).
+    pub(crate) fn new(
+        cables: [CableSpec; C],
+        attachments: [Vector3<f64>; C],
+        com: Vector3<f64>,
+        platform_weight: f64,
+    ) -> Self {
+        assert_eq!(U, unknowns(C), "a problem of {C} cables has {} unknowns", unknowns(C));
+        let total_length: f64 = cables.iter().map(|c| c.paid_out).sum();
+        let length_scale = (total_length / C as f64).max(1e-3);
+        // The platform's weight and an upper bound of the cables' (their heaviest weight per metre).
+        let heaviest = cables.iter().map(|c| c.weight_per_m).fold(0.0, f64::max);
+        let force_scale = platform_weight + heaviest * total_length;
+        let arm = attachments
+            .iter()
+            .chain(std::iter::once(&com))
+            .map(|b| b.norm())
+            .fold(0.0, f64::max)
+            .max(1e-3);
+        Problem {
+            cables,
+            attachments,
+            com,
+            platform_weight,
+            length_scale,
+            force_scale,
+            moment_scale: force_scale * arm,
+            offset: SVector::zeros(),
+        }
+    }
+
+    fn evaluate(&self, state: &State<C>) -> Option<(SVector<f64, U>, SMatrix<f64, U, U>)> {
         crate::steps::tick();
-        let mut r = VectorN::zeros();
-        let mut j = MatrixN::zeros();
+        let mut r = SVector::<f64, U>::zeros();
+        let mut j = SMatrix::<f64, U, U>::zeros();
+        let (force_row, moment_row, length_row) = (3 * C, 3 * C + 3, 3 * C + 6);
         let rotation = *state.pose.rotation_matrix().matrix();
         let p = state.pose.position_m;
         let gravity = Vector3::new(0.0, 0.0, -self.platform_weight);
@@ -527,12 +582,12 @@ impl Problem {
         let mut moment_sum = com_arm.cross(&gravity);
         // d(moment)/d(dtheta) of the weight: [g]x [R c]x R.
         let mut d_moment_rotation = gravity.cross_matrix() * com_arm.cross_matrix() * rotation;
-        for i in 0..CABLE_COUNT {
+        for i in 0..C {
             let arm = rotation * self.attachments[i];
             let start = p + arm;
             let force = state.forces[i];
             let block = cable_block(&self.cables[i], &start, &force, state.lengths[i])?;
-            let (row, fcol, lcol) = (3 * i, 6 + 3 * i, 6 + 3 * CABLE_COUNT + i);
+            let (row, fcol, lcol) = (3 * i, 6 + 3 * i, 6 + 3 * C + i);
             r.fixed_rows_mut::<3>(row).copy_from(&block.closure);
             // d start / d dtheta = -[R b]x R; d start / d dp = I.
             j.fixed_view_mut::<3, 3>(row, 0)
@@ -540,19 +595,21 @@ impl Problem {
             j.fixed_view_mut::<3, 3>(row, 3).copy_from(&Matrix3::identity());
             j.fixed_view_mut::<3, 3>(row, fcol).copy_from(&block.d_closure_force);
             j.fixed_view_mut::<3, 1>(row, lcol).copy_from(&block.d_closure_length);
-            let lrow = 18 + i;
+            let lrow = length_row + i;
             r[lrow] = block.length_residual;
             j.fixed_view_mut::<1, 3>(lrow, fcol).copy_from(&block.d_paid_force);
             j[(lrow, lcol)] = block.d_paid_length;
             force_sum += force;
             moment_sum += arm.cross(&force);
-            j.fixed_view_mut::<3, 3>(12, fcol).copy_from(&Matrix3::identity());
-            j.fixed_view_mut::<3, 3>(15, fcol).copy_from(&arm.cross_matrix());
+            j.fixed_view_mut::<3, 3>(force_row, fcol)
+                .copy_from(&Matrix3::identity());
+            j.fixed_view_mut::<3, 3>(moment_row, fcol)
+                .copy_from(&arm.cross_matrix());
             d_moment_rotation += force.cross_matrix() * arm.cross_matrix() * rotation;
         }
-        r.fixed_rows_mut::<3>(12).copy_from(&force_sum);
-        r.fixed_rows_mut::<3>(15).copy_from(&moment_sum);
-        j.fixed_view_mut::<3, 3>(15, 0).copy_from(&d_moment_rotation);
+        r.fixed_rows_mut::<3>(force_row).copy_from(&force_sum);
+        r.fixed_rows_mut::<3>(moment_row).copy_from(&moment_sum);
+        j.fixed_view_mut::<3, 3>(moment_row, 0).copy_from(&d_moment_rotation);
         r -= self.offset;
         if !(r.iter().all(|x| x.is_finite()) && j.iter().all(|x| x.is_finite())) {
             return None;
@@ -560,39 +617,44 @@ impl Problem {
         Some((r, j))
     }
 
-    fn residual_scales(&self) -> VectorN {
-        VectorN::from_fn(|k, _| match k {
-            0..12 => 1.0 / self.length_scale,
-            12..15 => 1.0 / self.force_scale,
-            15..18 => 1.0 / self.moment_scale,
-            _ => 1.0 / self.length_scale,
+    fn residual_scales(&self) -> SVector<f64, U> {
+        SVector::from_fn(|k, _| {
+            if k < 3 * C {
+                1.0 / self.length_scale
+            } else if k < 3 * C + 3 {
+                1.0 / self.force_scale
+            } else if k < 3 * C + 6 {
+                1.0 / self.moment_scale
+            } else {
+                1.0 / self.length_scale
+            }
         })
     }
 
-    fn unknown_scales(&self) -> VectorN {
-        VectorN::from_fn(|k, _| match k {
+    fn unknown_scales(&self) -> SVector<f64, U> {
+        SVector::from_fn(|k, _| match k {
             0..3 => 1.0,
             3..6 => self.length_scale,
-            6..18 => self.force_scale,
+            _ if k < 6 + 3 * C => self.force_scale,
             _ => self.length_scale,
         })
     }
 
-    fn merit(&self, r: &VectorN) -> f64 {
+    fn merit(&self, r: &SVector<f64, U>) -> f64 {
         r.component_mul(&self.residual_scales()).norm()
     }
 
-    fn step(state: &State, delta: &VectorN) -> State {
+    fn step(state: &State<C>, delta: &SVector<f64, U>) -> State<C> {
         let tangent = Vector6::from_fn(|k, _| delta[k]);
         State {
             pose: state.pose.retract(&tangent),
             forces: std::array::from_fn(|i| state.forces[i] + delta.fixed_rows::<3>(6 + 3 * i)),
-            lengths: std::array::from_fn(|i| state.lengths[i] + delta[18 + i]),
+            lengths: std::array::from_fn(|i| state.lengths[i] + delta[6 + 3 * C + i]),
         }
     }
 
     /// Damped Newton from `state`; `Ok` when the scaled residual reaches round-off.
-    fn newton(&self, state: State, max_iterations: usize) -> std::result::Result<(State, usize), usize> {
+    fn newton(&self, state: State<C>, max_iterations: usize) -> std::result::Result<(State<C>, usize), usize> {
         let row_scale = self.residual_scales();
         let col_scale = self.unknown_scales();
         let Some((mut r, mut j)) = self.evaluate(&state) else {
@@ -605,7 +667,7 @@ impl Problem {
                 return Ok((state, iteration - 1));
             }
             // Scaled system (D_r J D_x) (D_x^-1 delta) = -D_r r.
-            let scaled_j = MatrixN::from_fn(|a, b| j[(a, b)] * row_scale[a] * col_scale[b]);
+            let scaled_j = SMatrix::<f64, U, U>::from_fn(|a, b| j[(a, b)] * row_scale[a] * col_scale[b]);
             let scaled_r = r.component_mul(&row_scale);
             let newton_step = scaled_j
                 .lu()
@@ -623,8 +685,8 @@ impl Problem {
                 if rotation > 0.5 {
                     alpha = alpha.min(0.5 / rotation);
                 }
-                for i in 0..CABLE_COUNT {
-                    let dl = delta[18 + i].abs();
+                for i in 0..C {
+                    let dl = delta[6 + 3 * C + i].abs();
                     if dl > 0.5 * state.lengths[i] {
                         alpha = alpha.min(0.5 * state.lengths[i] / dl);
                     }
@@ -672,7 +734,7 @@ impl Problem {
 
     /// Newton homotopy `r(x) = (1 - t) r(x0)`, `t` from 0 to 1 with adaptive steps,
     /// for starts from which damped Newton alone fails.
-    fn continuation(&self, start: State, max_iterations: usize) -> std::result::Result<(State, usize), usize> {
+    fn continuation(&self, start: State<C>, max_iterations: usize) -> std::result::Result<(State<C>, usize), usize> {
         let Some((r0, _)) = self.evaluate(&start) else {
             return Err(0);
         };
@@ -703,13 +765,14 @@ impl Problem {
     }
 
     /// Damped least-squares steps of growing damping, for when Newton's direction fails.
+    #[allow(clippy::type_complexity)]
     fn levenberg_marquardt_step(
         &self,
-        state: &State,
-        scaled_j: &MatrixN,
-        r: &VectorN,
+        state: &State<C>,
+        scaled_j: &SMatrix<f64, U, U>,
+        r: &SVector<f64, U>,
         merit: f64,
-    ) -> Option<(State, VectorN, MatrixN, f64)> {
+    ) -> Option<(State<C>, SVector<f64, U>, SMatrix<f64, U, U>, f64)> {
         let row_scale = self.residual_scales();
         let col_scale = self.unknown_scales();
         let scaled_r = r.component_mul(&row_scale);
@@ -719,7 +782,7 @@ impl Problem {
         let mut damping = 1e-8;
         while damping < 1e8 {
             let mut damped = normal;
-            for k in 0..UNKNOWNS {
+            for k in 0..U {
                 damped[(k, k)] += damping * base;
             }
             if let Some(step) = damped.cholesky().map(|c| -c.solve(&gradient)) {
@@ -787,7 +850,7 @@ fn check_robot(robot: &Robot) -> Result<()> {
     Ok(())
 }
 
-fn check_lengths(lengths: &[f64; CABLE_COUNT]) -> Result<()> {
+pub(crate) fn check_lengths(lengths: &[f64]) -> Result<()> {
     if let Some((i, l)) = lengths.iter().enumerate().find(|(_, l)| !(l.is_finite() && **l > 0.0)) {
         return Err(Error::InvalidInput(format!(
             "cable {}: paid-out length must be a positive number of metres, got {l}",
@@ -797,7 +860,11 @@ fn check_lengths(lengths: &[f64; CABLE_COUNT]) -> Result<()> {
     Ok(())
 }
 
-fn problem(robot: &Robot, options: &DiscretisedOptions, paid_out: &[f64; CABLE_COUNT]) -> Problem {
+fn problem(
+    robot: &Robot,
+    options: &DiscretisedOptions,
+    paid_out: &[f64; CABLE_COUNT],
+) -> Problem<CABLE_COUNT, UNKNOWNS> {
     let compliance = 1.0 / options.axial_stiffness_n;
     let cables = std::array::from_fn(|i| CableSpec {
         anchor: robot.anchors_m[i],
@@ -808,26 +875,7 @@ fn problem(robot: &Robot, options: &DiscretisedOptions, paid_out: &[f64; CABLE_C
         compliance,
     });
     let com = options.com_offset_m.unwrap_or(robot.com_offset_m);
-    let total_length: f64 = paid_out.iter().sum();
-    let length_scale = (total_length / CABLE_COUNT as f64).max(1e-3);
-    let force_scale = robot.platform_weight_n + robot.cable_weight_n_per_m * total_length;
-    let arm = robot
-        .attachments_m
-        .iter()
-        .chain(std::iter::once(&com))
-        .map(|b| b.norm())
-        .fold(0.0, f64::max)
-        .max(1e-3);
-    Problem {
-        cables,
-        attachments: robot.attachments_m,
-        com,
-        platform_weight: robot.platform_weight_n,
-        length_scale,
-        force_scale,
-        moment_scale: force_scale * arm,
-        offset: VectorN::zeros(),
-    }
+    Problem::new(cables, robot.attachments_m, com, robot.platform_weight_n)
 }
 
 /// Newton for one cable between a fixed start point and its pulley: unknowns the
@@ -1019,13 +1067,13 @@ fn assemble_cable(
 
 /// Straight-cable statics at `pose`: tensions along the chords to the anchors
 /// balancing the platform's wrench in the least-squares sense, plus half of each cable's weight.
-fn straight_forces(robot: &Robot, problem: &Problem, pose: &PlatformPose) -> [Vector3<f64>; CABLE_COUNT] {
+fn straight_forces<const C: usize, const U: usize>(problem: &Problem<C, U>, pose: &PlatformPose) -> [Vector3<f64>; C] {
     let rotation = pose.rotation_matrix();
-    let mut structure = SMatrix::<f64, 6, CABLE_COUNT>::zeros();
-    let mut chords = [Vector3::zeros(); CABLE_COUNT];
-    for i in 0..CABLE_COUNT {
-        let arm = rotation * robot.attachments_m[i];
-        let chord = (robot.anchors_m[i] - pose.position_m - arm).normalize();
+    let mut structure = DMatrix::<f64>::zeros(6, C);
+    let mut chords = [Vector3::zeros(); C];
+    for i in 0..C {
+        let arm = rotation * problem.attachments[i];
+        let chord = (problem.cables[i].anchor - pose.position_m - arm).normalize();
         chords[i] = chord;
         let column = arm.cross(&chord);
         for k in 0..3 {
@@ -1037,18 +1085,30 @@ fn straight_forces(robot: &Robot, problem: &Problem, pose: &PlatformPose) -> [Ve
     let weight = Vector3::new(0.0, 0.0, problem.platform_weight);
     let moment = com_arm.cross(&weight);
     let wrench = Vector6::new(weight.x, weight.y, weight.z, moment.x, moment.y, moment.z);
-    let svd = structure.svd(true, true);
-    let tensions = svd
-        .solve(&wrench, 1e-12)
-        .unwrap_or_else(|_| SVector::repeat(problem.platform_weight / 4.0));
+    let share = problem.platform_weight / C as f64;
+    let tensions = least_squares_tensions(&structure, &wrench).unwrap_or_else(|| DVector::from_element(C, share));
     std::array::from_fn(|i| {
         let tension = if tensions[i].is_finite() && tensions[i] > 0.0 {
             tensions[i]
         } else {
-            problem.platform_weight / 4.0
+            share
         };
-        chords[i] * tension + Vector3::z() * (0.5 * robot.cable_weight_n_per_m * problem.cables[i].paid_out)
+        chords[i] * tension + Vector3::z() * (0.5 * problem.cables[i].weight_per_m * problem.cables[i].paid_out)
     })
+}
+
+/// The least-squares (minimum-norm) solution of `structure t = wrench` by
+/// the SVD. Four cables take the fixed-size 6 x 4 SVD the four-cable
+/// simulator has always used (its starts, and so its results, unchanged to
+/// the bit); other counts the dynamic one.
+fn least_squares_tensions(structure: &DMatrix<f64>, wrench: &Vector6<f64>) -> Option<DVector<f64>> {
+    if structure.ncols() == CABLE_COUNT {
+        let fixed = SMatrix::<f64, 6, CABLE_COUNT>::from_column_slice(structure.as_slice());
+        let solved = fixed.svd(true, true).solve(wrench, 1e-12).ok()?;
+        return Some(DVector::from_column_slice(solved.as_slice()));
+    }
+    let solved = structure.clone().svd(true, true).solve(wrench, 1e-12).ok()?;
+    Some(DVector::from_column_slice(solved.as_slice()))
 }
 
 /// Forward statics of the discretised robot: the four paid-out (unstretched)
@@ -1080,7 +1140,13 @@ pub fn solve_forward(
             paid_out_lengths_m[i]
         }
     });
-    let (solution, iterations) = newton_from_starts(robot, options, &problem, guess, lengths);
+    let (solution, iterations) = newton_from_starts(
+        &problem,
+        options.max_iterations,
+        &guess.pose,
+        guess.platform_forces_n,
+        lengths,
+    );
     let state = solution.ok_or_else(|| {
         Error::NoEquilibrium(format!(
             "discretised robot ({} segments, EA {} N, pulley radius {} m): Newton did not converge from the pose at {:?} for paid-out lengths {:?} m",
@@ -1093,12 +1159,14 @@ pub fn solve_forward(
     })?;
     let mut equilibrium = DiscretisedEquilibrium {
         pose: state.pose,
-        cables: assemble_cables(robot, &problem, &state)?,
+        cables: assemble_cables(&problem, &state)?
+            .try_into()
+            .map_err(|_| Error::NoEquilibrium("discretised robot: cable count".into()))?,
         paid_out_lengths_m: *paid_out_lengths_m,
         iterations,
         max_residual_n: 0.0,
     };
-    let residual = equilibrium_residual_n(robot, options, &equilibrium);
+    let residual = residual_of(&problem, &equilibrium.pose, &equilibrium.cables);
     equilibrium.max_residual_n = residual.max_n();
     if !(equilibrium.max_residual_n.is_finite() && residual.max_m().is_finite()) {
         return Err(Error::NoEquilibrium(
@@ -1132,28 +1200,31 @@ fn check_guess(guess: &InitialGuess) -> Result<()> {
 /// spent. Starts are computed only when the previous ones fail: the guess's
 /// forces, then each cable solved alone between the guessed attachment and
 /// its pulley (forces and free lengths), then the straight-cable statics.
-fn newton_from_starts(
-    robot: &Robot,
-    options: &DiscretisedOptions,
-    problem: &Problem,
-    guess: &InitialGuess,
-    lengths: [f64; CABLE_COUNT],
-) -> (Option<State>, usize) {
+pub(crate) fn newton_from_starts<const C: usize, const U: usize>(
+    problem: &Problem<C, U>,
+    max_iterations: usize,
+    guess_pose: &PlatformPose,
+    guess_forces: Option<[Vector3<f64>; C]>,
+    lengths: [f64; C],
+) -> (Option<State<C>>, usize)
+where
+    Const<U>: DimMin<Const<U>, Output = Const<U>>,
+{
     let mut iterations = 0;
-    let state = |(forces, lengths): ([Vector3<f64>; CABLE_COUNT], [f64; CABLE_COUNT])| State {
-        pose: guess.pose,
+    let state = |(forces, lengths): ([Vector3<f64>; C], [f64; C])| State {
+        pose: *guess_pose,
         forces,
         lengths,
     };
-    let rotation = guess.pose.rotation_matrix();
+    let rotation = guess_pose.rotation_matrix();
     let single_cables = |iterations: &mut usize| {
-        let mut forces = [Vector3::zeros(); CABLE_COUNT];
+        let mut forces = [Vector3::zeros(); C];
         let mut free_lengths = lengths;
-        for i in 0..CABLE_COUNT {
-            let start = guess.pose.position_m + rotation * robot.attachments_m[i];
+        for i in 0..C {
+            let start = guess_pose.position_m + rotation * problem.attachments[i];
             let spec = &problem.cables[i];
             let f0 = cable_force_guess(&start, &spec.anchor, lengths[i], spec.weight_per_m, spec.compliance);
-            let (f, l, used) = solve_single(spec, &start, f0, lengths[i], options.max_iterations)?;
+            let (f, l, used) = solve_single(spec, &start, f0, lengths[i], max_iterations)?;
             *iterations += used;
             forces[i] = f;
             free_lengths[i] = l;
@@ -1164,20 +1235,20 @@ fn newton_from_starts(
     // Damped Newton from each start in turn ...
     for strategy in 0..3 {
         let start = match strategy {
-            0 => guess.platform_forces_n.map(|forces| (forces, lengths)),
+            0 => guess_forces.map(|forces| (forces, lengths)),
             1 => single_cables(&mut iterations),
-            _ => Some((straight_forces(robot, problem, &guess.pose), lengths)),
+            _ => Some((straight_forces(problem, guess_pose), lengths)),
         };
         let Some(start) = start else { continue };
         tried.push(start);
-        match problem.newton(state(start), options.max_iterations) {
+        match problem.newton(state(start), max_iterations) {
             Ok((found, used)) => return (Some(found), iterations + used),
             Err(used) => iterations += used,
         }
     }
     // ... then the Newton homotopy from each.
     for start in tried {
-        match problem.continuation(state(start), options.max_iterations) {
+        match problem.continuation(state(start), max_iterations) {
             Ok((found, used)) => return (Some(found), iterations + used),
             Err(used) => iterations += used,
         }
@@ -1185,19 +1256,19 @@ fn newton_from_starts(
     (None, iterations)
 }
 
-/// The four chains of a solved state, node by node.
-fn assemble_cables(robot: &Robot, problem: &Problem, state: &State) -> Result<[DiscretisedCable; CABLE_COUNT]> {
+/// The chains of a solved state, node by node, in cable order.
+pub(crate) fn assemble_cables<const C: usize, const U: usize>(
+    problem: &Problem<C, U>,
+    state: &State<C>,
+) -> Result<Vec<DiscretisedCable>> {
     let rotation = state.pose.rotation_matrix();
-    let mut cables = Vec::with_capacity(CABLE_COUNT);
-    for i in 0..CABLE_COUNT {
-        let start = state.pose.position_m + rotation * robot.attachments_m[i];
-        let cable = assemble_cable(&problem.cables[i], &start, &state.forces[i], state.lengths[i])
-            .ok_or_else(|| Error::NoEquilibrium("discretised robot: degenerate chain at the solution".into()))?;
-        cables.push(cable);
-    }
-    cables
-        .try_into()
-        .map_err(|_| Error::NoEquilibrium("discretised robot: cable count".into()))
+    (0..C)
+        .map(|i| {
+            let start = state.pose.position_m + rotation * problem.attachments[i];
+            assemble_cable(&problem.cables[i], &start, &state.forces[i], state.lengths[i])
+                .ok_or_else(|| Error::NoEquilibrium("discretised robot: degenerate chain at the solution".into()))
+        })
+        .collect()
 }
 
 /// An independent check of an equilibrium from its node positions.
@@ -1216,15 +1287,26 @@ pub fn equilibrium_residual_n(
     options: &DiscretisedOptions,
     equilibrium: &DiscretisedEquilibrium,
 ) -> EquilibriumResidual {
-    let compliance = 1.0 / options.axial_stiffness_n;
-    let elastic = compliance > 0.0;
-    let radius = options.pulley_radius_m;
-    let com = options.com_offset_m.unwrap_or(robot.com_offset_m);
-    let rotation = equilibrium.pose.rotation_matrix();
-    let origin = equilibrium.pose.position_m;
-    let platform_weight = Vector3::new(0.0, 0.0, -robot.platform_weight_n);
+    residual_of(
+        &problem(robot, options, &equilibrium.paid_out_lengths_m),
+        &equilibrium.pose,
+        &equilibrium.cables,
+    )
+}
+
+/// [`equilibrium_residual_n`] of `cables` at `pose` for the equations of
+/// `problem` (its cables' anchors, weights, stiffnesses, pulleys and
+/// paid-out lengths, the platform's attachments, weight and centre of mass).
+pub(crate) fn residual_of<const C: usize, const U: usize>(
+    problem: &Problem<C, U>,
+    pose: &PlatformPose,
+    cables: &[DiscretisedCable],
+) -> EquilibriumResidual {
+    let rotation = pose.rotation_matrix();
+    let origin = pose.position_m;
+    let platform_weight = Vector3::new(0.0, 0.0, -problem.platform_weight);
     let mut force_sum = platform_weight;
-    let mut moment_sum = (rotation * com).cross(&platform_weight);
+    let mut moment_sum = (rotation * problem.com).cross(&platform_weight);
     let mut result = EquilibriumResidual {
         node_force_n: 0.0,
         platform_force_n: 0.0,
@@ -1235,8 +1317,17 @@ pub fn equilibrium_residual_n(
         segment_length_m: 0.0,
         paid_out_m: 0.0,
     };
+    if cables.len() != C {
+        return EquilibriumResidual {
+            node_force_n: f64::NAN,
+            ..result
+        };
+    }
     let worst = |slot: &mut f64, value: f64| *slot = nan_max(*slot, value);
-    for (i, cable) in equilibrium.cables.iter().enumerate() {
+    for (i, cable) in cables.iter().enumerate() {
+        let spec = &problem.cables[i];
+        let compliance = spec.compliance;
+        let elastic = compliance > 0.0;
         let n = cable.nodes_m.len().saturating_sub(1);
         if n == 0 || cable.segment_tensions_n.len() != n {
             return EquilibriumResidual {
@@ -1245,7 +1336,7 @@ pub fn equilibrium_residual_n(
             };
         }
         let l0 = cable.free_length_m / n as f64;
-        let node_weight = robot.cable_weight_n_per_m * l0;
+        let node_weight = spec.weight_per_m * l0;
         // Segment tension vectors from the positions.
         let segment = |k: usize| -> Vector3<f64> {
             let chord = cable.nodes_m[k + 1] - cable.nodes_m[k];
@@ -1279,17 +1370,17 @@ pub fn equilibrium_residual_n(
         let pull = segment(0) - Vector3::z() * (0.5 * node_weight);
         force_sum += pull;
         moment_sum += (cable.nodes_m[0] - origin).cross(&pull);
-        let attachment = origin + rotation * robot.attachments_m[i];
+        let attachment = origin + rotation * problem.attachments[i];
         worst(&mut result.closure_m, (cable.nodes_m[0] - attachment).norm());
         // Pulley end.
         let exit = cable.exit_point_m;
-        let anchor = robot.anchors_m[i];
+        let anchor = spec.anchor;
         worst(&mut result.closure_m, (cable.nodes_m[n] - exit).norm());
         let pulley_pull = segment(n - 1) + Vector3::z() * (0.5 * node_weight);
-        let wrapped_length = pulley_end(&mut result, cable, &anchor, radius, compliance, &pulley_pull);
+        let wrapped_length = pulley_end(&mut result, cable, &anchor, spec.radius, compliance, &pulley_pull);
         worst(
             &mut result.paid_out_m,
-            cable.free_length_m + wrapped_length - equilibrium.paid_out_lengths_m[i],
+            cable.free_length_m + wrapped_length - spec.paid_out,
         );
     }
     result.platform_force_n = nan_max(0.0, force_sum.norm());

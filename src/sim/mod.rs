@@ -3,6 +3,8 @@
 //! [`discretised`]: an independent check, elastic lumped-mass chains over swivelling pulleys.
 //! [`effects`]: data with effects the closed-form model lacks, through [`discretised`].
 //! [`suspended`]: the closed-form model on robots of 3 to 8 cables.
+//! [`discretised_suspended`]: the discretised simulator on robots of 3 to 8 cables.
+//! [`suspended_effects`]: data of robots of 3 to 8 cables with effects, through [`discretised_suspended`].
 //!
 //! ```
 //! use rand::SeedableRng;
@@ -26,5 +28,7 @@
 
 pub mod closed_form;
 pub mod discretised;
+pub mod discretised_suspended;
 pub mod effects;
 pub mod suspended;
+pub mod suspended_effects;

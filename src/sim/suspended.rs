@@ -36,6 +36,7 @@ use rand::Rng;
 
 use super::closed_form::{draw_poses, Closure, SensorSampler, Workspace, FIRST_DRAWS};
 use crate::error::{Error, Result};
+use crate::model::pose::PlatformPose;
 use crate::model::sensors::SensorNoise;
 use crate::model::suspended::{
     check_suspended, smallest_stiffness, solve_at, stiffness, Closure as Member, EquilibriumOptions,
@@ -109,30 +110,40 @@ pub fn measure_suspended(
     equilibria
         .iter()
         .map(|eq| {
-            let pose = sensors.localiser(&eq.pose, rng);
-            let (roll_deg, pitch_deg, yaw_deg) = pose.roll_pitch_yaw_deg();
-            let encoder_lengths_m = eq
+            let lengths = eq
                 .cable_lengths_m
                 .iter()
                 .zip(&robot.length_offsets_m)
-                .map(|(length, offset)| sensors.encoder(length + offset, rng))
-                .collect();
-            let load_cell_tensions_n = robot
-                .load_cells
-                .iter()
-                .map(|&cable| sensors.load_cell(eq.tensions[cable].magnitude_n(), rng))
-                .collect();
-            SuspendedMeasurement {
-                line: 0,
-                position_m: pose.position_m.into(),
-                roll_deg,
-                pitch_deg,
-                yaw_deg,
-                encoder_lengths_m,
-                load_cell_tensions_n,
-            }
+                .map(|(l, o)| l + o);
+            let tensions = robot.load_cells.iter().map(|&cable| eq.tensions[cable].magnitude_n());
+            read_suspended_row(&sensors, &eq.pose, lengths, tensions, rng)
         })
         .collect()
+}
+
+/// One row of readings with their noise drawn in the file's order: the
+/// localiser at `pose`, each encoder's noise-free reading of `encoders_m`
+/// in cable order, then each load cell's of `load_cells_n` in the robot's order.
+pub(crate) fn read_suspended_row(
+    sensors: &SensorSampler,
+    pose: &PlatformPose,
+    encoders_m: impl Iterator<Item = f64>,
+    load_cells_n: impl Iterator<Item = f64>,
+    rng: &mut impl Rng,
+) -> SuspendedMeasurement {
+    let pose = sensors.localiser(pose, rng);
+    let (roll_deg, pitch_deg, yaw_deg) = pose.roll_pitch_yaw_deg();
+    let encoder_lengths_m = encoders_m.map(|length| sensors.encoder(length, rng)).collect();
+    let load_cell_tensions_n = load_cells_n.map(|tension| sensors.load_cell(tension, rng)).collect();
+    SuspendedMeasurement {
+        line: 0,
+        position_m: pose.position_m.into(),
+        roll_deg,
+        pitch_deg,
+        yaw_deg,
+        encoder_lengths_m,
+        load_cell_tensions_n,
+    }
 }
 
 #[cfg(test)]
