@@ -534,3 +534,50 @@ fn discretised_data_calibrate_and_the_sweep_scores_them() {
         "{stderr}"
     );
 }
+
+/// Weightless cables (no sag ties a cable's force to its length) on the
+/// eight-cable robot: per pose 16 force components, 8 fixed by the heights
+/// (each force along its chord), 6 by the equilibrium and one by each load
+/// cell, so one load cell leaves exactly one force direction per pose that
+/// no reading sees, and two load cells none. The report says so, counts it
+/// out of the degrees of freedom (both fits have the same: a load cell adds
+/// a row and fixes a direction) and still gives the anchors' 1-sigma,
+/// which holds: every coordinate within the Bonferroni 99.9 % bound (4.10
+/// for 24 coordinates) of the truth.
+#[test]
+fn undetermined_forces_are_counted_and_the_anchors_still_bounded() {
+    use sagcal::calib::suspended::SuspendedCalibrationReport;
+    let mut dof = Vec::new();
+    for load_cells in [vec![0], vec![0, 4]] {
+        let mut truth = SuspendedRobot::builtin("eight").unwrap();
+        truth.cable_weights_n_per_m = vec![0.0; 8];
+        truth.load_cells = load_cells.clone();
+        let workspace = truth.workspace.unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let equilibria = sample_suspended(&truth, &workspace, 30, Closure::Level, &mut rng).unwrap();
+        let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
+        let data = measure_suspended(&truth, &equilibria, &noise, &mut rng);
+        let result = calibrate_suspended(&truth, &data, &paper_options(&truth), None, &mut |_| {}).unwrap();
+        let report = SuspendedCalibrationReport::new(&truth, &result);
+        let expected: Vec<(usize, usize)> = if load_cells.len() == 1 {
+            (0..30).map(|k| (k, 1)).collect()
+        } else {
+            Vec::new()
+        };
+        assert_eq!(result.undetermined_forces, expected, "load cells {load_cells:?}");
+        assert!(
+            report.consistent,
+            "{} for {}",
+            report.chi_square, report.degrees_of_freedom
+        );
+        let sigma = report.anchor_sigma_m.as_ref().expect("the anchors' 1-sigma");
+        for (i, cable_sigma) in sigma.iter().enumerate() {
+            for (k, s) in cable_sigma.iter().enumerate() {
+                let error = result.robot.anchors_m[i][k] - truth.anchors_m[i][k];
+                assert!(error.abs() < 4.10 * s, "cable {} axis {k}: {error} m, sigma {s}", i + 1);
+            }
+        }
+        dof.push(report.degrees_of_freedom);
+    }
+    assert_eq!(dof[0], dof[1], "{dof:?}");
+}

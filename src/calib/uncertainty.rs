@@ -15,7 +15,9 @@ use crate::model::measurement::PoseMeasurement;
 use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::statics::{CableTension, Equilibrium};
-use crate::solver::{marginal_covariance, marginal_covariance_cached, Covariance};
+use crate::solver::{
+    marginal_covariance, marginal_covariance_cached, marginal_covariance_over_local_gauge, Covariance,
+};
 
 /// The fitted parameters of `kind` in `built` with 1-sigma from the marginal covariance.
 pub(super) fn effect_estimate(built: &CalibrationGraph, kind: EffectKind) -> Result<EffectEstimate> {
@@ -62,6 +64,27 @@ pub fn anchor_and_offset_uncertainty(
         Covariance::Full(c) => uncertainty_from_covariance(&c, anchors.len()),
         Covariance::RankDeficient(directions) => ParameterUncertainty::RankDeficient { directions },
     })
+}
+
+/// [`anchor_and_offset_uncertainty`] for a graph whose local groups (each
+/// pose's variables) may hold directions the readings leave undetermined
+/// (the forces of a robot of many light cables): their covariance with a
+/// vague prior of 1-sigma `largest_sigma` on every local coordinate
+/// ([`marginal_covariance_over_local_gauge`]), and `(group, directions)` of
+/// each group with directions the readings know less well than that.
+pub fn anchor_and_offset_uncertainty_over_local_gauge(
+    graph: &FactorGraph,
+    anchors: &[VariableId],
+    length_offsets: &[VariableId],
+    largest_sigma: f64,
+) -> Result<(ParameterUncertainty, Vec<(usize, usize)>)> {
+    let selected: Vec<VariableId> = anchors.iter().chain(length_offsets).copied().collect();
+    let found = marginal_covariance_over_local_gauge(graph, &selected, largest_sigma)?;
+    let uncertainty = match found.covariance {
+        Covariance::Full(c) => uncertainty_from_covariance(&c, anchors.len()),
+        Covariance::RankDeficient(directions) => ParameterUncertainty::RankDeficient { directions },
+    };
+    Ok((uncertainty, found.undetermined))
 }
 
 /// The uncertainty of `cables` anchors and offsets from their joint covariance.

@@ -128,6 +128,7 @@ fn render(report: &SuspendedCalibrationReport, options: &CalibrationOptions) -> 
             found.critical
         );
     }
+    out += &undetermined_note(report);
     if !report.poses_without_start.is_empty() {
         out += &format!(
             "note: poses {} had no equilibrium at their measured position for the straight-cable anchors; they started from the measured pose\n",
@@ -138,6 +139,34 @@ fn render(report: &SuspendedCalibrationReport, options: &CalibrationOptions) -> 
         out += "WARNING: the solver did not converge\n";
     }
     out
+}
+
+/// What the readings leave undetermined of the forces, if anything.
+fn undetermined_note(report: &SuspendedCalibrationReport) -> String {
+    let undetermined = &report.undetermined_forces;
+    if undetermined.is_empty() {
+        return String::new();
+    }
+    let directions: usize = undetermined.iter().map(|u| u.directions).sum();
+    let poses: Vec<usize> = undetermined.iter().map(|u| u.pose).collect();
+    let most = undetermined.iter().map(|u| u.directions).max().unwrap_or(0);
+    format!(
+        "note: the readings do not determine the cable forces at {} of {} poses ({}): {directions} directions in all, \
+         up to {most} at a pose, change no reading (the cables' sag cannot tell those forces apart, and {} load \
+         cell{} read{} them). The anchors and offsets do not depend on them and their 1-sigma above holds; the \
+         degrees of freedom count them out; the forces of those poses are one solution of many. A load cell on more \
+         cables fixes them.\n",
+        poses.len(),
+        report.poses_used,
+        if poses.len() == report.poses_used {
+            "every pose".to_string()
+        } else {
+            format!("poses {}", cable_list(&poses))
+        },
+        report.load_cells.len(),
+        if report.load_cells.len() == 1 { "" } else { "s" },
+        if report.load_cells.len() == 1 { "s" } else { "" },
+    )
 }
 
 /// `1, 3 and 5`.

@@ -11,13 +11,19 @@ use super::gross_errors::{reading_count, worst_reading, SuspendedGrossError};
 use super::start::{catenary_starts, offsets_in_closed_form, straight_offsets};
 use crate::calib::options::{CalibrationOptions, GrossErrorOptions, OrientationPrior};
 use crate::calib::result::{factor_statistics, FactorStatistics, ParameterUncertainty, StageSummary};
-use crate::calib::uncertainty::anchor_and_offset_uncertainty;
+use crate::calib::uncertainty::anchor_and_offset_uncertainty_over_local_gauge;
 use crate::error::{Error, Result};
 use crate::model::pose::PlatformPose;
 use crate::model::statics::CableTension;
 use crate::model::suspended::{SuspendedMeasurement, SuspendedRobot};
 use crate::model::DataRow;
 use crate::solver::optimize;
+
+/// A force combination at a pose whose 1-sigma from the readings exceeds
+/// this many platform weights is undetermined: the readings say nothing of
+/// it that the robot's own scale does not (a vague prior of this 1-sigma on
+/// every force, [`anchor_and_offset_uncertainty_over_local_gauge`]).
+pub const UNDETERMINED_FORCE_WEIGHTS: f64 = 100.0;
 
 /// A calibration of `N` cables.
 #[derive(Debug, Clone)]
@@ -38,9 +44,17 @@ pub struct SuspendedCalibration {
     /// The anchors' and offsets' covariance at the solution, or the
     /// directions the poses leave unobservable.
     pub uncertainty: ParameterUncertainty,
-    /// Residual rows minus unknowns of the final graph: the degrees of
-    /// freedom of its chi-square `2 * final_cost`.
+    /// Residual rows minus the unknowns the readings determine (every
+    /// unknown but the undetermined force directions): the degrees of
+    /// freedom of the chi-square `2 * final_cost`.
     pub degrees_of_freedom: usize,
+    /// `(pose, directions)`, 0-based, of each pose whose cable forces the
+    /// readings do not determine: directions of its own variables (each a
+    /// combination of its cables' forces the six equations of equilibrium
+    /// allow) that change no reading, left out of the anchors' and
+    /// offsets' covariance, which they do not touch
+    /// ([`crate::solver::marginal_covariance_over_local_gauge`]).
+    pub undetermined_forces: Vec<(usize, usize)>,
     /// The readings left out as gross errors, in the order found (empty
     /// without the tests).
     pub left_out: Vec<SuspendedGrossError>,
@@ -115,10 +129,18 @@ pub fn calibrate_suspended(
         search_exhausted = leave_out_gross_errors(&inputs, tests, &mut full, &mut left_out, &mut stages, stage)?;
     }
     let solved = pose_starts_from_graph(&full);
-    let uncertainty = anchor_and_offset_uncertainty(&full.graph, &full.anchors, &full.length_offsets)?;
+    let (uncertainty, undetermined_forces) = anchor_and_offset_uncertainty_over_local_gauge(
+        &full.graph,
+        &full.anchors,
+        &full.length_offsets,
+        UNDETERMINED_FORCE_WEIGHTS * initial.platform_weight_n,
+    )?;
+    // A direction no reading sees takes no degree of freedom from the fit.
+    let undetermined: usize = undetermined_forces.iter().map(|(_, d)| d).sum();
     Ok(SuspendedCalibration {
         uncertainty,
-        degrees_of_freedom: degrees_of_freedom(&full),
+        degrees_of_freedom: degrees_of_freedom(&full, undetermined),
+        undetermined_forces,
         robot: robot_from_suspended_graph(initial, &full),
         poses: solved.iter().map(|s| s.pose).collect(),
         forces: solved.into_iter().map(|s| s.forces).collect(),
@@ -241,7 +263,7 @@ fn solve(
 
 /// Residual rows minus the free variables' tangent dimensions (0 where
 /// there are more unknowns than rows).
-fn degrees_of_freedom(built: &SuspendedGraph) -> usize {
+fn degrees_of_freedom(built: &SuspendedGraph, undetermined: usize) -> usize {
     let rows: usize = built.graph.factors.iter().map(|f| f.residual_dim()).sum();
     let values = &built.graph.values;
     let unknowns: usize = (0..values.len())
@@ -249,5 +271,5 @@ fn degrees_of_freedom(built: &SuspendedGraph) -> usize {
         .filter(|&id| !values.variable(id).fixed)
         .map(|id| values.tangent_dim(id))
         .sum();
-    rows.saturating_sub(unknowns)
+    (rows + undetermined).saturating_sub(unknowns)
 }

@@ -45,5 +45,5 @@ pub use graph::{
 };
 pub use gross_errors::{reading_count, worst_reading, SuspendedGrossError};
 pub use options::suspended_options;
-pub use report::SuspendedCalibrationReport;
+pub use report::{SuspendedCalibrationReport, UndeterminedForces};
 pub use start::{catenary_starts, chord_shares, offsets_in_closed_form, straight_offsets};

@@ -11,6 +11,15 @@ use crate::calib::result::{FactorStatistics, ParameterUncertainty, StageSummary}
 use crate::model::suspended::SuspendedRobot;
 use crate::stats::chi_square_quantile_999;
 
+/// A pose whose cable forces the readings do not determine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct UndeterminedForces {
+    /// The pose, 1-based (the row of the data).
+    pub pose: usize,
+    /// Directions of its forces that change no reading.
+    pub directions: usize,
+}
+
 /// The report of one calibration of `N` cables (serialised as the
 /// command's `--json`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -53,6 +62,10 @@ pub struct SuspendedCalibrationReport {
     pub consistent: bool,
     /// The poses (1-based) whose start fell back to the measured pose.
     pub poses_without_start: Vec<usize>,
+    /// The poses whose cable forces the readings do not determine, each
+    /// with the number of force directions that change no reading (the
+    /// anchors' and offsets' 1-sigma leave them out; they do not touch them).
+    pub undetermined_forces: Vec<UndeterminedForces>,
     /// The readings left out as gross errors, in the order found.
     pub readings_left_out: Vec<SuspendedGrossError>,
     /// Whether a gross error was still found with the most readings the
@@ -122,6 +135,14 @@ impl SuspendedCalibrationReport {
             chi_square_limit,
             consistent: converged && chi_square <= chi_square_limit && !result.search_exhausted,
             poses_without_start: result.fell_back.iter().map(|k| k + 1).collect(),
+            undetermined_forces: result
+                .undetermined_forces
+                .iter()
+                .map(|&(pose, directions)| UndeterminedForces {
+                    pose: pose + 1,
+                    directions,
+                })
+                .collect(),
             readings_left_out: result.left_out.clone(),
             search_exhausted: result.search_exhausted,
         }
