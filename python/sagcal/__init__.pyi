@@ -399,7 +399,10 @@ class SuspendedCalibration:
         """The fit's chi-square."""
     @property
     def degrees_of_freedom(self) -> int:
-        """Residual rows minus unknowns."""
+        """Residual rows minus the unknowns the readings determine."""
+    @property
+    def undetermined_forces(self) -> list[dict[str, int]]:
+        """The poses whose cable forces the readings do not determine (``pose``, ``directions``)."""
     @property
     def consistent(self) -> bool:
         """Whether the fit passes its chi-square test and the solver converged."""

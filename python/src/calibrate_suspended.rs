@@ -117,10 +117,19 @@ impl SuspendedCalibration {
         self.report.chi_square
     }
 
-    /// Its degrees of freedom: residual rows minus unknowns.
+    /// Its degrees of freedom: residual rows minus the unknowns the
+    /// readings determine (the undetermined force directions counted out).
     #[getter]
     fn degrees_of_freedom(&self) -> usize {
         self.report.degrees_of_freedom
+    }
+
+    /// The poses whose cable forces the readings do not determine: dicts
+    /// with ``pose`` (1-based) and ``directions`` (force combinations that
+    /// change no reading); empty when every force is determined.
+    #[getter]
+    fn undetermined_forces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.json["undetermined_forces"])
     }
 
     /// Whether the fit passes its chi-square test at 99.9 % and the solver

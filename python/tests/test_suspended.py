@@ -80,6 +80,19 @@ def test_calibrate_suspended_gives_the_commands_report(cli, tmp_path, name):
     assert result.robot.toml().count("[[cables]]") == robot.cable_count
 
 
+def test_undetermined_forces_are_reported(tmp_path):
+    # Weightless cables on the eight-cable robot with one load cell: one force direction per pose
+    # that no reading sees; a load cell on a second cable fixes it.
+    text = (ROOT / "robots" / "eight.toml").read_text().replace("cable_weight_n_per_m = 2.5506", "cable_weight_n_per_m = 0.0")
+    for load_cells, expected in [("[1]", [{"pose": k, "directions": 1} for k in range(1, 13)]), ("[1, 5]", [])]:
+        path = tmp_path / "light.toml"
+        path.write_text(text.replace("load_cells = [1, 5]", f"load_cells = {load_cells}"))
+        robot = sagcal.SuspendedRobot.from_file(path)
+        result = sagcal.calibrate_suspended(robot, sagcal.simulate_suspended(robot, 12, seed=2).measurements)
+        assert result.undetermined_forces == expected == result.report["undetermined_forces"]
+        assert result.anchor_sigma_m is not None and result.consistent
+
+
 def test_calibrate_suspended_leaves_a_blunder_out_and_refuses_a_wrong_model(tmp_path):
     robot = sagcal.SuspendedRobot.builtin("six")
     data = np.array(sagcal.simulate_suspended(robot, 30, seed=7).measurements)
