@@ -81,7 +81,7 @@ fn problem(name: &str) -> Problem {
     let mut rng = ChaCha8Rng::seed_from_u64(SEED);
     let equilibria = sample_suspended(&truth, &workspace, POSES, closure, &mut rng).expect("poses");
     let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
-    let data = measure_suspended(&truth, &equilibria, &noise, &mut rng);
+    let data = measure_suspended(&truth, &equilibria, &noise, &mut rng).unwrap();
     let mut guess = truth.clone();
     for (i, anchor) in guess.anchors_m.iter_mut().enumerate() {
         let angle = 1.3 * i as f64;

@@ -615,6 +615,57 @@ def suspended_cable_residual(
     return sf.Matrix([length, height])
 
 
+def suspended_elastic_cable_residual(
+    position_m: sf.V3,
+    rotation_xyzw: sf.V4,
+    cable_tension_n: sf.V2,
+    anchor_m: sf.V3,
+    attachment_m: sf.V3,
+    cable_weight_n_per_m: sf.Scalar,
+    axial_compliance_per_mn: sf.Scalar,
+    length_offset_m: sf.Scalar,
+    encoder_length_m: sf.Scalar,
+    epsilon: sf.Scalar,
+) -> sf.Matrix:
+    """One elastic cable of a robot of any number of cables: eq. (14) and (15) with Irvine's stretch.
+
+    :func:`suspended_cable_residual` for a cable of axial stiffness ``EA``:
+    the drum pays out the unstretched length ``L0 = l (1 - T_top / EA)``
+    and the attachment hangs ``g_c l^2 / (2 EA)`` lower
+    (``cable_model.elastic_free_length``, Irvine's elastic catenary to first
+    order in ``1/EA``). The length row ``L0 + l0 - z_enc`` depends on the
+    cable's tension, which the inextensible rows leave to the weight's sag
+    alone: stiffness is what fixes the forces of a light cable. With the
+    compliance 0 the rows are :func:`suspended_cable_residual`'s, and they
+    are ``cable_model.extended_cable``'s with no pulley and a smooth cable.
+
+    Args:
+        position_m: Platform origin, world frame, metres.
+        rotation_xyzw: Platform orientation, quaternion ``[x, y, z, w]``.
+        cable_tension_n: ``[f_h, f_v]`` of this cable at its attachment, newtons.
+        anchor_m: The cable's anchor, world frame, metres.
+        attachment_m: The cable's attachment, platform frame, metres.
+        cable_weight_n_per_m: The cable's weight per metre ``g_c``, N/m (0: massless).
+        axial_compliance_per_mn: ``1e6 / EA`` of the cable, 1/MN (0: inextensible).
+        length_offset_m: The encoder's length offset ``l0``, metres.
+        encoder_length_m: The encoder's reading ``z_enc``, metres.
+        epsilon: Small positive number (safe divisions, ``sinhc`` at ``g_c = 0``).
+
+    Returns:
+        ``[length error (m), height error (m)]``.
+    """
+    rotation = rotation_from_storage(rotation_xyzw)
+    attachment = position_m + rotation * attachment_m
+    span, _ = cable_model.horizontal_span(anchor_m, attachment, epsilon)
+    cable = cable_model.CableProperties(weight_n_per_m=cable_weight_n_per_m)
+    f_h, f_v = cable_tension_n[0], cable_tension_n[1]
+    compliance = axial_compliance_per_mn * sf.Rational(1, 10**6)
+    unstretched, drop, _ = cable_model.elastic_free_length(span, f_h, f_v, cable, compliance, epsilon)
+    length = unstretched + length_offset_m - encoder_length_m
+    height = attachment[2] - anchor_m[2] + drop
+    return sf.Matrix([length, height])
+
+
 def cable_wrench(
     position_m: sf.V3,
     rotation_xyzw: sf.V4,

@@ -367,6 +367,11 @@ FUNCTIONS = (
         "residual",
         ("pose", "cable_tension_n", "anchor_m", "length_offset_m"),
     ),
+    FunctionSpec(
+        factors.suspended_elastic_cable_residual,
+        "residual",
+        ("pose", "cable_tension_n", "anchor_m", "length_offset_m", "axial_compliance_per_mn"),
+    ),
     FunctionSpec(factors.cable_wrench, "wrench", ("pose", "cable_tension_n", "anchor_m")),
     FunctionSpec(factors.platform_weight_wrench, "wrench", ("rotation",)),
     FunctionSpec(factors.straight_cable_residual, "residual", ("pose", "anchor_m", "length_offset_m")),

@@ -52,6 +52,7 @@ mod reference_tension_residual;
 mod rigid_length_residual;
 mod straight_cable_residual;
 mod suspended_cable_residual;
+mod suspended_elastic_cable_residual;
 
 pub use attachment_height_residual::attachment_height_residual;
 pub use cable_geometry::cable_geometry;
@@ -68,3 +69,4 @@ pub use reference_tension_residual::reference_tension_residual;
 pub use rigid_length_residual::rigid_length_residual;
 pub use straight_cable_residual::straight_cable_residual;
 pub use suspended_cable_residual::suspended_cable_residual;
+pub use suspended_elastic_cable_residual::suspended_elastic_cable_residual;

@@ -26,7 +26,10 @@ fn readings(truth: &SuspendedRobot, count: usize, seed: u64) -> (Vec<SuspendedMe
     };
     let equilibria = sample_suspended(truth, &workspace, count, closure, &mut rng).unwrap();
     let silent = NoisePreset::None.sigmas(truth.platform_weight_n);
-    (measure_suspended(truth, &equilibria, &silent, &mut rng), equilibria)
+    (
+        measure_suspended(truth, &equilibria, &silent, &mut rng).unwrap(),
+        equilibria,
+    )
 }
 
 /// `truth` with offsets of a few decimetres, and a guess of it with every
@@ -133,7 +136,7 @@ fn four_cables_agree_with_the_four_cable_graph() {
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let equilibria = sample_suspended(&truth, &workspace, 20, Closure::Yaw { max_yaw_deg: 5.0 }, &mut rng).unwrap();
     let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
-    let measurements = measure_suspended(&truth, &equilibria, &noise, &mut rng);
+    let measurements = measure_suspended(&truth, &equilibria, &noise, &mut rng).unwrap();
     let rows: Vec<PoseMeasurement> = measurements
         .iter()
         .map(|m| PoseMeasurement {
@@ -182,7 +185,7 @@ fn ten_metre_guesses_reach_the_minimum_of_the_truth() {
         };
         let equilibria = sample_suspended(&truth, &workspace, 30, closure, &mut rng).unwrap();
         let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
-        let measurements = measure_suspended(&truth, &equilibria, &noise, &mut rng);
+        let measurements = measure_suspended(&truth, &equilibria, &noise, &mut rng).unwrap();
         let options = paper_options(&truth);
         let from_guess = calibrate_suspended(&guess, &measurements, &options, None, &mut |_| {}).unwrap();
         let from_truth = calibrate_suspended(&truth, &measurements, &options, None, &mut |_| {}).unwrap();
@@ -556,7 +559,7 @@ fn undetermined_forces_are_counted_and_the_anchors_still_bounded() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let equilibria = sample_suspended(&truth, &workspace, 30, Closure::Level, &mut rng).unwrap();
         let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
-        let data = measure_suspended(&truth, &equilibria, &noise, &mut rng);
+        let data = measure_suspended(&truth, &equilibria, &noise, &mut rng).unwrap();
         let result = calibrate_suspended(&truth, &data, &paper_options(&truth), None, &mut |_| {}).unwrap();
         let report = SuspendedCalibrationReport::new(&truth, &result);
         let expected: Vec<(usize, usize)> = if load_cells.len() == 1 {
@@ -580,4 +583,153 @@ fn undetermined_forces_are_counted_and_the_anchors_still_bounded() {
         dof.push(report.degrees_of_freedom);
     }
     assert_eq!(dof[0], dof[1], "{dof:?}");
+}
+
+/// The elastic catenary closes what the readings leave open: the same
+/// weightless eight-cable robot with one load cell whose forces are
+/// undetermined in one direction per pose when its cables are inextensible
+/// has every force determined once they stretch (EA = 2 MN, 8 mm steel
+/// wire rope), because each encoder then reads `l (1 - T / EA)`: the
+/// tensions enter the lengths. The data come from the discretised
+/// simulator (the chains stretch exactly, not to first order); the fit
+/// passes its chi-square test and its anchors lie within their bounds.
+#[test]
+fn elastic_cables_determine_the_forces_one_load_cell_leaves_open() {
+    use sagcal::calib::suspended::SuspendedCalibrationReport;
+    use sagcal::model::effects::Effects;
+    use sagcal::sim::suspended_effects::simulate_readings;
+    let mut truth = SuspendedRobot::builtin("eight").unwrap();
+    truth.cable_weights_n_per_m = vec![0.0; 8];
+    truth.load_cells = vec![0];
+    truth.axial_stiffness_n = vec![2e6; 8];
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let equilibria = sample_suspended(&truth, &truth.workspace.unwrap(), 30, Closure::Level, &mut rng).unwrap();
+    let noise = NoisePreset::Paper.sigmas(truth.platform_weight_n);
+    let data = simulate_readings(&truth, &Effects::default(), &equilibria, &noise, 50, &mut rng).unwrap();
+    // The cables stretch by millimetres (a third of the encoders' 1 cm sigma
+    // at one pose; thirty poses and eight cables are what determine them).
+    let paid_out = equilibria[0].paid_out_lengths_m(&truth);
+    let stretch_m = (0..8)
+        .map(|i| equilibria[0].cable_lengths_m[i] - paid_out[i])
+        .fold(0.0, f64::max);
+    assert!(stretch_m > 2e-3, "stretch {stretch_m} m");
+    let result = calibrate_suspended(&truth, &data, &paper_options(&truth), None, &mut |_| {}).unwrap();
+    let report = SuspendedCalibrationReport::new(&truth, &result);
+    assert_eq!(result.undetermined_forces, Vec::<(usize, usize)>::new());
+    assert!(
+        report.consistent,
+        "{} for {}",
+        report.chi_square, report.degrees_of_freedom
+    );
+    let sigma = report.anchor_sigma_m.as_ref().expect("the anchors' 1-sigma");
+    let mut worst: f64 = 0.0;
+    for (i, cable_sigma) in sigma.iter().enumerate() {
+        for (k, s) in cable_sigma.iter().enumerate() {
+            let error = result.robot.anchors_m[i][k] - truth.anchors_m[i][k];
+            assert!(error.abs() < 4.10 * s, "cable {} axis {k}: {error} m, sigma {s}", i + 1);
+            worst = worst.max(error.abs() / s);
+        }
+    }
+    println!(
+        "elastic model of the elastic robot: no undetermined force, chi-square {:.1} for {}, worst anchor {worst:.2} sigma",
+        report.chi_square, report.degrees_of_freedom
+    );
+    // The same readings under an inextensible model: the forces fall open again.
+    let mut rigid = truth.clone();
+    rigid.axial_stiffness_n = vec![f64::INFINITY; 8];
+    let result = calibrate_suspended(&rigid, &data, &paper_options(&rigid), None, &mut |_| {}).unwrap();
+    println!(
+        "inextensible model of the elastic robot: {} poses with undetermined forces, chi-square {:.1} for {}",
+        result.undetermined_forces.len(),
+        SuspendedCalibrationReport::new(&rigid, &result).chi_square,
+        result.degrees_of_freedom
+    );
+    assert_eq!(result.undetermined_forces.len(), 30);
+}
+
+/// A robot file that gives its cables' stiffness: `sagcal simulate` draws
+/// its data with the discretised simulator (the chains stretch), `sagcal
+/// calibrate` fits the elastic catenary and says so, its anchors lie within
+/// 4 sigma of the truth, the written robot keeps the stiffness, and
+/// `sagcal localize` with it flags no row. The inextensible model of the
+/// same readings is printed beside it.
+#[test]
+fn the_command_calibrates_an_elastic_robot() {
+    let dir = tempfile::tempdir().unwrap();
+    // 10 mm steel wire rope: 45 mm^2 of steel at a rope modulus of 100 GPa.
+    let six = std::fs::read_to_string(robot_path("six")).unwrap();
+    let elastic = six.replacen("com_offset_m", "axial_stiffness_n = 4.5e6\ncom_offset_m", 1);
+    std::fs::write(dir.path().join("elastic.toml"), &elastic).unwrap();
+    let truth = SuspendedRobot::from_file(&dir.path().join("elastic.toml")).unwrap();
+    let simulate = [
+        "simulate",
+        "--robot",
+        "elastic.toml",
+        "--poses",
+        "30",
+        "--seed",
+        "7",
+        "--segments",
+        "20",
+        "--out",
+        "d.csv",
+    ];
+    let out = sagcal(dir.path(), &simulate);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("elastic cables"));
+    let calibrate = [
+        "calibrate",
+        "--robot",
+        "elastic.toml",
+        "--data",
+        "d.csv",
+        "--out",
+        "c.toml",
+    ];
+    let out = sagcal(dir.path(), &calibrate);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("elastic catenary model (EA 4.50e6 N)"), "{text}");
+    let out = sagcal(dir.path(), &[&calibrate[..5], &["--json"]].concat());
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["consistent"], true, "{}", report["chi_square"]);
+    assert_eq!(report["axial_stiffness_n"][5], 4.5e6);
+    let worst = worst_sigma(&report, &truth);
+    assert!(worst < 4.0, "{worst}");
+    let calibrated = SuspendedRobot::from_file(&dir.path().join("c.toml")).unwrap();
+    assert_eq!(calibrated.axial_stiffness_n, vec![4.5e6; 6]);
+    let out = sagcal(
+        dir.path(),
+        &["localize", "--robot", "c.toml", "--data", "d.csv", "--json"],
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let localized: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(localized["rows_flagged"], 0);
+    let out = sagcal(
+        dir.path(),
+        &["calibrate", "--robot", &robot_path("six"), "--data", "d.csv", "--json"],
+    );
+    let rigid: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    println!(
+        "elastic model: chi-square {:.1} for {}, worst anchor {worst:.2} sigma; the inextensible model of the same \
+         readings: chi-square {:.1} for {}, worst anchor {:.2} sigma",
+        report["chi_square"].as_f64().unwrap(),
+        report["degrees_of_freedom"],
+        rigid["chi_square"].as_f64().unwrap(),
+        rigid["degrees_of_freedom"],
+        worst_sigma(&rigid, &truth)
+    );
+}
+
+/// The largest distance of a reported anchor coordinate from the truth's, in its reported sigmas.
+fn worst_sigma(report: &serde_json::Value, truth: &SuspendedRobot) -> f64 {
+    let mut worst: f64 = 0.0;
+    for i in 0..truth.cable_count() {
+        for k in 0..3 {
+            let estimate = report["anchors_m"][i][k].as_f64().unwrap();
+            let sigma = report["anchor_sigma_m"][i][k].as_f64().unwrap();
+            worst = worst.max((estimate - truth.anchors_m[i][k]).abs() / sigma);
+        }
+    }
+    worst
 }

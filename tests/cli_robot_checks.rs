@@ -390,7 +390,8 @@ fn simulate_takes_three_to_eight_cables() {
             &poses,
             &NoisePreset::Paper.sigmas(suspended.platform_weight_n),
             &mut rng,
-        );
+        )
+        .unwrap();
         assert_eq!(rows.len(), 7);
         for (row, want) in rows.iter().zip(&expected) {
             assert_eq!(row.encoder_lengths_m, want.encoder_lengths_m, "{name}");

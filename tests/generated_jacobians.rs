@@ -1455,3 +1455,139 @@ fn per_cable_factors_agree_with_the_n_cable_model() {
     println!("worst relative Jacobian error {worst:.2e}");
     assert!(worst < TOLERANCE, "{worst}");
 }
+
+/// The elastic cable of a robot of any number of cables
+/// (`suspended_elastic_cable_residual`) against closed forms: with no
+/// compliance it is the inextensible `suspended_cable_residual`; with one,
+/// the drum pays out `l (1 - T_top / EA)` and the attachment hangs
+/// `g_c l^2 / (2 EA)` lower (Irvine, first order); a weightless cable is
+/// Hooke's spring `l / (1 + T / EA)` to within `l (T / EA)^2`; the
+/// Jacobians are central differences'.
+#[test]
+fn the_elastic_cable_stretches_as_irvine_and_hooke_say() {
+    use sagcal::model::suspended::{solve_at, Closure, EquilibriumOptions, SuspendedRobot};
+    type Blocks = (
+        SMatrix<f64, 2, 6>,
+        SMatrix<f64, 2, 2>,
+        SMatrix<f64, 2, 3>,
+        SVector<f64, 2>,
+        SVector<f64, 2>,
+    );
+    let mut worst: f64 = 0.0;
+    for weight_n_per_m in [2.5506, 0.0] {
+        let mut robot = SuspendedRobot::builtin("eight").unwrap();
+        robot.cable_weights_n_per_m = vec![weight_n_per_m; 8];
+        let eq = solve_at(
+            &robot,
+            Vector3::new(1.0, -0.5, 2.0),
+            Closure::Level,
+            &EquilibriumOptions::default(),
+        )
+        .unwrap();
+        for i in 0..8 {
+            let (attachment, l) = (robot.attachments_m[i], eq.cable_lengths_m[i]);
+            let (offset, reading) = (0.25, l + 0.25);
+            let elastic =
+                |pose: &PlatformPose, f: &Vector2<f64>, anchor: &Vector3<f64>, c: f64, b: Option<&mut Blocks>| {
+                    let (jp, jf, ja, jo, jc) = match b {
+                        Some((p, f, a, o, c)) => (Some(p), Some(f), Some(a), Some(o), Some(c)),
+                        None => (None, None, None, None, None),
+                    };
+                    generated::suspended_elastic_cable_residual(
+                        &pose.position_m,
+                        &pose.rotation_xyzw(),
+                        f,
+                        anchor,
+                        &attachment,
+                        weight_n_per_m,
+                        c,
+                        offset,
+                        reading,
+                        EPSILON,
+                        jp,
+                        jf,
+                        ja,
+                        jo,
+                        jc,
+                    )
+                };
+            let f = Vector2::new(eq.tensions[i].horizontal_n, eq.tensions[i].vertical_n);
+            let anchor = robot.anchors_m[i];
+            let inextensible = generated::suspended_cable_residual(
+                &eq.pose.position_m,
+                &eq.pose.rotation_xyzw(),
+                &f,
+                &anchor,
+                &attachment,
+                weight_n_per_m,
+                offset,
+                reading,
+                EPSILON,
+                None,
+                None,
+                None,
+                None,
+            );
+            assert_eq!(elastic(&eq.pose, &f, &anchor, 0.0, None), inextensible, "cable {i}");
+            // EA = 0.5 MN: a compliance of 2 per MN.
+            let (compliance, k) = (2.0, 2e-6);
+            let r = elastic(&eq.pose, &f, &anchor, compliance, None);
+            let top = (f.x.powi(2) + (f.y + weight_n_per_m * l).powi(2)).sqrt();
+            let stretch = l * k * top;
+            assert!(stretch > 1e-3, "cable {i}: a stretch of {stretch} m tests nothing");
+            assert!(
+                (r[0] - (inextensible[0] - stretch)).abs() < 1e-9,
+                "cable {i}: {} vs {}",
+                r[0],
+                stretch
+            );
+            let sag = k * weight_n_per_m * l * l / 2.0;
+            assert!(
+                (r[1] - (inextensible[1] - sag)).abs() < 1e-12,
+                "cable {i}: {} vs {sag}",
+                r[1]
+            );
+            if weight_n_per_m == 0.0 {
+                let hooke = l / (1.0 + k * top) + offset - reading;
+                assert!(
+                    (r[0] - hooke).abs() < 1.01 * l * (k * top).powi(2),
+                    "cable {i}: {} vs {hooke}",
+                    r[0]
+                );
+            }
+            let mut b: Blocks = Default::default();
+            elastic(&eq.pose, &f, &anchor, compliance, Some(&mut b));
+            assert_eq!(b.3, SVector::<f64, 2>::new(1.0, 0.0));
+            let relative = |analytic: f64, numeric: f64, scale: f64| (analytic - numeric).abs() / scale.max(1e-12);
+            let central = |g: &dyn Fn(f64) -> SVector<f64, 2>, h: f64| (g(h) - g(-h)) / (2.0 * h);
+            for k in 0..6 {
+                let step = |t: f64| eq.pose.retract(&Vector6::from_fn(|j, _| if j == k { t } else { 0.0 }));
+                let d = central(&|t| elastic(&step(t), &f, &anchor, compliance, None), 1e-6);
+                for row in 0..2 {
+                    worst = worst.max(relative(b.0[(row, k)], d[row], b.0.amax()));
+                }
+            }
+            for k in 0..2 {
+                let moved = |t: f64| f + Vector2::from_fn(|j, _| if j == k { t } else { 0.0 });
+                let d = central(&|t| elastic(&eq.pose, &moved(t), &anchor, compliance, None), 1e-3);
+                for row in 0..2 {
+                    worst = worst.max(relative(b.1[(row, k)], d[row], b.1.amax()));
+                }
+            }
+            for k in 0..3 {
+                let moved = |t: f64| anchor + Vector3::from_fn(|j, _| if j == k { t } else { 0.0 });
+                let d = central(&|t| elastic(&eq.pose, &f, &moved(t), compliance, None), 1e-6);
+                for row in 0..2 {
+                    worst = worst.max(relative(b.2[(row, k)], d[row], b.2.amax()));
+                }
+            }
+            let d = central(&|t| elastic(&eq.pose, &f, &anchor, compliance + t, None), 1e-4);
+            for row in 0..2 {
+                worst = worst.max(relative(b.4[row], d[row], b.4.amax()));
+            }
+            // The tension moves the length row only through the stretch: l k dT_top/df.
+            assert!(b.1[(0, 0)].abs() > 1e-7, "cable {i}: {}", b.1);
+        }
+    }
+    assert!(worst < TOLERANCE, "worst relative Jacobian error {worst:e}");
+}

@@ -59,6 +59,10 @@ fn generated_sources() {
             "suspended_cable_residual",
             include_str!("../generated/suspended_cable_residual.rs"),
         ),
+        (
+            "suspended_elastic_cable_residual",
+            include_str!("../generated/suspended_elastic_cable_residual.rs"),
+        ),
         ("cable_wrench", include_str!("../generated/cable_wrench.rs")),
         (
             "platform_weight_wrench",
@@ -483,6 +487,43 @@ fn suspended_cable_residual_outputs() {
     format_block(&mut out, "jacobian_cable_tension", &tension);
     format_block(&mut out, "jacobian_anchor", &anchor);
     format_block(&mut out, "jacobian_length_offset", &offset);
+    insta::assert_snapshot!(out);
+}
+
+#[test]
+fn suspended_elastic_cable_residual_outputs() {
+    let x = inputs();
+    let (mut pose, mut tension, mut anchor, mut offset, mut compliance) = (
+        nan::<2, 6>(),
+        nan::<2, 2>(),
+        nan::<2, 3>(),
+        nan::<2, 1>(),
+        nan::<2, 1>(),
+    );
+    let value = generated::suspended_elastic_cable_residual(
+        &x.pose.position_m,
+        &x.pose.rotation_xyzw(),
+        &x.reference_tension_n,
+        &x.anchors_m.column(1).into_owned(),
+        &x.attachments_m.column(1).into_owned(),
+        x.cable_weight_n_per_m,
+        2.0,
+        x.length_offsets_m[1],
+        x.encoder_lengths_m[1],
+        EPSILON,
+        Some(&mut pose),
+        Some(&mut tension),
+        Some(&mut anchor),
+        Some(&mut offset),
+        Some(&mut compliance),
+    );
+    let mut out = String::new();
+    format_block(&mut out, "residual", &value);
+    format_block(&mut out, "jacobian_pose", &pose);
+    format_block(&mut out, "jacobian_cable_tension", &tension);
+    format_block(&mut out, "jacobian_anchor", &anchor);
+    format_block(&mut out, "jacobian_length_offset", &offset);
+    format_block(&mut out, "jacobian_axial_compliance", &compliance);
     insta::assert_snapshot!(out);
 }
 

@@ -352,6 +352,9 @@ class SuspendedRobot:
     @property
     def length_offsets_m(self) -> FloatArray:
         """The encoder length offsets, metres: (N,)."""
+    @property
+    def axial_stiffness_n(self) -> list[float | None]:
+        """Each cable's axial stiffness EA, newtons; ``None`` for an inextensible cable."""
     def toml(self) -> str:
         """The robot file's text (TOML)."""
 

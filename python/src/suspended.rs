@@ -86,6 +86,17 @@ impl SuspendedRobot {
         crate::arrays::out1(py, &self.inner.length_offsets_m)
     }
 
+    /// Each cable's axial stiffness ``EA`` in newtons, ``None`` for an
+    /// inextensible cable (the robot file's ``axial_stiffness_n``).
+    #[getter]
+    fn axial_stiffness_n(&self) -> Vec<Option<f64>> {
+        self.inner
+            .axial_stiffness_n
+            .iter()
+            .map(|ea| ea.is_finite().then_some(*ea))
+            .collect()
+    }
+
     /// The robot file's text (TOML), as ``sagcal calibrate --out`` writes it
     /// (without a covariance).
     fn toml(&self) -> PyResult<String> {

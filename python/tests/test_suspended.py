@@ -91,6 +91,13 @@ def test_undetermined_forces_are_reported(tmp_path):
         result = sagcal.calibrate_suspended(robot, sagcal.simulate_suspended(robot, 12, seed=2).measurements)
         assert result.undetermined_forces == expected == result.report["undetermined_forces"]
         assert result.anchor_sigma_m is not None and result.consistent
+    # Elastic cables (EA 2 MN) with the one load cell: each encoder reads its tension, nothing is left open.
+    path.write_text(text.replace("load_cells = [1, 5]", "load_cells = [1]\naxial_stiffness_n = 2.0e6"))
+    robot = sagcal.SuspendedRobot.from_file(path)
+    assert robot.axial_stiffness_n == [2.0e6] * 8
+    result = sagcal.calibrate_suspended(robot, sagcal.simulate_suspended(robot, 12, seed=2, segments=20).measurements)
+    assert result.undetermined_forces == [] and result.consistent
+    assert result.report["axial_stiffness_n"] == [2.0e6] * 8
 
 
 def test_calibrate_suspended_leaves_a_blunder_out_and_refuses_a_wrong_model(tmp_path):

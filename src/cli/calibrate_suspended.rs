@@ -88,10 +88,11 @@ fn render(report: &SuspendedCalibrationReport, options: &CalibrationOptions) -> 
         _ => format!("{:.4} rad prior", n.orientation_sigma_rad),
     };
     let mut out = format!(
-        "sagcal calibrate: robot `{}`, {} cables (load cells on {}), catenary model, {} poses\nnoise: encoders {:.4} m, load cells {:.2} N, position {:.4} m, orientation {orientation}\n\n",
+        "sagcal calibrate: robot `{}`, {} cables (load cells on {}), {}, {} poses\nnoise: encoders {:.4} m, load cells {:.2} N, position {:.4} m, orientation {orientation}\n\n",
         report.robot,
         report.cables,
         cable_list(&report.load_cells),
+        cable_model(&report.axial_stiffness_n),
         report.poses_used,
         n.encoder_sigma_m,
         n.load_cell_sigma_n,
@@ -155,7 +156,7 @@ fn undetermined_note(report: &SuspendedCalibrationReport) -> String {
          up to {most} at a pose, change no reading (the cables' sag cannot tell those forces apart, and {} load \
          cell{} read{} them). The anchors and offsets do not depend on them and their 1-sigma above holds; the \
          degrees of freedom count them out; the forces of those poses are one solution of many. A load cell on more \
-         cables fixes them.\n",
+         cables fixes them{}.\n",
         poses.len(),
         report.poses_used,
         if poses.len() == report.poses_used {
@@ -166,7 +167,30 @@ fn undetermined_note(report: &SuspendedCalibrationReport) -> String {
         report.load_cells.len(),
         if report.load_cells.len() == 1 { "" } else { "s" },
         if report.load_cells.len() == 1 { "s" } else { "" },
+        if report.axial_stiffness_n.iter().all(Option::is_none) {
+            ", and so does the cables' known stiffness (`axial_stiffness_n` in the robot file), through which each \
+             encoder reads its cable's tension"
+        } else {
+            ""
+        },
     )
+}
+
+/// `catenary model`, or with elastic cables `elastic catenary model (EA
+/// 2.00e6 N)` (one value when every cable has it, else one per cable,
+/// `inf` for an inextensible one).
+fn cable_model(axial_stiffness_n: &[Option<f64>]) -> String {
+    if axial_stiffness_n.iter().all(Option::is_none) {
+        return "catenary model".into();
+    }
+    let text = |ea: &Option<f64>| ea.map_or("inf".to_string(), |ea| format!("{ea:.2e}"));
+    let values = if axial_stiffness_n.iter().all(|ea| *ea == axial_stiffness_n[0]) {
+        text(&axial_stiffness_n[0])
+    } else {
+        let each: Vec<String> = axial_stiffness_n.iter().map(text).collect();
+        each.join(", ")
+    };
+    format!("elastic catenary model (EA {values} N)")
 }
 
 /// `1, 3 and 5`.

@@ -1,6 +1,6 @@
 //! `sagcal simulate` on a robot of 3 to 8 cables: the closed-form model
-//! ([`sagcal::sim::suspended`]), or with `--effect` the discretised
-//! simulator with those effects acting ([`sagcal::sim::suspended_effects`]),
+//! ([`sagcal::sim::suspended`]), or with `--effect` or elastic cables the
+//! discretised simulator with those effects acting ([`sagcal::sim::suspended_effects`]),
 //! written in the N-cable measurement file
 //! ([`sagcal::io::suspended_measurements`]).
 
@@ -29,7 +29,7 @@ pub(super) fn run(args: &SimulateArgs, robot: &SuspendedRobot) -> sagcal::Result
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     let equilibria = sample_suspended(robot, &workspace, args.poses, args.closure, &mut rng)?;
     let rows = measure(args, robot, &effects, &equilibria, &mut rng)?;
-    let model = model_phrase(!effects.is_none(), args.segments);
+    let model = model_phrase(!effects.is_none() || robot.is_elastic(), args.segments);
     let mut comments = vec![
         format!(
             "simulated by sagcal {} ({model}, {} cables)",
@@ -98,6 +98,11 @@ fn measure(
     if !effects.is_none() {
         println!(
             "effects: {effects}; seed {}; discretised simulator, {} segments per cable",
+            args.seed, args.segments
+        );
+    } else if robot.is_elastic() {
+        println!(
+            "elastic cables (the robot file's axial_stiffness_n); seed {}; discretised simulator, {} segments per cable",
             args.seed, args.segments
         );
     }

@@ -15,6 +15,12 @@
 //!
 //! Every trial has its own random stream, seeded from `seed + trial`.
 //!
+//! A robot with elastic cables (a finite `axial_stiffness_n`) is simulated
+//! by the discretised simulator at [`SEGMENTS`] segments per cable: its
+//! drums pay out the closed-form lengths and it settles where it stretches
+//! to (the bound is taken at the closed-form poses and forces, which differ
+//! from those by the cables' stretch).
+//!
 //! ```
 //! use sagcal::experiments::suspended_trials::{suspended_trials, SuspendedTrialsOptions};
 //! use sagcal::model::sensors::NoisePreset;
@@ -39,10 +45,15 @@ use crate::calib::suspended::{
 };
 use crate::calib::{anchor_and_offset_uncertainty, CalibrationOptions, OrientationPrior, ParameterUncertainty};
 use crate::error::{Error, Result};
+use crate::model::effects::Effects;
 use crate::model::sensors::NoisePreset;
 use crate::model::suspended::{SuspendedEquilibrium, SuspendedRobot};
 use crate::sim::closed_form::{Closure, Workspace};
-use crate::sim::suspended::{measure_suspended, sample_suspended};
+use crate::sim::suspended::sample_suspended;
+use crate::sim::suspended_effects::simulate_readings;
+
+/// Segments per cable of the discretised simulator of an elastic robot.
+pub const SEGMENTS: usize = 100;
 
 /// How the trials are run.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -103,7 +114,7 @@ pub fn suspended_trials(
     for trial in 0..options.trials {
         let mut rng = ChaCha8Rng::seed_from_u64(options.seed.wrapping_add(trial as u64));
         let equilibria = trial_poses(truth, options.poses, &mut rng)?;
-        let data = measure_suspended(truth, &equilibria, &noise, &mut rng);
+        let data = simulate_readings(truth, &Effects::default(), &equilibria, &noise, SEGMENTS, &mut rng)?;
         let guess = moved_guess(truth, options.guess_m, &mut rng);
         // The bound at the truth: the graph's information at the true values.
         let starts: Vec<PoseStart> = equilibria

@@ -14,12 +14,19 @@
 //! anchor_m = [30.0, 0.0, 25.0]
 //! attachment_m = [0.766, 0.6428, 0.3]
 //! weight_n_per_m = 3.924                 # optional: this cable's own weight per metre
+//! axial_stiffness_n = 5.0e6              # optional: this cable's own EA
 //! ```
+//!
+//! `axial_stiffness_n` (newtons, top level for every cable or in a cable's
+//! table for its own) makes the cables elastic: the model pays out Irvine's
+//! unstretched length (`generated::suspended_elastic_cable_residual`).
+//! Without it the cables are inextensible.
 //!
 //! A four-cable file reads too: its `reference_cable` is its load cell
 //! (where it gives no `load_cells`). Its `paper_robot` and `[calibration]`
 //! are read and not used here; a `[effects]` table is refused, as the
-//! N-cable model has none of the catalogue's effects.
+//! N-cable model has none of the catalogue's effects (the cables' known
+//! stiffness is `axial_stiffness_n` instead).
 //!
 //! ```
 //! use sagcal::model::suspended::SuspendedRobot;
@@ -56,6 +63,8 @@ struct CableEntry {
     attachment_m: [f64; 3],
     #[serde(default, skip_serializing_if = "Option::is_none")]
     weight_n_per_m: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    axial_stiffness_n: Option<f64>,
 }
 
 /// The contents of an N-cable robot file, before validation.
@@ -71,6 +80,8 @@ struct SuspendedFile {
     load_cells: Option<Vec<usize>>,
     platform_weight_n: f64,
     cable_weight_n_per_m: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    axial_stiffness_n: Option<f64>,
     com_offset_m: [f64; 3],
     #[serde(default, skip_serializing_if = "Option::is_none")]
     length_offsets_m: Option<Vec<f64>>,
@@ -138,6 +149,30 @@ impl SuspendedFile {
             .collect()
     }
 
+    /// Each cable's axial stiffness: its own, else the file's, else
+    /// inextensible (`f64::INFINITY`); a given one finite and positive.
+    fn axial_stiffnesses(&self) -> std::result::Result<Vec<f64>, String> {
+        let stiff = |ea: Option<f64>, field: String| match ea {
+            None => Ok(None),
+            Some(ea) if ea.is_finite() && ea > 0.0 => Ok(Some(ea)),
+            Some(ea) => Err(format!(
+                "{field} must be a finite EA > 0 newtons (leave it out for an inextensible cable), got {ea}"
+            )),
+        };
+        let shared = stiff(self.axial_stiffness_n, "field `axial_stiffness_n`".into())?;
+        self.cables
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let own = stiff(
+                    c.axial_stiffness_n,
+                    format!("cable {}: field `axial_stiffness_n`", i + 1),
+                )?;
+                Ok(own.or(shared).unwrap_or(f64::INFINITY))
+            })
+            .collect()
+    }
+
     /// The validated robot (errors name the field; the caller adds the file).
     fn robot(self) -> std::result::Result<SuspendedRobot, String> {
         let n = self.cables.len();
@@ -149,7 +184,8 @@ impl SuspendedFile {
         if self.effects.as_ref().is_some_and(|e| !e.is_none()) {
             return Err(
                 "table `effects`: the model of 3 to 8 cables has none of the effects of the catalogue; \
-                        remove the table or use a four-cable robot"
+                 remove the table or use a four-cable robot (a known stiffness of the cables is the key \
+                 `axial_stiffness_n`, for every cable or in a cable's own table)"
                     .into(),
             );
         }
@@ -160,6 +196,7 @@ impl SuspendedFile {
         super::robot_file::distinct_points(&anchors_m, &attachments_m)?;
         let load_cells = self.load_cells()?;
         let weights = self.cable_weights()?;
+        let axial_stiffness_n = self.axial_stiffnesses()?;
         let length_offsets_m = match &self.length_offsets_m {
             None => vec![0.0; n],
             Some(v) if v.len() == n && v.iter().all(|x| x.is_finite()) => v.clone(),
@@ -177,6 +214,7 @@ impl SuspendedFile {
         robot.name = self.name;
         robot.load_cells = load_cells;
         robot.length_offsets_m = length_offsets_m;
+        robot.axial_stiffness_n = axial_stiffness_n;
         robot.workspace = workspace;
         crate::model::suspended::check_suspended(&robot)?;
         Ok(robot)
@@ -215,6 +253,19 @@ impl SuspendedRobot {
     /// x, y, z, then offsets 1..N; m^2) as its `[calibration]` table if given.
     pub fn to_toml(&self, covariance_m2: Option<&[Vec<f64>]>) -> Result<String> {
         let shared = self.cable_weights_n_per_m.first().copied().unwrap_or(0.0);
+        // One stiffness for every cable is written once; otherwise each
+        // elastic cable's own, an inextensible cable's left out.
+        let first_stiffness = self.axial_stiffness_n.first().copied().unwrap_or(f64::INFINITY);
+        let shared_stiffness = self
+            .axial_stiffness_n
+            .iter()
+            .all(|ea| *ea == first_stiffness)
+            .then_some(first_stiffness)
+            .filter(|ea| ea.is_finite());
+        let own_stiffness = |i: usize| {
+            let ea = self.axial_stiffness_n[i];
+            (shared_stiffness.is_none() && ea.is_finite()).then_some(ea)
+        };
         let file = SuspendedFile {
             name: self.name.clone(),
             paper_robot: None,
@@ -222,6 +273,7 @@ impl SuspendedRobot {
             load_cells: Some(self.load_cells.iter().map(|c| c + 1).collect()),
             platform_weight_n: self.platform_weight_n,
             cable_weight_n_per_m: shared,
+            axial_stiffness_n: shared_stiffness,
             com_offset_m: self.com_offset_m.into(),
             length_offsets_m: Some(self.length_offsets_m.clone()),
             cables: (0..self.cable_count())
@@ -229,6 +281,7 @@ impl SuspendedRobot {
                     anchor_m: self.anchors_m[i].into(),
                     attachment_m: self.attachments_m[i].into(),
                     weight_n_per_m: (self.cable_weights_n_per_m[i] != shared).then_some(self.cable_weights_n_per_m[i]),
+                    axial_stiffness_n: own_stiffness(i),
                 })
                 .collect(),
             workspace: self.workspace.map(|w| WorkspaceEntry {
@@ -285,6 +338,15 @@ mod tests {
             robot.anchors_m[0].x += 1.0 / 3.0;
             let text = robot.to_toml(None).unwrap();
             assert_eq!(read(&text).unwrap(), robot, "{name}:\n{text}");
+            // Elastic cables: one stiffness for all, then one cable inextensible among them.
+            let mut elastic = robot.clone();
+            elastic.axial_stiffness_n = vec![4.5e6; robot.cable_count()];
+            let text = elastic.to_toml(None).unwrap();
+            assert_eq!(read(&text).unwrap(), elastic, "{name}:\n{text}");
+            elastic.axial_stiffness_n[0] = f64::INFINITY;
+            elastic.axial_stiffness_n[2] = 3e6 / 7.0;
+            let text = elastic.to_toml(None).unwrap();
+            assert_eq!(read(&text).unwrap(), elastic, "{name}:\n{text}");
             let n = 4 * robot.cable_count();
             let covariance: Vec<Vec<f64>> = (0..n)
                 .map(|r| (0..n).map(|k| if r == k { 1e-4 } else { 0.0 }).collect())
@@ -358,6 +420,17 @@ mod tests {
         assert_eq!(robot.cable_weights_n_per_m[0], 5.0);
         assert_eq!(robot.cable_weights_n_per_m[1], 3.924);
         assert_eq!(robot.load_cells, vec![1, 3]);
+        assert!(!robot.is_elastic());
+        let text = text
+            .replace("com_offset_m", "axial_stiffness_n = 5e6\ncom_offset_m")
+            .replacen(
+                "weight_n_per_m = 5.0",
+                "weight_n_per_m = 5.0\naxial_stiffness_n = 2e6",
+                1,
+            );
+        let robot = read(&text).unwrap();
+        assert_eq!(robot.axial_stiffness_n, [2e6, 5e6, 5e6, 5e6, 5e6, 5e6]);
+        assert_eq!(robot.axial_compliance_per_mn(1), 0.2);
     }
 
     /// Each blunder is refused with the file, the field and the reason.
@@ -412,6 +485,18 @@ mod tests {
                 "table `effects`",
             ),
             (SIX.replace("com_offset_m", "com_offset"), "not a valid robot file"),
+            (
+                SIX.replace("com_offset_m", "axial_stiffness_n = 0.0\ncom_offset_m"),
+                "field `axial_stiffness_n` must be a finite EA > 0",
+            ),
+            (
+                SIX.replacen(
+                    "attachment_m = [0.766, 0.6428, 0.3]",
+                    "attachment_m = [0.766, 0.6428, 0.3]\naxial_stiffness_n = -1e6",
+                    1,
+                ),
+                "cable 1: field `axial_stiffness_n` must be a finite EA > 0",
+            ),
         ] {
             let message = read(&text).unwrap_err();
             assert!(

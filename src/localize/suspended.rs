@@ -243,10 +243,7 @@ fn row_graph(
             anchor,
             length_offset: offset,
         };
-        let constants = CableConstants {
-            attachment_m: robot.attachments_m[i],
-            weight_n_per_m: robot.cable_weights_n_per_m[i],
-        };
+        let constants = CableConstants::of(robot, i);
         for (cable_row, sigma_m) in [
             (CableRow::Length, noise.encoder_sigma_m),
             (CableRow::Height, HEIGHT_SIGMA_M),

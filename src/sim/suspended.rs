@@ -25,7 +25,7 @@
 //! let workspace = robot.workspace.unwrap();
 //! let poses = sample_suspended(&robot, &workspace, 3, Closure::Level, &mut rng)?;
 //! let noise = NoisePreset::None.sigmas(robot.platform_weight_n);
-//! let rows = measure_suspended(&robot, &poses, &noise, &mut rng);
+//! let rows = measure_suspended(&robot, &poses, &noise, &mut rng)?;
 //! // Without noise an encoder reads its catenary's length (and a zero offset).
 //! assert_eq!(rows[0].encoder_lengths_m, poses[0].cable_lengths_m);
 //! assert_eq!(rows[0].load_cell_tensions_n[0], poses[0].tensions[0].magnitude_n());
@@ -99,15 +99,25 @@ fn is_stable(robot: &SuspendedRobot, eq: &SuspendedEquilibrium) -> bool {
 
 /// What the robot's sensors read at these equilibria (module docs), in the
 /// order of the draws: per pose the localiser, the encoders in cable order,
-/// then the load cells in the robot's order.
+/// then the load cells in the robot's order. The closed-form model's cables
+/// are inextensible: a robot with elastic cables (a finite
+/// `axial_stiffness_n`) is refused, its readings are the discretised
+/// simulator's ([`super::suspended_effects::simulate_readings`]).
 pub fn measure_suspended(
     robot: &SuspendedRobot,
     equilibria: &[SuspendedEquilibrium],
     noise: &SensorNoise,
     rng: &mut impl Rng,
-) -> Vec<SuspendedMeasurement> {
+) -> Result<Vec<SuspendedMeasurement>> {
+    if robot.is_elastic() {
+        return Err(Error::InvalidInput(format!(
+            "robot `{}` has elastic cables: the closed-form model's are inextensible; \
+             simulate it with the discretised simulator (sim::suspended_effects::simulate_readings)",
+            robot.name
+        )));
+    }
     let sensors = SensorSampler::new(noise);
-    equilibria
+    Ok(equilibria
         .iter()
         .map(|eq| {
             let lengths = eq
@@ -118,7 +128,7 @@ pub fn measure_suspended(
             let tensions = robot.load_cells.iter().map(|&cable| eq.tensions[cable].magnitude_n());
             read_suspended_row(&sensors, &eq.pose, lengths, tensions, rng)
         })
-        .collect()
+        .collect())
 }
 
 /// One row of readings with their noise drawn in the file's order: the
@@ -202,7 +212,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(2);
         let poses = sample_suspended(&robot, &robot.workspace.unwrap(), 5, Closure::Level, &mut rng).unwrap();
         let none = crate::model::sensors::NoisePreset::None.sigmas(robot.platform_weight_n);
-        let rows = measure_suspended(&robot, &poses, &none, &mut rng);
+        let rows = measure_suspended(&robot, &poses, &none, &mut rng).unwrap();
         for (row, eq) in rows.iter().zip(&poses) {
             let pose = crate::model::pose::PlatformPose::from_roll_pitch_yaw_deg(
                 row.position_m.into(),

@@ -4,7 +4,9 @@
 //! cables.
 //!
 //! The robot is commanded to each closed-form equilibrium's cable lengths:
-//! the drums pay them out. The discretised robot (elastic cables, pulley
+//! the drums pay them out (less each elastic cable's stretch where the
+//! robot file gives its stiffness, [`SuspendedEquilibrium::paid_out_lengths_m`]:
+//! the controller knows the cables it was given). The discretised robot (elastic cables, pulley
 //! wrap, finite elements, a shifted centre of mass, another platform or
 //! cable weight than its file says) settles where it settles under those
 //! lengths; that pose is the truth the localiser sees (through its
@@ -110,7 +112,8 @@ pub fn weighed_suspended(robot: &SuspendedRobot, effects: &Effects) -> Suspended
 /// The discretised model's settings for `effects` on `robot`, `segments`
 /// segments per cable (or a finite-element cable's own count,
 /// `effects.cable_segments`, rounded): every cable with the effects' `EA`
-/// and pulley radius, the centre of mass shifted.
+/// (else its own from the robot file) and pulley radius, the centre of
+/// mass shifted.
 pub fn suspended_discretised_options(
     robot: &SuspendedRobot,
     effects: &Effects,
@@ -119,7 +122,11 @@ pub fn suspended_discretised_options(
     let cables = robot.cable_count();
     SuspendedDiscretisedOptions {
         segments: effects.cable_segments.map_or(segments, |n| n.round().max(1.0) as usize),
-        axial_stiffness_n: vec![effects.axial_stiffness_n.unwrap_or(f64::INFINITY); cables],
+        axial_stiffness_n: robot
+            .axial_stiffness_n
+            .iter()
+            .map(|own| effects.axial_stiffness_n.unwrap_or(*own))
+            .collect(),
         pulley_radius_m: vec![effects.pulley_radius_m; cables],
         com_offset_m: Some(robot.com_offset_m + Vector3::from(effects.com_shift_m)),
         ..SuspendedDiscretisedOptions::inextensible(cables, segments)
@@ -127,7 +134,7 @@ pub fn suspended_discretised_options(
 }
 
 /// The discretised robot's equilibrium under each closed-form equilibrium's
-/// cable lengths as paid-out lengths; a pose whose solve fails is an error
+/// paid-out lengths ([`SuspendedEquilibrium::paid_out_lengths_m`]); a pose whose solve fails is an error
 /// naming the pose (1-based) and its commanded position.
 pub fn solve_suspended_with_effects(
     robot: &SuspendedRobot,
@@ -155,7 +162,8 @@ pub fn solve_suspended_with_effects(
         .enumerate()
         .map(|(k, eq)| {
             let guess = closed_form_forces(robot, eq);
-            solve_forward_suspended(&truth, &options, &eq.cable_lengths_m, &eq.pose, Some(&guess)).map_err(|e| {
+            let commanded = eq.paid_out_lengths_m(robot);
+            solve_forward_suspended(&truth, &options, &commanded, &eq.pose, Some(&guess)).map_err(|e| {
                 let p = eq.pose.position_m;
                 context(format!(
                     "pose {} (commanded position [{:.3}, {:.3}, {:.3}] m): the discretised robot with effects \
@@ -191,8 +199,10 @@ pub fn effects_from_specs(specs: &[String], front_end: FrontEnd) -> Result<Effec
 
 /// The readings of a simulation of `robot` at `equilibria`: the
 /// closed-form model's ([`super::suspended::measure_suspended`]) without
-/// effects, the discretised robot's ([`measure_suspended_with_effects`])
-/// with them.
+/// effects on inextensible cables, the discretised robot's
+/// ([`measure_suspended_with_effects`]) with effects or elastic cables
+/// (whose drums pay out the closed-form lengths and which stretch under
+/// them).
 pub fn simulate_readings(
     robot: &SuspendedRobot,
     effects: &Effects,
@@ -201,8 +211,8 @@ pub fn simulate_readings(
     segments: usize,
     rng: &mut impl Rng,
 ) -> Result<Vec<SuspendedMeasurement>> {
-    if effects.is_none() {
-        return Ok(super::suspended::measure_suspended(robot, equilibria, noise, rng));
+    if effects.is_none() && !robot.is_elastic() {
+        return super::suspended::measure_suspended(robot, equilibria, noise, rng);
     }
     measure_suspended_with_effects(robot, effects, equilibria, noise, segments, rng)
 }
@@ -253,6 +263,42 @@ mod tests {
         sample_suspended(robot, &robot.workspace.unwrap(), count, Closure::Level, &mut rng).unwrap()
     }
 
+    /// An elastic robot commanded to its paid-out lengths (the catenary's
+    /// less Irvine's first-order stretch) settles where the closed-form
+    /// model drew it: within the second-order stretch `l (T / EA)^2` on
+    /// weightless cables, within the height the first order leaves
+    /// (`g_c l^2 / 2EA` and the chain's `1/n^2`) on heavy ones; commanded the
+    /// inextensible lengths, it hangs millimetres lower.
+    #[test]
+    fn an_elastic_robot_settles_at_the_pose_its_paid_out_lengths_hold() {
+        for (name, weightless, bound_m) in [("three", true, 2e-5), ("eight", true, 2e-5), ("eight", false, 2e-4)] {
+            let mut robot = SuspendedRobot::builtin(name).unwrap();
+            if weightless {
+                robot.cable_weights_n_per_m = vec![0.0; robot.cable_count()];
+            }
+            robot.axial_stiffness_n = vec![2e6; robot.cable_count()];
+            let equilibria = poses(&robot, 5, 8);
+            let settled = solve_suspended_with_effects(&robot, &Effects::default(), &equilibria, 40).unwrap();
+            let mut worst: f64 = 0.0;
+            for (eq, truth) in equilibria.iter().zip(&settled) {
+                worst = worst.max((truth.pose.position_m - eq.pose.position_m).norm());
+                let paid_out = eq.paid_out_lengths_m(&robot);
+                assert_eq!(truth.paid_out_lengths_m, paid_out);
+                assert!(eq.cable_lengths_m.iter().zip(&paid_out).all(|(l, p)| l - p > 1e-4));
+            }
+            assert!(worst < bound_m, "{name}, weightless {weightless}: {worst} m");
+            // The same chains paid out the inextensible lengths sag further.
+            let options = suspended_discretised_options(&robot, &Effects::default(), 40);
+            let eq = &equilibria[0];
+            let guess = closed_form_forces(&robot, eq);
+            let sagged =
+                solve_forward_suspended(&robot, &options, &eq.cable_lengths_m, &eq.pose, Some(&guess)).unwrap();
+            let drop_m = eq.pose.position_m.z - sagged.pose.position_m.z;
+            println!("{name}, weightless {weightless}: settled within {worst:.1e} m; {drop_m:.1e} m lower on the inextensible lengths");
+            assert!(drop_m > 10.0 * worst, "{name}: {drop_m} m");
+        }
+    }
+
     /// With no effect the chains' readings approach the closed-form
     /// readings as the segments grow (`O(1/n^2)`), and the noise is the
     /// closed-form simulation's draw for draw.
@@ -262,7 +308,8 @@ mod tests {
         let equilibria = poses(&robot, 3, 4);
         let noise = NoisePreset::Paper.sigmas(robot.platform_weight_n);
         let closed =
-            crate::sim::suspended::measure_suspended(&robot, &equilibria, &noise, &mut ChaCha8Rng::seed_from_u64(9));
+            crate::sim::suspended::measure_suspended(&robot, &equilibria, &noise, &mut ChaCha8Rng::seed_from_u64(9))
+                .unwrap();
         let gap = |segments: usize| {
             let rows = measure_suspended_with_effects(
                 &robot,

@@ -28,8 +28,7 @@
 //! let offset = values.insert("offset", vector(&[0.2]));
 //! // At an equilibrium every cable reaches its attachment with the length its encoder reads ...
 //! let variables = CableVariables { pose, forces: forces[1], anchor: anchors[1], length_offset: offset };
-//! let constants =
-//!     CableConstants { attachment_m: robot.attachments_m[1], weight_n_per_m: robot.cable_weights_n_per_m[1] };
+//! let constants = CableConstants::of(&robot, 1);
 //! for (row, sigma_m) in [(CableRow::Length, 0.01), (CableRow::Height, 1e-4)] {
 //!     let cable =
 //!         CatenaryCableFactor::new(variables, constants, eq.cable_lengths_m[1] + 0.2, row, sigma_m, RobustKernel::None);
@@ -53,6 +52,7 @@ use nalgebra::{DMatrix, DVector, SMatrix, Vector2, Vector3};
 use crate::calib::factors::{pose_arguments, EPSILON};
 use crate::generated;
 use crate::graph::{evaluate_through_into, Factor, Noise, RobustKernel, Values, VariableId};
+use crate::model::suspended::SuspendedRobot;
 
 /// The methods every factor of this file shares: its variables, its
 /// residual evaluated through `evaluate_into` and its noise; each fills
@@ -88,13 +88,26 @@ pub struct CableVariables {
     pub length_offset: VariableId,
 }
 
-/// What one cable is: its attachment on the platform and its weight.
+/// What one cable is: its attachment on the platform, its weight and its stretch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CableConstants {
     /// Attachment, platform frame, metres.
     pub attachment_m: Vector3<f64>,
     /// Weight per metre, N/m.
     pub weight_n_per_m: f64,
+    /// Axial compliance `1e6 / EA`, 1/MN; 0 for an inextensible cable.
+    pub axial_compliance_per_mn: f64,
+}
+
+impl CableConstants {
+    /// Cable `cable` (0-based) of `robot`.
+    pub fn of(robot: &SuspendedRobot, cable: usize) -> Self {
+        Self {
+            attachment_m: robot.attachments_m[cable],
+            weight_n_per_m: robot.cable_weights_n_per_m[cable],
+            axial_compliance_per_mn: robot.axial_compliance_per_mn(cable),
+        }
+    }
 }
 
 /// Which row of one cable's eq. (14)-(15) a [`CatenaryCableFactor`] is.
@@ -107,7 +120,8 @@ pub enum CableRow {
 }
 
 /// Paper eq. (14) or (15) for one cable with its own forces (one row of
-/// `generated::suspended_cable_residual`): its statistics are the
+/// `generated::suspended_cable_residual`, or of
+/// `generated::suspended_elastic_cable_residual` for an elastic cable): its statistics are the
 /// encoders' (`catenary_length`) or the constraint's (`attachment_height`),
 /// as the four-cable graph reports them.
 pub struct CatenaryCableFactor {
@@ -171,21 +185,43 @@ impl Factor for CatenaryCableFactor {
             SMatrix::<f64, 2, 1>::zeros(),
         );
         let want = jacobians.is_some();
-        let r = generated::suspended_cable_residual(
-            &position,
-            &rotation,
-            &forces,
-            &anchor,
-            &self.cable.attachment_m,
-            self.cable.weight_n_per_m,
-            offset,
-            self.encoder_length_m,
-            EPSILON,
-            want.then_some(&mut j_pose),
-            want.then_some(&mut j_forces),
-            want.then_some(&mut j_anchor),
-            want.then_some(&mut j_offset),
-        );
+        let c = &self.cable;
+        // An inextensible cable keeps the shorter code of eq. (14)-(15).
+        let r = if c.axial_compliance_per_mn == 0.0 {
+            generated::suspended_cable_residual(
+                &position,
+                &rotation,
+                &forces,
+                &anchor,
+                &c.attachment_m,
+                c.weight_n_per_m,
+                offset,
+                self.encoder_length_m,
+                EPSILON,
+                want.then_some(&mut j_pose),
+                want.then_some(&mut j_forces),
+                want.then_some(&mut j_anchor),
+                want.then_some(&mut j_offset),
+            )
+        } else {
+            generated::suspended_elastic_cable_residual(
+                &position,
+                &rotation,
+                &forces,
+                &anchor,
+                &c.attachment_m,
+                c.weight_n_per_m,
+                c.axial_compliance_per_mn,
+                offset,
+                self.encoder_length_m,
+                EPSILON,
+                want.then_some(&mut j_pose),
+                want.then_some(&mut j_forces),
+                want.then_some(&mut j_anchor),
+                want.then_some(&mut j_offset),
+                None,
+            )
+        };
         let k = match self.row {
             CableRow::Length => 0,
             CableRow::Height => 1,

@@ -250,10 +250,7 @@ fn add_cable(
         anchor,
         length_offset,
     };
-    let constants = CableConstants {
-        attachment_m: robot.attachments_m[i],
-        weight_n_per_m: robot.cable_weights_n_per_m[i],
-    };
+    let constants = CableConstants::of(robot, i);
     let cable = |row, sigma_m, kernel| {
         Box::new(CatenaryCableFactor::new(
             variables,

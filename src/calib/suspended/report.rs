@@ -30,6 +30,9 @@ pub struct SuspendedCalibrationReport {
     pub cables: usize,
     /// The cables with a load cell, 1-based.
     pub load_cells: Vec<usize>,
+    /// Each cable's axial stiffness `EA` the model used, newtons (`null`:
+    /// an inextensible cable).
+    pub axial_stiffness_n: Vec<Option<f64>>,
     /// Number of poses.
     pub poses_used: usize,
     /// Calibrated anchors, world frame, metres (N x 3).
@@ -115,6 +118,11 @@ impl SuspendedCalibrationReport {
             robot: robot.name.clone(),
             cables: robot.cable_count(),
             load_cells: robot.load_cells.iter().map(|c| c + 1).collect(),
+            axial_stiffness_n: robot
+                .axial_stiffness_n
+                .iter()
+                .map(|ea| ea.is_finite().then_some(*ea))
+                .collect(),
             poses_used: result.poses.len(),
             anchors_m: robot.anchors_m.iter().map(|a| (*a).into()).collect(),
             anchor_sigma_m,

@@ -119,6 +119,31 @@ pub struct SuspendedEquilibrium {
     pub iterations: usize,
 }
 
+impl SuspendedEquilibrium {
+    /// The length each drum of `robot` pays out to hold this equilibrium:
+    /// each cable's catenary length (paper eq. 4), less an elastic cable's
+    /// stretch to first order in `1/EA` (Irvine's elastic catenary,
+    /// `l (1 - T_top / EA)` with `T_top = |(f_h, f_v + g_c l)|`, as
+    /// `generated::suspended_elastic_cable_residual` reads its encoder),
+    /// metres. An inextensible cable's is its catenary length.
+    pub fn paid_out_lengths_m(&self, robot: &SuspendedRobot) -> Vec<f64> {
+        (0..self.cable_lengths_m.len())
+            .map(|i| {
+                let length = self.cable_lengths_m[i];
+                let compliance_per_n = robot.axial_compliance_per_mn(i) * 1e-6;
+                if compliance_per_n == 0.0 {
+                    return length;
+                }
+                let t = &self.tensions[i];
+                let top_n = t
+                    .horizontal_n
+                    .hypot(t.vertical_n + robot.cable_weights_n_per_m[i] * length);
+                length * (1.0 - compliance_per_n * top_n)
+            })
+            .collect()
+    }
+}
+
 /// The problem of one position: the unknowns' meaning, the target and the metric.
 pub(super) struct Problem<'a> {
     robot: &'a SuspendedRobot,

@@ -30,6 +30,10 @@ pub struct SuspendedRobot {
     pub attachments_m: Vec<Vector3<f64>>,
     /// Each cable's weight per metre `g_c,i = rho_c,i g`, newtons per metre.
     pub cable_weights_n_per_m: Vec<f64>,
+    /// Each cable's axial stiffness `EA_i`, newtons; `f64::INFINITY` for an
+    /// inextensible cable (Irvine's elastic catenary otherwise:
+    /// [`SuspendedRobot::axial_compliance_per_mn`]).
+    pub axial_stiffness_n: Vec<f64>,
     /// Centre of mass `b_com` in the platform frame, metres.
     pub com_offset_m: Vector3<f64>,
     /// Platform weight `m_e g`, newtons.
@@ -95,6 +99,7 @@ impl SuspendedRobot {
         }
         Ok(Self {
             length_offsets_m: vec![0.0; n],
+            axial_stiffness_n: vec![f64::INFINITY; n],
             anchors_m,
             attachments_m,
             cable_weights_n_per_m,
@@ -113,6 +118,7 @@ impl SuspendedRobot {
             anchors_m: robot.anchors_m.to_vec(),
             attachments_m: robot.attachments_m.to_vec(),
             cable_weights_n_per_m: vec![robot.cable_weight_n_per_m; robot.anchors_m.len()],
+            axial_stiffness_n: vec![f64::INFINITY; robot.anchors_m.len()],
             com_offset_m: robot.com_offset_m,
             platform_weight_n: robot.platform_weight_n,
             name: robot.name.clone(),
@@ -131,6 +137,17 @@ impl SuspendedRobot {
     /// Number of cables `N`.
     pub fn cable_count(&self) -> usize {
         self.anchors_m.len()
+    }
+
+    /// Cable `cable`'s axial compliance `1e6 / EA` in 1/MN, the argument of
+    /// the elastic cable's residual; 0 for an inextensible cable.
+    pub fn axial_compliance_per_mn(&self, cable: usize) -> f64 {
+        1e6 / self.axial_stiffness_n[cable]
+    }
+
+    /// Whether any cable stretches (a finite axial stiffness).
+    pub fn is_elastic(&self) -> bool {
+        self.axial_stiffness_n.iter().any(|ea| ea.is_finite())
     }
 
     /// The force components left free at each pose, `2N - 6`.
