@@ -733,3 +733,124 @@ fn worst_sigma(report: &serde_json::Value, truth: &SuspendedRobot) -> f64 {
     }
     worst
 }
+
+/// `sagcal plan` on robots of 3 to 8 cables: the plan's bound (summed from
+/// each candidate's Schur-complement information) is the marginal
+/// covariance of the calibration graph of the chosen poses at the truth,
+/// computed independently by the sparse solver; chosen for it, the plan
+/// beats random sets of as many candidates.
+#[test]
+fn the_plan_of_n_cables_is_the_bound_of_its_calibration_graph() {
+    use sagcal::calib::suspended::{build_suspended_graph, Exclusions, PoseStart, SuspendedStage};
+    use sagcal::calib::{anchor_and_offset_uncertainty, ParameterUncertainty};
+    use sagcal::experiments::suspended_plan::{plan_suspended, SuspendedPlanSettings};
+    use sagcal::plan::suspended_information::noise_free_suspended_reading;
+    for (name, poses) in [("three", 8), ("six", 10), ("eight", 12)] {
+        let robot = SuspendedRobot::builtin(name).unwrap();
+        let settings = SuspendedPlanSettings {
+            candidates: 80,
+            ..SuspendedPlanSettings::new(poses)
+        };
+        let planned = plan_suspended(&robot, &settings, &mut |_| {}).unwrap();
+        let report = &planned.report;
+        assert_eq!((report.cables, report.plan.len()), (robot.cable_count(), poses));
+        let chosen: Vec<&SuspendedEquilibrium> = planned.plan.order.iter().map(|&k| &planned.candidates[k]).collect();
+        let readings: Vec<_> = chosen
+            .iter()
+            .map(|eq| noise_free_suspended_reading(&robot, eq))
+            .collect();
+        let starts: Vec<PoseStart> = chosen
+            .iter()
+            .map(|eq| PoseStart {
+                pose: eq.pose,
+                forces: eq.tensions.clone(),
+            })
+            .collect();
+        let built = build_suspended_graph(
+            &robot,
+            &readings,
+            &starts,
+            SuspendedStage::Catenary,
+            &paper_options(&robot),
+            false,
+            &Exclusions::new(),
+        );
+        let ParameterUncertainty::Full {
+            anchor_sigma_m,
+            offset_sigma_m,
+            ..
+        } = anchor_and_offset_uncertainty(&built.graph, &built.anchors, &built.length_offsets).unwrap()
+        else {
+            panic!("{name}: the chosen poses leave the anchors undetermined");
+        };
+        let n = robot.cable_count() as f64;
+        let anchor_rms = (anchor_sigma_m.iter().flatten().map(|s| s * s).sum::<f64>() / n).sqrt();
+        let offset_rms = (offset_sigma_m.iter().map(|s| s * s).sum::<f64>() / n).sqrt();
+        println!(
+            "{name}: plan of {poses} bounds the anchors to {:.4} m RMS (graph {anchor_rms:.4} m), random sets to {:.4} m",
+            report.anchor_bound_m, report.random_anchor_bound_m
+        );
+        assert!((report.anchor_bound_m / anchor_rms - 1.0).abs() < 1e-6, "{name}");
+        assert!((report.offset_bound_m / offset_rms - 1.0).abs() < 1e-6, "{name}");
+        assert!(report.anchor_bound_m < report.random_anchor_bound_m, "{name}");
+    }
+}
+
+/// `sagcal plan --robot six.toml`: the JSON report, the plan as a
+/// measurement file of six cables (noise-free: calibrating it from the
+/// nominal robot moves no anchor), the figure, and `--from` refused by name.
+#[test]
+fn the_plan_command_plans_six_cables() {
+    let dir = tempfile::tempdir().unwrap();
+    let six = robot_path("six");
+    let args = [
+        "plan",
+        "--robot",
+        &six,
+        "--poses",
+        "10",
+        "--candidates",
+        "60",
+        "--out",
+        "plan.csv",
+        "--plot",
+        "plan.svg",
+        "--json",
+    ];
+    let out = sagcal(dir.path(), &args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        (report["cables"].as_u64(), report["poses"].as_u64()),
+        (Some(6), Some(10))
+    );
+    assert_eq!(report["plan"][0]["cable_lengths_m"].as_array().unwrap().len(), 6);
+    let svg = std::fs::read_to_string(dir.path().join("plan.svg")).unwrap();
+    assert!(svg.contains("A6 x-z"), "an ellipse cell per anchor");
+    let csv = std::fs::read_to_string(dir.path().join("plan.csv")).unwrap();
+    assert!(csv.contains("l6_m,f1_n"));
+    let calibrate = sagcal(
+        dir.path(),
+        &["calibrate", "--robot", &six, "--data", "plan.csv", "--json"],
+    );
+    assert!(
+        calibrate.status.success(),
+        "{}",
+        String::from_utf8_lossy(&calibrate.stderr)
+    );
+    let fit: serde_json::Value = serde_json::from_slice(&calibrate.stdout).unwrap();
+    let moved = fit["anchor_change_m"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|a| a.as_array().unwrap().clone());
+    let moved = moved.map(|v| v.as_f64().unwrap().abs()).fold(0.0, f64::max);
+    assert!(moved < 1e-6, "noise-free readings of the nominal robot: {moved} m");
+    let from = sagcal(
+        dir.path(),
+        &["plan", "--robot", &six, "--poses", "10", "--from", "plan.csv"],
+    );
+    assert!(!from.status.success());
+    let message = String::from_utf8_lossy(&from.stderr);
+    assert!(message.contains("--from: robot `six` has 6 cables"), "{message}");
+}

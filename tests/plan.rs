@@ -87,7 +87,7 @@ fn rank_k_update_equals_the_bound_from_scratch() {
     for k in 5..30 {
         let with_k: Vec<usize> = chosen.iter().copied().chain([k]).collect();
         let m = information_sum(&information, &with_k, 0.0);
-        let scratch = bound_from_covariance(&covariance_of(&m).unwrap());
+        let scratch = bound_from_covariance(&covariance_of(&m).unwrap(), 4);
         let scratch_a = 4.0 * scratch.anchor_rms_m.powi(2);
         assert!(
             relative_difference(a[k], scratch_a) < 1e-9,

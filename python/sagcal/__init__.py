@@ -9,8 +9,9 @@ in and out, the same jobs with the same options, results and error messages.
   weights, encoder offsets and effects as numpy arrays and floats.
 - :func:`simulate`: measurements of a robot (``sagcal simulate``);
   :class:`SuspendedRobot` and :func:`simulate_suspended`: a robot of 3 to 8
-  cables and its measurements; :func:`calibrate_suspended` calibrates it
-  and :func:`localize_suspended` localises it.
+  cables and its measurements; :func:`calibrate_suspended` calibrates it,
+  :func:`localize_suspended` localises it and :func:`plan_suspended` plans
+  its calibration poses.
 - :func:`calibrate`: anchors and encoder offsets from measurements
   (``sagcal calibrate``), with their covariance and the gross-error tests.
 - :func:`diagnose`: what the calibration model gets wrong (``sagcal diagnose``).
@@ -66,6 +67,7 @@ from ._sagcal import (
     SolverError,
     SuspendedCalibration,
     SuspendedLocalization,
+    SuspendedPlan,
     SuspendedRobot,
     SuspendedSimulation,
     __version__,
@@ -83,6 +85,7 @@ init_robot = _entry(_sagcal.init_robot)
 localize = _entry(_sagcal.localize)
 localize_suspended = _entry(_sagcal.localize_suspended)
 plan = _entry(_sagcal.plan, ints={"poses": _COUNT, "seed": _COUNT})
+plan_suspended = _entry(_sagcal.plan_suspended, ints={"poses": _COUNT, "seed": _COUNT, "candidates": _COUNT})
 read_measurements = _entry(_sagcal.read_measurements, ints={"reference_cable": (1, 5)})
 simulate = _entry(_sagcal.simulate, ints={"poses": _COUNT, "seed": _COUNT, "segments": _COUNT}, lists=("effects",))
 simulate_suspended = _entry(_sagcal.simulate_suspended, ints={"poses": _COUNT, "seed": _COUNT})
@@ -108,6 +111,7 @@ __all__ = [
     "SolverError",
     "SuspendedCalibration",
     "SuspendedLocalization",
+    "SuspendedPlan",
     "SuspendedRobot",
     "SuspendedSimulation",
     "__version__",
@@ -119,6 +123,7 @@ __all__ = [
     "localize",
     "localize_suspended",
     "plan",
+    "plan_suspended",
     "read_measurements",
     "simulate",
     "simulate_suspended",

@@ -259,6 +259,43 @@ class Localization:
     def position_error_m(self) -> Optional[FloatArray]:
         """Distance from the input's localiser positions, metres: (N,), or ``None``."""
 
+class SuspendedPlan:
+    """The result of :func:`plan_suspended` (one row per chosen pose, in visiting order)."""
+
+    @property
+    def positions_m(self) -> FloatArray:
+        """Commanded platform positions, metres: (poses, 3)."""
+    @property
+    def cable_lengths_m(self) -> FloatArray:
+        """The lengths the drums pay out, metres: (poses, N)."""
+    @property
+    def min_horizontal_tension_n(self) -> FloatArray:
+        """Each pose's smallest horizontal cable tension, newtons: (poses,)."""
+    @property
+    def measurements(self) -> FloatArray:
+        """The nominal model's noise-free readings, in :attr:`SuspendedRobot.columns`."""
+    @property
+    def order(self) -> list[int]:
+        """The candidates' indices in visiting order."""
+    @property
+    def anchor_covariance_m2(self) -> FloatArray:
+        """Each anchor's 3x3 covariance of the bound, m^2: (N, 3, 3)."""
+    @property
+    def anchor_bound_m(self) -> float:
+        """The plan's bound, RMS per anchor, metres."""
+    @property
+    def offset_bound_m(self) -> float:
+        """The plan's bound, RMS per offset, metres."""
+    @property
+    def random_anchor_bound_m(self) -> float:
+        """The mean bound of random sets of as many poses, RMS per anchor, metres."""
+    @property
+    def path_length_m(self) -> float:
+        """The visiting path's length, metres."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The report as ``sagcal plan --json`` prints it."""
+
 class PosePlan:
     """The result of :func:`plan` (one row per chosen pose, in visiting order)."""
 
@@ -522,6 +559,20 @@ def localize(
     progress: Optional[Callable[[int, int, str], Any]] = None,
 ) -> Localization:
     """Pose and tensions from the cable readings, as ``sagcal localize`` does."""
+
+def plan_suspended(
+    robot: SuspendedRobot,
+    poses: int,
+    *,
+    candidates: int = 1000,
+    workspace: Union[Sequence[float], str, None] = None,
+    noise: str = "paper",
+    criterion: str = "a",
+    seed: int = 1,
+    orientation_prior: str = "off",
+    progress: Optional[Callable[[int, int, str], Any]] = None,
+) -> SuspendedPlan:
+    """The calibration poses of a robot of 3 to 8 cables, as ``sagcal plan`` chooses them."""
 
 def plan(
     robot: Robot,

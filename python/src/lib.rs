@@ -20,6 +20,7 @@ mod localize;
 mod localize_suspended;
 mod options;
 mod plan;
+mod plan_suspended;
 mod progress;
 mod robot;
 mod simulate;
@@ -155,6 +156,7 @@ fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<diagnose::Diagnosis>()?;
     m.add_class::<localize::Localization>()?;
     m.add_class::<plan::PosePlan>()?;
+    m.add_class::<plan_suspended::SuspendedPlan>()?;
     m.add_class::<simulate::Simulation>()?;
     m.add_class::<suspended::SuspendedRobot>()?;
     m.add_class::<suspended::SuspendedSimulation>()?;
@@ -170,6 +172,7 @@ fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(data::read_measurements, m)?)?;
     m.add_function(wrap_pyfunction!(data::write_measurements, m)?)?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
+    m.add_function(wrap_pyfunction!(plan_suspended::plan_suspended, m)?)?;
     m.add_function(wrap_pyfunction!(init::init_robot, m)?)?;
     m.add_function(wrap_pyfunction!(check::check, m)?)?;
     m.add_function(wrap_pyfunction!(_cancel, m)?)?;

@@ -246,7 +246,7 @@ pub fn plan(
 }
 
 /// The workspace: the command's text `x0,x1,y0,y1,z0,z1`, or six numbers.
-fn workspace_argument(value: &Bound<'_, PyAny>) -> PyResult<Workspace> {
+pub(crate) fn workspace_argument(value: &Bound<'_, PyAny>) -> PyResult<Workspace> {
     let checked = match value.extract::<String>() {
         Ok(text) => parse_workspace(&text),
         Err(_) => {

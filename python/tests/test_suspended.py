@@ -142,3 +142,19 @@ def test_localize_suspended_gives_the_commands_report(cli, tmp_path):
     assert [r["position_m"] for r in command["rows"]] == [r["position_m"] for r in found.report["rows"]]
     with pytest.raises(sagcal.SagcalError, match="false_alarm must be between 0 and 1"):
         sagcal.localize_suspended(calibrated.robot, simulation.measurements, false_alarm=2.0)
+
+
+def test_plan_suspended_is_the_commands_plan(cli, tmp_path):
+    robot = sagcal.SuspendedRobot.builtin("eight")
+    steps = []
+    plan = sagcal.plan_suspended(robot, 12, candidates=60, seed=3, progress=lambda d, t, w: steps.append(w))
+    assert steps[0].startswith("drawing 60 candidate poses") and steps[-1] == "done"
+    out = tmp_path / "plan.csv"
+    command = json.loads(cli("plan", "--robot", ROOT / "robots" / "eight.toml", "--poses", 12, "--candidates", 60,
+                             "--seed", 3, "--out", out, "--json").stdout)
+    assert command == plan.report
+    assert plan.anchor_bound_m == command["anchor_bound_m"] < plan.random_anchor_bound_m
+    assert plan.cable_lengths_m.shape == (12, 8) and plan.anchor_covariance_m2.shape == (8, 3, 3)
+    rows = [line for line in out.read_text().splitlines() if not line.startswith("#")]
+    written = np.array([[float(v) for v in row.split(",")] for row in rows[1:]])
+    np.testing.assert_array_equal(written, plan.measurements)

@@ -14,7 +14,7 @@ use super::hidden_args::HiddenEffectsArgs;
 use super::init::InitArgs;
 use super::localize::LocalizeArgs;
 use super::localize_experiment::LocalizeExperimentArgs;
-use super::plan::PlanArgs;
+use super::plan_args::PlanArgs;
 use super::simulate_args::SimulateArgs;
 use super::verify::VerifyArgs;
 

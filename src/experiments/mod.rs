@@ -10,6 +10,7 @@
 //! - [`suspended_sweep`]: effects hidden in data of robots of 3 to 8 cables,
 //!   scored by the calibration's own verdict (`sagcal experiment hidden-effects --robots six`);
 //! - [`plan_candidates`]: candidate poses for `sagcal plan`;
+//! - [`suspended_plan`]: `sagcal plan` on a robot of 3 to 8 cables;
 //! - [`benchmark`]: the reproducible calibration graph the solver benches and
 //!   the peer comparison share.
 //!
@@ -35,6 +36,7 @@ pub mod plan_candidates;
 pub mod pose_plan;
 pub mod selection;
 pub mod suspended_effect_draws;
+pub mod suspended_plan;
 pub mod suspended_sweep;
 pub mod suspended_trials;
 pub mod table2;

@@ -424,14 +424,10 @@ pub fn plan_among(
         ..DesignOptions::new(settings.poses)
     };
     let start = start_point(&set.equilibria);
-    let plan = plan_poses(
-        &set.equilibria,
-        &information,
-        &design,
-        &start,
-        settings.seed,
-        &mut |step| progress(PlanProgress::Choosing(step)),
-    )?;
+    let poses: Vec<_> = set.equilibria.iter().map(|eq| eq.pose).collect();
+    let plan = plan_poses(&poses, &information, &design, &start, settings.seed, &mut |step| {
+        progress(PlanProgress::Choosing(step))
+    })?;
     progress(PlanProgress::Done);
     let report = PlanReport {
         robot: robot.name.clone(),

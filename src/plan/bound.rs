@@ -9,7 +9,7 @@
 //! // Sixteen poses, each measuring one global parameter with sigma 2 cm: Sigma = (0.02 m)^2 1,
 //! // so the RMS anchor error is sqrt(3) x 2 cm and the RMS offset error 2 cm.
 //! let poses: Vec<PoseInformation> = (0..16)
-//!     .map(|k| PoseInformation { factor: DMatrix::from_fn(16, 1, |r, _| if r == k { 1.0 / 0.02 } else { 0.0 }) })
+//!     .map(|k| PoseInformation { factor: DMatrix::from_fn(16, 1, |r, _| if r == k { 1.0 / 0.02 } else { 0.0 }), cables: 4 })
 //!     .collect();
 //! let all: Vec<usize> = (0..16).collect();
 //! let bound = plan_bound(&poses, &all).unwrap();
@@ -22,8 +22,7 @@
 use nalgebra::DMatrix;
 use serde::Serialize;
 
-use super::information::{PoseInformation, ANCHOR_PARAMETERS, OFFSET_PARAMETERS};
-use crate::model::robot::CABLE_COUNT;
+use super::information::{anchor_parameters, offset_parameters, PoseInformation};
 
 /// A direction whose variance exceeds this, (m)^2, is not determined (the
 /// limit `marginal_covariance` uses: a 10 km standard deviation).
@@ -32,9 +31,9 @@ const UNDETERMINED_VARIANCE: f64 = 1e8;
 /// The bound of a pose set on anchors and offsets.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlanBound {
-    /// RMS Euclidean anchor error the bound allows, `sqrt(trace Sigma_anchors / 4)`, metres.
+    /// RMS Euclidean anchor error the bound allows, `sqrt(trace Sigma_anchors / N)`, metres.
     pub anchor_rms_m: f64,
-    /// RMS length-offset error, `sqrt(trace Sigma_offsets / 4)`, metres.
+    /// RMS length-offset error, `sqrt(trace Sigma_offsets / N)`, metres.
     pub offset_rms_m: f64,
     /// Per anchor, the 3x3 covariance block, m^2.
     pub anchor_covariance_m2: Vec<[[f64; 3]; 3]>,
@@ -66,16 +65,16 @@ pub fn covariance_of(information: &DMatrix<f64>) -> Option<DMatrix<f64>> {
 pub fn plan_bound(poses: &[PoseInformation], chosen: &[usize]) -> Option<PlanBound> {
     let covariance = covariance_of(&information_sum(poses, chosen, 0.0))?;
     let determined = (0..covariance.nrows()).all(|k| covariance[(k, k)] < UNDETERMINED_VARIANCE);
-    determined.then(|| bound_from_covariance(&covariance))
+    determined.then(|| bound_from_covariance(&covariance, poses.first().map_or(0, |p| p.cables)))
 }
 
-/// The summary of a joint covariance of the global parameters.
-pub fn bound_from_covariance(covariance: &DMatrix<f64>) -> PlanBound {
+/// The summary of a joint covariance of the global parameters of a robot of `cables` cables.
+pub fn bound_from_covariance(covariance: &DMatrix<f64>, cables: usize) -> PlanBound {
     let trace = |range: std::ops::Range<usize>| range.map(|k| covariance[(k, k)]).sum::<f64>();
     PlanBound {
-        anchor_rms_m: (trace(ANCHOR_PARAMETERS) / CABLE_COUNT as f64).sqrt(),
-        offset_rms_m: (trace(OFFSET_PARAMETERS) / CABLE_COUNT as f64).sqrt(),
-        anchor_covariance_m2: (0..CABLE_COUNT)
+        anchor_rms_m: (trace(anchor_parameters(cables)) / cables as f64).sqrt(),
+        offset_rms_m: (trace(offset_parameters(cables)) / cables as f64).sqrt(),
+        anchor_covariance_m2: (0..cables)
             .map(|i| std::array::from_fn(|r| std::array::from_fn(|c| covariance[(3 * i + r, 3 * i + c)])))
             .collect(),
     }

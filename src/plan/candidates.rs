@@ -26,6 +26,7 @@
 
 use serde::Serialize;
 
+use crate::model::pose::PlatformPose;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::statics::{catenaries, Equilibrium};
 
@@ -98,12 +99,19 @@ pub const SAME_ORIENTATION_RAD: f64 = 1e-6;
 /// candidates beyond them are left out), so asking whether there are at
 /// least `limit` distinct poses costs `limit` comparisons per candidate.
 pub fn distinct_poses(candidates: &[Equilibrium], limit: usize) -> Vec<Vec<usize>> {
+    let poses: Vec<PlatformPose> = candidates.iter().map(|eq| eq.pose).collect();
+    distinct_platform_poses(&poses, limit)
+}
+
+/// [`distinct_poses`] of the platform poses themselves (a robot of any
+/// number of cables).
+pub fn distinct_platform_poses(poses: &[PlatformPose], limit: usize) -> Vec<Vec<usize>> {
     let mut groups: Vec<Vec<usize>> = Vec::new();
-    for (k, eq) in candidates.iter().enumerate() {
+    for (k, pose) in poses.iter().enumerate() {
         let same = groups.iter().position(|g| {
-            let first = &candidates[g[0]].pose;
-            (first.position_m - eq.pose.position_m).norm() <= SAME_POSITION_M
-                && first.rotation.angle_to(&eq.pose.rotation) <= SAME_ORIENTATION_RAD
+            let first = &poses[g[0]];
+            (first.position_m - pose.position_m).norm() <= SAME_POSITION_M
+                && first.rotation.angle_to(&pose.rotation) <= SAME_ORIENTATION_RAD
         });
         match same {
             Some(g) => groups[g].push(k),

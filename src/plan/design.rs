@@ -38,7 +38,7 @@
 //! // and once with sigma 1/2 (16..32). The A-criterion weighs the 12 anchor coordinates:
 //! // the A-optimal 12 poses are their precise measurements, and the trace of the anchor
 //! // covariance is then 12 x (1/2)^2 = 3.
-//! let unit = |k: usize, w: f64| PoseInformation { factor: DMatrix::from_fn(16, 1, |r, _| if r == k { w } else { 0.0 }) };
+//! let unit = |k: usize, w: f64| PoseInformation { factor: DMatrix::from_fn(16, 1, |r, _| if r == k { w } else { 0.0 }), cables: 4 };
 //! let candidates: Vec<PoseInformation> = (0..16).map(|k| unit(k, 1.0)).chain((0..16).map(|k| unit(k, 2.0))).collect();
 //! let design = choose_poses(&candidates, &DesignOptions::new(12))?;
 //! let mut chosen = design.chosen.clone();
@@ -52,7 +52,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::bound::{covariance_of, information_sum};
-use super::information::{PoseInformation, ANCHOR_PARAMETERS};
+use super::information::{anchor_parameters, PoseInformation};
 use crate::error::{Error, ParseError, Result};
 
 /// The ridge of the search, relative to the mean diagonal of one pose's information.
@@ -143,6 +143,7 @@ struct Stack {
     factors: DMatrix<f64>,
     columns: Vec<(usize, usize)>,
     max_rank: usize,
+    cables: usize,
 }
 
 impl Stack {
@@ -162,6 +163,7 @@ impl Stack {
             factors,
             columns,
             max_rank,
+            cables: poses[0].cables,
         }
     }
 
@@ -171,7 +173,7 @@ impl Stack {
         let n = c.nrows();
         let w = c * &self.factors;
         let r_max = self.max_rank;
-        let anchors = ANCHOR_PARAMETERS.len().min(n);
+        let anchors = anchor_parameters(self.cables).len().min(n);
         let mut s = vec![0.0; r_max * r_max];
         let mut y = vec![0.0; r_max * anchors];
         let u_all = self.factors.as_slice();
@@ -240,9 +242,9 @@ fn cholesky_in_place(s: &mut [f64], r: usize, stride: usize) -> bool {
 }
 
 /// The criterion at information `m` (with its covariance `c`).
-fn criterion_value(m: &DMatrix<f64>, c: &DMatrix<f64>, criterion: Criterion) -> f64 {
+fn criterion_value(m: &DMatrix<f64>, c: &DMatrix<f64>, criterion: Criterion, cables: usize) -> f64 {
     match criterion {
-        Criterion::A => ANCHOR_PARAMETERS.map(|k| c[(k, k)]).sum(),
+        Criterion::A => anchor_parameters(cables).map(|k| c[(k, k)]).sum(),
         Criterion::D => m.clone().cholesky().map_or(f64::INFINITY, |l| {
             -2.0 * l.l().diagonal().iter().map(|d| d.ln()).sum::<f64>()
         }),
@@ -271,7 +273,7 @@ pub fn updated_values(
 ) -> Option<Vec<f64>> {
     let m = information_sum(poses, chosen, ridge);
     let c = covariance_of(&m)?;
-    let base = criterion_value(&m, &c, criterion);
+    let base = criterion_value(&m, &c, criterion, poses[0].cables);
     let gains = Stack::new(poses).gains(&c, criterion);
     Some(gains.into_iter().map(|g| base - g).collect())
 }
@@ -323,7 +325,7 @@ pub fn choose_more_poses(poses: &[PoseInformation], fixed: &[usize], options: &D
 /// use nalgebra::DMatrix;
 /// use sagcal::plan::information::PoseInformation;
 /// use sagcal::plan::{choose_more_poses_with_progress, DesignOptions, DesignProgress};
-/// let unit = |k: usize| PoseInformation { factor: DMatrix::from_fn(16, 1, |r, _| if r == k % 16 { 1.0 } else { 0.5 }) };
+/// let unit = |k: usize| PoseInformation { factor: DMatrix::from_fn(16, 1, |r, _| if r == k % 16 { 1.0 } else { 0.5 }), cables: 4 };
 /// let candidates: Vec<PoseInformation> = (0..40).map(unit).collect();
 /// let mut greedy = Vec::new();
 /// choose_more_poses_with_progress(&candidates, &[], &DesignOptions::new(16), &mut |step| {
@@ -376,7 +378,7 @@ pub fn choose_more_poses_with_progress(
     let value_of = |chosen: &[usize]| -> Result<f64> {
         let m = information_sum(poses, chosen, ridge);
         let c = covariance_of(&m).ok_or_else(singular)?;
-        Ok(criterion_value(&m, &c, options.criterion))
+        Ok(criterion_value(&m, &c, options.criterion, poses[0].cables))
     };
     let greedy_value = value_of(&chosen)?;
     let (mut exchanges, mut passes) = (0, 0);

@@ -60,7 +60,7 @@ use rayon::prelude::*;
 
 use crate::calib::{build_graph, CalibrationOptions, RobustKernels};
 use crate::error::{Error, Result};
-use crate::graph::linearize_factor;
+use crate::graph::{linearize_factor, FactorGraph, VariableId};
 use crate::model::measurement::PoseMeasurement;
 use crate::model::robot::{Robot, CABLE_COUNT};
 use crate::model::statics::Equilibrium;
@@ -72,9 +72,12 @@ const RANK_TOLERANCE: f64 = 1e-13;
 #[derive(Debug, Clone, PartialEq)]
 pub struct PoseInformation {
     /// The low-rank factor `U_k`: one row per global parameter (anchors
-    /// 1..4 x, y, z; offsets 1..4; effect parameters), one column per
+    /// 1..N x, y, z; offsets 1..N; effect parameters), one column per
     /// independent equation the pose adds. Units: 1 / (parameter unit).
     pub factor: DMatrix<f64>,
+    /// The robot's cables `N`: the first `3N` rows are the anchors'
+    /// coordinates ([`anchor_parameters`]), the next `N` the offsets.
+    pub cables: usize,
 }
 
 impl PoseInformation {
@@ -133,8 +136,22 @@ pub fn pose_information(
         options.model,
         &plain,
     );
-    let values = &built.graph.values;
     let locals = [built.poses[0].pose, built.poses[0].reference_tension];
+    graph_information(&built.graph, &locals, CABLE_COUNT, &reading.position_m)
+}
+
+/// The information about the global parameters of `graph` (every free
+/// variable but `locals`, in the order of their ids: the anchors of the
+/// robot's `cables`, its offsets, then any effect parameters) of a graph of
+/// one pose whose own variables are `locals`, these eliminated exactly
+/// (module docs); the errors name the pose by its position `position_m`.
+pub fn graph_information(
+    graph: &FactorGraph,
+    locals: &[VariableId],
+    cables: usize,
+    position_m: &[f64; 3],
+) -> Result<PoseInformation> {
+    let values = &graph.values;
     // Column layout: free globals in variable order (anchors, offsets,
     // effects), then the free locals.
     let mut column = vec![None; values.len()];
@@ -146,20 +163,20 @@ pub fn pose_information(
         }
     }
     let mut width = globals;
-    for &id in &locals {
+    for &id in locals {
         if !values.variable(id).fixed {
             column[id.0] = Some(width);
             width += values.tangent_dim(id);
         }
     }
-    let rows: usize = built.graph.factors.iter().map(|f| f.residual_dim()).sum();
+    let rows: usize = graph.factors.iter().map(|f| f.residual_dim()).sum();
     let mut jacobian = DMatrix::zeros(rows, width);
     let mut row = 0;
-    for factor in &built.graph.factors {
+    for factor in &graph.factors {
         let linearized = linearize_factor(factor.as_ref(), values).map_err(|what| {
             Error::InvalidInput(format!(
                 "pose at {:?}: the {} factor cannot be linearised: {what}",
-                reading.position_m,
+                position_m,
                 factor.kind()
             ))
         })?;
@@ -174,13 +191,14 @@ pub fn pose_information(
     if rows <= local_dim {
         return Err(Error::InvalidInput(format!(
             "pose at {:?}: {rows} equations cannot determine its {local_dim} own unknowns and add information",
-            reading.position_m
+            position_m
         )));
     }
     let global_part = jacobian.columns(0, globals).into_owned();
     let information = eliminate_locals(global_part, jacobian.columns(globals, local_dim).into_owned());
     Ok(PoseInformation {
         factor: low_rank_factor(&information),
+        cables,
     })
 }
 
@@ -220,7 +238,18 @@ fn low_rank_factor(information: &DMatrix<f64>) -> DMatrix<f64> {
     })
 }
 
-/// Index ranges of the global parameters: anchor coordinates `0..12`, offsets `12..16`.
+/// The anchor coordinates' rows of the global parameters of a robot of
+/// `cables` cables: `0..3N`.
+pub fn anchor_parameters(cables: usize) -> std::ops::Range<usize> {
+    0..3 * cables
+}
+
+/// The length offsets' rows of the global parameters: `3N..4N`.
+pub fn offset_parameters(cables: usize) -> std::ops::Range<usize> {
+    3 * cables..4 * cables
+}
+
+/// Index ranges of the global parameters of four cables: anchor coordinates `0..12`, offsets `12..16`.
 pub const ANCHOR_PARAMETERS: std::ops::Range<usize> = 0..3 * CABLE_COUNT;
 /// The length offsets' rows of the global parameters.
 pub const OFFSET_PARAMETERS: std::ops::Range<usize> = 3 * CABLE_COUNT..4 * CABLE_COUNT;

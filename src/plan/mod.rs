@@ -12,7 +12,9 @@
 //! 5. [`candidates`]: the tension and clearance margins a candidate keeps.
 //!
 //! [`plan_poses`] runs 1-4 and compares the plan with random pose sets of
-//! the same candidates.
+//! the same candidates. [`suspended_information`] gives step 1 for a robot of
+//! any number of cables `N` (its `3N` anchor coordinates and `N` offsets);
+//! steps 2-4 take its terms as they are.
 //!
 //! ```
 //! use rand::SeedableRng;
@@ -42,9 +44,10 @@ pub mod information;
 pub mod order;
 mod plan_poses;
 mod random;
+pub mod suspended_information;
 
 pub use bound::{plan_bound, PlanBound};
-pub use candidates::{distinct_poses, Margins};
+pub use candidates::{distinct_platform_poses, distinct_poses, Margins};
 pub use design::{
     choose_more_poses, choose_more_poses_with_progress, choose_poses, Criterion, Design, DesignOptions, DesignProgress,
 };

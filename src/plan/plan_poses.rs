@@ -7,14 +7,14 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use super::bound::{plan_bound, PlanBound};
-use super::candidates::distinct_poses;
+use super::candidates::distinct_platform_poses;
 use super::design::{choose_more_poses_with_progress, Design, DesignOptions, DesignProgress};
 use super::information::PoseInformation;
 use super::order::{path_length_m, visiting_order};
 use super::random::{random_bounds, RandomBounds, RANDOM_DRAWS};
 use crate::calib::MIN_POSES;
 use crate::error::{Error, Result};
-use crate::model::statics::Equilibrium;
+use crate::model::pose::PlatformPose;
 
 /// A plan: the chosen candidates in visiting order, their bound, and random sets for comparison.
 #[derive(Debug, Clone, Serialize)]
@@ -39,7 +39,7 @@ pub struct Plan {
 /// take seconds (choosing 100 of 10 000 candidates); the order and the
 /// random sets take milliseconds.
 pub fn plan_poses(
-    candidates: &[Equilibrium],
+    candidates: &[PlatformPose],
     information: &[PoseInformation],
     options: &DesignOptions,
     start_m: &Vector3<f64>,
@@ -47,13 +47,15 @@ pub fn plan_poses(
     progress: &mut dyn FnMut(DesignProgress),
 ) -> Result<Plan> {
     let design = choose_more_poses_with_progress(information, &[], options, progress)?;
-    let bound = plan_bound(information, &design.chosen).ok_or_else(|| undetermined(candidates, &design.chosen))?;
-    let points: Vec<Vector3<f64>> = design.chosen.iter().map(|&k| candidates[k].pose.position_m).collect();
+    let cables = information.first().map_or(0, |p| p.cables);
+    let bound =
+        plan_bound(information, &design.chosen).ok_or_else(|| undetermined(candidates, &design.chosen, cables))?;
+    let points: Vec<Vector3<f64>> = design.chosen.iter().map(|&k| candidates[k].position_m).collect();
     let order: Vec<usize> = visiting_order(&points, start_m)
         .into_iter()
         .map(|i| design.chosen[i])
         .collect();
-    let ordered: Vec<Vector3<f64>> = order.iter().map(|&k| candidates[k].pose.position_m).collect();
+    let ordered: Vec<Vector3<f64>> = order.iter().map(|&k| candidates[k].position_m).collect();
     Ok(Plan {
         path_length_m: path_length_m(&ordered),
         bound,
@@ -66,9 +68,9 @@ pub fn plan_poses(
 
 /// Why the poses `chosen` do not determine every anchor and offset: too
 /// few, too few distinct, or an arrangement that leaves a direction free.
-fn undetermined(candidates: &[Equilibrium], chosen: &[usize]) -> Error {
-    let poses: Vec<Equilibrium> = chosen.iter().map(|&k| candidates[k].clone()).collect();
-    let distinct = distinct_poses(&poses, MIN_POSES).len();
+fn undetermined(candidates: &[PlatformPose], chosen: &[usize], cables: usize) -> Error {
+    let poses: Vec<PlatformPose> = chosen.iter().map(|&k| candidates[k]).collect();
+    let distinct = distinct_platform_poses(&poses, MIN_POSES).len();
     let why = if chosen.len() < MIN_POSES {
         format!("choose at least {MIN_POSES}")
     } else if distinct < MIN_POSES {
@@ -78,7 +80,8 @@ fn undetermined(candidates: &[Equilibrium], chosen: &[usize]) -> Error {
             .into()
     };
     Error::InvalidInput(format!(
-        "the {} chosen poses do not determine every anchor and offset (each pose gives 4 equations for the 12 anchor coordinates and 4 offsets): {why}",
-        chosen.len()
+        "the {} chosen poses do not determine every anchor and offset (each pose gives {cables} equations for the {} anchor coordinates and {cables} offsets): {why}",
+        chosen.len(),
+        3 * cables
     ))
 }

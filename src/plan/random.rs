@@ -32,7 +32,8 @@ pub fn random_bounds(information: &[PoseInformation], poses: usize, draws: usize
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut anchor = Vec::with_capacity(draws);
     let mut offset = Vec::with_capacity(draws);
-    let mut covariance = vec![[[0.0; 3]; 3]; crate::model::robot::CABLE_COUNT];
+    let cables = information.first().map_or(0, |p| p.cables);
+    let mut covariance = vec![[[0.0; 3]; 3]; cables];
     let mut indices: Vec<usize> = (0..information.len()).collect();
     let poses = poses.min(information.len());
     for _ in 0..draws {

@@ -50,6 +50,10 @@ pub struct PlanPlot {
 const WIDTH: f64 = 1200.0;
 const TOP_H: f64 = 430.0;
 const CELL: f64 = 128.0;
+/// Anchors whose two ellipse cells share a row.
+const ANCHORS_PER_ROW: usize = 4;
+/// From one row of ellipse cells to the next (a cell, its title and a gap).
+const ROW_PITCH: f64 = CELL + 32.0;
 const C_PLAN: &str = "#1f5fbf";
 const C_RANDOM: &str = "#d9822b";
 const C_CANDIDATE: &str = "#b8b8b8";
@@ -182,7 +186,15 @@ fn overview(s: &mut String, plot: &PlanPlot, axes: [usize; 2], left: f64, top: f
             );
         }
     }
-    // Anchors that project onto one point (the side view) share one label.
+    anchor_labels(s, plot, &f, axes, left + width);
+}
+
+/// The anchors' squares and labels in a view on `axes`: anchors that
+/// project onto one point (the side view) or within a label's height of it
+/// (pulleys in pairs on one post) share one label, which ends at its anchor
+/// where it would pass `right`.
+fn anchor_labels(s: &mut String, plot: &PlanPlot, f: &Frame, axes: [usize; 2], right: f64) {
+    let pick = |p: &[f64; 3]| [p[axes[0]], p[axes[1]]];
     let mut labelled: Vec<((f64, f64), Vec<String>)> = Vec::new();
     for (i, a) in plot.anchors_m.iter().enumerate() {
         let (x, y) = f.px(pick(a));
@@ -194,14 +206,20 @@ fn overview(s: &mut String, plot: &PlanPlot, axes: [usize; 2], left: f64, top: f
         );
         match labelled
             .iter_mut()
-            .find(|(p, _)| (p.0 - x).abs() < 8.0 && (p.1 - y).abs() < 8.0)
+            .find(|(p, _)| (p.0 - x).abs() < 16.0 && (p.1 - y).abs() < 16.0)
         {
             Some((_, names)) => names.push(format!("A{}", i + 1)),
             None => labelled.push(((x, y), vec![format!("A{}", i + 1)])),
         }
     }
     for ((x, y), names) in labelled {
-        plain_text(s, x + 7.0, y - 6.0, "start", &names.join(", "));
+        let text = names.join(", ");
+        // About 7 px a character at 12 px: a label that would leave the view ends at its anchor.
+        if x + 7.0 + 7.0 * text.len() as f64 > right {
+            plain_text(s, x - 7.0, y - 6.0, "end", &text);
+        } else {
+            plain_text(s, x + 7.0, y - 6.0, "start", &text);
+        }
     }
 }
 
@@ -308,7 +326,10 @@ fn ellipse_extent(plot: &PlanPlot) -> f64 {
 /// The SVG text of the figure (module docs).
 pub fn plan_plot_svg(plot: &PlanPlot) -> String {
     let cells_top = TOP_H + 40.0;
-    let height = cells_top + CELL + 50.0 + 64.0 + 76.0 + 14.0 * plot.caption.lines().count() as f64;
+    // Four anchors a row (two cells each), as many rows as the robot needs.
+    let rows = plot.anchors_m.len().div_ceil(ANCHORS_PER_ROW).max(1);
+    let cells_bottom = cells_top + (rows - 1) as f64 * ROW_PITCH;
+    let height = cells_bottom + CELL + 50.0 + 64.0 + 76.0 + 14.0 * plot.caption.lines().count() as f64;
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -330,12 +351,14 @@ pub fn plan_plot_svg(plot: &PlanPlot) -> String {
         r#"<text x="20" y="{}" fill="{C_TEXT}">Per-anchor 1-sigma error ellipses of the bound, true scale: <tspan fill="{C_PLAN}" font-weight="bold">plan</tspan> and <tspan fill="{C_RANDOM}" font-weight="bold">random sets of the same size</tspan> (mean covariance)</text>"#,
         n2(cells_top - 8.0)
     );
-    for i in 0..plot.anchors_m.len().min(4) {
-        let left = 20.0 + i as f64 * 2.0 * (CELL + 12.0) + i as f64 * 6.0;
-        anchor_cell(&mut s, plot, i, [0, 1], left, cells_top, half);
-        anchor_cell(&mut s, plot, i, [0, 2], left + CELL + 12.0, cells_top, half);
+    for i in 0..plot.anchors_m.len() {
+        let column = (i % ANCHORS_PER_ROW) as f64;
+        let left = 20.0 + column * 2.0 * (CELL + 12.0) + column * 6.0;
+        let top = cells_top + (i / ANCHORS_PER_ROW) as f64 * ROW_PITCH;
+        anchor_cell(&mut s, plot, i, [0, 1], left, top, half);
+        anchor_cell(&mut s, plot, i, [0, 2], left + CELL + 12.0, top, half);
     }
-    let legend_y = cells_top + CELL + 50.0;
+    let legend_y = cells_bottom + CELL + 50.0;
     let items = [
         (C_CANDIDATE, "candidate poses"),
         (C_PLAN, "chosen poses, numbered in visiting order, and the path"),
