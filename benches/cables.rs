@@ -52,15 +52,9 @@ struct Problem {
 fn robot(name: &str) -> SuspendedRobot {
     match name {
         "large" => SuspendedRobot::from_robot(&Robot::builtin("large").expect("large")),
-        "five" | "seven" => {
-            let mut robot = SuspendedRobot::builtin(if name == "five" { "six" } else { "eight" }).expect("robot");
-            robot.anchors_m.pop();
-            robot.attachments_m.pop();
-            robot.cable_weights_n_per_m.pop();
-            robot.length_offsets_m.pop();
-            robot.name = name.into();
-            robot
-        }
+        "five" | "seven" => SuspendedRobot::builtin(if name == "five" { "six" } else { "eight" })
+            .and_then(|robot| robot.without_last_cable(name))
+            .expect("robot"),
         other => SuspendedRobot::builtin(other).expect("built-in robot"),
     }
 }

@@ -49,20 +49,17 @@ fn truth_and_guess(name: &str, guess_m: f64) -> (SuspendedRobot, SuspendedRobot)
 /// A built-in robot, or `five` / `seven`: the six- and eight-cable robots
 /// without their last cable.
 fn robot(name: &str) -> SuspendedRobot {
-    let (source, drop) = match name {
-        "five" => ("six", true),
-        "seven" => ("eight", true),
-        other => (other, false),
-    };
-    let mut robot = SuspendedRobot::builtin(source).unwrap();
-    if drop {
-        robot.anchors_m.pop();
-        robot.attachments_m.pop();
-        robot.cable_weights_n_per_m.pop();
-        robot.length_offsets_m.pop();
-        robot.name = name.into();
+    match name {
+        "five" => SuspendedRobot::builtin("six")
+            .unwrap()
+            .without_last_cable(name)
+            .unwrap(),
+        "seven" => SuspendedRobot::builtin("eight")
+            .unwrap()
+            .without_last_cable(name)
+            .unwrap(),
+        other => SuspendedRobot::builtin(other).unwrap(),
     }
-    robot
 }
 
 fn paper_options(robot: &SuspendedRobot) -> CalibrationOptions {

@@ -23,7 +23,7 @@
 //! 0.1 %, plus the chains' `O(1/n^2)` departure from the catenary).
 //!
 //! ```
-//! use sagcal::experiments::suspended_sweep::{suspended_effect_sweep, SuspendedSweepOptions};
+//! use sagcal::experiments::suspended_sweep::{suspended_effect_sweep, SuspendedSweepOptions, SweepVerdict};
 //! use sagcal::model::sensors::NoisePreset;
 //! use sagcal::model::suspended::SuspendedRobot;
 //! let robot = SuspendedRobot::builtin("three")?;
@@ -34,8 +34,7 @@
 //! assert_eq!(sweep.rows.len(), 10); // none and nine effects
 //! // Every case is judged (or says why it could not be) and names its seed.
 //! for case in &sweep.cases {
-//!     assert!(["refused", "passed, biased", "passed", "failed"].contains(&case.verdict.as_str()));
-//!     assert_eq!(case.verdict == "failed", case.failure.is_some());
+//!     assert_eq!(case.verdict == SweepVerdict::Failed, case.failure.is_some());
 //! }
 //! # Ok::<(), sagcal::Error>(())
 //! ```
@@ -76,6 +75,24 @@ pub struct SuspendedSweepOptions {
     pub false_alarm: f64,
 }
 
+/// What the calibration made of one case, serialised as `refused`,
+/// `passed, biased`, `passed` or `failed`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum SweepVerdict {
+    /// The fit failed its own tests.
+    #[serde(rename = "refused")]
+    Refused,
+    /// The fit passed with an anchor beyond the Bonferroni bound of its 1-sigma.
+    #[serde(rename = "passed, biased")]
+    PassedBiased,
+    /// The fit passed, every anchor within the bound.
+    #[serde(rename = "passed")]
+    Passed,
+    /// No data or no fit: the reason in the case's `failure`.
+    #[serde(rename = "failed")]
+    Failed,
+}
+
 /// One case of the sweep.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SuspendedSweepCase {
@@ -85,8 +102,8 @@ pub struct SuspendedSweepCase {
     pub spec: Option<String>,
     /// The case's seed (`sagcal simulate --seed` draws other poses: the sweep's closure differs).
     pub seed: u64,
-    /// `refused`, `passed, biased`, `passed` or `failed` (no data or no fit: the reason in `failure`).
-    pub verdict: String,
+    /// The calibration's verdict on the case.
+    pub verdict: SweepVerdict,
     /// The fit's chi-square and its degrees of freedom.
     pub chi_square: f64,
     /// Degrees of freedom.
@@ -191,7 +208,7 @@ fn run_case(
         effect: effect.into(),
         spec: None,
         seed,
-        verdict: "failed".into(),
+        verdict: SweepVerdict::Failed,
         chi_square: f64::NAN,
         degrees_of_freedom: 0,
         readings_left_out: 0,
@@ -252,13 +269,12 @@ fn fit_case(
         None => f64::INFINITY,
     };
     case.verdict = if report.inconsistency().is_some() {
-        "refused"
+        SweepVerdict::Refused
     } else if case.worst_anchor_sigmas > bias_bound_sigmas {
-        "passed, biased"
+        SweepVerdict::PassedBiased
     } else {
-        "passed"
-    }
-    .into();
+        SweepVerdict::Passed
+    };
     Ok(())
 }
 
@@ -274,7 +290,7 @@ fn mean_load_cell_tension_n(robot: &SuspendedRobot, equilibria: &[SuspendedEquil
 /// One effect's row from its cases.
 fn score(range: &SuspendedEffectRange, cases: &[SuspendedSweepCase]) -> SuspendedSweepRow {
     let mine: Vec<&SuspendedSweepCase> = cases.iter().filter(|c| c.effect == range.effect).collect();
-    let count = |verdict: &str| mine.iter().filter(|c| c.verdict == verdict).count();
+    let count = |verdict: SweepVerdict| mine.iter().filter(|c| c.verdict == verdict).count();
     let mut errors: Vec<f64> = mine
         .iter()
         .map(|c| c.worst_anchor_error_m)
@@ -290,10 +306,10 @@ fn score(range: &SuspendedEffectRange, cases: &[SuspendedSweepCase]) -> Suspende
         effect: range.effect.clone(),
         range: range.range.clone(),
         cases: mine.len(),
-        refused: count("refused"),
-        passed_biased: count("passed, biased"),
-        passed: count("passed"),
-        failed: count("failed"),
+        refused: count(SweepVerdict::Refused),
+        passed_biased: count(SweepVerdict::PassedBiased),
+        passed: count(SweepVerdict::Passed),
+        failed: count(SweepVerdict::Failed),
         median_worst_anchor_error_m: median,
     }
 }

@@ -128,6 +128,32 @@ impl SuspendedRobot {
         }
     }
 
+    /// The robot without its last cable, named `name` (the six- and
+    /// eight-cable robots as five and seven, for tests and benches): every
+    /// per-cable list one shorter, a load cell on that cable dropped. Fails
+    /// where that leaves fewer than [`MIN_CABLES`] cables or no load cell.
+    pub fn without_last_cable(&self, name: &str) -> Result<Self> {
+        let last = self.cable_count() - 1;
+        let mut robot = self.clone();
+        robot.anchors_m.pop();
+        robot.attachments_m.pop();
+        robot.cable_weights_n_per_m.pop();
+        robot.axial_stiffness_n.pop();
+        robot.length_offsets_m.pop();
+        robot.load_cells.retain(|&c| c != last);
+        robot.name = name.into();
+        if robot.cable_count() < MIN_CABLES || robot.load_cells.is_empty() {
+            return Err(Error::InvalidInput(format!(
+                "robot `{}` without cable {}: {} cables and {} load cells cannot be calibrated",
+                self.name,
+                last + 1,
+                robot.cable_count(),
+                robot.load_cells.len()
+            )));
+        }
+        Ok(robot)
+    }
+
     /// The cables with a load cell as a reader says them: `cable 1, cable 5`.
     pub fn load_cells_phrase(&self) -> String {
         let cables: Vec<String> = self.load_cells.iter().map(|c| format!("cable {}", c + 1)).collect();
@@ -523,5 +549,30 @@ mod tests {
             1.0,
         );
         assert!(mismatched.unwrap_err().to_string().contains("3 attachments"));
+    }
+
+    /// Dropping the last cable shortens every per-cable list and its load
+    /// cell; three cables, or the only load cell, cannot be dropped.
+    #[test]
+    fn the_last_cable_is_dropped_with_everything_it_carries() {
+        let mut six = ring(6);
+        six.axial_stiffness_n[5] = 3e6;
+        six.load_cells = vec![0, 5];
+        let five = six.without_last_cable("five").unwrap();
+        assert_eq!(five.cable_count(), 5);
+        let lengths = [
+            five.attachments_m.len(),
+            five.cable_weights_n_per_m.len(),
+            five.axial_stiffness_n.len(),
+            five.length_offsets_m.len(),
+        ];
+        assert_eq!(
+            (lengths, five.load_cells.clone(), five.is_elastic()),
+            ([5; 4], vec![0], false)
+        );
+        assert!(ring(3).without_last_cable("two").is_err());
+        six.load_cells = vec![5];
+        let message = six.without_last_cable("five").unwrap_err().to_string();
+        assert!(message.contains("0 load cells"), "{message}");
     }
 }
