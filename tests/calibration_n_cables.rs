@@ -850,4 +850,25 @@ fn the_plan_command_plans_six_cables() {
     assert!(!from.status.success());
     let message = String::from_utf8_lossy(&from.stderr);
     assert!(message.contains("--from: robot `six` has 6 cables"), "{message}");
+    // A box beyond the anchors' footprint is refused under the flag's name, once.
+    let outside = sagcal(
+        dir.path(),
+        &[
+            "plan",
+            "--robot",
+            &six,
+            "--poses",
+            "10",
+            "--workspace=-50,50,-50,50,5,20",
+        ],
+    );
+    let message = String::from_utf8_lossy(&outside.stderr);
+    assert!(!outside.status.success(), "{message}");
+    assert!(
+        message.contains(
+            "--workspace: [-50, -50, 5] .. [50, 50, 20] m for robot `six`: the box's corner (-50, -50) m lies outside"
+        ),
+        "{message}"
+    );
+    assert_eq!(message.matches("robot `six`").count(), 1, "{message}");
 }

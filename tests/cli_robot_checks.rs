@@ -398,24 +398,21 @@ fn simulate_takes_three_to_eight_cables() {
             assert_eq!(row.load_cell_tensions_n, want.load_cell_tensions_n, "{name}");
             assert_eq!(row.position_m, want.position_m, "{name}");
         }
-        let refused = sagcal(
-            dir.path(),
-            &[
-                "diagnose",
-                "--robot",
-                &robot(name),
-                "--data",
-                "d.csv",
-                "--plots",
-                "c.toml",
-            ],
-        );
+        let refused = sagcal(dir.path(), &["verify", "--robot", &robot(name), "--data", "d.csv"]);
         let message = String::from_utf8_lossy(&refused.stderr);
         assert_eq!(refused.status.code(), Some(1), "{name}: {message}");
         assert!(
             message.contains("field `cables`") && message.contains("this command models 4"),
             "{message}"
         );
-        assert!(!dir.path().join("c.toml").exists());
+        // `diagnose` takes the robot, and refuses the four-cable flag by name, writing nothing.
+        let refused = sagcal(
+            dir.path(),
+            &["diagnose", "--robot", &robot(name), "--data", "d.csv", "--plots", "c"],
+        );
+        let message = String::from_utf8_lossy(&refused.stderr);
+        assert_eq!(refused.status.code(), Some(1), "{name}: {message}");
+        assert!(message.contains(&format!("--plots: robot `{name}` has")), "{message}");
+        assert!(!dir.path().join("c").exists());
     }
 }

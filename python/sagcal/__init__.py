@@ -10,8 +10,9 @@ in and out, the same jobs with the same options, results and error messages.
 - :func:`simulate`: measurements of a robot (``sagcal simulate``);
   :class:`SuspendedRobot` and :func:`simulate_suspended`: a robot of 3 to 8
   cables and its measurements; :func:`calibrate_suspended` calibrates it,
-  :func:`localize_suspended` localises it and :func:`plan_suspended` plans
-  its calibration poses.
+  :func:`localize_suspended` localises it, :func:`plan_suspended` plans
+  its calibration poses and :func:`diagnose_suspended` says what its model
+  gets wrong.
 - :func:`calibrate`: anchors and encoder offsets from measurements
   (``sagcal calibrate``), with their covariance and the gross-error tests.
 - :func:`diagnose`: what the calibration model gets wrong (``sagcal diagnose``).
@@ -81,6 +82,7 @@ calibrate = _entry(_sagcal.calibrate)
 calibrate_suspended = _entry(_sagcal.calibrate_suspended)
 check = _entry(_sagcal.check)
 diagnose = _entry(_sagcal.diagnose, ints={"folds": _COUNT}, lists=("candidates",))
+diagnose_suspended = _entry(_sagcal.diagnose_suspended, ints={"folds": _COUNT}, lists=("candidates",))
 init_robot = _entry(_sagcal.init_robot)
 localize = _entry(_sagcal.localize)
 localize_suspended = _entry(_sagcal.localize_suspended)
@@ -119,6 +121,7 @@ __all__ = [
     "calibrate_suspended",
     "check",
     "diagnose",
+    "diagnose_suspended",
     "init_robot",
     "localize",
     "localize_suspended",

@@ -1,7 +1,7 @@
 """Type stubs of sagcal (the extension module `sagcal._sagcal`, re-exported)."""
 
 import os
-from typing import Any, Callable, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -546,6 +546,19 @@ def diagnose(
     robust_pose: str = "none",
 ) -> Diagnosis:
     """Find what the calibration model gets wrong, as ``sagcal diagnose`` does."""
+
+def diagnose_suspended(
+    robot: SuspendedRobot,
+    measurements: Union[ArrayLike, PathLike],
+    noise: str = "paper",
+    *,
+    candidates: Optional[Sequence[str]] = None,
+    folds: int = 5,
+    false_alarm: float = 1e-3,
+    orientation_prior: str = "auto",
+    progress: Optional[Callable[[int, int, str], Any]] = None,
+) -> Dict[str, Any]:
+    """What the model of a robot of 3 to 8 cables gets wrong, as ``sagcal diagnose --json`` reports it."""
 
 def localize(
     robot: Robot,

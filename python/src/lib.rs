@@ -14,6 +14,7 @@ mod calibrate_suspended;
 mod check;
 mod data;
 mod diagnose;
+mod diagnose_suspended;
 mod init;
 mod json;
 mod localize;
@@ -164,6 +165,7 @@ fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<localize_suspended::SuspendedLocalization>()?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose::diagnose, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose_suspended::diagnose_suspended, m)?)?;
     m.add_function(wrap_pyfunction!(localize::localize, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(suspended::simulate_suspended, m)?)?;

@@ -158,3 +158,22 @@ def test_plan_suspended_is_the_commands_plan(cli, tmp_path):
     rows = [line for line in out.read_text().splitlines() if not line.startswith("#")]
     written = np.array([[float(v) for v in row.split(",")] for row in rows[1:]])
     np.testing.assert_array_equal(written, plan.measurements)
+
+
+def test_diagnose_suspended_is_the_commands_diagnosis(cli, tmp_path):
+    robot = sagcal.SuspendedRobot.builtin("three")
+    simulation = sagcal.simulate_suspended(robot, 16, seed=4)
+    data = tmp_path / "d.csv"
+    simulation.write(data)
+    seen = []
+    names = ["elastic", "encoder-scale"]
+    report = sagcal.diagnose_suspended(robot, simulation.measurements, candidates=names, folds=4,
+                                       progress=lambda d, t, w: seen.append((d, t)))
+    assert seen[-1][0] == seen[-1][1] == 6, "the baseline's and each extension's fit and cross-validation"
+    assert [e["extension"] for e in report["extensions"]] == names
+    command = json.loads(cli("diagnose", "--robot", ROOT / "robots" / "three.toml", "--data", data,
+                             "--candidates", ",".join(names), "--folds", 4, "--json").stdout)
+    assert command == report, "an array and its file give the command's numbers"
+    assert report["verdict"]["kind"] == "consistent"
+    with pytest.raises(sagcal.InvalidInputError, match="`pulley` is not an extension"):
+        sagcal.diagnose_suspended(robot, simulation.measurements, candidates=["pulley"])

@@ -8,7 +8,7 @@ use clap::{Parser, Subcommand};
 use super::calibrate::CalibrateArgs;
 use super::check::CheckArgs;
 use super::demo::DemoArgs;
-use super::diagnose::DiagnoseArgs;
+use super::diagnose_args::DiagnoseArgs;
 use super::experiment::Table2Args;
 use super::hidden_args::HiddenEffectsArgs;
 use super::init::InitArgs;

@@ -1,9 +1,8 @@
 //! `sagcal diagnose`: what the calibration model gets wrong, and what an extension gains;
-//! its flags ([`DiagnoseArgs`], [`PlotFormat`]) and the run.
+//! the run on a four-cable robot (flags: [`DiagnoseArgs`]).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use clap::ValueEnum;
 use sagcal::diagnose::{diagnose, DiagnoseOptions, DiagnoseSettings, Diagnosis};
 use sagcal::error::FrontEnd;
 use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
@@ -12,71 +11,17 @@ use sagcal::model::effect_kind::EffectKind;
 use sagcal::model::Robot;
 use sagcal::plot::residuals::{residual_plot_svg, ResidualPlot, ResidualSeries};
 
+use super::diagnose_args::DiagnoseArgs;
 use super::output::{counted, opt, print_json, progress_bar, Table};
-use super::solver_args::SolverArgs;
-
-#[derive(Debug, clap::Args)]
-pub(super) struct DiagnoseArgs {
-    /// Nominal robot description (TOML): the initial guess; its `[effects]` are known inputs.
-    #[arg(long)]
-    robot: PathBuf,
-    /// Measurements: sagcal CSV, a RecurDyn log, or the authors' dataset folder.
-    #[arg(long)]
-    data: PathBuf,
-    /// The true robot (TOML, e.g. from `sagcal simulate --truth`): report anchor and offset errors.
-    #[arg(long)]
-    truth: Option<PathBuf>,
-    /// Write the plot of the residual against the winning driver (before and after) into this folder.
-    #[arg(long)]
-    plots: Option<PathBuf>,
-    /// Format of the `--plots` figures: svg or png.
-    #[arg(long, value_enum, default_value = "svg")]
-    plot_format: PlotFormat,
-    /// Candidate effects, comma separated (default: the whole catalogue).
-    #[arg(long, long_help = candidates_help())]
-    candidates: Option<String>,
-    /// Leave out the hypothesis "the localiser's orientations are unreliable".
-    #[arg(long)]
-    no_orientation_hypothesis: bool,
-    /// Folds of the cross-validation over poses.
-    #[arg(long, default_value_t = 5)]
-    folds: usize,
-    /// False-alarm rate of the whole search: the probability of declaring an
-    /// effect on data the baseline model describes.
-    #[arg(long, default_value_t = 1e-3)]
-    false_alarm: f64,
-    /// Write the selected model's calibrated robot (anchors, offsets, effects) here (TOML).
-    #[arg(long)]
-    out: Option<PathBuf>,
-    /// Print the diagnosis as JSON.
-    #[arg(long)]
-    json: bool,
-    #[command(flatten)]
-    solver: SolverArgs,
-}
-
-/// The file format of figures written into a folder.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum PlotFormat {
-    /// Scalable vector graphics (the figure as drawn).
-    Svg,
-    /// The same figure rendered to a PNG image (2x pixel density, bundled font).
-    Png,
-}
-
-impl PlotFormat {
-    /// The file-name extension.
-    fn extension(self) -> &'static str {
-        match self {
-            PlotFormat::Svg => "svg",
-            PlotFormat::Png => "png",
-        }
-    }
-}
+use super::robot_kind::{read_robot, AnyRobot};
 
 /// Diagnose the data against the nominal robot, write the requested files, print the report (or JSON).
+/// A robot of 3 to 8 cables goes to [`super::diagnose_suspended::run`].
 pub fn run(args: &DiagnoseArgs) -> sagcal::Result<()> {
-    let nominal = Robot::from_file(&args.robot)?;
+    let nominal = match read_robot(&args.robot)? {
+        AnyRobot::Four(robot) => *robot,
+        AnyRobot::Suspended(robot) => return super::diagnose_suspended::run(args, &robot),
+    };
     let truth = args.truth.as_deref().map(Robot::from_file).transpose()?;
     let data = read_measurements(
         &args.data,
@@ -232,22 +177,6 @@ pub fn render(d: &Diagnosis, options: &DiagnoseOptions) -> String {
     out += &render_candidates(d);
     out += &render_verdict(d);
     out
-}
-
-/// `--candidates`' long help: the catalogue, from the library's list of effects.
-fn candidates_help() -> String {
-    let names = |in_time_order: bool| -> String {
-        let kinds = EffectKind::ALL
-            .into_iter()
-            .filter(|k| k.needs_time_order() == in_time_order);
-        kinds.map(EffectKind::name).collect::<Vec<_>>().join(", ")
-    };
-    format!(
-        "Candidate effects, comma separated (default: the whole catalogue: {}, and, for rows in the order \
-         taken (a sagcal file), {}).",
-        names(false),
-        names(true)
-    )
 }
 
 /// Step 0: readings left out as gross errors, and mistakes named.

@@ -1,7 +1,7 @@
 //! `sagcal experiment hidden-effects --robots three,six,eight`: the sweep
 //! of robots of 3 to 8 cables ([`sagcal::experiments::suspended_sweep`]),
-//! scored by the calibration's own verdict (such robots have no diagnosis
-//! yet), one table per robot and noise reading.
+//! scored by the calibration's own verdict (`sagcal diagnose` names
+//! causes), one table per robot and noise reading.
 
 use sagcal::calib::gross_errors::GrossErrorOptions;
 use sagcal::experiments::hidden_effects::Catalogue;

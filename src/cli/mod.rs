@@ -14,6 +14,8 @@ mod calibration_tables;
 mod check;
 mod demo;
 mod diagnose;
+mod diagnose_args;
+mod diagnose_suspended;
 mod experiment;
 mod experiment_suspended;
 mod gross_errors;

@@ -70,7 +70,7 @@ impl Table {
 
 /// `text` in lines of at most `width` characters, broken after `, ` where it
 /// can be and at a space otherwise (a word longer than `width` stays whole).
-fn wrapped(text: &str, width: usize) -> Vec<String> {
+pub(super) fn wrapped(text: &str, width: usize) -> Vec<String> {
     let mut lines: Vec<String> = Vec::new();
     let mut current = String::new();
     for word in text.split(' ') {

@@ -95,6 +95,7 @@ mod search;
 mod selection;
 mod settings;
 mod stand_ins;
+pub mod suspended;
 mod term_refit;
 mod variance_components;
 pub mod verify;

@@ -30,7 +30,7 @@ use crate::calib::{CalibrationOptions, OrientationPrior};
 use crate::error::{Error, FrontEnd, Result};
 use crate::model::robot::Workspace;
 use crate::model::sensors::NoisePreset;
-use crate::model::suspended::{SuspendedEquilibrium, SuspendedRobot};
+use crate::model::suspended::{check_suspended, SuspendedEquilibrium, SuspendedRobot};
 use crate::plan::suspended_information::suspended_candidate_information;
 use crate::plan::{plan_poses, Criterion, DesignOptions, Plan};
 use crate::sim::closed_form::Closure;
@@ -167,6 +167,7 @@ pub fn plan_suspended(
 ) -> Result<SuspendedPlanned> {
     check_counts(settings)?;
     let (workspace, from) = workspace(robot, settings);
+    check_workspace(robot, &workspace, settings)?;
     let what = format!(
         "drawing {} candidate poses in {from}, seed {}",
         settings.candidates, settings.seed
@@ -263,6 +264,24 @@ fn workspace(robot: &SuspendedRobot, settings: &SuspendedPlanSettings) -> (Works
             "the box below the anchors".into(),
         ),
     }
+}
+
+/// A box asked for (not the robot file's) below the anchors and inside
+/// their footprint ([`check_suspended`]), refused under its own name.
+fn check_workspace(robot: &SuspendedRobot, workspace: &Workspace, settings: &SuspendedPlanSettings) -> Result<()> {
+    if settings.workspace.is_none() {
+        return Ok(());
+    }
+    let mut boxed = robot.clone();
+    boxed.workspace = Some(*workspace);
+    check_suspended(&boxed).map_err(|e| {
+        let why = e.strip_prefix("field `workspace`: ").unwrap_or(&e);
+        Error::InvalidInput(format!(
+            "{}: {workspace} for robot `{}`: {why}",
+            settings.front_end.option("workspace"),
+            robot.name
+        ))
+    })
 }
 
 /// `settings.candidates` level equilibria in `workspace`, drawn in batches

@@ -12,7 +12,8 @@
 //!
 //! - **refused**: the chi-square test at 99.9 % (after any readings left
 //!   out) finds the readings inconsistent with the model: the effect is
-//!   found out, though not named (`diagnose` does not take such robots);
+//!   found out, though not named (the sweep scores the calibration alone;
+//!   `sagcal diagnose` names causes, [`crate::diagnose::suspended`]);
 //! - **passed, biased**: the fit passes, yet an anchor coordinate lies
 //!   further from the truth than the two-sided Bonferroni 99.9 % quantile
 //!   of `3 N` standard normals times its 1-sigma: a wrong robot reported

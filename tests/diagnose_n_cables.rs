@@ -1,0 +1,247 @@
+//! `diagnose` on robots of 3 to 8 cables: the profile fit of one extension
+//! against readings with a known gain hidden in them, its 1-sigma against
+//! the chi-squares it comes from, the verdicts on clean and on gained
+//! readings, and the command.
+
+#[path = "common/cli.rs"]
+mod cli;
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use sagcal::calib::CalibrationOptions;
+use sagcal::diagnose::suspended::{
+    calibrated_chi_square, diagnose_suspended, fit_profile, SuspendedDiagnoseSettings, SuspendedExtension,
+    SuspendedVerdict, SUSPENDED_EXTENSIONS,
+};
+use sagcal::model::sensors::NoisePreset;
+use sagcal::model::suspended::{SuspendedMeasurement, SuspendedRobot};
+use sagcal::sim::closed_form::Closure;
+use sagcal::sim::suspended::{measure_suspended, sample_suspended};
+
+/// `count` readings of the six-cable robot (offsets of a few decimetres)
+/// with `noise`, seed `seed`, every encoder reading times `gain`; and the robot file.
+fn six_cable_readings(
+    count: usize,
+    seed: u64,
+    noise: NoisePreset,
+    gain: f64,
+) -> (SuspendedRobot, Vec<SuspendedMeasurement>) {
+    let nominal = SuspendedRobot::builtin("six").unwrap();
+    let mut truth = nominal.clone();
+    truth.length_offsets_m = (0..truth.cable_count()).map(|i| 0.1 + 0.07 * i as f64).collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let workspace = truth.workspace.unwrap();
+    let equilibria = sample_suspended(&truth, &workspace, count, Closure::Yaw { max_yaw_deg: 5.0 }, &mut rng).unwrap();
+    let sigmas = noise.sigmas(truth.platform_weight_n);
+    let mut readings = measure_suspended(&truth, &equilibria, &sigmas, &mut rng).unwrap();
+    for reading in &mut readings {
+        reading.encoder_lengths_m.iter_mut().for_each(|l| *l *= gain);
+    }
+    (nominal, readings)
+}
+
+fn paper_options(robot: &SuspendedRobot) -> CalibrationOptions {
+    CalibrationOptions::new(NoisePreset::Paper.sigmas(robot.platform_weight_n))
+}
+
+/// Noiseless readings through encoders 0.2 % long: the profile's minimum
+/// is the gain, to the solver's tolerance, and leaves no misfit, where the
+/// baseline's is above the likelihood-ratio limit (14.2 at 1e-3 over six
+/// extensions: 20 poses see the gain though the anchors take up most of
+/// it); the elastic extension's minimum leaves a misfit.
+#[test]
+fn noiseless_readings_give_back_the_encoder_gain_hidden_in_them() {
+    let (robot, readings) = six_cable_readings(20, 3, NoisePreset::None, 1.002);
+    let options = paper_options(&robot);
+    let fit = fit_profile(&robot, &readings, SuspendedExtension::EncoderScale, &options).unwrap();
+    println!(
+        "gain {:.9} +- {:.2e}, chi-square {:.3e} (null {:.3e})",
+        fit.value, fit.sigma, fit.chi_square, fit.null_chi_square
+    );
+    assert!((fit.value - 1.002).abs() < 1e-6, "{fit:?}");
+    assert!(fit.chi_square < 1e-6, "{fit:?}");
+    assert!(fit.null_chi_square > 14.2, "{fit:?}");
+    let elastic = fit_profile(&robot, &readings, SuspendedExtension::Elastic, &options).unwrap();
+    println!("elastic: {elastic:?}");
+    assert!(elastic.chi_square > 1.0, "{elastic:?}");
+}
+
+/// The 1-sigma from the profile's curvature is the distance at which the
+/// chi-square, computed again by independent calibrations, rises by one.
+#[test]
+fn the_profile_sigma_is_where_the_chi_square_rises_by_one() {
+    let (robot, readings) = six_cable_readings(25, 5, NoisePreset::Paper, 1.0);
+    let options = paper_options(&robot);
+    for extension in [SuspendedExtension::EncoderScale, SuspendedExtension::CableWeight] {
+        let fit = fit_profile(&robot, &readings, extension, &options).unwrap();
+        for side in [-1.0, 1.0] {
+            let at =
+                calibrated_chi_square(&robot, &readings, extension, fit.value + side * fit.sigma, &options).unwrap();
+            let rise = at - fit.chi_square;
+            println!(
+                "{}: {:.6} +- {:.2e}, rise {rise:.3} at {side:+} sigma",
+                extension.name(),
+                fit.value,
+                fit.sigma
+            );
+            assert!((rise - 1.0).abs() < 0.15, "{extension:?} {fit:?} rise {rise}");
+        }
+    }
+}
+
+fn settings() -> SuspendedDiagnoseSettings {
+    SuspendedDiagnoseSettings {
+        extensions: SUSPENDED_EXTENSIONS.to_vec(),
+        folds: 5,
+        false_alarm: 1e-3,
+    }
+}
+
+/// Clean readings with the paper's noise: no cause named. The same poses
+/// read through encoders 0.2 % long: the encoder gain is named, within
+/// three of its 1-sigma of the truth.
+#[test]
+fn the_encoder_gain_is_named_and_clean_readings_name_nothing() {
+    let (robot, clean) = six_cable_readings(30, 7, NoisePreset::Paper, 1.0);
+    let options = paper_options(&robot);
+    let diagnosis = diagnose_suspended(&robot, &clean, &settings(), &options, &|_, _| {}).unwrap();
+    println!("clean: {}", diagnosis.conclusion);
+    assert_eq!(diagnosis.verdict, SuspendedVerdict::Consistent, "{diagnosis:#?}");
+    let (_, gained) = six_cable_readings(30, 7, NoisePreset::Paper, 1.002);
+    let diagnosis = diagnose_suspended(&robot, &gained, &settings(), &options, &|_, _| {}).unwrap();
+    println!("gained: {}", diagnosis.conclusion);
+    assert_eq!(
+        diagnosis.verdict,
+        SuspendedVerdict::Named {
+            extension: SuspendedExtension::EncoderScale
+        },
+        "{diagnosis:#?}"
+    );
+    let fit = &diagnosis.extensions[3];
+    assert_eq!(fit.extension, SuspendedExtension::EncoderScale);
+    assert!((fit.value - 1.002).abs() < 3.0 * fit.sigma, "{fit:?}");
+}
+
+/// `sagcal diagnose --robot robots/six.toml --data six.csv ARGS` in `dir`.
+fn diagnose_six(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
+    let robot = cli::robot("six");
+    let mut all = vec!["diagnose", "--robot", robot.as_str(), "--data", "six.csv"];
+    all.extend_from_slice(args);
+    cli::sagcal(dir, &all)
+}
+
+/// `sagcal diagnose` on simulated readings of the six-cable robot: the
+/// JSON's verdict and extensions; a four-cable flag and an unknown
+/// extension refused by name, with a non-zero exit.
+#[test]
+fn the_diagnose_command_diagnoses_six_cables() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = cli::robot("six");
+    let simulated = cli::sagcal(
+        dir.path(),
+        &[
+            "simulate", "--robot", &robot, "--poses", "20", "--seed", "4", "--out", "six.csv",
+        ],
+    );
+    assert!(
+        simulated.status.success(),
+        "{}",
+        String::from_utf8_lossy(&simulated.stderr)
+    );
+    let out = diagnose_six(dir.path(), &["--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["cables"], 6);
+    assert_eq!(json["extensions"].as_array().unwrap().len(), 6);
+    assert_eq!(json["verdict"]["kind"], "consistent", "{json:#}");
+    let text = diagnose_six(dir.path(), &["--candidates", "elastic,encoder-scale"]);
+    let stdout = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        stdout.contains("baseline: chi-square") && stdout.contains("encoder-scale"),
+        "{stdout}"
+    );
+    assert!(
+        !stdout.lines().any(|line| line.starts_with("loadcell-gain")),
+        "{stdout}"
+    );
+    let truth = diagnose_six(dir.path(), &["--truth", &robot]);
+    let message = String::from_utf8_lossy(&truth.stderr);
+    assert!(
+        !truth.status.success() && message.contains("--truth: robot `six` has 6 cables"),
+        "{message}"
+    );
+    let unknown = diagnose_six(dir.path(), &["--candidates", "pulley"]);
+    let message = String::from_utf8_lossy(&unknown.stderr);
+    assert!(
+        !unknown.status.success() && message.contains("`pulley` is not an extension"),
+        "{message}"
+    );
+}
+
+/// `text` with every run of white space as one space.
+fn flat(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// The example of docs/diagnose.md (and its number in the README) is what
+/// the commands printed beside it print: the table's rows and the verdict.
+#[test]
+fn the_documented_example_prints_what_the_pages_show() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let page = flat(&std::fs::read_to_string(root.join("docs/diagnose.md")).unwrap());
+    let readme = flat(&std::fs::read_to_string(root.join("README.md")).unwrap());
+    let dir = tempfile::tempdir().unwrap();
+    let robot = cli::robot("six");
+    let simulate = [
+        "simulate",
+        "--robot",
+        &robot,
+        "--poses",
+        "30",
+        "--seed",
+        "2",
+        "--effect",
+        "encoder-scale:gain=1.002",
+        "--out",
+        "six-gain.csv",
+    ];
+    assert!(page.contains(
+        "sagcal simulate --robot robots/six.toml --poses 30 --seed 2 --effect encoder-scale:gain=1.002 --out six-gain.csv"
+    ));
+    let simulated = cli::sagcal(dir.path(), &simulate);
+    assert!(
+        simulated.status.success(),
+        "{}",
+        String::from_utf8_lossy(&simulated.stderr)
+    );
+    let out = cli::sagcal(dir.path(), &["diagnose", "--robot", &robot, "--data", "six-gain.csv"]);
+    let printed = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows = printed.lines().filter(|l| {
+        SUSPENDED_EXTENSIONS
+            .iter()
+            .any(|e| l.starts_with(&format!("{} ", e.name())))
+    });
+    for row in rows {
+        assert!(page.contains(&flat(row)), "docs/diagnose.md does not show `{row}`");
+    }
+    let verdict = &printed[printed.find("named cause").expect("a named cause")..];
+    let verdict = flat(&verdict[..verdict.find("not in the model").unwrap()]);
+    assert!(page.contains(&verdict), "docs/diagnose.md does not say `{verdict}`");
+    let json = cli::sagcal(
+        dir.path(),
+        &["diagnose", "--robot", &robot, "--data", "six-gain.csv", "--json"],
+    );
+    let json: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let gain = &json["extensions"][3];
+    let quoted = format!(
+        "{:.5} +- {:.5}",
+        gain["value"].as_f64().unwrap(),
+        gain["sigma"].as_f64().unwrap()
+    );
+    assert!(readme.contains(&quoted), "README.md does not say `{quoted}`");
+    assert!(
+        page.contains(&format!("found at {quoted}")),
+        "docs/diagnose.md does not say `{quoted}`"
+    );
+}
