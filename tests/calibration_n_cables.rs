@@ -795,7 +795,8 @@ fn the_plan_of_n_cables_is_the_bound_of_its_calibration_graph() {
 
 /// `sagcal plan --robot six.toml`: the JSON report, the plan as a
 /// measurement file of six cables (noise-free: calibrating it from the
-/// nominal robot moves no anchor), the figure, and `--from` refused by name.
+/// nominal robot moves no anchor), the figure, and a plan among logged
+/// poses (`--from`): each planned pose is one of them.
 #[test]
 fn the_plan_command_plans_six_cables() {
     let dir = tempfile::tempdir().unwrap();
@@ -843,13 +844,53 @@ fn the_plan_command_plans_six_cables() {
         .flat_map(|a| a.as_array().unwrap().clone());
     let moved = moved.map(|v| v.as_f64().unwrap().abs()).fold(0.0, f64::max);
     assert!(moved < 1e-6, "noise-free readings of the nominal robot: {moved} m");
+    let simulate = [
+        "simulate",
+        "--robot",
+        &six,
+        "--poses",
+        "40",
+        "--seed",
+        "8",
+        "--out",
+        "logged.csv",
+    ];
+    assert!(sagcal(dir.path(), &simulate).status.success());
     let from = sagcal(
         dir.path(),
-        &["plan", "--robot", &six, "--poses", "10", "--from", "plan.csv"],
+        &[
+            "plan",
+            "--robot",
+            &six,
+            "--poses",
+            "8",
+            "--from",
+            "logged.csv",
+            "--json",
+        ],
     );
-    assert!(!from.status.success());
-    let message = String::from_utf8_lossy(&from.stderr);
-    assert!(message.contains("--from: robot `six` has 6 cables"), "{message}");
+    assert!(from.status.success(), "{}", String::from_utf8_lossy(&from.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&from.stdout).unwrap();
+    let words = report["candidates_from"].as_str().unwrap();
+    assert!(words.starts_with("40 logged poses of logged.csv"), "{words}");
+    let logged = sagcal::io::suspended_measurements::read_suspended_measurements(
+        &dir.path().join("logged.csv"),
+        &SuspendedRobot::builtin("six").unwrap(),
+    )
+    .unwrap();
+    for pose in report["plan"].as_array().unwrap() {
+        let p: Vec<f64> = pose["position_m"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let nearest = logged
+            .iter()
+            .map(|m| (0..3).map(|a| (m.position_m[a] - p[a]).abs()).fold(0.0, f64::max))
+            .fold(f64::INFINITY, f64::min);
+        assert!(nearest < 1e-12, "planned {p:?} is {nearest} m from every logged pose");
+    }
     // A box beyond the anchors' footprint is refused under the flag's name, once.
     let outside = sagcal(
         dir.path(),

@@ -1,17 +1,18 @@
 //! `diagnose` on robots of 3 to 8 cables: the profile fit of one extension
 //! against readings with a known gain hidden in them, its 1-sigma against
 //! the chi-squares it comes from, the verdicts on clean and on gained
-//! readings, and the command.
+//! readings, and the command; `verify` of a robot file against readings.
 
 #[path = "common/cli.rs"]
 mod cli;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use sagcal::calib::suspended::SuspendedReading;
 use sagcal::calib::CalibrationOptions;
 use sagcal::diagnose::suspended::{
-    calibrated_chi_square, diagnose_suspended, fit_profile, SuspendedDiagnoseSettings, SuspendedExtension,
-    SuspendedVerdict, SUSPENDED_EXTENSIONS,
+    calibrated_chi_square, diagnose_suspended, fit_profile, verify_suspended, SuspendedDiagnoseSettings,
+    SuspendedExtension, SuspendedVerdict, SUSPENDED_EXTENSIONS,
 };
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::suspended::{SuspendedMeasurement, SuspendedRobot};
@@ -244,4 +245,136 @@ fn the_documented_example_prints_what_the_pages_show() {
         page.contains(&format!("found at {quoted}")),
         "docs/diagnose.md does not say `{quoted}`"
     );
+}
+
+/// `count` readings of the built-in robot `name` with `noise`, seed `seed`:
+/// the robot (its offsets as the readings have them) and the readings.
+fn readings_of(name: &str, count: usize, seed: u64, noise: NoisePreset) -> (SuspendedRobot, Vec<SuspendedMeasurement>) {
+    let mut truth = SuspendedRobot::builtin(name).unwrap();
+    truth.length_offsets_m = (0..truth.cable_count()).map(|i| 0.1 + 0.07 * i as f64).collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let workspace = truth.workspace.unwrap();
+    let closure = match truth.cable_count() {
+        3 => Closure::Level,
+        _ => Closure::Yaw { max_yaw_deg: 5.0 },
+    };
+    let equilibria = sample_suspended(&truth, &workspace, count, closure, &mut rng).unwrap();
+    let readings = measure_suspended(&truth, &equilibria, &noise.sigmas(truth.platform_weight_n), &mut rng).unwrap();
+    (truth, readings)
+}
+
+/// Readings the model made itself leave nothing, and each row has the
+/// degrees of freedom its readings less its unknowns give: 3 positions, N
+/// encoders and K load cells against the pose's 6 coordinates and N free
+/// forces (2N less the N attachment heights), so 3 + K.
+#[test]
+fn verify_leaves_nothing_of_noiseless_readings_with_three_plus_k_dof_a_row() {
+    for name in ["three", "six", "eight"] {
+        let (robot, readings) = readings_of(name, 8, 21, NoisePreset::None);
+        let report = verify_suspended(&robot, name, &readings, &paper_options(&robot), 1e-3).unwrap();
+        let k = robot.load_cells.len();
+        println!(
+            "{name}: chi-square {:.2e}, dof {}",
+            report.chi_square, report.degrees_of_freedom
+        );
+        assert!(report.chi_square < 1e-9, "{name}: {}", report.chi_square);
+        assert!(report.rows.iter().all(|r| r.degrees_of_freedom == 3 + k), "{name}");
+        assert!(report.passes && report.suspect_readings.is_empty(), "{name}");
+        // The summed redundancy numbers are that count before rounding, less
+        // the little the statics' tight constraints (sigma 1e-5 of the
+        // platform's weight, not exact) take up: below 1e-3.
+        for row in &report.rows {
+            let sum: f64 = row.readings.iter().map(|r| r.redundancy).sum();
+            assert!((sum - (3 + k) as f64).abs() < 1e-3, "{name} {}: {sum}", row.at);
+        }
+    }
+}
+
+/// The minimal detectable error of encoder 1, put into encoder 1 of every
+/// row, is found in about 80 % of the rows (Baarda's power, 30 independent
+/// rows: 19 to 28 is the binomial's 99 % range), half of it in few (a 3 %
+/// power: at most 5); clean readings pass; the nominal robot (offsets 0)
+/// against readings whose encoders have offsets of 0.1 to 0.45 m fails.
+#[test]
+fn verify_finds_an_encoder_error_of_its_minimal_detectable_size_four_times_in_five() {
+    let (robot, clean) = readings_of("six", 30, 11, NoisePreset::Paper);
+    let options = paper_options(&robot);
+    let report = verify_suspended(&robot, "clean", &clean, &options, 1e-3).unwrap();
+    assert!(report.passes, "{}", report.conclusion);
+    let detectable = report.summaries[0].minimal_detectable.unwrap();
+    println!(
+        "encoder 1: found from {detectable:.4} m (mean r {:.3})",
+        report.summaries[0].mean_redundancy
+    );
+    let found = |size: f64| {
+        let mut damaged = clean.clone();
+        damaged.iter_mut().for_each(|m| m.encoder_lengths_m[0] += size);
+        let report = verify_suspended(&robot, "damaged", &damaged, &options, 1e-3).unwrap();
+        report
+            .suspect_readings
+            .iter()
+            .filter(|s| s.reading.reading == SuspendedReading::Encoder(0))
+            .count()
+    };
+    let (full, half) = (found(detectable), found(detectable / 2.0));
+    println!("found in {full} of 30 rows at full size, {half} at half");
+    assert!((19..=28).contains(&full), "{full}");
+    assert!(half <= 5, "{half}");
+    let nominal = SuspendedRobot::builtin("six").unwrap();
+    let wrong = verify_suspended(&nominal, "offsets", &clean, &options, 1e-3).unwrap();
+    assert!(!wrong.passes, "{}", wrong.conclusion);
+}
+
+/// `sagcal verify` on a six-cable file: text and JSON; the four-cable
+/// closures refused by name for six cables, the weighted fit's flags for four.
+#[test]
+fn the_verify_command_verifies_six_cables() {
+    let dir = tempfile::tempdir().unwrap();
+    let six = cli::robot("six");
+    let simulate = [
+        "simulate", "--robot", &six, "--poses", "12", "--seed", "4", "--out", "six.csv",
+    ];
+    assert!(cli::sagcal(dir.path(), &simulate).status.success());
+    let verify = ["verify", "--robot", &six, "--data", "six.csv"];
+    let out = cli::sagcal(dir.path(), &[&verify[..], &["--json"]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        (json["cables"].as_u64(), json["degrees_of_freedom"].as_u64()),
+        (Some(6), Some(48))
+    );
+    assert_eq!(json["passes"], true, "{json:#}");
+    let text = cli::sagcal(dir.path(), &verify);
+    let stdout = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        stdout.contains("dl6 mm") && stdout.contains("found from (80 %)"),
+        "{stdout}"
+    );
+    let closed = cli::sagcal(dir.path(), &[&verify[..], &["--close-with", "cable-lengths"]].concat());
+    let message = String::from_utf8_lossy(&closed.stderr);
+    assert!(
+        !closed.status.success() && message.contains("--close-with: robot `six` has 6 cables"),
+        "{message}"
+    );
+    let large = cli::robot("large");
+    let simulate = [
+        "simulate",
+        "--robot",
+        &large,
+        "--poses",
+        "3",
+        "--seed",
+        "4",
+        "--out",
+        "large.csv",
+    ];
+    assert!(cli::sagcal(dir.path(), &simulate).status.success());
+    let four = ["verify", "--robot", &large, "--data", "large.csv", "--noise", "authors"];
+    let refused = cli::sagcal(dir.path(), &four);
+    let message = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        !refused.status.success() && message.contains("--noise: robot `large` has 4 cables"),
+        "{message}"
+    );
+    assert!(refused.stdout.is_empty());
 }

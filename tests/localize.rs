@@ -596,3 +596,57 @@ fn n_cable_lengths_give_the_pose_back() {
         assert!(worst.0 < 1e-9 && worst.1 < 1e-9, "{name}: {worst:?}");
     }
 }
+
+/// `sagcal localize --plot` on six cables: one ellipse per row and view, a
+/// marker for each of the six anchors, and each top-view ellipse the
+/// position covariance's x-y block: its squared semi-axes sum to the trace
+/// `sx^2 + sy^2` of the per-axis sigmas the JSON reports.
+#[test]
+fn the_six_cable_localisation_is_drawn_with_its_ellipses() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).display().to_string();
+    let six = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("robots/six.toml")
+        .display()
+        .to_string();
+    let simulate = [
+        "simulate",
+        "--robot",
+        &six,
+        "--poses",
+        "5",
+        "--seed",
+        "3",
+        "--out",
+        &path("six.csv"),
+    ];
+    assert!(sagcal(&simulate).status.success());
+    let (data, plot) = (path("six.csv"), path("six.svg"));
+    let run = sagcal(&["localize", "--robot", &six, "--data", &data, "--plot", &plot, "--json"]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert_eq!(svg.matches("<ellipse class=\"sigma\"").count(), 2 * 5);
+    assert!(svg.contains(">A6") || svg.contains(", A6"), "a marker per anchor");
+    for (k, row) in report["rows"].as_array().unwrap().iter().enumerate() {
+        let sigma = |a: usize| row["position_sigma_m"][a].as_f64().unwrap();
+        let marker = format!(r#"data-row="{}" data-view="xy" data-semi-axes-m=""#, k + 1);
+        let at = svg
+            .find(&marker)
+            .unwrap_or_else(|| panic!("no top-view ellipse for row {}", k + 1))
+            + marker.len();
+        let axes: Vec<f64> = svg[at..]
+            .split('"')
+            .next()
+            .unwrap()
+            .split(' ')
+            .map(|v| v.parse().unwrap())
+            .collect();
+        let (drawn, reported) = (axes[0].powi(2) + axes[1].powi(2), sigma(0).powi(2) + sigma(1).powi(2));
+        assert!(
+            (drawn / reported - 1.0).abs() < 1e-6,
+            "row {}: {drawn} against {reported}",
+            k + 1
+        );
+    }
+}

@@ -11,8 +11,9 @@ in and out, the same jobs with the same options, results and error messages.
   :class:`SuspendedRobot` and :func:`simulate_suspended`: a robot of 3 to 8
   cables and its measurements; :func:`calibrate_suspended` calibrates it,
   :func:`localize_suspended` localises it, :func:`plan_suspended` plans
-  its calibration poses and :func:`diagnose_suspended` says what its model
-  gets wrong.
+  its calibration poses, :func:`diagnose_suspended` says what its model
+  gets wrong and :func:`verify_suspended` tests a robot file against
+  measurements.
 - :func:`calibrate`: anchors and encoder offsets from measurements
   (``sagcal calibrate``), with their covariance and the gross-error tests.
 - :func:`diagnose`: what the calibration model gets wrong (``sagcal diagnose``).
@@ -87,11 +88,12 @@ init_robot = _entry(_sagcal.init_robot)
 localize = _entry(_sagcal.localize)
 localize_suspended = _entry(_sagcal.localize_suspended)
 plan = _entry(_sagcal.plan, ints={"poses": _COUNT, "seed": _COUNT})
-plan_suspended = _entry(_sagcal.plan_suspended, ints={"poses": _COUNT, "seed": _COUNT, "candidates": _COUNT})
+plan_suspended = _entry(_sagcal.plan_suspended, ints={"poses": _COUNT, "seed": _COUNT})
 read_measurements = _entry(_sagcal.read_measurements, ints={"reference_cable": (1, 5)})
 simulate = _entry(_sagcal.simulate, ints={"poses": _COUNT, "seed": _COUNT, "segments": _COUNT}, lists=("effects",))
 simulate_suspended = _entry(_sagcal.simulate_suspended, ints={"poses": _COUNT, "seed": _COUNT})
 write_measurements = _entry(_sagcal.write_measurements, lists=("comments",))
+verify_suspended = _entry(_sagcal.verify_suspended)
 
 __all__ = [
     "MEASUREMENT_COLUMNS",
@@ -130,5 +132,6 @@ __all__ = [
     "read_measurements",
     "simulate",
     "simulate_suspended",
+    "verify_suspended",
     "write_measurements",
 ]

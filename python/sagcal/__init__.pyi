@@ -560,6 +560,15 @@ def diagnose_suspended(
 ) -> Dict[str, Any]:
     """What the model of a robot of 3 to 8 cables gets wrong, as ``sagcal diagnose --json`` reports it."""
 
+def verify_suspended(
+    robot: SuspendedRobot,
+    measurements: Union[ArrayLike, PathLike],
+    noise: str = "paper",
+    *,
+    false_alarm: float = 1e-3,
+) -> Dict[str, Any]:
+    """A robot file of 3 to 8 cables, held, against measurements, as ``sagcal verify --json`` reports it."""
+
 def localize(
     robot: Robot,
     readings: Union[ArrayLike, PathLike],
@@ -577,7 +586,7 @@ def plan_suspended(
     robot: SuspendedRobot,
     poses: int,
     *,
-    candidates: int = 1000,
+    candidates: Union[int, ArrayLike, PathLike, None] = 1000,
     workspace: Union[Sequence[float], str, None] = None,
     noise: str = "paper",
     criterion: str = "a",

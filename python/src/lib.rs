@@ -26,6 +26,7 @@ mod progress;
 mod robot;
 mod simulate;
 mod suspended;
+mod verify_suspended;
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -166,6 +167,7 @@ fn _sagcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose::diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose_suspended::diagnose_suspended, m)?)?;
+    m.add_function(wrap_pyfunction!(verify_suspended::verify_suspended, m)?)?;
     m.add_function(wrap_pyfunction!(localize::localize, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(suspended::simulate_suspended, m)?)?;

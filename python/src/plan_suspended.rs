@@ -7,19 +7,23 @@ use numpy::ndarray::Array2;
 use pyo3::prelude::*;
 use sagcal::calib::OrientationPrior;
 use sagcal::error::FrontEnd;
-use sagcal::experiments::suspended_plan::{plan_suspended as plan_n_cables, SuspendedPlanSettings, SuspendedPlanned};
+use sagcal::experiments::pose_plan::DEFAULT_CANDIDATES;
+use sagcal::experiments::suspended_plan::{
+    plan_suspended as plan_n_cables, LoggedPoses, SuspendedPlanSettings, SuspendedPlanned,
+};
 use sagcal::io::suspended_measurements::{row_values, suspended_header};
 use sagcal::model::suspended::SuspendedMeasurement;
 use sagcal::plan::suspended_information::noise_free_suspended_reading;
 use sagcal::plan::Criterion;
 
 use crate::arrays::{frozen, out1, out2, out3};
+use crate::calibrate_suspended::suspended_measurements;
 use crate::json::to_python;
 use crate::options::{noise_preset, parse};
 use crate::plan::workspace_argument;
 use crate::progress::Progress;
 use crate::suspended::SuspendedRobot;
-use crate::to_py;
+use crate::{invalid, to_py};
 
 /// A plan of a robot of 3 to 8 cables: the chosen poses in visiting order,
 /// their Cramer-Rao bound and the bound of random sets of as many poses.
@@ -130,13 +134,17 @@ impl SuspendedPlan {
 /// Plan the calibration of a robot of 3 to 8 cables: ``poses`` poses among
 /// ``candidates`` level equilibria drawn in ``workspace`` (the robot file's
 /// by default), as ``sagcal plan --robot`` plans them; ``progress(done,
-/// total, what)`` follows the draw and the choice.
+/// total, what)`` follows the draw and the choice. ``candidates`` may
+/// instead be poses already logged, as ``sagcal plan --from`` reads them:
+/// the path of a measurement file of the robot or an array in the columns
+/// of :attr:`SuspendedRobot.columns` (each row the nominal model's
+/// equilibrium at its logged position).
 #[pyfunction]
 #[pyo3(signature = (
     robot,
     poses,
     *,
-    candidates = 1000,
+    candidates = None,
     workspace = None,
     noise = "paper",
     criterion = "a",
@@ -149,7 +157,7 @@ pub fn plan_suspended(
     py: Python<'_>,
     robot: &SuspendedRobot,
     poses: usize,
-    candidates: usize,
+    candidates: Option<&Bound<'_, PyAny>>,
     workspace: Option<&Bound<'_, PyAny>>,
     noise: &str,
     criterion: &str,
@@ -158,10 +166,12 @@ pub fn plan_suspended(
     progress: Option<Py<PyAny>>,
 ) -> PyResult<SuspendedPlan> {
     let robot = robot.inner.clone();
+    let (candidates, logged) = candidate_source(candidates, &robot)?;
     let settings = SuspendedPlanSettings {
         poses,
         noise: noise_preset(noise)?,
         candidates,
+        logged,
         workspace: workspace.map(workspace_argument).transpose()?,
         seed,
         criterion: parse("criterion", criterion, Criterion::parse)?,
@@ -189,4 +199,25 @@ pub fn plan_suspended(
         planned,
         readings,
     })
+}
+
+/// ``candidates``: a count to draw (the command's 1000 without one), or
+/// logged poses (a path or an array).
+fn candidate_source(
+    candidates: Option<&Bound<'_, PyAny>>,
+    robot: &sagcal::model::suspended::SuspendedRobot,
+) -> PyResult<(usize, Option<LoggedPoses>)> {
+    let Some(value) = candidates else {
+        return Ok((DEFAULT_CANDIDATES, None));
+    };
+    if let Ok(count) = value.extract::<i64>() {
+        return usize::try_from(count).map(|n| (n, None)).map_err(|_| {
+            invalid(format!(
+                "candidates: {count}: the number of candidates to draw, at least the poses asked for"
+            ))
+        });
+    }
+    let (rows, path) = suspended_measurements(value, robot)?;
+    let label = path.display().to_string();
+    Ok((DEFAULT_CANDIDATES, Some(LoggedPoses { rows, label })))
 }

@@ -160,6 +160,25 @@ def test_plan_suspended_is_the_commands_plan(cli, tmp_path):
     np.testing.assert_array_equal(written, plan.measurements)
 
 
+
+def test_plan_suspended_chooses_among_logged_poses_as_the_command_does(cli, tmp_path):
+    robot = sagcal.SuspendedRobot.builtin("six")
+    logged = sagcal.simulate_suspended(robot, 30, seed=8)
+    path = tmp_path / "logged.csv"
+    logged.write(path)
+    plan = sagcal.plan_suspended(robot, 6, candidates=path)
+    command = json.loads(cli("plan", "--robot", ROOT / "robots" / "six.toml", "--poses", 6, "--from", path,
+                             "--json").stdout)
+    assert command == plan.report
+    assert plan.report["candidates_from"].startswith("30 logged poses of")
+    from_array = sagcal.plan_suspended(robot, 6, candidates=logged.measurements)
+    assert from_array.anchor_bound_m == plan.anchor_bound_m
+    positions = logged.measurements[:, :3]
+    for p in plan.measurements[:, :3]:
+        assert np.min(np.max(np.abs(positions - p), axis=1)) < 1e-12, "each planned pose is a logged one"
+    with pytest.raises(sagcal.InvalidInputError, match="candidates: -1"):
+        sagcal.plan_suspended(robot, 6, candidates=-1)
+
 def test_diagnose_suspended_is_the_commands_diagnosis(cli, tmp_path):
     robot = sagcal.SuspendedRobot.builtin("three")
     simulation = sagcal.simulate_suspended(robot, 16, seed=4)
@@ -177,3 +196,18 @@ def test_diagnose_suspended_is_the_commands_diagnosis(cli, tmp_path):
     assert report["verdict"]["kind"] == "consistent"
     with pytest.raises(sagcal.InvalidInputError, match="`pulley` is not an extension"):
         sagcal.diagnose_suspended(robot, simulation.measurements, candidates=["pulley"])
+
+
+def test_verify_suspended_is_the_commands_verification(cli, tmp_path):
+    robot = sagcal.SuspendedRobot.builtin("six")
+    simulation = sagcal.simulate_suspended(robot, 10, seed=6)
+    data = tmp_path / "d.csv"
+    simulation.write(data)
+    report = sagcal.verify_suspended(robot, data)
+    command = json.loads(cli("verify", "--robot", ROOT / "robots" / "six.toml", "--data", data, "--json").stdout)
+    assert command == report, "the library call and the command give the same report"
+    assert report["passes"] and report["degrees_of_freedom"] == 10 * 4, "3 positions and 1 load cell a row"
+    from_array = sagcal.verify_suspended(robot, simulation.measurements)
+    assert from_array["chi_square"] == report["chi_square"]
+    with pytest.raises(sagcal.InvalidInputError, match="false_alarm: false-alarm rate 2"):
+        sagcal.verify_suspended(robot, data, false_alarm=2.0)

@@ -16,7 +16,7 @@ use super::localize::LocalizeArgs;
 use super::localize_experiment::LocalizeExperimentArgs;
 use super::plan_args::PlanArgs;
 use super::simulate_args::SimulateArgs;
-use super::verify::VerifyArgs;
+use super::verify_args::VerifyArgs;
 
 /// Self-calibration of suspended cable-driven parallel robots with sagging cables.
 #[derive(Debug, Parser)]

@@ -117,7 +117,12 @@ pub fn run(args: &LocalizeArgs) -> sagcal::Result<()> {
         let plot = LocalizePlot {
             title: format!("sagcal localize: {} rows of {}", report.rows.len(), report.data),
             caption: format!("robot {}; {}", report.robot, report.covariance),
-            anchors_m: robot.anchors_m.map(Into::into),
+            anchors_m: robot.anchors_m.map(Into::into).to_vec(),
+            sigma_source: match robot.calibration_covariance_m2.is_some() && !args.no_calibration_uncertainty {
+                true => "reading noise and calibration",
+                false => "reading noise",
+            }
+            .into(),
             reference_label: if args.pose_prior { "prior" } else { "logged" }.into(),
             poses: report.plotted.clone(),
         };

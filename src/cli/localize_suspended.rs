@@ -1,10 +1,14 @@
 //! `sagcal localize` on a calibrated robot of 3 to 8 cables
 //! ([`sagcal::localize::suspended`]): a table (or JSON, or CSV) of every
-//! row's pose, forces' magnitudes, 1-sigma and tests.
+//! row's pose, forces' magnitudes, 1-sigma and tests; with `--plot` the
+//! figure of the four-cable command (`sagcal::plot::localize`), an anchor
+//! marker per cable.
 
 use sagcal::io::suspended_measurements::read_suspended_measurements;
 use sagcal::localize::{localize_suspended_rows, SuspendedLocalizationReport};
-use sagcal::model::suspended::SuspendedRobot;
+use sagcal::model::suspended::{SuspendedMeasurement, SuspendedRobot};
+use sagcal::plot::figure_bytes;
+use sagcal::plot::localize::{localize_plot_svg, LocalizePlot, PlottedPose};
 
 use super::localize_args::LocalizeArgs;
 use super::output::{print_json, progress_bar, Table};
@@ -26,15 +30,54 @@ pub(super) fn run(args: &LocalizeArgs, robot: &SuspendedRobot) -> sagcal::Result
     if let Some(out) = &args.out {
         outputs.file("--out", out, render_csv(&report));
     }
+    if let Some(path) = &args.plot {
+        let svg = localize_plot_svg(&plot(&report, robot, &rows, &args.data.display().to_string()));
+        outputs.file("--plot", path, figure_bytes(path, &svg)?);
+    }
     outputs.write()?;
     if args.json {
         return print_json(&report);
     }
     print!("{}", render(&report, &args.data.display().to_string()));
-    if let Some(path) = &args.out {
+    for path in args.out.iter().chain(&args.plot) {
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The figure of `--plot`: every localised row's position and its 1-sigma
+/// ellipse (the reading noise), joined to the file's localiser position.
+fn plot(
+    report: &SuspendedLocalizationReport,
+    robot: &SuspendedRobot,
+    rows: &[SuspendedMeasurement],
+    data: &str,
+) -> LocalizePlot {
+    let poses = report
+        .rows
+        .iter()
+        .zip(rows)
+        .filter_map(|(r, logged)| {
+            Some(PlottedPose {
+                row: r.at.row,
+                position_m: r.position_m?,
+                covariance_m2: r.position_covariance_m2,
+                reference_m: Some(logged.position_m),
+                flagged: r.flag.is_some(),
+            })
+        })
+        .collect();
+    LocalizePlot {
+        title: format!("sagcal localize: {} rows of {data}", report.rows.len()),
+        caption: format!(
+            "robot {} ({} cables); 1-sigma from the reading noise (the calibration's covariance is not carried into these)",
+            report.robot, report.cables
+        ),
+        anchors_m: robot.anchors_m.iter().map(|a| [a.x, a.y, a.z]).collect(),
+        sigma_source: "reading noise".into(),
+        reference_label: "logged".into(),
+        poses,
+    }
 }
 
 /// The flags of the four-cable localiser that this one does not have.
@@ -42,7 +85,6 @@ fn refuse_four_cable_options(args: &LocalizeArgs, robot: &SuspendedRobot) -> sag
     let given = [
         (args.pose_prior, "--pose-prior"),
         (args.fast, "--fast"),
-        (args.plot.is_some(), "--plot"),
         (args.no_calibration_uncertainty, "--no-calibration-uncertainty"),
     ];
     refuse_four_cable_flags(

@@ -41,5 +41,7 @@ mod simulate_suspended;
 mod solver_args;
 mod table2_args;
 mod verify;
+mod verify_args;
+mod verify_suspended;
 
 pub use run::run;

@@ -6,8 +6,8 @@ use std::path::Path;
 
 use sagcal::error::FrontEnd;
 use sagcal::experiments::pose_plan::PlanProgress;
-use sagcal::experiments::suspended_plan::{plan_suspended, SuspendedPlanSettings, SuspendedPlanned};
-use sagcal::io::suspended_measurements::suspended_measurements_text;
+use sagcal::experiments::suspended_plan::{plan_suspended, LoggedPoses, SuspendedPlanSettings, SuspendedPlanned};
+use sagcal::io::suspended_measurements::{read_suspended_measurements, suspended_measurements_text};
 use sagcal::io::OutputSet;
 use sagcal::model::suspended::SuspendedRobot;
 use sagcal::plan::suspended_information::noise_free_suspended_reading;
@@ -17,16 +17,9 @@ use sagcal::plot::plan::{plan_plot_svg, PlanPlot};
 use super::output::{print_json, progress_bar};
 use super::plan_args::PlanArgs;
 use super::plan_tables::{plan_caption, print_plan_tables, Visit};
-use super::robot_kind::refuse_four_cable_flags;
 
 /// Plan `robot` as `args` ask, print the table (or JSON), write the CSV and the figure.
 pub(super) fn run(args: &PlanArgs, robot: &SuspendedRobot) -> sagcal::Result<()> {
-    refuse_four_cable_flags(
-        &[(args.from.is_some(), "--from")],
-        robot,
-        "its candidates are drawn in its workspace (--candidates, --workspace); logged poses are read as \
-         candidates for four cables",
-    )?;
     eprintln!(
         "sagcal plan: seed {}, {} poses, {}-optimal, {} cables",
         args.seed,
@@ -43,6 +36,13 @@ pub(super) fn run(args: &PlanArgs, robot: &SuspendedRobot) -> sagcal::Result<()>
         criterion: args.criterion,
         orientation_prior: args.orientation_prior,
         front_end: FrontEnd::Cli,
+        logged: match &args.from {
+            Some(path) => Some(LoggedPoses {
+                rows: read_suspended_measurements(path, robot)?,
+                label: path.display().to_string(),
+            }),
+            None => None,
+        },
     };
     let bar = progress_bar(1, "{msg} [{bar:30}] {pos}/{len}, {elapsed}");
     let planned = plan_suspended(robot, &settings, &mut |step: PlanProgress<'_>| {
@@ -54,6 +54,9 @@ pub(super) fn run(args: &PlanArgs, robot: &SuspendedRobot) -> sagcal::Result<()>
     // All the files or none, none over an input.
     let mut outputs = OutputSet::new();
     outputs.input("--robot", &args.robot);
+    if let Some(from) = &args.from {
+        outputs.input("--from", from);
+    }
     if let Some(path) = &args.out {
         outputs.file("--out", path, plan_csv(path, robot, &planned, args)?);
     }

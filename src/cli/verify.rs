@@ -1,9 +1,6 @@
-//! `sagcal verify`: the model against measured data; its flags
-//! ([`VerifyArgs`], [`ClosureArg`]) and the run.
+//! `sagcal verify`: the model against measured data (four cables; robots of
+//! 3 to 8 cables in `verify_suspended.rs`).
 
-use std::path::PathBuf;
-
-use clap::ValueEnum;
 use sagcal::diagnose::verify::{nothing_verified, verify, Closure, LengthKind, MeasuredData, VerifyReport};
 use sagcal::io::measurements::{read_measurements, MeasurementFormat, ReadOptions};
 use sagcal::io::recurdyn::{read_recurdyn, LoadOptions};
@@ -11,40 +8,18 @@ use sagcal::model::statics::StaticsOptions;
 use sagcal::model::Robot;
 
 use super::output::{opt, print_json, Table};
-
-/// Which measurement closes the statics in `verify`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum ClosureArg {
-    /// Position + the reference cable's load-cell tension (default).
-    ReferenceTension,
-    /// Position + the four measured cable lengths (least squares).
-    CableLengths,
-}
-
-#[derive(Debug, clap::Args)]
-pub(super) struct VerifyArgs {
-    /// Robot description (TOML), e.g. robots/large.toml.
-    #[arg(long)]
-    robot: PathBuf,
-    /// Measurement log: RecurDyn CSV, sagcal CSV or the authors' dataset folder.
-    #[arg(long)]
-    data: PathBuf,
-    /// The measurement that closes the one-parameter family of equilibria.
-    #[arg(long, value_enum, default_value = "reference-tension")]
-    close_with: ClosureArg,
-    /// Keep rows whose pose was transcribed rounded to 0.01 m (rejected by default).
-    #[arg(long)]
-    keep_rounded: bool,
-    /// Print the full report as JSON instead of tables.
-    #[arg(long)]
-    json: bool,
-}
+use super::robot_kind::{read_robot, AnyRobot};
+use super::verify_args::{ClosureArg, VerifyArgs};
 
 /// Verify the model against the data and print the report (or JSON).
 pub fn run(args: &VerifyArgs) -> sagcal::Result<()> {
-    let robot = Robot::from_file(&args.robot)?;
+    let robot = match read_robot(&args.robot)? {
+        AnyRobot::Four(robot) => *robot,
+        AnyRobot::Suspended(robot) => return super::verify_suspended::run(args, &robot),
+    };
+    refuse_four_flags(args, &robot)?;
     let data = read_data(args, &robot)?;
-    let closure = match args.close_with {
+    let closure = match args.close_with.unwrap_or(ClosureArg::ReferenceTension) {
         ClosureArg::ReferenceTension => Closure::ReferenceTension,
         ClosureArg::CableLengths => Closure::CableLengths,
     };
@@ -61,6 +36,22 @@ pub fn run(args: &VerifyArgs) -> sagcal::Result<()> {
     } else {
         print!("{}", render(&report));
         Ok(())
+    }
+}
+
+/// The flags only robots of 3 to 8 cables take, refused by name.
+fn refuse_four_flags(args: &VerifyArgs, robot: &Robot) -> sagcal::Result<()> {
+    let given = [
+        (args.noise.is_some(), "--noise"),
+        (args.false_alarm.is_some(), "--false-alarm"),
+    ];
+    match given.iter().find(|(on, _)| *on) {
+        Some((_, flag)) => Err(sagcal::Error::InvalidInput(format!(
+            "{flag}: robot `{}` has 4 cables, whose verification closes the model with one reading and reports \
+             its errors in percent, unweighted (robots of 3 to 8 cables are verified by a weighted fit)",
+            robot.name
+        ))),
+        None => Ok(()),
     }
 }
 

@@ -7,6 +7,10 @@
 //! [`crate::plan::plan_poses`] over them, as for four cables
 //! ([`super::pose_plan`]): chosen for the Cramer-Rao bound at the nominal
 //! robot, in a short visiting order, beside random sets of as many poses.
+//! Poses already logged ([`LoggedPoses`], `sagcal plan --from`) serve as
+//! the candidates instead: each one the nominal model's equilibrium at its
+//! logged position (its yaw held at the logged yaw from four cables on,
+//! the one equilibrium of three), kept where it is stable.
 //!
 //! ```
 //! use sagcal::experiments::suspended_plan::{plan_suspended, SuspendedPlanSettings};
@@ -30,7 +34,11 @@ use crate::calib::{CalibrationOptions, OrientationPrior};
 use crate::error::{Error, FrontEnd, Result};
 use crate::model::robot::Workspace;
 use crate::model::sensors::NoisePreset;
-use crate::model::suspended::{check_suspended, SuspendedEquilibrium, SuspendedRobot};
+use crate::model::suspended::{
+    check_suspended, smallest_stiffness, solve_at, stiffness, Closure as Member, EquilibriumOptions,
+    SuspendedEquilibrium, SuspendedMeasurement, SuspendedRobot,
+};
+use crate::model::DataRow;
 use crate::plan::suspended_information::suspended_candidate_information;
 use crate::plan::{plan_poses, Criterion, DesignOptions, Plan};
 use crate::sim::closed_form::Closure;
@@ -60,6 +68,18 @@ pub struct SuspendedPlanSettings {
     pub orientation_prior: OrientationPrior,
     /// Who asks: a refused workspace is named as this front end spells it.
     pub front_end: FrontEnd,
+    /// Poses already logged, the candidates instead of drawing
+    /// `candidates` in `workspace` (`None`: draw them).
+    pub logged: Option<LoggedPoses>,
+}
+
+/// Poses already logged, as a plan's candidates.
+#[derive(Debug, Clone)]
+pub struct LoggedPoses {
+    /// The logged rows (their positions and yaws are read).
+    pub rows: Vec<SuspendedMeasurement>,
+    /// Where they came from, as the report names it (the file, as given).
+    pub label: String,
 }
 
 impl SuspendedPlanSettings {
@@ -76,6 +96,7 @@ impl SuspendedPlanSettings {
             criterion: Criterion::A,
             orientation_prior: OrientationPrior::Off,
             front_end: FrontEnd::Cli,
+            logged: None,
         }
     }
 }
@@ -166,19 +187,25 @@ pub fn plan_suspended(
     progress: &mut dyn FnMut(PlanProgress<'_>),
 ) -> Result<SuspendedPlanned> {
     check_counts(settings)?;
-    let (workspace, from) = workspace(robot, settings);
-    check_workspace(robot, &workspace, settings)?;
-    let what = format!(
-        "drawing {} candidate poses in {from}, seed {}",
-        settings.candidates, settings.seed
-    );
-    let drawn = draw(robot, &workspace, settings, &mut |found| {
-        progress(PlanProgress::Drawing {
-            what: &what,
-            found,
-            count: settings.candidates,
-        })
-    })?;
+    let (drawn, workspace, candidates_from) = match &settings.logged {
+        Some(logged) => logged_candidates(robot, logged)?,
+        None => {
+            let (workspace, from) = workspace(robot, settings);
+            check_workspace(robot, &workspace, settings)?;
+            let what = format!(
+                "drawing {} candidate poses in {from}, seed {}",
+                settings.candidates, settings.seed
+            );
+            let drawn = draw(robot, &workspace, settings, &mut |found| {
+                progress(PlanProgress::Drawing {
+                    what: &what,
+                    found,
+                    count: settings.candidates,
+                })
+            })?;
+            (drawn, workspace, format!("{} drawn in {from}", settings.candidates))
+        }
+    };
     let margin_n = 0.1 * robot.platform_weight_n / robot.cable_count() as f64;
     let examined = drawn.len();
     let candidates: Vec<SuspendedEquilibrium> = drawn
@@ -218,7 +245,7 @@ pub fn plan_suspended(
         criterion: settings.criterion,
         orientation_prior: settings.orientation_prior,
         workspace,
-        candidates_from: format!("{} drawn in {from}", settings.candidates),
+        candidates_from,
         examined,
         outside_margins: examined - candidates.len(),
         min_horizontal_tension_n: margin_n,
@@ -245,7 +272,7 @@ fn check_counts(settings: &SuspendedPlanSettings) -> Result<()> {
     if settings.poses == 0 {
         return Err(Error::InvalidInput("poses = 0: a plan chooses at least 1 pose".into()));
     }
-    if settings.candidates < settings.poses {
+    if settings.logged.is_none() && settings.candidates < settings.poses {
         return Err(Error::InvalidInput(format!(
             "{} poses requested but only {} candidates to draw: a plan chooses its poses among the candidates",
             settings.poses, settings.candidates
@@ -308,6 +335,56 @@ fn draw(
         progress(drawn.len());
     }
     Ok(drawn)
+}
+
+/// The nominal model's stable equilibrium at each logged row's position
+/// (module docs), the box the kept ones span, and the report's words for
+/// them (naming the rows left out); an error where none is left.
+fn logged_candidates(
+    robot: &SuspendedRobot,
+    logged: &LoggedPoses,
+) -> Result<(Vec<SuspendedEquilibrium>, Workspace, String)> {
+    let mut kept = Vec::with_capacity(logged.rows.len());
+    let mut left_out = Vec::new();
+    for (k, row) in logged.rows.iter().enumerate() {
+        let measured = row.localiser_pose();
+        let closure = if robot.cable_count() > 3 {
+            Member::Yaw {
+                yaw_rad: measured.yaw_rad(),
+            }
+        } else {
+            Member::Level
+        };
+        let stable = |eq: &SuspendedEquilibrium| stiffness(robot, eq).is_some_and(|k| smallest_stiffness(&k) > 0.0);
+        match solve_at(robot, measured.position_m, closure, &EquilibriumOptions::default()) {
+            Ok(eq) if stable(&eq) => kept.push(eq),
+            _ => left_out.push(DataRow::at(k, row.line).to_string()),
+        }
+    }
+    if kept.is_empty() {
+        return Err(Error::InvalidInput(format!(
+            "{}: none of its {} rows has a stable equilibrium of robot `{}` at its logged position",
+            logged.label,
+            logged.rows.len(),
+            robot.name
+        )));
+    }
+    let corner = |pick: fn(f64, f64) -> f64, from: f64| {
+        [0, 1, 2].map(|a| kept.iter().map(|eq| eq.pose.position_m[a]).fold(from, pick))
+    };
+    let span = Workspace {
+        min_m: corner(f64::min, f64::INFINITY),
+        max_m: corner(f64::max, f64::NEG_INFINITY),
+    };
+    let mut from = format!("{} logged poses of {}", logged.rows.len(), logged.label);
+    if !left_out.is_empty() {
+        from += &format!(
+            " ({} without a stable equilibrium of the nominal model at the logged position left out: {})",
+            left_out.len(),
+            left_out.join(", ")
+        );
+    }
+    Ok((kept, span, from))
 }
 
 /// Where the path starts: the point below the candidates' centre at the

@@ -71,6 +71,10 @@ pub struct SuspendedLocalization {
     pub forces: Vec<CableTension>,
     /// 1-sigma of the position per axis from the reading noise, metres.
     pub position_sigma_m: [f64; 3],
+    /// The position's 3 x 3 covariance from the reading noise, m^2
+    /// (`None` where the readings leave it undetermined).
+    #[serde(skip)]
+    pub position_covariance_m2: Option<[[f64; 3]; 3]>,
     /// The row's chi-square, `sum (r / sigma)^2`.
     pub chi_square: f64,
     /// Its degrees of freedom: the number of load cells.
@@ -129,10 +133,13 @@ pub fn localize_suspended(
             }
         })
         .collect();
-    let position_sigma_m = match marginal_covariance(&graph, &[pose_id])? {
-        Covariance::Full(c) => [3, 4, 5].map(|k| c[(k, k)].max(0.0).sqrt()),
-        Covariance::RankDeficient(_) => [f64::INFINITY; 3],
+    // The pose's tangent is [rotation (3); position (3)].
+    let position_covariance_m2 = match marginal_covariance(&graph, &[pose_id])? {
+        Covariance::Full(c) => Some([3, 4, 5].map(|i| [3, 4, 5].map(|j| c[(i, j)]))),
+        Covariance::RankDeficient(_) => None,
     };
+    let position_sigma_m =
+        position_covariance_m2.map_or([f64::INFINITY; 3], |c| [0, 1, 2].map(|k| c[k][k].max(0.0).sqrt()));
     let chi_square = 2.0 * summary.final_cost;
     let degrees_of_freedom = robot.load_cells.len();
     // The model's own lengths at the solution (the readings' noise aside).
@@ -148,6 +155,7 @@ pub fn localize_suspended(
         pose,
         forces,
         position_sigma_m,
+        position_covariance_m2,
         chi_square,
         degrees_of_freedom,
         consistent: chi_square <= chi_square_critical(degrees_of_freedom.max(1), false_alarm),

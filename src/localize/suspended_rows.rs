@@ -23,6 +23,11 @@ pub struct SuspendedRowReport {
     pub forces_n: Option<Vec<[f64; 2]>>,
     /// 1-sigma per axis from the reading noise, metres.
     pub position_sigma_m: Option<[f64; 3]>,
+    /// The position's 3 x 3 covariance from the reading noise, m^2 (the
+    /// ellipses of `sagcal localize --plot`; not in the JSON, whose
+    /// per-axis sigmas are its diagonal's roots).
+    #[serde(skip)]
+    pub position_covariance_m2: Option<[[f64; 3]; 3]>,
     /// The row's chi-square and its degrees of freedom (the load cells).
     pub chi_square: Option<f64>,
     /// See [`SuspendedRowReport::chi_square`].
@@ -85,6 +90,7 @@ pub fn localize_suspended_rows(
                     roll_pitch_yaw_deg: Some([roll, pitch, yaw]),
                     forces_n: Some(found.forces.iter().map(|t| [t.horizontal_n, t.vertical_n]).collect()),
                     position_sigma_m: Some(found.position_sigma_m),
+                    position_covariance_m2: found.position_covariance_m2,
                     chi_square: Some(found.chi_square),
                     degrees_of_freedom: Some(found.degrees_of_freedom),
                     consistent: found.consistent,
@@ -99,6 +105,7 @@ pub fn localize_suspended_rows(
                 roll_pitch_yaw_deg: None,
                 forces_n: None,
                 position_sigma_m: None,
+                position_covariance_m2: None,
                 chi_square: None,
                 degrees_of_freedom: None,
                 consistent: false,

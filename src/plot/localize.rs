@@ -18,7 +18,8 @@
 //! let plot = LocalizePlot {
 //!     title: "Localised poses".into(),
 //!     caption: "sagcal localize".into(),
-//!     anchors_m: [[-5.0, -2.0, 20.0], [5.0, -2.0, 20.0], [5.0, 2.0, 20.0], [-5.0, 2.0, 20.0]],
+//!     anchors_m: vec![[-5.0, -2.0, 20.0], [5.0, -2.0, 20.0], [5.0, 2.0, 20.0], [-5.0, 2.0, 20.0]],
+//!     sigma_source: "reading noise".into(),
 //!     reference_label: "logged".into(),
 //!     poses: vec![PlottedPose {
 //!         row: 2,
@@ -59,8 +60,11 @@ pub struct LocalizePlot {
     pub title: String,
     /// Free text at the bottom (command, robot, data).
     pub caption: String,
-    /// The robot's anchors, world frame, metres.
-    pub anchors_m: [[f64; 3]; 4],
+    /// The robot's anchors, world frame, metres, in cable order (any number).
+    pub anchors_m: Vec<[f64; 3]>,
+    /// What the ellipses' covariance holds, as the legend says it:
+    /// `reading noise and calibration` or `reading noise`.
+    pub sigma_source: String,
     /// What the references are: `logged` or `prior`.
     pub reference_label: String,
     /// The localised rows.
@@ -261,7 +265,7 @@ fn draw_panel(s: &mut String, view: &View, name: &str) {
 
 /// Anchors inside the view as triangles; outside it, a marker on the edge
 /// along the direction from the view's centre.
-fn draw_anchors(s: &mut String, view: &View, anchors: &[[f64; 3]; 4]) {
+fn draw_anchors(s: &mut String, view: &View, anchors: &[[f64; 3]]) {
     let c = [view.left + 0.5 * PANEL, TOP + 0.5 * PANEL];
     // Markers that land within 12 px of each other (anchors one behind the
     // other in this view) share one marker and one label, e.g. "A1, A4".
@@ -377,9 +381,9 @@ fn draw_legend(s: &mut String, plot: &LocalizePlot, magnification: f64) {
         flagged
     );
     let magnified = if magnification > 1.0 {
-        format!("1-sigma ellipses drawn x{magnification:.0} (reading noise and calibration)")
+        format!("1-sigma ellipses drawn x{magnification:.0} ({})", plot.sigma_source)
     } else {
-        "1-sigma ellipses, true size (reading noise and calibration)".to_owned()
+        format!("1-sigma ellipses, true size ({})", plot.sigma_source)
     };
     let _ = writeln!(
         s,

@@ -22,8 +22,8 @@ use crate::model::DataRow;
 use crate::solver::redundancy_numbers;
 use crate::stats::chi_square_critical;
 
-/// The factor kinds whose rows are readings.
-const READING_KINDS: [&str; 3] = ["catenary_length", "load_cell", "pose_prior"];
+/// The factor kinds whose rows are readings (encoders, load cells, the localiser).
+pub const READING_KINDS: [&str; 3] = ["catenary_length", "load_cell", "pose_prior"];
 
 /// Redundancy numbers below this are readings the fit cannot check (their
 /// `w` would divide by nearly zero).

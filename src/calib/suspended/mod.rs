@@ -43,7 +43,7 @@ pub use graph::{
     build_suspended_graph, min_poses, pose_starts_from_graph, robot_from_suspended_graph, Exclusions, PoseStart,
     SuspendedGraph, SuspendedPoseVariables, SuspendedReading, SuspendedStage, EQUILIBRIUM_SIGMA_PER_WEIGHT,
 };
-pub use gross_errors::{reading_count, worst_reading, SuspendedGrossError};
+pub use gross_errors::{reading_count, worst_reading, SuspendedGrossError, READING_KINDS};
 pub use options::suspended_options;
 pub use report::{SuspendedCalibrationReport, UndeterminedForces};
 pub use start::{catenary_starts, chord_shares, offsets_in_closed_form, straight_offsets};

@@ -14,9 +14,9 @@
 
 use super::extensions::SuspendedExtension;
 use super::profile::{calibrate_with, fit_profile};
-use crate::calib::suspended::{build_suspended_graph, catenary_starts, Exclusions, SuspendedStage};
+use crate::calib::suspended::{build_suspended_graph, catenary_starts, Exclusions, SuspendedGraph, SuspendedStage};
 use crate::calib::{CalibrationOptions, OrientationPrior};
-use crate::error::Result;
+use crate::error::{Result, SolverError};
 use crate::graph::FactorGraph;
 use crate::model::suspended::{SuspendedMeasurement, SuspendedRobot};
 use crate::solver::optimize;
@@ -35,8 +35,31 @@ pub fn held_out_chi_squares(
     measurements: &[SuspendedMeasurement],
     options: &CalibrationOptions,
 ) -> Result<Vec<f64>> {
-    let (starts, _) = catenary_starts(robot, measurements);
     let with_orientation = options.orientation_prior != OrientationPrior::Off;
+    let built =
+        fit_poses_robot_held(robot, measurements, options, with_orientation).map_err(|e| e.during("held-out poses"))?;
+    let mut per_pose = vec![0.0; measurements.len()];
+    for (factor, readings) in built.graph.factors.iter().zip(&built.readings) {
+        if let (Some(&(pose, _)), Some(cost)) = (
+            readings.first(),
+            FactorGraph::factor_cost(factor.as_ref(), &built.graph.values),
+        ) {
+            per_pose[pose] += 2.0 * cost;
+        }
+    }
+    Ok(per_pose)
+}
+
+/// The graph of every pose of `measurements` (its platform pose and cable
+/// forces) under `robot`, its anchors and offsets held, solved: the
+/// localiser's orientation a reading only `with_orientation`.
+pub fn fit_poses_robot_held(
+    robot: &SuspendedRobot,
+    measurements: &[SuspendedMeasurement],
+    options: &CalibrationOptions,
+    with_orientation: bool,
+) -> std::result::Result<SuspendedGraph, SolverError> {
+    let (starts, _) = catenary_starts(robot, measurements);
     let mut built = build_suspended_graph(
         robot,
         measurements,
@@ -49,17 +72,8 @@ pub fn held_out_chi_squares(
     for &id in built.anchors.iter().chain(&built.length_offsets) {
         built.graph.values.set_fixed(id, true);
     }
-    optimize(&mut built.graph, &options.lm).map_err(|e| e.during("held-out poses"))?;
-    let mut per_pose = vec![0.0; measurements.len()];
-    for (factor, readings) in built.graph.factors.iter().zip(&built.readings) {
-        if let (Some(&(pose, _)), Some(cost)) = (
-            readings.first(),
-            FactorGraph::factor_cost(factor.as_ref(), &built.graph.values),
-        ) {
-            per_pose[pose] += 2.0 * cost;
-        }
-    }
-    Ok(per_pose)
+    optimize(&mut built.graph, &options.lm)?;
+    Ok(built)
 }
 
 /// Per pose, the held-out chi-square of `extension` over `folds` folds

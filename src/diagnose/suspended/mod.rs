@@ -27,6 +27,10 @@
 //!    The effects the N-cable model does not carry ([`NOT_MODELLED`]) are
 //!    found by the baseline's test, never named.
 //!
+//! [`verify_suspended`] tests a robot file, held as it is, against a data
+//! file (`sagcal verify`): each row's pose and forces fitted to its
+//! readings, the whole file, each row and each reading tested.
+//!
 //! ```
 //! use sagcal::calib::CalibrationOptions;
 //! use sagcal::diagnose::suspended::{diagnose_suspended, SuspendedDiagnoseSettings, SUSPENDED_EXTENSIONS};
@@ -44,11 +48,16 @@ mod extensions;
 pub mod held_out;
 mod pipeline;
 mod profile;
+mod verify;
 
 pub use extensions::{SuspendedExtension, MAX_SPECIFIC_MODULUS_J_PER_KG, NOT_MODELLED, SUSPENDED_EXTENSIONS};
-pub use held_out::{cross_validated_chi_square, fold_of, held_out_chi_squares};
+pub use held_out::{cross_validated_chi_square, fit_poses_robot_held, fold_of, held_out_chi_squares};
 pub use pipeline::{
     diagnose_suspended, paired_z, SuspendedBaseline, SuspendedDiagnoseSettings, SuspendedDiagnosis,
     SuspendedExtensionFit, SuspendedVerdict, INDISTINGUISHABLE_Z,
 };
 pub use profile::{calibrate_with, calibrated_chi_square, fit_profile, ProfileFit};
+pub use verify::{
+    verify_suspended, ResidualSummary, SuspectReading, SuspendedVerifiedRow, SuspendedVerifyReport, VerifiedReading,
+    DETECTION_POWER_Z,
+};
