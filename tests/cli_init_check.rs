@@ -448,3 +448,115 @@ fn unreadable_files_are_errors_naming_them() {
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("junk.csv"), "{}", stderr(&out));
 }
+
+/// `sagcal check` on robots of six and eight cables and their simulated
+/// files: the load cells, the free force components (`2N - 6`), every
+/// column, the encoders following the geometry (slope about 1); then the
+/// same file with one encoder in mm, the load cell in kN, the positions in
+/// mm, each named; a reading shorter than its chord named with its row.
+#[test]
+fn check_reads_robots_of_six_and_eight_cables_and_names_their_mistakes() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, cells, free) in [("six", vec![1], 6), ("eight", vec![1, 5], 10)] {
+        let robot = cli::robot(name);
+        let data = dir.path().join(format!("{name}.csv"));
+        let simulate = [
+            "simulate",
+            "--robot",
+            &robot,
+            "--poses",
+            "12",
+            "--seed",
+            "5",
+            "--out",
+            data.to_str().unwrap(),
+        ];
+        assert!(sagcal(dir.path(), &simulate).status.success());
+        let report = check_json(dir.path(), Path::new(&robot), &data);
+        let cables = if name == "six" { 6 } else { 8 };
+        assert_eq!(report["robot"]["cables"], cables);
+        assert_eq!(report["robot"]["free_force_components"], free);
+        let read: Vec<u64> = report["robot"]["load_cells"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_u64().unwrap())
+            .collect();
+        assert_eq!(read, cells);
+        assert_eq!(report["data"]["rows"], 12);
+        assert_eq!(
+            report["data"]["columns"].as_array().unwrap().len(),
+            6 + cables + cells.len()
+        );
+        assert!(warnings(&report).is_empty(), "{:?}", warnings(&report));
+        for g in report["data"]["geometry"].as_array().unwrap() {
+            let slope = g["slope"].as_f64().unwrap();
+            assert!((0.9..1.1).contains(&slope), "{name}: {g}");
+        }
+    }
+    let text = sagcal(
+        dir.path(),
+        &["check", "--robot", &cli::robot("six"), "--data", "six.csv"],
+    );
+    let printed = stdout(&text);
+    assert!(
+        printed.contains("load cells on cable 1;") && printed.contains("warnings: none"),
+        "{printed}"
+    );
+    // The six-cable file, damaged one way at a time: (column index, scale, words expected).
+    let original = std::fs::read_to_string(dir.path().join("six.csv")).unwrap();
+    let cases = [
+        (8, 1e3, "column l3_m", "look like mm"),
+        (12, 1e-3, "column f1_n", "look like kN"),
+        (0, 1e3, "the positions", "look like mm"),
+    ];
+    for (column, scale, what, words) in cases {
+        let damaged: String = original
+            .lines()
+            .map(|line| {
+                if line.starts_with('#') || line.starts_with('x') {
+                    return format!("{line}\n");
+                }
+                let mut values: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+                let columns = if column == 0 { 0..3 } else { column..column + 1 };
+                values[columns].iter_mut().for_each(|v| *v *= scale);
+                values.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(",") + "\n"
+            })
+            .collect();
+        let path = dir.path().join("damaged.csv");
+        std::fs::write(&path, damaged).unwrap();
+        let report = check_json(dir.path(), Path::new(&cli::robot("six")), &path);
+        let found = warnings(&report);
+        assert!(
+            found
+                .iter()
+                .any(|(kind, message)| kind == "unit" && message.contains(what) && message.contains(words)),
+            "{what}: {found:?}"
+        );
+    }
+    // Row 4's encoder 2 half a metre short: shorter than the straight line.
+    let mut row = 0;
+    let short: String = original
+        .lines()
+        .map(|line| {
+            if line.starts_with('#') || line.starts_with('x') {
+                return format!("{line}\n");
+            }
+            row += 1;
+            let mut values: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+            if row == 4 {
+                values[7] -= 0.5;
+            }
+            values.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(",") + "\n"
+        })
+        .collect();
+    let path = dir.path().join("short.csv");
+    std::fs::write(&path, short).unwrap();
+    let found = warnings(&check_json(dir.path(), Path::new(&cli::robot("six")), &path));
+    assert!(
+        found
+            .iter()
+            .any(|(kind, m)| kind == "geometry" && m.starts_with("cable 2:") && m.contains("row 4 (line")),
+        "{found:?}"
+    );
+}

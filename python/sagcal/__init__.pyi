@@ -654,7 +654,7 @@ def init_robot(
 ) -> str:
     """A new robot file's text (TOML, every key commented), as ``sagcal init`` writes it; with ``out``, written there."""
 
-def check(robot: Union[Robot, PathLike], data: Optional[PathLike] = None) -> dict[str, Any]:
+def check(robot: Union[Robot, SuspendedRobot, PathLike], data: Optional[PathLike] = None) -> dict[str, Any]:
     """What sagcal understood from a robot file and a data file, as ``sagcal check --json`` prints it."""
 
 def read_measurements(path: PathLike, reference_cable: int = 1) -> FloatArray:

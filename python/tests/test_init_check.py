@@ -126,3 +126,14 @@ def test_unreadable_files_raise_naming_them(tmp_path):
         sagcal.check(ROOT / "robots" / "large.toml", tmp_path / "missing.csv")
     with pytest.raises(sagcal.FileError, match="missing.toml"):
         sagcal.check(tmp_path / "missing.toml")
+
+
+def test_check_reads_a_robot_of_six_cables_as_the_command_does(cli, tmp_path):
+    robot = sagcal.SuspendedRobot.builtin("six")
+    data = tmp_path / "six.csv"
+    sagcal.simulate_suspended(robot, 10, seed=2).write(data)
+    path = ROOT / "robots" / "six.toml"
+    report = sagcal.check(path, data)
+    assert report == cli_json(cli("check", "--robot", path, "--data", data, "--json"))
+    assert report["robot"]["free_force_components"] == 6 and report["warnings"] == []
+    assert sagcal.check(robot, data)["data"]["rows"] == 10

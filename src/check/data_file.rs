@@ -253,16 +253,27 @@ pub(super) fn against_geometry(robot: &Robot, poses: &[PoseMeasurement]) -> Vec<
         .map(|i| {
             let d: Vec<f64> = distances.iter().map(|d| d[i]).collect();
             let r: Vec<f64> = poses.iter().map(|p| p.encoder_lengths_m[i]).collect();
-            let (slope, correlation) = fit(&d, &r).unzip();
-            CableAgainstGeometry {
-                cable: i + 1,
-                median_reading_minus_distance_m: median(r.iter().zip(&d).map(|(r, d)| r - d).collect()),
-                robot_offset_m: robot.length_offsets_m[i],
-                slope,
-                correlation,
-            }
+            cable_against_geometry(i, &d, &r, robot.length_offsets_m[i])
         })
         .collect()
+}
+
+/// Cable `i`'s (0-based) `readings` against its straight `distances` at the
+/// same poses, with the robot file's `offset_m`.
+pub(super) fn cable_against_geometry(
+    i: usize,
+    distances: &[f64],
+    readings: &[f64],
+    offset_m: f64,
+) -> CableAgainstGeometry {
+    let (slope, correlation) = fit(distances, readings).unzip();
+    CableAgainstGeometry {
+        cable: i + 1,
+        median_reading_minus_distance_m: median(readings.iter().zip(distances).map(|(r, d)| r - d).collect()),
+        robot_offset_m: offset_m,
+        slope,
+        correlation,
+    }
 }
 
 /// The least-squares slope of `y` on `x` and their correlation; `None` with

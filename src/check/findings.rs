@@ -34,13 +34,13 @@ const QUOTED_REASONS: usize = 3;
 /// readings do not follow the geometry: the sag changes a catenary's excess
 /// over its chord by a few per cent of the chord at most, and a robot file a
 /// few metres off moves the distances by as much at every pose.
-const SLOPE_FACTOR: f64 = 2.0;
+pub(super) const SLOPE_FACTOR: f64 = 2.0;
 /// See [`SLOPE_FACTOR`].
-const MIN_CORRELATION: f64 = 0.5;
+pub(super) const MIN_CORRELATION: f64 = 0.5;
 
 /// A unit ratio within this factor of 1000 (100) names mm (cm): the
 /// tolerance of [`crate::calib::mistakes`].
-const UNIT_TOLERANCE: f64 = 3.0;
+pub(super) const UNIT_TOLERANCE: f64 = 3.0;
 
 /// The warnings for `data` read for `robot`, in the order found.
 pub(super) fn findings(robot: &Robot, data: &DataRead, geometry: &[CableAgainstGeometry]) -> Vec<CheckWarning> {

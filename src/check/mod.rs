@@ -11,7 +11,9 @@
 //! checks are `calibrate`'s own ([`crate::calib::mistakes`],
 //! [`crate::calib::screen`]), so `check` warns of what `calibrate` refuses.
 //!
-//! One [`CheckReport`] is both the text `sagcal check` prints and its JSON.
+//! One [`CheckReport`] is both the text `sagcal check` prints and its JSON;
+//! a robot of 3 to 8 cables and its measurement file get a
+//! [`SuspendedCheckReport`] ([`check_suspended_files`]).
 //!
 //! ```
 //! use rand::SeedableRng;
@@ -52,9 +54,14 @@ mod findings;
 mod job;
 mod report;
 mod robot_summary;
+mod suspended;
 
 pub use job::{check_files, check_robot_and_data};
 pub use report::{
     row_label, CableAgainstGeometry, CheckReport, CheckWarning, ColumnSummary, DataFormat, DataSummary, RejectedLine,
     RobotSummary, SampleRow, Sensors, Span, WarningKind, WorkspaceSummary,
+};
+pub use suspended::{
+    check_suspended_files, check_suspended_robot_and_data, SuspendedCheckReport, SuspendedDataSummary,
+    SuspendedRobotSummary,
 };

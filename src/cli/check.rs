@@ -1,12 +1,15 @@
 //! `sagcal check`: what sagcal understood from a robot file and a data file,
 //! before any fit; its flags ([`CheckArgs`]) and the text of the report
-//! (`sagcal::check` makes it; `--json` prints the same struct).
+//! (`sagcal::check` makes it; `--json` prints the same struct); a robot of
+//! 3 to 8 cables in `check_suspended.rs`.
 
 use std::path::PathBuf;
 
-use sagcal::check::{check_files, row_label, CheckReport, DataSummary, RobotSummary};
+use sagcal::check::{check_robot_and_data, check_suspended_robot_and_data, CheckReport, DataSummary, RobotSummary};
 
+use super::check_tables::{data_tables, frame_lines, indent, point, short, warnings_text};
 use super::output::{print_json, Table};
+use super::robot_kind::{read_robot, AnyRobot};
 
 #[derive(Debug, clap::Args)]
 pub(super) struct CheckArgs {
@@ -23,7 +26,13 @@ pub(super) struct CheckArgs {
 
 /// Check the files and print what was understood (or JSON).
 pub fn run(args: &CheckArgs) -> sagcal::Result<()> {
-    let report = check_files(&args.robot, args.data.as_deref())?;
+    let report = match read_robot(&args.robot)? {
+        AnyRobot::Four(robot) => check_robot_and_data(&robot, &args.robot, args.data.as_deref())?,
+        AnyRobot::Suspended(robot) => {
+            let report = check_suspended_robot_and_data(&robot, &args.robot, args.data.as_deref())?;
+            return super::check_suspended::print(&report, args.json);
+        }
+    };
     if args.json {
         return print_json(&report);
     }
@@ -39,45 +48,21 @@ fn render(report: &CheckReport) -> String {
         out += &render_data(data);
     }
     out += "\n";
-    if report.warnings.is_empty() {
-        out += "warnings: none\n";
-    } else {
-        out += &format!("warnings ({}):\n", report.warnings.len());
-        for w in &report.warnings {
-            out += &format!("  - {}\n", w.message);
-        }
-    }
+    out += &warnings_text(&report.warnings);
     out
 }
 
-/// `v` to 6 significant digits, as short as it reads (333.54, 0.710070).
-fn short(v: f64) -> String {
-    format!("{v:.5e}")
-        .parse::<f64>()
-        .map_or_else(|_| v.to_string(), |r| r.to_string())
-}
-
-fn point(p: &[f64; 3]) -> String {
-    format!("[{:.3}, {:.3}, {:.3}]", p[0], p[1], p[2])
-}
-
 fn render_robot(r: &RobotSummary) -> String {
-    let [x, y, z] = r.anchor_span_m;
     let mut out = format!(
         "robot {}: `{}`, {} cables, the load cell on cable {}\n",
         r.path, r.name, r.cables, r.reference_cable
     );
-    out += &format!(
-        "  anchors (world frame): x {:.3} .. {:.3} m, y {:.3} .. {:.3} m, z {:.3} .. {:.3} m; footprint {:.3} m wide, \
-         {:.3} m across\n",
-        x.min, x.max, y.min, y.max, z.min, z.max, r.footprint_width_m, r.footprint_diameter_m
-    );
-    out += &format!(
-        "  platform: {} N ({:.3} kg), centre of mass {} m (platform frame), attachments up to {:.3} m from its origin\n",
-        short(r.platform_weight_n),
-        r.platform_mass_kg,
-        point(&r.com_offset_m),
-        r.platform_reach_m
+    out += &frame_lines(
+        &r.anchor_span_m,
+        [r.footprint_width_m, r.footprint_diameter_m],
+        [r.platform_weight_n, r.platform_mass_kg],
+        &r.com_offset_m,
+        r.platform_reach_m,
     );
     out += &format!(
         "  cables: {} N/m ({:.2} g/m)\n",
@@ -116,19 +101,6 @@ fn render_robot(r: &RobotSummary) -> String {
     out
 }
 
-/// A value of a column, `-` for none (a column no row holds a value in).
-fn value(v: f64) -> String {
-    if v.is_nan() {
-        "-".into()
-    } else {
-        format!("{v:.4}")
-    }
-}
-
-fn indent(text: &str) -> String {
-    text.lines().map(|l| format!("  {}\n", l.trim_end())).collect()
-}
-
 fn render_data(d: &DataSummary) -> String {
     let mut out = format!(
         "data {}: {}, {} rows (lines {} .. {})\n",
@@ -165,53 +137,6 @@ fn render_data(d: &DataSummary) -> String {
     );
     out += &format!("  closure: {}\n", s.closure);
     out += &format!("  usable by: {}\n", d.usable_by.join(", "));
-    // The quantity last and padded: the table right-aligns every column but the first.
-    let width = d.columns.iter().map(|c| c.quantity.chars().count()).max().unwrap_or(0);
-    let mut columns = Table::new([
-        "column",
-        "unit",
-        "rows",
-        "min",
-        "max",
-        &format!("{:<width$}", "quantity"),
-    ]);
-    for c in &d.columns {
-        columns.row([
-            c.column.clone(),
-            c.unit.clone(),
-            c.rows.to_string(),
-            value(c.range.min),
-            value(c.range.max),
-            format!("{:<width$}", c.quantity),
-        ]);
-    }
-    out += &indent(&columns.to_string());
-    out += "  rows as read:\n";
-    let mut samples = Table::new(std::iter::once("row".to_string()).chain(d.columns.iter().map(|c| c.column.clone())));
-    for row in &d.samples {
-        samples.row(
-            std::iter::once(row_label(row.row, row.line)).chain(
-                row.values
-                    .iter()
-                    .map(|v| v.map_or("-".to_string(), |v| format!("{v:.4}"))),
-            ),
-        );
-    }
-    out += &indent(&samples.to_string());
-    if !d.geometry.is_empty() {
-        out += "  encoders against the geometry (reading - distance from the anchor to the attachment at the logged \
-                pose; slope of the readings on the distances):\n";
-        let mut table = Table::new(["cable", "median m", "robot offset m", "slope", "correlation"]);
-        for g in &d.geometry {
-            table.row([
-                g.cable.to_string(),
-                format!("{:+.3}", g.median_reading_minus_distance_m),
-                format!("{:.3}", g.robot_offset_m),
-                g.slope.map_or("-".into(), |v| format!("{v:.4}")),
-                g.correlation.map_or("-".into(), |v| format!("{v:.4}")),
-            ]);
-        }
-        out += &indent(&table.to_string());
-    }
+    out += &data_tables(&d.columns, &d.samples, &d.geometry);
     out
 }

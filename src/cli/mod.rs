@@ -12,6 +12,8 @@ mod calibrate_args;
 mod calibrate_suspended;
 mod calibration_tables;
 mod check;
+mod check_suspended;
+mod check_tables;
 mod demo;
 mod diagnose;
 mod diagnose_args;

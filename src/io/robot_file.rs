@@ -193,7 +193,7 @@ impl RobotFile {
             Some(n) => Error::Robot {
                 path: path.to_path_buf(),
                 message: format!(
-                    "field `cables`: the file has {n} cables; this command models {CABLE_COUNT} (`simulate`, `calibrate`, `diagnose`, `localize`, `plan`, `verify`, `experiment table2` and `experiment hidden-effects` take 3 to 8)"
+                    "field `cables`: the file has {n} cables; this command models {CABLE_COUNT} (`simulate`, `calibrate`, `diagnose`, `localize`, `plan`, `verify`, `check`, `experiment table2` and `experiment hidden-effects` take 3 to 8)"
                 ),
             },
             None => Error::Format {
@@ -229,7 +229,7 @@ impl RobotFile {
     fn check_fields(&self) -> std::result::Result<(), String> {
         if self.cables.len() != CABLE_COUNT {
             return Err(format!(
-                "field `cables`: the file has {} cables; this command models {CABLE_COUNT} (`simulate`, `calibrate`, `diagnose`, `localize`, `plan`, `verify`, `experiment table2` and `experiment hidden-effects` take 3 to 8)",
+                "field `cables`: the file has {} cables; this command models {CABLE_COUNT} (`simulate`, `calibrate`, `diagnose`, `localize`, `plan`, `verify`, `check`, `experiment table2` and `experiment hidden-effects` take 3 to 8)",
                 self.cables.len()
             ));
         }
