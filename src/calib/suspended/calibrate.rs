@@ -1,7 +1,14 @@
 //! The staged calibration of `N` cables ([`calibrate_suspended`]): straight
 //! cables from the initial guess, then every pose's equilibrium for those
 //! anchors with the offsets in closed form, then the catenary graph with the
-//! anchors held, then the full graph.
+//! anchors held, then the full graph. Where that minimum fails the
+//! chi-square test at 99.9 % (or the solver stopped), a second start runs
+//! the catenary stages from each cable's own trilateration at the
+//! localiser's poses ([`super::anchors_by_trilateration`], many starts a
+//! cable, independent of the guess) and the lower minimum is kept, if lower
+//! by more than one in chi-square (another minimum, not the same one to
+//! rounding): the joint straight-cable fit can lead a guess far from the
+//! truth into another basin.
 
 use super::graph::{
     build_suspended_graph, min_poses, pose_starts_from_graph, robot_from_suspended_graph, Exclusions, PoseStart,
@@ -9,6 +16,7 @@ use super::graph::{
 };
 use super::gross_errors::{reading_count, worst_reading, SuspendedGrossError};
 use super::start::{catenary_starts, offsets_in_closed_form, straight_offsets};
+use super::trilateration::anchors_by_trilateration;
 use crate::calib::options::{CalibrationOptions, GrossErrorOptions, OrientationPrior};
 use crate::calib::result::{factor_statistics, FactorStatistics, ParameterUncertainty, StageSummary};
 use crate::calib::uncertainty::anchor_and_offset_uncertainty_over_local_gauge;
@@ -18,6 +26,7 @@ use crate::model::statics::CableTension;
 use crate::model::suspended::{SuspendedMeasurement, SuspendedRobot};
 use crate::model::DataRow;
 use crate::solver::optimize;
+use crate::stats::chi_square_quantile_999;
 
 /// A force combination at a pose whose 1-sigma from the readings exceeds
 /// this many platform weights is undetermined: the readings say nothing of
@@ -102,30 +111,38 @@ pub fn calibrate_suspended(
     };
     let mut straight = build(&start_robot, &measured, SuspendedStage::Straight);
     let mut stages = vec![solve(STRAIGHT_STAGE, &mut straight, options, stage)?];
-    // (2) Each pose's equilibrium for those anchors; offsets in closed form.
-    let mut robot = robot_from_suspended_graph(initial, &straight);
-    let (starts, fell_back) = catenary_starts(&robot, measurements);
-    robot.length_offsets_m = offsets_in_closed_form(&robot, measurements, &starts);
-    // (3) The catenary graph with the anchors held, then (4) all free.
-    let mut held = build(&robot, &starts, SuspendedStage::Catenary);
-    for &anchor in &held.anchors {
-        held.graph.values.set_fixed(anchor, true);
+    // (2) - (4) from the straight cables' anchors.
+    let inputs = Inputs {
+        template: initial,
+        measurements,
+        options,
+        with_orientation,
+    };
+    let from_straight = robot_from_suspended_graph(initial, &straight);
+    let (mut full, more, mut fell_back) = catenary_fit(&inputs, from_straight, "", stage)?;
+    stages.extend(more);
+    // A failed minimum: the catenary stages again from each cable's own
+    // trilateration at the localiser's poses.
+    if fails(&full, stages.last()) {
+        let mut trilaterated = initial.clone();
+        trilaterated.anchors_m = anchors_by_trilateration(initial, measurements);
+        let (second, more, second_fell_back) = catenary_fit(&inputs, trilaterated, ", second start", stage)?;
+        let lower =
+            2.0 * (more[more.len() - 1].summary.final_cost - stages[stages.len() - 1].summary.final_cost) < -1.0;
+        if lower {
+            stages.extend(more);
+            (full, fell_back) = (second, second_fell_back);
+        } else {
+            // The first minimum stays: its stages last, as the report reads them.
+            let first: Vec<StageSummary> = stages.drain(1..).collect();
+            stages.extend(more);
+            stages.extend(first);
+        }
     }
-    stages.push(solve(HELD_ANCHORS_STAGE, &mut held, options, stage)?);
-    let robot = robot_from_suspended_graph(initial, &held);
-    let starts = pose_starts_from_graph(&held);
-    let mut full = build(&robot, &starts, SuspendedStage::Catenary);
-    stages.push(solve(CATENARY_STAGE, &mut full, options, stage)?);
     // (5) Gross errors left out one at a time, each followed by a new solve.
     let mut left_out = Vec::new();
     let mut search_exhausted = false;
     if let Some(tests) = gross_errors {
-        let inputs = Inputs {
-            template: initial,
-            measurements,
-            options,
-            with_orientation,
-        };
         search_exhausted = leave_out_gross_errors(&inputs, tests, &mut full, &mut left_out, &mut stages, stage)?;
     }
     let solved = pose_starts_from_graph(&full);
@@ -150,6 +167,64 @@ pub fn calibrate_suspended(
         statistics: factor_statistics(&full.graph),
         left_out,
         search_exhausted,
+    })
+}
+
+/// Stages (2) to (4) from `robot`'s anchors: each pose's equilibrium for
+/// them with the offsets in closed form, the catenary graph with the
+/// anchors held, then all free; each stage's name ends with `suffix`. The
+/// solved full graph, its stages and the poses whose start fell back.
+fn catenary_fit(
+    inputs: &Inputs<'_>,
+    mut robot: SuspendedRobot,
+    suffix: &str,
+    stage: &mut dyn FnMut(&str),
+) -> Result<(SuspendedGraph, Vec<StageSummary>, Vec<usize>)> {
+    let build = |robot: &SuspendedRobot, starts: &[PoseStart]| {
+        build_suspended_graph(
+            robot,
+            inputs.measurements,
+            starts,
+            SuspendedStage::Catenary,
+            inputs.options,
+            inputs.with_orientation,
+            &Exclusions::new(),
+        )
+    };
+    // (2) Each pose's equilibrium for those anchors; offsets in closed form.
+    let (starts, fell_back) = catenary_starts(&robot, inputs.measurements);
+    robot.length_offsets_m = offsets_in_closed_form(&robot, inputs.measurements, &starts);
+    // (3) The catenary graph with the anchors held, then (4) all free.
+    let mut held = build(&robot, &starts);
+    for &anchor in &held.anchors {
+        held.graph.values.set_fixed(anchor, true);
+    }
+    let mut stages = vec![solve(
+        &format!("{HELD_ANCHORS_STAGE}{suffix}"),
+        &mut held,
+        inputs.options,
+        stage,
+    )?];
+    let robot = robot_from_suspended_graph(inputs.template, &held);
+    let starts = pose_starts_from_graph(&held);
+    let mut full = build(&robot, &starts);
+    stages.push(solve(
+        &format!("{CATENARY_STAGE}{suffix}"),
+        &mut full,
+        inputs.options,
+        stage,
+    )?);
+    Ok((full, stages, fell_back))
+}
+
+/// Whether the solved `full` fails: its solver stopped short, or its
+/// chi-square exceeds the 99.9 % quantile of its degrees of freedom counted
+/// without undetermined force directions (a lower count, so a lower limit:
+/// a fit the report passes may try the second start, never the reverse).
+fn fails(full: &SuspendedGraph, last: Option<&StageSummary>) -> bool {
+    last.is_none_or(|s| {
+        !s.summary.termination.converged()
+            || 2.0 * s.summary.final_cost > chi_square_quantile_999(degrees_of_freedom(full, 0).max(1))
     })
 }
 

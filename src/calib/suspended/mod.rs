@@ -37,6 +37,7 @@ mod gross_errors;
 mod options;
 mod report;
 mod start;
+mod trilateration;
 
 pub use calibrate::{calibrate_suspended, SuspendedCalibration};
 pub use graph::{
@@ -47,3 +48,4 @@ pub use gross_errors::{reading_count, worst_reading, SuspendedGrossError, READIN
 pub use options::suspended_options;
 pub use report::{SuspendedCalibrationReport, UndeterminedForces};
 pub use start::{catenary_starts, chord_shares, offsets_in_closed_form, straight_offsets};
+pub use trilateration::{anchors_by_trilateration, STARTS};
