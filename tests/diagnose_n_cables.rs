@@ -11,8 +11,8 @@ use rand_chacha::ChaCha8Rng;
 use sagcal::calib::suspended::SuspendedReading;
 use sagcal::calib::CalibrationOptions;
 use sagcal::diagnose::suspended::{
-    calibrated_chi_square, diagnose_suspended, fit_profile, verify_suspended, SuspendedDiagnoseSettings,
-    SuspendedExtension, SuspendedVerdict, SUSPENDED_EXTENSIONS,
+    calibrated_chi_square, diagnose_suspended, fit_profile, suspended_catalogue, verify_suspended,
+    SuspendedDiagnoseSettings, SuspendedExtension, SuspendedVerdict, SUSPENDED_EXTENSIONS,
 };
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::suspended::{SuspendedMeasurement, SuspendedRobot};
@@ -123,6 +123,40 @@ fn the_encoder_gain_is_named_and_clean_readings_name_nothing() {
     assert!((fit.value - 1.002).abs() < 3.0 * fit.sigma, "{fit:?}");
 }
 
+/// The same poses read through cable 3's encoder alone 0.5 % long, with
+/// the common gain, one cable's weight and two other drums' gains as
+/// rivals: drum 3's gain is named, within three of its 1-sigma of the
+/// truth, and the common gain is not a candidate the readings confuse it
+/// with.
+#[test]
+fn one_drum_s_gain_is_named_as_that_drum_s() {
+    let (robot, mut readings) = six_cable_readings(30, 7, NoisePreset::Paper, 1.0);
+    readings.iter_mut().for_each(|r| r.encoder_lengths_m[2] *= 1.005);
+    let options = paper_options(&robot);
+    let settings = SuspendedDiagnoseSettings {
+        extensions: vec![
+            SuspendedExtension::EncoderScale,
+            SuspendedExtension::DrumGain(1),
+            SuspendedExtension::DrumGain(2),
+            SuspendedExtension::DrumGain(3),
+            SuspendedExtension::OneCableWeight(2),
+        ],
+        ..settings()
+    };
+    let diagnosis = diagnose_suspended(&robot, &readings, &settings, &options, &|_, _| {}).unwrap();
+    println!("drum 3: {}", diagnosis.conclusion);
+    let drum = SuspendedExtension::DrumGain(2);
+    assert_eq!(
+        diagnosis.verdict,
+        SuspendedVerdict::Named { extension: drum },
+        "{diagnosis:#?}"
+    );
+    let fit = &diagnosis.extensions[2];
+    assert_eq!(fit.extension, drum);
+    assert!((fit.value - 1.005).abs() < 3.0 * fit.sigma, "{fit:?}");
+    assert!(fit.sigma < 1e-3, "{fit:?}");
+}
+
 /// `sagcal diagnose --robot robots/six.toml --data six.csv ARGS` in `dir`.
 fn diagnose_six(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
     let robot = cli::robot("six");
@@ -149,11 +183,29 @@ fn the_diagnose_command_diagnoses_six_cables() {
         "{}",
         String::from_utf8_lossy(&simulated.stderr)
     );
-    let out = diagnose_six(dir.path(), &["--json"]);
+    let out = diagnose_six(
+        dir.path(),
+        &["--json", "--candidates", "elastic,encoder-scale,drum-gain"],
+    );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["cables"], 6);
-    assert_eq!(json["extensions"].as_array().unwrap().len(), 6);
+    let names: Vec<&str> = json["extensions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["extension"].as_str().unwrap())
+        .collect();
+    let drums = [
+        "drum-gain-1",
+        "drum-gain-2",
+        "drum-gain-3",
+        "drum-gain-4",
+        "drum-gain-5",
+        "drum-gain-6",
+    ];
+    assert_eq!(names[..2], ["elastic", "encoder-scale"]);
+    assert_eq!(names[2..], drums);
     assert_eq!(json["verdict"]["kind"], "consistent", "{json:#}");
     let text = diagnose_six(dir.path(), &["--candidates", "elastic,encoder-scale"]);
     let stdout = String::from_utf8_lossy(&text.stdout);
@@ -175,6 +227,12 @@ fn the_diagnose_command_diagnoses_six_cables() {
     let message = String::from_utf8_lossy(&unknown.stderr);
     assert!(
         !unknown.status.success() && message.contains("`pulley` is not an extension"),
+        "{message}"
+    );
+    let lacking = diagnose_six(dir.path(), &["--candidates", "cable-weight-7"]);
+    let message = String::from_utf8_lossy(&lacking.stderr);
+    assert!(
+        !lacking.status.success() && message.contains("`cable-weight-7` names a cable the robot lacks"),
         "{message}"
     );
 }
@@ -218,28 +276,23 @@ fn the_documented_example_prints_what_the_pages_show() {
     let out = cli::sagcal(dir.path(), &["diagnose", "--robot", &robot, "--data", "six-gain.csv"]);
     let printed = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let rows = printed.lines().filter(|l| {
-        SUSPENDED_EXTENSIONS
-            .iter()
-            .any(|e| l.starts_with(&format!("{} ", e.name())))
-    });
-    for row in rows {
+    // Every extension of the catalogue has its row, and the page shows it.
+    let catalogue = suspended_catalogue(&SuspendedRobot::builtin("six").unwrap());
+    let rows: Vec<&str> = printed
+        .lines()
+        .filter(|l| catalogue.iter().any(|e| l.starts_with(&format!("{} ", e.name()))))
+        .collect();
+    assert_eq!(rows.len(), catalogue.len(), "{printed}");
+    for row in &rows {
         assert!(page.contains(&flat(row)), "docs/diagnose.md does not show `{row}`");
     }
     let verdict = &printed[printed.find("named cause").expect("a named cause")..];
     let verdict = flat(&verdict[..verdict.find("not in the model").unwrap()]);
     assert!(page.contains(&verdict), "docs/diagnose.md does not say `{verdict}`");
-    let json = cli::sagcal(
-        dir.path(),
-        &["diagnose", "--robot", &robot, "--data", "six-gain.csv", "--json"],
-    );
-    let json: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
-    let gain = &json["extensions"][3];
-    let quoted = format!(
-        "{:.5} +- {:.5}",
-        gain["value"].as_f64().unwrap(),
-        gain["sigma"].as_f64().unwrap()
-    );
+    // The encoder gain's row: its fitted value and 1-sigma as quoted.
+    let gain: Vec<&str> = rows[3].split_whitespace().collect();
+    assert_eq!(gain[0], "encoder-scale");
+    let quoted = format!("{} +- {}", gain[1], gain[2]);
     assert!(readme.contains(&quoted), "README.md does not say `{quoted}`");
     assert!(
         page.contains(&format!("found at {quoted}")),

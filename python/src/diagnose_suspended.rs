@@ -5,7 +5,7 @@
 use pyo3::prelude::*;
 use sagcal::calib::suspended::suspended_options;
 use sagcal::diagnose::suspended::{
-    diagnose_suspended as diagnose_library, SuspendedDiagnoseSettings, SuspendedExtension, SUSPENDED_EXTENSIONS,
+    diagnose_suspended as diagnose_library, extensions_named, suspended_catalogue, SuspendedDiagnoseSettings,
 };
 use sagcal::error::FrontEnd;
 
@@ -20,8 +20,9 @@ use crate::to_py;
 /// ``sagcal diagnose --json`` does for such a robot: the baseline's
 /// chi-square test, each extension of the model (``"elastic"``,
 /// ``"cable-weight"``, ``"platform-weight"``, ``"encoder-scale"``,
-/// ``"loadcell-gain"``, ``"loadcell-bias"``; all by default, or those
-/// ``candidates`` names) fitted, tested by its likelihood ratio at the
+/// ``"loadcell-gain"``, ``"loadcell-bias"``, and for each cable K
+/// ``"drum-gain-K"`` and ``"cable-weight-K"``; all by default, or those
+/// ``candidates`` names, ``"drum-gain"`` for every drum's) fitted, tested by its likelihood ratio at the
 /// search's ``false_alarm`` rate and scored on poses held out of its
 /// calibration (``folds``-fold), and the verdict.
 ///
@@ -72,18 +73,11 @@ pub fn diagnose_suspended<'py>(
     .settings()?;
     let options = suspended_options(&solver, &nominal, FrontEnd::Python).map_err(to_py)?;
     let extensions = match candidates {
-        None => SUSPENDED_EXTENSIONS.to_vec(),
-        Some(names) => names
-            .iter()
-            .map(|name| {
-                SuspendedExtension::from_name(name).ok_or_else(|| {
-                    crate::invalid(format!(
-                        "candidates: `{name}` is not an extension of the model of 3 to 8 cables (one of {})",
-                        SUSPENDED_EXTENSIONS.map(SuspendedExtension::name).join(", ")
-                    ))
-                })
-            })
-            .collect::<PyResult<_>>()?,
+        None => suspended_catalogue(&nominal),
+        Some(names) => {
+            let names: Vec<&str> = names.iter().map(String::as_str).collect();
+            extensions_named(&nominal, &names).map_err(|e| crate::invalid(format!("candidates: {e}")))?
+        }
     };
     let settings = SuspendedDiagnoseSettings {
         extensions,

@@ -78,7 +78,8 @@ fn candidates_help() -> String {
     };
     format!(
         "Candidate effects, comma separated (default: the whole catalogue: {}, and, for rows in the order \
-         taken (a sagcal file), {}; for a robot of 3 to 8 cables: {}).",
+         taken (a sagcal file), {}; for a robot of 3 to 8 cables: {}, drum-gain-K and cable-weight-K for each \
+         cable K; drum-gain names every drum's).",
         names(false),
         names(true),
         SUSPENDED_EXTENSIONS.map(SuspendedExtension::name).join(", ")

@@ -4,7 +4,8 @@
 
 use sagcal::calib::suspended::suspended_options;
 use sagcal::diagnose::suspended::{
-    diagnose_suspended, SuspendedDiagnoseSettings, SuspendedDiagnosis, SuspendedExtension, SUSPENDED_EXTENSIONS,
+    diagnose_suspended, extensions_named, suspended_catalogue, SuspendedDiagnoseSettings, SuspendedDiagnosis,
+    SuspendedExtension,
 };
 use sagcal::error::FrontEnd;
 use sagcal::io::suspended_measurements::read_suspended_measurements;
@@ -30,7 +31,7 @@ pub(super) fn run(args: &DiagnoseArgs, nominal: &SuspendedRobot) -> sagcal::Resu
         "its diagnosis reports the extensions' fits and scores only",
     )?;
     let settings = SuspendedDiagnoseSettings {
-        extensions: extensions(args.candidates.as_deref())?,
+        extensions: extensions(args.candidates.as_deref(), nominal)?,
         folds: args.folds,
         false_alarm: args.false_alarm,
     };
@@ -49,22 +50,13 @@ pub(super) fn run(args: &DiagnoseArgs, nominal: &SuspendedRobot) -> sagcal::Resu
     Ok(())
 }
 
-/// The extensions `--candidates` names (all without it).
-fn extensions(candidates: Option<&str>) -> sagcal::Result<Vec<SuspendedExtension>> {
+/// The extensions `--candidates` names (the whole catalogue without it).
+fn extensions(candidates: Option<&str>, robot: &SuspendedRobot) -> sagcal::Result<Vec<SuspendedExtension>> {
     let Some(list) = candidates else {
-        return Ok(SUSPENDED_EXTENSIONS.to_vec());
+        return Ok(suspended_catalogue(robot));
     };
-    list.split(',')
-        .map(|name| {
-            SuspendedExtension::from_name(name).ok_or_else(|| {
-                sagcal::Error::InvalidInput(format!(
-                    "--candidates: `{}` is not an extension of the model of 3 to 8 cables (one of {})",
-                    name.trim(),
-                    SUSPENDED_EXTENSIONS.map(SuspendedExtension::name).join(", ")
-                ))
-            })
-        })
-        .collect()
+    let names: Vec<&str> = list.split(',').collect();
+    extensions_named(robot, &names).map_err(|e| sagcal::Error::InvalidInput(format!("--candidates: {e}")))
 }
 
 /// The report as text.
@@ -111,7 +103,7 @@ fn render(d: &SuspendedDiagnosis) -> String {
         let plausible = if f.plausible { "yes" } else { "no" };
         let passes = if f.passes { "passes" } else { "fails" };
         table.row([
-            f.extension.name().into(),
+            f.extension.name(),
             fitted,
             sigma,
             lr,
@@ -122,8 +114,9 @@ fn render(d: &SuspendedDiagnosis) -> String {
     }
     text += &table.to_string();
     let mut notes = vec![
-        "fitted: for elastic the compliance 1/EA (1/N), for cable-weight and platform-weight a scale on the \
-         robot file's weight, for encoder-scale and loadcell-gain a gain, for loadcell-bias newtons"
+        "fitted: for elastic the compliance 1/EA (1/N), for cable-weight, cable-weight-K and platform-weight a \
+         scale on the robot file's weight, for encoder-scale, drum-gain-K and loadcell-gain a gain, for \
+         loadcell-bias newtons"
             .to_string(),
         format!(
             "LR: the likelihood ratio chi2(baseline) - chi2(extension); * above {:.2}, the 1-dof quantile at \

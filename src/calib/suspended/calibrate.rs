@@ -126,17 +126,19 @@ pub fn calibrate_suspended(
     if fails(&full, stages.last()) {
         let mut trilaterated = initial.clone();
         trilaterated.anchors_m = anchors_by_trilateration(initial, measurements);
-        let (second, more, second_fell_back) = catenary_fit(&inputs, trilaterated, ", second start", stage)?;
-        let lower =
-            2.0 * (more[more.len() - 1].summary.final_cost - stages[stages.len() - 1].summary.final_cost) < -1.0;
-        if lower {
-            stages.extend(more);
-            (full, fell_back) = (second, second_fell_back);
-        } else {
-            // The first minimum stays: its stages last, as the report reads them.
-            let first: Vec<StageSummary> = stages.drain(1..).collect();
-            stages.extend(more);
-            stages.extend(first);
+        let first_cost = stages.last().map_or(f64::NAN, |s| s.summary.final_cost);
+        match second_start(first_cost, catenary_fit(&inputs, trilaterated, ", second start", stage)) {
+            SecondStart::Lower(second, more, second_fell_back) => {
+                stages.extend(more);
+                (full, fell_back) = (second, second_fell_back);
+            }
+            SecondStart::NotLower(more) => {
+                // The first minimum stays: its stages last, as the report reads them.
+                let first: Vec<StageSummary> = stages.drain(1..).collect();
+                stages.extend(more);
+                stages.extend(first);
+            }
+            SecondStart::Failed => {}
         }
     }
     // (5) Gross errors left out one at a time, each followed by a new solve.
@@ -226,6 +228,34 @@ fn fails(full: &SuspendedGraph, last: Option<&StageSummary>) -> bool {
         !s.summary.termination.converged()
             || 2.0 * s.summary.final_cost > chi_square_quantile_999(degrees_of_freedom(full, 0).max(1))
     })
+}
+
+/// What the second start leaves of a failed first minimum.
+enum SecondStart<T> {
+    /// Its minimum is lower: the fit, its stages and its fallen-back poses
+    /// replace the first's.
+    Lower(T, Vec<StageSummary>, Vec<usize>),
+    /// Its minimum is not lower: the first stays; its stages are reported.
+    NotLower(Vec<StageSummary>),
+    /// Its solver stopped with an error: the first minimum stays as found,
+    /// reported (and tested) as the first start left it, never an error of
+    /// the whole calibration.
+    Failed,
+}
+
+/// Sort the second start's outcome `second` against the first minimum's
+/// cost `first_cost` (`1/2 chi^2`): lower only where its chi-square is
+/// lower by more than one (another minimum, not the same one to rounding).
+fn second_start<T>(first_cost: f64, second: Result<(T, Vec<StageSummary>, Vec<usize>)>) -> SecondStart<T> {
+    let Ok((fit, stages, fell_back)) = second else {
+        return SecondStart::Failed;
+    };
+    let second_cost = stages.last().map_or(f64::NAN, |s| s.summary.final_cost);
+    if 2.0 * (second_cost - first_cost) < -1.0 {
+        SecondStart::Lower(fit, stages, fell_back)
+    } else {
+        SecondStart::NotLower(stages)
+    }
 }
 
 /// What every solve of one calibration shares.
@@ -347,4 +377,48 @@ fn degrees_of_freedom(built: &SuspendedGraph, undetermined: usize) -> usize {
         .map(|id| values.tangent_dim(id))
         .sum();
     (rows + undetermined).saturating_sub(unknowns)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::{SolveSummary, Termination};
+
+    fn stages(final_cost: f64) -> Vec<StageSummary> {
+        let summary = SolveSummary {
+            initial_cost: 1e6,
+            final_cost,
+            iterations: 3,
+            termination: Termination::CostConverged,
+            history: Vec::new(),
+        };
+        vec![StageSummary {
+            name: CATENARY_STAGE.to_string(),
+            summary,
+        }]
+    }
+
+    #[test]
+    fn a_second_start_the_solver_cannot_finish_leaves_the_first_minimum() {
+        let failed: Result<((), Vec<StageSummary>, Vec<usize>)> =
+            Err(Error::from(crate::solver::SolverError::NothingToSolve));
+        assert!(matches!(second_start(50.0, failed), SecondStart::Failed));
+    }
+
+    #[test]
+    fn the_second_minimum_replaces_the_first_only_when_lower_by_more_than_one_in_chi_square() {
+        // Costs are 1/2 chi^2: 0.6 lower is 1.2 lower in chi-square.
+        assert!(matches!(
+            second_start(50.0, Ok(((), stages(49.4), vec![2]))),
+            SecondStart::Lower((), _, _)
+        ));
+        assert!(matches!(
+            second_start(50.0, Ok(((), stages(49.6), vec![]))),
+            SecondStart::NotLower(_)
+        ));
+        assert!(matches!(
+            second_start(50.0, Ok(((), stages(80.0), vec![]))),
+            SecondStart::NotLower(_)
+        ));
+    }
 }

@@ -22,6 +22,15 @@
 //!   reading, plausible within +-15 %
 //!   ([`crate::model::effect_limits::LOAD_CELL_GAIN_LIMIT`],
 //!   [`crate::model::effect_limits::LOAD_CELL_BIAS_LIMIT`]).
+//! - `drum-gain-K`: cable K's encoder alone reads its length times a gain
+//!   (one drum's radius error, a slipping or mis-wound drum), plausible as
+//!   `encoder-scale`; `drum-gain` names every drum's.
+//! - `cable-weight-K`: a scale on cable K's weight per metre alone (one
+//!   cable of another rope or carrying a hose), plausible as
+//!   `cable-weight`.
+//!
+//! [`suspended_catalogue`] is every global extension that applies and each
+//! cable's two, `6 + 2N` at most; [`extensions_named`] reads a list of names.
 //!
 //! ```
 //! use sagcal::diagnose::suspended::SuspendedExtension;
@@ -33,10 +42,15 @@
 //! let (same, _) = SuspendedExtension::CableWeight.apply(&robot, &[], 1.0);
 //! assert_eq!(same.cable_weights_n_per_m, robot.cable_weights_n_per_m);
 //! assert!(!SuspendedExtension::Elastic.is_plausible(&robot, &[], -1e-7));
+//! // One drum's gain scales its own cable's readings only.
+//! let (_, read) = SuspendedExtension::DrumGain(2).apply(&robot, &[], 1.01);
+//! assert!(read.is_empty());
+//! assert_eq!(SuspendedExtension::DrumGain(2).name(), "drum-gain-3");
+//! assert_eq!(sagcal::diagnose::suspended::suspended_catalogue(&robot).len(), 6 + 2 * 6);
 //! # Ok::<(), sagcal::Error>(())
 //! ```
 
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 
 use crate::model::effect_limits::{
     CABLE_WEIGHT_LIMIT, ENCODER_GAIN_LIMIT, LOAD_CELL_BIAS_LIMIT, LOAD_CELL_GAIN_LIMIT, PLATFORM_WEIGHT_LIMIT,
@@ -47,9 +61,9 @@ use crate::model::suspended::{SuspendedMeasurement, SuspendedRobot};
 /// The highest specific modulus of rope fibres, J/kg (module docs).
 pub const MAX_SPECIFIC_MODULUS_J_PER_KG: f64 = 1.4e8;
 
-/// One extension of the N-cable model (module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
+/// One extension of the N-cable model (module docs); serialised as its
+/// [`SuspendedExtension::name`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SuspendedExtension {
     /// Every cable's compliance `1/EA`.
     Elastic,
@@ -63,9 +77,24 @@ pub enum SuspendedExtension {
     LoadcellGain,
     /// One bias on every load cell, newtons.
     LoadcellBias,
+    /// One drum's gain: the cable's encoder (0-based index) alone.
+    DrumGain(usize),
+    /// A scale on one cable's (0-based index) weight per metre.
+    OneCableWeight(usize),
 }
 
-/// Every extension, in the report's order.
+impl Serialize for SuspendedExtension {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(&self.name())
+    }
+}
+
+/// The per-cable family that names every drum's gain.
+const DRUM_GAIN: &str = "drum-gain";
+/// The prefix of one cable's weight scale, `cable-weight-K`.
+const CABLE_WEIGHT_OF: &str = "cable-weight-";
+
+/// Every global extension, in the report's order.
 pub const SUSPENDED_EXTENSIONS: [SuspendedExtension; 6] = [
     SuspendedExtension::Elastic,
     SuspendedExtension::CableWeight,
@@ -78,35 +107,100 @@ pub const SUSPENDED_EXTENSIONS: [SuspendedExtension; 6] = [
 /// The effects of the four-cable catalogue the N-cable model does not carry:
 /// a misfit they cause is found by the baseline's test, never named.
 pub const NOT_MODELLED: &str = "pulley wrap, cable discretisation (segments), a shifted centre of mass, \
-the localiser's mounting, moved attachments and the per-drum encoder and load-cell effects";
+the localiser's mounting, moved attachments, per-drum effects other than a gain and per-load-cell effects";
+
+/// The whole catalogue for `robot`, in the report's order: every global
+/// extension that applies, then each drum's gain, then each cable's weight.
+pub fn suspended_catalogue(robot: &SuspendedRobot) -> Vec<SuspendedExtension> {
+    let cables = 0..robot.cable_count();
+    let global = SUSPENDED_EXTENSIONS.into_iter().filter(|e| e.applies_to(robot));
+    let drums = cables.clone().map(SuspendedExtension::DrumGain);
+    global
+        .chain(drums)
+        .chain(cables.map(SuspendedExtension::OneCableWeight))
+        .collect()
+}
+
+/// The extensions `names` name for `robot`, in their order: a global one
+/// by its name, `drum-gain` for every drum's gain, `drum-gain-K` and
+/// `cable-weight-K` for cable K (from 1); an error naming the first name
+/// that is none of them, or a cable the robot lacks.
+pub fn extensions_named(robot: &SuspendedRobot, names: &[&str]) -> Result<Vec<SuspendedExtension>, String> {
+    let mut extensions = Vec::new();
+    for name in names {
+        let name = name.trim();
+        if name == DRUM_GAIN {
+            extensions.extend((0..robot.cable_count()).map(SuspendedExtension::DrumGain));
+            continue;
+        }
+        match SuspendedExtension::from_name(name) {
+            Some(e) if e.cable().is_none_or(|c| c < robot.cable_count()) => extensions.push(e),
+            Some(_) => {
+                return Err(format!(
+                    "`{name}` names a cable the robot lacks (it has cables 1 to {})",
+                    robot.cable_count()
+                ))
+            }
+            None => {
+                return Err(format!(
+                    "`{name}` is not an extension of the model of 3 to 8 cables (one of {}, {DRUM_GAIN}, \
+                     {DRUM_GAIN}-K or {CABLE_WEIGHT_OF}K for cable K)",
+                    SUSPENDED_EXTENSIONS.map(SuspendedExtension::name).join(", ")
+                ))
+            }
+        }
+    }
+    Ok(extensions)
+}
 
 impl SuspendedExtension {
-    /// Its name, as `--candidates` takes it.
-    pub fn name(self) -> &'static str {
+    /// Its name, as `--candidates` takes it (cables counted from 1).
+    pub fn name(self) -> String {
         match self {
-            Self::Elastic => "elastic",
-            Self::CableWeight => "cable-weight",
-            Self::PlatformWeight => "platform-weight",
-            Self::EncoderScale => "encoder-scale",
-            Self::LoadcellGain => "loadcell-gain",
-            Self::LoadcellBias => "loadcell-bias",
+            Self::Elastic => "elastic".into(),
+            Self::CableWeight => "cable-weight".into(),
+            Self::PlatformWeight => "platform-weight".into(),
+            Self::EncoderScale => "encoder-scale".into(),
+            Self::LoadcellGain => "loadcell-gain".into(),
+            Self::LoadcellBias => "loadcell-bias".into(),
+            Self::DrumGain(cable) => format!("{DRUM_GAIN}-{}", cable + 1),
+            Self::OneCableWeight(cable) => format!("{CABLE_WEIGHT_OF}{}", cable + 1),
         }
     }
 
-    /// The extension named `name`.
+    /// The extension named `name` (a per-cable one for any cable from 1).
     pub fn from_name(name: &str) -> Option<Self> {
-        SUSPENDED_EXTENSIONS.into_iter().find(|e| e.name() == name.trim())
+        let name = name.trim();
+        let cable = |prefix: &str| {
+            let k: usize = name.strip_prefix(prefix)?.parse().ok()?;
+            k.checked_sub(1)
+        };
+        SUSPENDED_EXTENSIONS
+            .into_iter()
+            .find(|e| e.name() == name)
+            .or_else(|| cable(&format!("{DRUM_GAIN}-")).map(Self::DrumGain))
+            .or_else(|| cable(CABLE_WEIGHT_OF).map(Self::OneCableWeight))
+    }
+
+    /// The cable a per-cable extension acts on (0-based).
+    pub fn cable(self) -> Option<usize> {
+        match self {
+            Self::DrumGain(cable) | Self::OneCableWeight(cable) => Some(cable),
+            _ => None,
+        }
     }
 
     /// Its parameter, with its unit.
-    pub fn parameter(self) -> &'static str {
+    pub fn parameter(self) -> String {
         match self {
-            Self::Elastic => "compliance 1/EA (1/N)",
-            Self::CableWeight => "cable weight scale",
-            Self::PlatformWeight => "platform weight scale",
-            Self::EncoderScale => "encoder gain",
-            Self::LoadcellGain => "load-cell gain",
-            Self::LoadcellBias => "load-cell bias (N)",
+            Self::Elastic => "compliance 1/EA (1/N)".into(),
+            Self::CableWeight => "cable weight scale".into(),
+            Self::PlatformWeight => "platform weight scale".into(),
+            Self::EncoderScale => "encoder gain".into(),
+            Self::LoadcellGain => "load-cell gain".into(),
+            Self::LoadcellBias => "load-cell bias (N)".into(),
+            Self::DrumGain(cable) => format!("drum {} gain", cable + 1),
+            Self::OneCableWeight(cable) => format!("cable {} weight scale", cable + 1),
         }
     }
 
@@ -128,9 +222,14 @@ impl SuspendedExtension {
         }
     }
 
-    /// Whether the extension applies to `robot` (the load-cell ones need a load cell).
+    /// Whether the extension applies to `robot` (the load-cell ones need a
+    /// load cell, the per-cable ones the cable).
     pub fn applies_to(self, robot: &SuspendedRobot) -> bool {
-        !matches!(self, Self::LoadcellGain | Self::LoadcellBias) || !robot.load_cells.is_empty()
+        match self {
+            Self::LoadcellGain | Self::LoadcellBias => !robot.load_cells.is_empty(),
+            Self::DrumGain(cable) | Self::OneCableWeight(cable) => cable < robot.cable_count(),
+            _ => true,
+        }
     }
 
     /// A first step of the parameter's search: a mid-range magnitude.
@@ -145,8 +244,8 @@ impl SuspendedExtension {
                     1.0 / (1e4 * robot.platform_weight_n)
                 }
             }
-            Self::CableWeight | Self::PlatformWeight => 0.05,
-            Self::EncoderScale => 1e-3,
+            Self::CableWeight | Self::PlatformWeight | Self::OneCableWeight(_) => 0.05,
+            Self::EncoderScale | Self::DrumGain(_) => 1e-3,
             Self::LoadcellGain => 0.02,
             Self::LoadcellBias => 0.05 * mean_load_cell_reading_n(measurements),
         }
@@ -177,6 +276,10 @@ impl SuspendedExtension {
             Self::LoadcellBias => measurements
                 .iter_mut()
                 .for_each(|m| m.load_cell_tensions_n.iter_mut().for_each(|t| *t -= value)),
+            Self::DrumGain(cable) => measurements
+                .iter_mut()
+                .for_each(|m| m.encoder_lengths_m[cable] /= value),
+            Self::OneCableWeight(cable) => robot.cable_weights_n_per_m[cable] *= value,
         }
         (robot, measurements)
     }
@@ -188,9 +291,9 @@ impl SuspendedExtension {
                 Some(ea) => format!("1/EA > 0 and EA <= {ea:.2e} N"),
                 None => "1/EA > 0".into(),
             },
-            Self::CableWeight => scale_range(CABLE_WEIGHT_LIMIT),
+            Self::CableWeight | Self::OneCableWeight(_) => scale_range(CABLE_WEIGHT_LIMIT),
             Self::PlatformWeight => scale_range(PLATFORM_WEIGHT_LIMIT),
-            Self::EncoderScale => scale_range(ENCODER_GAIN_LIMIT),
+            Self::EncoderScale | Self::DrumGain(_) => scale_range(ENCODER_GAIN_LIMIT),
             Self::LoadcellGain => scale_range(LOAD_CELL_GAIN_LIMIT),
             Self::LoadcellBias => {
                 let limit = LOAD_CELL_BIAS_LIMIT * mean_load_cell_reading_n(measurements);
@@ -204,9 +307,9 @@ impl SuspendedExtension {
         let within = |limit: f64| (value - 1.0).abs() <= limit;
         match self {
             Self::Elastic => value > 0.0 && stiffest_rope_n(robot).is_none_or(|ea| 1.0 / value <= ea),
-            Self::CableWeight => within(CABLE_WEIGHT_LIMIT),
+            Self::CableWeight | Self::OneCableWeight(_) => within(CABLE_WEIGHT_LIMIT),
             Self::PlatformWeight => within(PLATFORM_WEIGHT_LIMIT),
-            Self::EncoderScale => within(ENCODER_GAIN_LIMIT),
+            Self::EncoderScale | Self::DrumGain(_) => within(ENCODER_GAIN_LIMIT),
             Self::LoadcellGain => within(LOAD_CELL_GAIN_LIMIT),
             Self::LoadcellBias => value.abs() <= LOAD_CELL_BIAS_LIMIT * mean_load_cell_reading_n(measurements),
         }
@@ -240,5 +343,57 @@ fn mean_load_cell_reading_n(measurements: &[SuspendedMeasurement]) -> f64 {
         0.0
     } else {
         readings.iter().sum::<f64>() / readings.len() as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_name_reads_back_as_its_extension() {
+        let robot = SuspendedRobot::builtin("eight").unwrap();
+        let catalogue = suspended_catalogue(&robot);
+        assert_eq!(catalogue.len(), 6 + 2 * 8);
+        for extension in &catalogue {
+            assert_eq!(SuspendedExtension::from_name(&extension.name()), Some(*extension));
+        }
+        assert_eq!(SuspendedExtension::from_name("drum-gain-0"), None);
+        assert_eq!(SuspendedExtension::from_name("cable-weight-x"), None);
+    }
+
+    #[test]
+    fn a_list_of_names_expands_drum_gain_and_refuses_a_cable_the_robot_lacks() {
+        let robot = SuspendedRobot::builtin("three").unwrap();
+        let named = extensions_named(&robot, &["elastic", " drum-gain", "cable-weight-2"]).unwrap();
+        let drums = (0..3).map(SuspendedExtension::DrumGain);
+        let expected: Vec<_> = std::iter::once(SuspendedExtension::Elastic)
+            .chain(drums)
+            .chain([SuspendedExtension::OneCableWeight(1)])
+            .collect();
+        assert_eq!(named, expected);
+        let lacking = extensions_named(&robot, &["drum-gain-4"]).unwrap_err();
+        assert!(lacking.contains("cables 1 to 3"), "{lacking}");
+        let unknown = extensions_named(&robot, &["pulley"]).unwrap_err();
+        assert!(unknown.contains("`pulley` is not an extension"), "{unknown}");
+    }
+
+    #[test]
+    fn one_drum_s_gain_and_one_cable_s_weight_touch_that_cable_only() {
+        let robot = SuspendedRobot::builtin("three").unwrap();
+        let reading = SuspendedMeasurement {
+            line: 1,
+            position_m: [0.0; 3],
+            roll_deg: 0.0,
+            pitch_deg: 0.0,
+            yaw_deg: 0.0,
+            encoder_lengths_m: vec![10.0, 20.0, 30.0],
+            load_cell_tensions_n: vec![100.0],
+        };
+        let (_, read) = SuspendedExtension::DrumGain(1).apply(&robot, &[reading], 1.25);
+        assert_eq!(read[0].encoder_lengths_m, vec![10.0, 16.0, 30.0]);
+        let (heavier, _) = SuspendedExtension::OneCableWeight(2).apply(&robot, &[], 2.0);
+        let w = &robot.cable_weights_n_per_m;
+        assert_eq!(heavier.cable_weights_n_per_m, vec![w[0], w[1], 2.0 * w[2]]);
     }
 }

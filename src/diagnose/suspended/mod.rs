@@ -6,7 +6,8 @@
 //!    degrees of freedom. Where it passes, no cause is named.
 //! 2. Each extension of the model ([`SuspendedExtension`]: the cables'
 //!    stiffness, their weight, the platform's weight, the encoders' common
-//!    gain, the load cells' gain or bias) has its one parameter fitted by
+//!    gain, the load cells' gain or bias, one drum's gain, one cable's
+//!    weight) has its one parameter fitted by
 //!    the profile of the calibration's chi-square ([`fit_profile`]) and is
 //!    tested by the likelihood ratio against chi-square with one degree of
 //!    freedom at `false_alarm / K` (Bonferroni over the `K` extensions, so
@@ -50,7 +51,10 @@ mod pipeline;
 mod profile;
 mod verify;
 
-pub use extensions::{SuspendedExtension, MAX_SPECIFIC_MODULUS_J_PER_KG, NOT_MODELLED, SUSPENDED_EXTENSIONS};
+pub use extensions::{
+    extensions_named, suspended_catalogue, SuspendedExtension, MAX_SPECIFIC_MODULUS_J_PER_KG, NOT_MODELLED,
+    SUSPENDED_EXTENSIONS,
+};
 pub use held_out::{cross_validated_chi_square, fit_poses_robot_held, fold_of, held_out_chi_squares};
 pub use pipeline::{
     diagnose_suspended, paired_z, SuspendedBaseline, SuspendedDiagnoseSettings, SuspendedDiagnosis,

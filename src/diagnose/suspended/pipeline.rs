@@ -253,7 +253,7 @@ impl Scores<'_> {
     fn fit(&self, extension: SuspendedExtension, folds: usize, tick: &(dyn Fn() + Sync)) -> SuspendedExtensionFit {
         let mut row = SuspendedExtensionFit {
             extension,
-            parameter: extension.parameter().into(),
+            parameter: extension.parameter(),
             value: f64::NAN,
             sigma: f64::NAN,
             chi_square: f64::NAN,
