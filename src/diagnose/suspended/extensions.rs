@@ -105,7 +105,8 @@ pub const SUSPENDED_EXTENSIONS: [SuspendedExtension; 6] = [
 ];
 
 /// The effects of the four-cable catalogue the N-cable model does not carry:
-/// a misfit they cause is found by the baseline's test, never named.
+/// a misfit they cause is found by the baseline's test, never named as
+/// themselves (an extension of the catalogue can stand in for one).
 pub const NOT_MODELLED: &str = "pulley wrap, cable discretisation (segments), a shifted centre of mass, \
 the localiser's mounting, moved attachments, per-drum effects other than a gain and per-load-cell effects";
 

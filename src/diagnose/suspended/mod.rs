@@ -26,7 +26,9 @@
 //!    value no real robot has is reported as a stand-in, and one that leaves
 //!    the model failing as taking up part of the misfit: neither is named.
 //!    The effects the N-cable model does not carry ([`NOT_MODELLED`]) are
-//!    found by the baseline's test, never named.
+//!    found by the baseline's test, never named as themselves; an
+//!    extension can still stand in for one with a plausible value and be
+//!    named (one drum's fault as its cable's weight: docs/diagnose.md).
 //!
 //! [`verify_suspended`] tests a robot file, held as it is, against a data
 //! file (`sagcal verify`): each row's pose and forces fitted to its
