@@ -11,8 +11,9 @@ use rand_chacha::ChaCha8Rng;
 use sagcal::calib::suspended::SuspendedReading;
 use sagcal::calib::CalibrationOptions;
 use sagcal::diagnose::suspended::{
-    calibrated_chi_square, diagnose_suspended, fit_profile, suspended_catalogue, verify_suspended,
-    SuspendedDiagnoseSettings, SuspendedExtension, SuspendedVerdict, SUSPENDED_EXTENSIONS,
+    calibrated_chi_square, diagnose_suspended, errors_against_truth, fit_profile, residual_structure,
+    suspended_catalogue, verify_suspended, SuspendedDiagnoseSettings, SuspendedExtension, SuspendedVerdict,
+    SUSPENDED_EXTENSIONS,
 };
 use sagcal::model::sensors::NoisePreset;
 use sagcal::model::suspended::{SuspendedMeasurement, SuspendedRobot};
@@ -157,6 +158,116 @@ fn one_drum_s_gain_is_named_as_that_drum_s() {
     assert!(fit.sigma < 1e-3, "{fit:?}");
 }
 
+/// The score tests of the baseline's residuals: on clean readings no term
+/// is beyond the limit; with drum 3 reading its cable 0.5 % long, the
+/// strongest term is encoder 3 against its own reading, its coefficient
+/// (metres per metre, the model's parameters re-fitted with it) the gain
+/// less one within three of its 1-sigma.
+#[test]
+fn the_residual_tests_see_a_drum_s_gain_the_model_lacks() {
+    let (robot, mut readings) = six_cable_readings(30, 7, NoisePreset::Paper, 1.0);
+    let options = paper_options(&robot);
+    let baseline = SuspendedExtension::Elastic;
+    let clean = residual_structure(&robot, &readings, (baseline, 0.0), &options, 1e-3, &[]).unwrap();
+    println!(
+        "clean: {:?} of {} (limit {:.2})",
+        clean.strongest, clean.tested, clean.limit
+    );
+    assert!(clean.clean(), "{clean:#?}");
+    assert_eq!(clean.tested, 6 * 3 + 3 + 3 + 3, "{clean:#?}");
+    readings.iter_mut().for_each(|r| r.encoder_lengths_m[2] *= 1.005);
+    let gained = residual_structure(&robot, &readings, (baseline, 0.0), &options, 1e-3, &[]).unwrap();
+    let strongest = gained.strongest.clone().unwrap();
+    println!(
+        "drum 3: {strongest:?}, {} beyond {:.2}",
+        gained.beyond.len(),
+        gained.limit
+    );
+    assert_eq!(strongest.reading, "encoder 3", "{gained:#?}");
+    assert_eq!(strongest.driver, "its reading (m)", "{gained:#?}");
+    assert!(
+        (strongest.coefficient - 0.005).abs() < 3.0 * strongest.sigma,
+        "{strongest:?}"
+    );
+    assert!(!gained.clean(), "{gained:#?}");
+}
+
+/// Drum 3's gain with cable 3's weight the only extension tried (the gain
+/// outside the catalogue): the baseline's residuals show encoder 3 against
+/// its own reading, the weight takes up part of it (significant, better on
+/// held-out poses, plausible, passing), but what the term still takes off
+/// the extended model is beyond its limit, so the weight is not named.
+/// Seed 2 is one where the weight would be named without that check; over
+/// seeds 1 to 13 the weight is `partial` in 3 (2, 5, 12), a stand-in in 2,
+/// `unexplained` in 7 and still named in 1 (13: the term left in it below
+/// its limit), which docs/diagnose.md reports.
+#[test]
+fn a_drum_s_gain_outside_the_catalogue_is_not_named_as_its_cable_s_weight() {
+    let (robot, mut readings) = six_cable_readings(30, 2, NoisePreset::Paper, 1.0);
+    readings.iter_mut().for_each(|r| r.encoder_lengths_m[2] *= 1.005);
+    let options = paper_options(&robot);
+    let weight = SuspendedExtension::OneCableWeight(2);
+    let settings = SuspendedDiagnoseSettings {
+        extensions: vec![weight],
+        ..settings()
+    };
+    let diagnosis = diagnose_suspended(&robot, &readings, &settings, &options, &|_, _| {}).unwrap();
+    println!("{}", diagnosis.conclusion);
+    let lacked = &diagnosis.baseline_structure.describing;
+    println!(
+        "baseline lacked {lacked:?}; named model {:?}",
+        diagnosis.named_structure
+    );
+    assert_eq!(lacked[0].reading, "encoder 3", "{diagnosis:#?}");
+    assert_eq!(lacked[0].driver, "its reading (m)", "{diagnosis:#?}");
+    assert_eq!(
+        diagnosis.verdict,
+        SuspendedVerdict::Partial { extension: weight },
+        "{diagnosis:#?}"
+    );
+    let named = diagnosis.named_structure.as_ref().unwrap();
+    assert!(
+        diagnosis.extensions[0].passes && diagnosis.extensions[0].plausible,
+        "{diagnosis:#?}"
+    );
+    assert!(named.given_drop > named.given_limit, "{named:#?}");
+}
+
+/// Each model against the truth: the baseline's anchor error is that of
+/// an independent calibration of the same readings, and where noiseless
+/// encoders read 0.2 % long, the encoder gain's model lands its anchors
+/// and offsets on the truth (to 0.1 mm) where the baseline's are
+/// centimetres off (the gain, measured).
+#[test]
+fn the_encoder_gain_s_model_lands_on_the_truth() {
+    let (robot, readings) = six_cable_readings(20, 3, NoisePreset::None, 1.002);
+    let mut truth = robot.clone();
+    truth.length_offsets_m = (0..truth.cable_count()).map(|i| 0.1 + 0.07 * i as f64).collect();
+    let options = paper_options(&robot);
+    let gain = fit_profile(&robot, &readings, SuspendedExtension::EncoderScale, &options).unwrap();
+    let models = [
+        (SuspendedExtension::Elastic, 0.0),
+        (SuspendedExtension::EncoderScale, gain.value),
+    ];
+    let errors = errors_against_truth(&robot, &readings, &models, &truth, &options).unwrap();
+    println!("{errors:#?}");
+    let alone = sagcal::calib::suspended::calibrate_suspended(&robot, &readings, &options, None, &mut |_| {}).unwrap();
+    let mae: f64 = (0..6)
+        .map(|i| (alone.robot.anchors_m[i] - truth.anchors_m[i]).abs().sum())
+        .sum::<f64>()
+        / 18.0;
+    assert_eq!(errors[0].model, "baseline");
+    assert!(
+        (errors[0].anchor_mae_m - mae).abs() < 1e-12,
+        "{} against {mae}",
+        errors[0].anchor_mae_m
+    );
+    assert_eq!(errors[1].model, "encoder-scale");
+    assert!(errors[1].anchor_max_distance_m < 1e-4, "{errors:#?}");
+    assert!(errors[1].offset_mae_m < 1e-4, "{errors:#?}");
+    assert!(errors[0].anchor_mae_m > 1e-2, "{errors:#?}");
+}
+
 /// `sagcal diagnose --robot robots/six.toml --data six.csv ARGS` in `dir`.
 fn diagnose_six(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
     let robot = cli::robot("six");
@@ -207,20 +318,39 @@ fn the_diagnose_command_diagnoses_six_cables() {
     assert_eq!(names[..2], ["elastic", "encoder-scale"]);
     assert_eq!(names[2..], drums);
     assert_eq!(json["verdict"]["kind"], "consistent", "{json:#}");
-    let text = diagnose_six(dir.path(), &["--candidates", "elastic,encoder-scale"]);
+    let text = diagnose_six(
+        dir.path(),
+        &["--candidates", "elastic,encoder-scale", "--truth", &robot],
+    );
     let stdout = String::from_utf8_lossy(&text.stdout);
     assert!(
         stdout.contains("baseline: chi-square") && stdout.contains("encoder-scale"),
         "{stdout}"
     );
+    // Against the truth: the baseline's and each extension's anchors.
+    let against: Vec<&str> = stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("against the truth"))
+        .skip(2)
+        .take(3)
+        .map(|l| l.split_whitespace().next().unwrap_or_default())
+        .collect();
+    assert_eq!(against, ["baseline", "elastic", "encoder-scale"], "{stdout}");
     assert!(
         !stdout.lines().any(|line| line.starts_with("loadcell-gain")),
         "{stdout}"
     );
-    let truth = diagnose_six(dir.path(), &["--truth", &robot]);
+    let three = cli::robot("three");
+    let truth = diagnose_six(dir.path(), &["--candidates", "elastic", "--truth", &three]);
     let message = String::from_utf8_lossy(&truth.stderr);
     assert!(
-        !truth.status.success() && message.contains("--truth: robot `six` has 6 cables"),
+        !truth.status.success() && message.contains("the truth `three` has 3 cables"),
+        "{message}"
+    );
+    let plots = diagnose_six(dir.path(), &["--plots", "figures"]);
+    let message = String::from_utf8_lossy(&plots.stderr);
+    assert!(
+        !plots.status.success() && message.contains("--plots: robot `six` has 6 cables"),
         "{message}"
     );
     let unknown = diagnose_six(dir.path(), &["--candidates", "pulley"]);

@@ -557,6 +557,7 @@ def diagnose_suspended(
     false_alarm: float = 1e-3,
     orientation_prior: str = "auto",
     progress: Optional[Callable[[int, int, str], Any]] = None,
+    truth: Optional[SuspendedRobot] = None,
 ) -> Dict[str, Any]:
     """What the model of a robot of 3 to 8 cables gets wrong, as ``sagcal diagnose --json`` reports it."""
 

@@ -5,7 +5,8 @@
 use pyo3::prelude::*;
 use sagcal::calib::suspended::suspended_options;
 use sagcal::diagnose::suspended::{
-    diagnose_suspended as diagnose_library, extensions_named, suspended_catalogue, SuspendedDiagnoseSettings,
+    diagnose_suspended as diagnose_library, errors_against_truth, extensions_named, suspended_catalogue,
+    SuspendedDiagnoseSettings,
 };
 use sagcal::error::FrontEnd;
 
@@ -28,7 +29,10 @@ use crate::to_py;
 ///
 /// ``measurements`` is an array in the columns of
 /// :attr:`SuspendedRobot.columns` or the path of a measurement file;
-/// ``progress`` an optional ``callable(done, total, what)``. Returns the
+/// ``progress`` an optional ``callable(done, total, what)``; ``truth`` the
+/// robot the readings were made with, where it is known (a simulation),
+/// fills ``report["against_truth"]``: each model's calibrated anchors and
+/// offsets against it (``sagcal diagnose --truth``). Returns the
 /// command's JSON report as a dict (``report["verdict"]["kind"]`` is one of
 /// ``consistent``, ``named``, ``partial``, ``stand_in``,
 /// ``indistinguishable``, ``unexplained``).
@@ -45,6 +49,7 @@ use crate::to_py;
     false_alarm = 1e-3,
     orientation_prior = "auto",
     progress = None,
+    truth = None,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn diagnose_suspended<'py>(
@@ -57,6 +62,7 @@ pub fn diagnose_suspended<'py>(
     false_alarm: f64,
     orientation_prior: &str,
     progress: Option<Py<PyAny>>,
+    truth: Option<&SuspendedRobot>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let nominal = robot.inner.clone();
     let solver = SolverArgs {
@@ -86,11 +92,17 @@ pub fn diagnose_suspended<'py>(
     };
     let (data, _) = suspended_measurements(measurements, &nominal)?;
     let progress = Progress::new(progress);
+    let truth = truth.map(|t| t.inner.clone());
     let diagnosis = py
         .detach(|| {
-            diagnose_library(&nominal, &data, &settings, &options, &|done, total| {
+            let mut diagnosis = diagnose_library(&nominal, &data, &settings, &options, &|done, total| {
                 progress.report(done, total, "fitting the extensions")
-            })
+            })?;
+            if let Some(truth) = &truth {
+                let models = diagnosis.fitted_models();
+                diagnosis.against_truth = errors_against_truth(&nominal, &data, &models, truth, &options)?;
+            }
+            Ok::<_, sagcal::Error>(diagnosis)
         })
         .map_err(to_py)?;
     progress.finish()?;

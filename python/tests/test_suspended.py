@@ -187,12 +187,14 @@ def test_diagnose_suspended_is_the_commands_diagnosis(cli, tmp_path):
     seen = []
     names = ["elastic", "encoder-scale"]
     report = sagcal.diagnose_suspended(robot, simulation.measurements, candidates=names, folds=4,
-                                       progress=lambda d, t, w: seen.append((d, t)))
+                                       progress=lambda d, t, w: seen.append((d, t)), truth=robot)
     assert seen[-1][0] == seen[-1][1] == 6, "the baseline's and each extension's fit and cross-validation"
     assert [e["extension"] for e in report["extensions"]] == names
     command = json.loads(cli("diagnose", "--robot", ROOT / "robots" / "three.toml", "--data", data,
-                             "--candidates", ",".join(names), "--folds", 4, "--json").stdout)
+                             "--candidates", ",".join(names), "--folds", 4, "--truth",
+                             ROOT / "robots" / "three.toml", "--json").stdout)
     assert command == report, "an array and its file give the command's numbers"
+    assert [m["model"] for m in report["against_truth"]] == ["baseline"] + names
     assert report["verdict"]["kind"] == "consistent"
     with pytest.raises(sagcal.InvalidInputError, match="`pulley` is not an extension"):
         sagcal.diagnose_suspended(robot, simulation.measurements, candidates=["pulley"])

@@ -4,8 +4,8 @@
 
 use sagcal::calib::suspended::suspended_options;
 use sagcal::diagnose::suspended::{
-    diagnose_suspended, extensions_named, suspended_catalogue, SuspendedDiagnoseSettings, SuspendedDiagnosis,
-    SuspendedExtension,
+    diagnose_suspended, errors_against_truth, extensions_named, suspended_catalogue, ResidualStructure,
+    SuspendedDiagnoseSettings, SuspendedDiagnosis, SuspendedExtension, TruthError,
 };
 use sagcal::error::FrontEnd;
 use sagcal::io::suspended_measurements::read_suspended_measurements;
@@ -22,7 +22,6 @@ const WIDTH: usize = 100;
 pub(super) fn run(args: &DiagnoseArgs, nominal: &SuspendedRobot) -> sagcal::Result<()> {
     refuse_four_cable_flags(
         &[
-            (args.truth.is_some(), "--truth"),
             (args.plots.is_some(), "--plots"),
             (args.out.is_some(), "--out"),
             (args.no_orientation_hypothesis, "--no-orientation-hypothesis"),
@@ -37,10 +36,22 @@ pub(super) fn run(args: &DiagnoseArgs, nominal: &SuspendedRobot) -> sagcal::Resu
     };
     let options = suspended_options(&args.solver.settings(), nominal, FrontEnd::Cli)?;
     let data = read_suspended_measurements(&args.data, nominal)?;
+    let truth = args.truth.as_deref().map(SuspendedRobot::from_file).transpose()?;
     let bar = progress_bar(1, "{msg} [{bar:30}] {pos}/{len} fits, {elapsed}");
     let diagnosis = diagnose_suspended(nominal, &data, &settings, &options, &|done, total| {
         bar.report(done, total, "fitting the extensions")
     });
+    let diagnosis = match (diagnosis, &truth) {
+        (Ok(mut diagnosis), Some(truth)) => {
+            let models = diagnosis.fitted_models();
+            bar.report(0, 1, &format!("calibrating {} models against the truth", models.len()));
+            errors_against_truth(nominal, &data, &models, truth, &options).map(|errors| {
+                diagnosis.against_truth = errors;
+                diagnosis
+            })
+        }
+        (diagnosis, _) => diagnosis,
+    };
     bar.finish_and_clear();
     let diagnosis = diagnosis?;
     if args.json {
@@ -76,6 +87,7 @@ fn render(d: &SuspendedDiagnosis) -> String {
             if b.passes { "passes" } else { "fails" },
             b.held_out_chi_square
         ),
+        structure_line("baseline", &d.baseline_structure),
     ];
     for paragraph in head {
         text += &wrapped(&paragraph, WIDTH).join("\n");
@@ -136,6 +148,9 @@ fn render(d: &SuspendedDiagnosis) -> String {
         ));
     }
     notes.push(String::new());
+    if let Some(named) = &d.named_structure {
+        notes.push(structure_line(&named.extension.name(), named));
+    }
     notes.push(d.conclusion.clone());
     notes.push(format!(
         "not in the model of {} cables, so never named: {}",
@@ -145,5 +160,48 @@ fn render(d: &SuspendedDiagnosis) -> String {
         text += &wrapped(&note, WIDTH).join("\n");
         text += "\n";
     }
+    if !d.against_truth.is_empty() {
+        text += "\n";
+        text += &truth_table(&d.against_truth);
+    }
     text
+}
+
+/// Each model's anchors and offsets against the truth, in millimetres.
+fn truth_table(errors: &[TruthError]) -> String {
+    let mut table = Table::new([
+        "against the truth",
+        "anchor MAE mm",
+        "mean anchor distance mm",
+        "max anchor distance mm",
+        "offset MAE mm",
+    ]);
+    let mm = |m: f64| format!("{:.2}", 1e3 * m);
+    for e in errors {
+        table.row([
+            e.model.clone(),
+            mm(e.anchor_mae_m),
+            mm(e.anchor_mean_distance_m),
+            mm(e.anchor_max_distance_m),
+            mm(e.offset_mae_m),
+        ]);
+    }
+    let mut text = table.to_string();
+    for e in errors.iter().filter(|e| e.failure.is_some()) {
+        text += &format!("{}: {}\n", e.model, e.failure.as_deref().unwrap_or_default());
+    }
+    text += "each model calibrated on every pose, its parameter at the fitted value above\n";
+    text
+}
+
+/// The score tests of one model's residuals in a line.
+fn structure_line(model: &str, s: &ResidualStructure) -> String {
+    let strongest = s.strongest.as_ref().map_or("none testable".into(), |t| t.describe());
+    format!(
+        "residual tests of the {model} model: {} terms; limit |z| {:.2} (the false-alarm rate shared over them); \
+         {} beyond; strongest: {strongest}",
+        s.tested,
+        s.limit,
+        s.beyond.len()
+    )
 }

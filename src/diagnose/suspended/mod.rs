@@ -19,16 +19,19 @@
 //!    held-out poses better than the baseline and than every other such
 //!    extension (Vuong's paired test on the poses' held-out chi-squares at
 //!    [`INDISTINGUISHABLE_Z`] standard errors), its fitted
-//!    value is one a real robot has, and the extended model passes the
-//!    chi-square test ([`SuspendedVerdict`]). The likelihood ratio is the
+//!    value is one a real robot has, the extended model passes the
+//!    chi-square test ([`SuspendedVerdict`]), and its residuals hold no
+//!    term it lacks (score tests of each reading against its own drivers,
+//!    [`residual_structure`]). The likelihood ratio is the
 //!    more powerful test against one named alternative, so an extension can
 //!    be named where the baseline's omnibus test passes. An extension whose
 //!    value no real robot has is reported as a stand-in, and one that leaves
-//!    the model failing as taking up part of the misfit: neither is named.
-//!    The effects the N-cable model does not carry ([`NOT_MODELLED`]) are
-//!    found by the baseline's test, never named as themselves; an
-//!    extension can still stand in for one with a plausible value and be
-//!    named (one drum's fault as its cable's weight: docs/diagnose.md).
+//!    the model failing, or structure in its residuals, as taking up part
+//!    of the misfit: neither is named. The effects the N-cable model does
+//!    not carry ([`NOT_MODELLED`]) are found by the baseline's test, never
+//!    named as themselves; an extension can still stand in for one with a
+//!    plausible value, and where the residual tests lack the power to see
+//!    what it leaves, be named (docs/diagnose.md).
 //!
 //! [`verify_suspended`] tests a robot file, held as it is, against a data
 //! file (`sagcal verify`): each row's pose and forces fitted to its
@@ -51,6 +54,8 @@ mod extensions;
 pub mod held_out;
 mod pipeline;
 mod profile;
+mod residual_structure;
+mod truth;
 mod verify;
 
 pub use extensions::{
@@ -63,6 +68,8 @@ pub use pipeline::{
     SuspendedExtensionFit, SuspendedVerdict, INDISTINGUISHABLE_Z,
 };
 pub use profile::{calibrate_with, calibrated_chi_square, fit_profile, ProfileFit};
+pub use residual_structure::{residual_structure, ResidualStructure, ResidualTerm};
+pub use truth::{errors_against_truth, TruthError};
 pub use verify::{
     verify_suspended, ResidualSummary, SuspectReading, SuspendedVerifiedRow, SuspendedVerifyReport, VerifiedReading,
     DETECTION_POWER_Z,

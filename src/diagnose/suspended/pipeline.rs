@@ -9,6 +9,8 @@ use serde::Serialize;
 use super::extensions::{SuspendedExtension, NOT_MODELLED};
 use super::held_out::cross_validated_chi_square;
 use super::profile::{calibrate_with, fit_profile};
+use super::residual_structure::{residual_structure, ResidualStructure, ResidualTerm, TermKey};
+use super::truth::TruthError;
 use crate::calib::CalibrationOptions;
 use crate::error::{Error, Result};
 use crate::model::suspended::{SuspendedMeasurement, SuspendedRobot};
@@ -104,9 +106,11 @@ pub enum SuspendedVerdict {
         /// The stand-in.
         extension: SuspendedExtension,
     },
-    /// As `Named`, but the extended model still fails the chi-square test:
-    /// the extension takes up part of a misfit whose cause (or a second
-    /// one) is outside the catalogue; it is not named as the cause.
+    /// As `Named`, but the extended model still fails the chi-square test,
+    /// or its residuals still hold a term it lacks
+    /// ([`super::residual_structure`]): the extension takes up part of a
+    /// misfit whose cause (or a second one) is outside the catalogue; it is
+    /// not named as the cause.
     Partial {
         /// The extension that takes up part of the misfit.
         extension: SuspendedExtension,
@@ -137,12 +141,36 @@ pub struct SuspendedDiagnosis {
     pub baseline: SuspendedBaseline,
     /// Every extension, in the settings' order.
     pub extensions: Vec<SuspendedExtensionFit>,
+    /// The score tests of the baseline's residuals
+    /// ([`super::residual_structure`]).
+    pub baseline_structure: ResidualStructure,
+    /// The score tests of the residuals of the model that would be named
+    /// (`null` where none would be), with the drop of the baseline's
+    /// describing terms in it.
+    pub named_structure: Option<ResidualStructure>,
     /// The verdict.
     pub verdict: SuspendedVerdict,
     /// The verdict in words.
     pub conclusion: String,
     /// What the model cannot name.
     pub not_modelled: String,
+    /// Where the truth is known, each model's anchors and offsets against
+    /// it ([`super::errors_against_truth`]; empty otherwise).
+    pub against_truth: Vec<TruthError>,
+}
+
+impl SuspendedDiagnosis {
+    /// The models to compare with a truth ([`super::errors_against_truth`]):
+    /// the baseline, then every extension that was fitted, at its fitted value.
+    pub fn fitted_models(&self) -> Vec<(SuspendedExtension, f64)> {
+        let baseline = (SuspendedExtension::Elastic, 0.0);
+        let fitted = self
+            .extensions
+            .iter()
+            .filter(|f| f.failure.is_none())
+            .map(|f| (f.extension, f.value));
+        std::iter::once(baseline).chain(fitted).collect()
+    }
 }
 
 /// Diagnose `measurements` against `robot` (module docs of
@@ -180,18 +208,38 @@ pub fn diagnose_suspended(
             scores.fit(extension, settings.folds, &tick)
         })
         .collect();
-    let verdict = verdict(&baseline, &fits);
+    let structure = |extension: SuspendedExtension, value: f64, given: &[TermKey]| {
+        residual_structure(
+            robot,
+            measurements,
+            (extension, value),
+            options,
+            settings.false_alarm,
+            given,
+        )
+    };
+    let null = SuspendedExtension::Elastic;
+    let baseline_structure = structure(null, null.null_value(), &[])?;
+    let context = Checked {
+        baseline_structure: &baseline_structure,
+    };
+    let checked = context.check(verdict(&baseline, &fits), &fits, &|fit, given| {
+        structure(fit.extension, fit.value, given)
+    })?;
     Ok(SuspendedDiagnosis {
         robot: robot.name.clone(),
         cables: robot.cable_count(),
         poses: measurements.len(),
         settings: settings.clone(),
         likelihood_ratio_limit,
-        conclusion: conclusion(&verdict, &baseline, &fits),
+        conclusion: conclusion(&checked, &baseline, &fits, &context),
         baseline,
         extensions: fits,
-        verdict,
+        baseline_structure,
+        named_structure: checked.structure,
+        verdict: checked.verdict,
         not_modelled: NOT_MODELLED.into(),
+        against_truth: Vec::new(),
     })
 }
 
@@ -324,6 +372,64 @@ fn verdict(baseline: &SuspendedBaseline, fits: &[SuspendedExtensionFit]) -> Susp
     }
 }
 
+/// The verdict once the residuals' score tests have spoken
+/// ([`super::residual_structure`]).
+struct CheckedVerdict {
+    verdict: SuspendedVerdict,
+    /// The named model's tests (`Named` before the check).
+    structure: Option<ResidualStructure>,
+}
+
+/// What the check of a verdict reads.
+struct Checked<'a> {
+    baseline_structure: &'a ResidualStructure,
+}
+
+impl Checked<'_> {
+    /// `verdict` checked against the residuals' score tests:
+    /// - `Consistent` becomes `Unexplained` where the baseline's residuals
+    ///   hold a term beyond the limit (a misfit the omnibus chi-square is
+    ///   too blunt to see);
+    /// - `Named` becomes `Partial` where the extended model does not explain
+    ///   the terms that describe what the baseline lacks (they still take
+    ///   more off it than their limit: the extension is a proxy that took
+    ///   up part of them), or where its own residuals still hold a term
+    ///   beyond the limit.
+    ///
+    /// `structure(fit, given)` runs the tests of an extension's model.
+    fn check(
+        &self,
+        verdict: SuspendedVerdict,
+        fits: &[SuspendedExtensionFit],
+        structure: &dyn Fn(&SuspendedExtensionFit, &[TermKey]) -> Result<ResidualStructure>,
+    ) -> Result<CheckedVerdict> {
+        let unchanged = |verdict| CheckedVerdict {
+            verdict,
+            structure: None,
+        };
+        let extension = match verdict {
+            SuspendedVerdict::Consistent if !self.baseline_structure.clean() => {
+                return Ok(unchanged(SuspendedVerdict::Unexplained));
+            }
+            SuspendedVerdict::Named { extension } => extension,
+            other => return Ok(unchanged(other)),
+        };
+        let fit = fits
+            .iter()
+            .find(|f| f.extension == extension)
+            .expect("a verdict names a fit");
+        let tested = structure(fit, &self.baseline_structure.describing_keys())?;
+        let verdict = match tested.explains_given() && tested.clean() {
+            true => SuspendedVerdict::Named { extension },
+            false => SuspendedVerdict::Partial { extension },
+        };
+        Ok(CheckedVerdict {
+            verdict,
+            structure: Some(tested),
+        })
+    }
+}
+
 /// Vuong's statistic of `worse` against `better`: the sum of the poses'
 /// held-out chi-square differences over its standard error from their
 /// sample variance (0 for a model against itself).
@@ -340,29 +446,63 @@ pub fn paired_z(worse: &[f64], better: &[f64]) -> f64 {
 }
 
 /// The verdict in words.
-fn conclusion(verdict: &SuspendedVerdict, baseline: &SuspendedBaseline, fits: &[SuspendedExtensionFit]) -> String {
+fn conclusion(
+    checked: &CheckedVerdict,
+    baseline: &SuspendedBaseline,
+    fits: &[SuspendedExtensionFit],
+    context: &Checked<'_>,
+) -> String {
     let fit_of = |e: SuspendedExtension| fits.iter().find(|f| f.extension == e).expect("a verdict names a fit");
-    match verdict {
+    let cause = |e: SuspendedExtension| {
+        let f = fit_of(e);
+        format!(
+            "{} ({} = {} +- {}) predicts the held-out poses better by {:.1} in chi-square",
+            e.name(),
+            f.parameter,
+            e.value_text(f.value),
+            e.value_text(f.sigma),
+            f.held_out_gain
+        )
+    };
+    let terms = |s: &ResidualStructure, terms: &[ResidualTerm]| {
+        let listed: Vec<String> = terms.iter().take(3).map(ResidualTerm::describe).collect();
+        format!(
+            "{}; limit |z| {:.2} over {} terms",
+            listed.join("; "),
+            s.limit,
+            s.tested
+        )
+    };
+    let outside = "it takes up part of a misfit whose cause is outside this catalogue";
+    match &checked.verdict {
         SuspendedVerdict::Consistent => format!(
-            "the baseline model explains the readings (chi-square {:.1} for {}, limit {:.1}): no cause is named",
+            "the baseline model explains the readings (chi-square {:.1} for {}, limit {:.1}, and no term beyond the limit in its residuals): no cause is named",
             baseline.chi_square, baseline.degrees_of_freedom, baseline.limit
         ),
-        SuspendedVerdict::Named { extension } => {
-            let f = fit_of(*extension);
-            format!(
-                "named cause: {} ({} = {} +- {}); it predicts the held-out poses better by {:.1} in chi-square, and the extended model passes the chi-square test (chi-square {:.1})",
-                extension.name(), f.parameter, extension.value_text(f.value), extension.value_text(f.sigma), f.held_out_gain, f.chi_square
-            )
-        }
-        SuspendedVerdict::Partial { extension } => {
-            let f = fit_of(*extension);
-            format!(
-                "no cause named: {} ({} = {} +- {}) predicts the held-out poses better by {:.1} in chi-square, \
-                 but the extended model still fails the chi-square test (chi-square {:.1}): it takes up part of a misfit \
-                 whose cause, or a second cause, is outside this catalogue",
-                extension.name(), f.parameter, extension.value_text(f.value), extension.value_text(f.sigma), f.held_out_gain, f.chi_square
-            )
-        }
+        SuspendedVerdict::Named { extension } => format!(
+            "named cause: {}; the extended model passes the chi-square test (chi-square {:.1}) and its residuals hold no term beyond the limit",
+            cause(*extension), fit_of(*extension).chi_square
+        ),
+        SuspendedVerdict::Partial { extension } if !fit_of(*extension).passes => format!(
+            "no cause named: {} but the extended model still fails the chi-square test (chi-square {:.1}): {outside}, or a second cause is",
+            cause(*extension), fit_of(*extension).chi_square
+        ),
+        SuspendedVerdict::Partial { extension } => match &checked.structure {
+            Some(s) if !s.explains_given() => format!(
+                "no cause named: {} and passes the chi-square test but leaves what the baseline lacked ({}): \
+                 those terms still take {:.1} off its chi-square (limit {:.1}): {outside}",
+                cause(*extension),
+                terms(context.baseline_structure, &context.baseline_structure.describing),
+                s.given_drop,
+                s.given_limit
+            ),
+            Some(s) => format!(
+                "no cause named: {} and passes the chi-square test but its residuals still hold what it lacks ({}): {outside}",
+                cause(*extension),
+                terms(s, &s.beyond)
+            ),
+            None => format!("no cause named: {}: {outside}", cause(*extension)),
+        },
         SuspendedVerdict::StandIn { extension } => {
             let f = fit_of(*extension);
             format!(
@@ -386,9 +526,114 @@ fn conclusion(verdict: &SuspendedVerdict, baseline: &SuspendedBaseline, fits: &[
                 extensions.iter().map(|e| e.name()).collect::<Vec<_>>().join(", ")
             )
         }
+        SuspendedVerdict::Unexplained if baseline.passes => format!(
+            "the baseline passes the chi-square test (chi-square {:.1} for {}, limit {:.1}), but its residuals hold what it lacks ({}), \
+             and no extension both passes its test and predicts the held-out poses better: the cause is outside this catalogue (for example {NOT_MODELLED})",
+            baseline.chi_square, baseline.degrees_of_freedom, baseline.limit,
+            terms(context.baseline_structure, &context.baseline_structure.beyond)
+        ),
         SuspendedVerdict::Unexplained => format!(
             "the baseline fails (chi-square {:.1} for {}, limit {:.1}) and no extension both passes its test and predicts the held-out poses better: the cause is outside this catalogue (for example {NOT_MODELLED})",
             baseline.chi_square, baseline.degrees_of_freedom, baseline.limit
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tests of a model with `beyond` terms beyond the limit, the
+    /// baseline's describing terms `describing`, and `given_drop` left of
+    /// given terms (limit 10.83, one term at 1e-3).
+    fn structure(beyond: usize, describing: usize, given_drop: f64) -> ResidualStructure {
+        let term = ResidualTerm {
+            reading: "encoder 3".into(),
+            driver: "its reading (m)".into(),
+            points: 30,
+            coefficient: 0.005,
+            sigma: 0.001,
+            z: 5.0,
+        };
+        ResidualStructure {
+            extension: SuspendedExtension::Elastic,
+            value: 0.0,
+            tested: 27,
+            limit: 4.13,
+            strongest: Some(term.clone()),
+            beyond: vec![term.clone(); beyond],
+            terms: vec![term.clone(); 27],
+            describing: vec![term; describing],
+            describing_drop: 25.0,
+            given_drop,
+            given_limit: 10.83,
+        }
+    }
+
+    fn fit(extension: SuspendedExtension) -> SuspendedExtensionFit {
+        SuspendedExtensionFit {
+            extension,
+            parameter: extension.parameter(),
+            value: 1.25,
+            sigma: 0.08,
+            chi_square: 180.0,
+            likelihood_ratio: 40.0,
+            significant: true,
+            held_out_chi_square: 300.0,
+            held_out_gain: 30.0,
+            held_out_per_pose: vec![10.0; 30],
+            plausible_range: "0.50 .. 1.50".into(),
+            plausible: true,
+            passes: true,
+            failure: None,
+        }
+    }
+
+    /// The verdict `verdict` checked with the baseline's tests `baseline`
+    /// and the named model's `named`.
+    fn checked(verdict: SuspendedVerdict, baseline: &ResidualStructure, named: ResidualStructure) -> SuspendedVerdict {
+        let weight = SuspendedExtension::OneCableWeight(2);
+        let context = Checked {
+            baseline_structure: baseline,
+        };
+        let run = |_: &SuspendedExtensionFit, given: &[TermKey]| {
+            assert_eq!(given.len(), baseline.describing.len());
+            Ok(named.clone())
+        };
+        context.check(verdict, &[fit(weight)], &run).unwrap().verdict
+    }
+
+    #[test]
+    fn a_named_model_must_explain_what_the_baseline_lacked_and_leave_nothing() {
+        let weight = SuspendedExtension::OneCableWeight(2);
+        let named = SuspendedVerdict::Named { extension: weight };
+        let partial = SuspendedVerdict::Partial { extension: weight };
+        let baseline = structure(1, 1, 0.0);
+        // It explains the baseline's term and leaves none: named.
+        assert_eq!(checked(named.clone(), &baseline, structure(0, 0, 3.0)), named);
+        // The baseline's term still takes 15.4 off it (limit 10.83): a proxy.
+        assert_eq!(checked(named.clone(), &baseline, structure(0, 0, 15.4)), partial);
+        // A term of its own beyond the limit.
+        assert_eq!(checked(named.clone(), &baseline, structure(1, 0, 0.0)), partial);
+    }
+
+    #[test]
+    fn a_consistent_baseline_must_leave_no_term() {
+        let anything = structure(0, 0, 0.0);
+        let consistent = SuspendedVerdict::Consistent;
+        assert_eq!(
+            checked(consistent.clone(), &structure(0, 0, 0.0), anything.clone()),
+            consistent
+        );
+        assert_eq!(
+            checked(consistent, &structure(2, 1, 0.0), anything.clone()),
+            SuspendedVerdict::Unexplained
+        );
+        // Other verdicts pass as they are.
+        let unexplained = SuspendedVerdict::Unexplained;
+        assert_eq!(
+            checked(unexplained.clone(), &structure(2, 1, 0.0), anything),
+            unexplained
+        );
     }
 }
