@@ -124,8 +124,9 @@ pub fn suspended_catalogue(robot: &SuspendedRobot) -> Vec<SuspendedExtension> {
 
 /// The extensions `names` name for `robot`, in their order: a global one
 /// by its name, `drum-gain` for every drum's gain, `drum-gain-K` and
-/// `cable-weight-K` for cable K (from 1); an error naming the first name
-/// that is none of them, or a cable the robot lacks.
+/// `cable-weight-K` for cable K (from 1), each once where first named; an
+/// error naming the first name that is none of them, or a cable the robot
+/// lacks.
 pub fn extensions_named(robot: &SuspendedRobot, names: &[&str]) -> Result<Vec<SuspendedExtension>, String> {
     let mut extensions = Vec::new();
     for name in names {
@@ -151,6 +152,16 @@ pub fn extensions_named(robot: &SuspendedRobot, names: &[&str]) -> Result<Vec<Su
             }
         }
     }
+    // A name given twice (`drum-gain,drum-gain-3`) is tried once, its
+    // first place kept, and counts once in the search's Bonferroni share.
+    let mut tried = Vec::with_capacity(extensions.len());
+    extensions.retain(|e| match tried.contains(e) {
+        true => false,
+        false => {
+            tried.push(*e);
+            true
+        }
+    });
     Ok(extensions)
 }
 
@@ -366,10 +377,13 @@ mod tests {
     #[test]
     fn a_list_of_names_expands_drum_gain_and_refuses_a_cable_the_robot_lacks() {
         let robot = SuspendedRobot::builtin("three").unwrap();
-        let named = extensions_named(&robot, &["elastic", " drum-gain", "cable-weight-2"]).unwrap();
+        let names = ["elastic", "drum-gain-2", " drum-gain", "cable-weight-2", "elastic"];
+        let named = extensions_named(&robot, &names).unwrap();
         let drums = (0..3).map(SuspendedExtension::DrumGain);
-        let expected: Vec<_> = std::iter::once(SuspendedExtension::Elastic)
-            .chain(drums)
+        // Each once, in the place it was first named.
+        let expected: Vec<_> = [SuspendedExtension::Elastic, SuspendedExtension::DrumGain(1)]
+            .into_iter()
+            .chain(drums.filter(|d| *d != SuspendedExtension::DrumGain(1)))
             .chain([SuspendedExtension::OneCableWeight(1)])
             .collect();
         assert_eq!(named, expected);
